@@ -1,0 +1,52 @@
+"""The ``greybox`` command line.
+
+Each sub-command lives in its own module of this package and provides
+``add_parser(subparsers)``, which registers the sub-command and sets
+``run=<callable(args) -> int>`` as its default. Errors caused by the user's
+input (:class:`greybox.errors.GreyboxError`) are printed as one line naming the
+file and the problem, with exit status 2 and no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ..errors import GreyboxError
+
+#: Sub-command modules, in the order ``greybox --help`` lists them.
+COMMANDS = ("synth", "info", "plot")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the argument parser of the ``greybox`` command."""
+    from .. import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="greybox",
+        description="Grey-box motor-current models of machine-tool feed axes.",
+    )
+    parser.add_argument("--version", action="version", version=f"greybox {__version__}")
+    subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(f"{__name__}.{name}").add_parser(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the ``greybox`` command and return its exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.run(args) or 0)
+    except GreyboxError as error:
+        print(f"greybox {args.command}: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"greybox {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

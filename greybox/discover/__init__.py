@@ -1,0 +1,1 @@
+"""Discrepancy workflow: locate, name and add missing physical effects."""

@@ -1,0 +1,1 @@
+"""Physical friction models: Coulomb, Stribeck, LuGre and GMS."""

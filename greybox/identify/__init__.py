@@ -1,0 +1,1 @@
+"""Parameter identification and hyperparameter optimisation."""

@@ -1,0 +1,1 @@
+"""Current models: inertia plus friction (plus SVR correction)."""

@@ -1,0 +1,1 @@
+"""Synthetic machine-tool feed axis: truth plant, trajectories, hidden effects."""
