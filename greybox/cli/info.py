@@ -1,0 +1,83 @@
+"""``greybox info``: summarise logs (samples, step, ranges, effort, noise floor)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+
+from ..data.log import AxisLog
+from ._options import add_log_arguments, read_logs
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "info",
+        help="summarise logs",
+        description="Print one line per log: samples, step, duration, position, velocity and effort ranges.",
+    )
+    parser.add_argument("logs", nargs="+", metavar="LOG", help="log files (CSV, Parquet, MCAP or EMPS .mat)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object per log instead of a table")
+    add_log_arguments(parser)
+    parser.set_defaults(run=run)
+
+
+def summarise(log: AxisLog) -> dict:
+    """Return the summary figures of one prepared log.
+
+    Parameters
+    ----------
+    log : AxisLog
+        A log with velocity present.
+
+    Returns
+    -------
+    dict
+        Samples, sample time [ms], duration [s], position range [mm], peak
+        speed [mm/min], effort RMS and range (in the log's unit) and, for
+        synthetic logs, the RMS of the known noise (the noise floor).
+    """
+    summary = {
+        "file": log.source,
+        "axis": log.axis,
+        "dataset": log.dataset,
+        "samples": len(log),
+        "sample_time_ms": 1e3 * log.sample_time,
+        "duration_s": log.duration,
+        "position_min_mm": float(log.position.min()),
+        "position_max_mm": float(log.position.max()),
+        "speed_max_mm_min": float(60.0 * np.abs(log.velocity).max()) if log.velocity is not None else None,
+        "effort_unit": log.effort_unit,
+        "effort_rms": float(np.sqrt(np.mean(log.effort**2))),
+        "effort_min": float(log.effort.min()),
+        "effort_max": float(log.effort.max()),
+        "extras": sorted(log.extras),
+    }
+    noise = log.extras.get("truth_noise_A")
+    if noise is None and "truth_current_A" in log.extras:
+        noise = log.effort - log.extras["truth_current_A"]
+    if noise is not None:
+        summary["noise_floor_rmse_A"] = float(np.sqrt(np.mean(noise**2)))
+    return summary
+
+
+def run(args: argparse.Namespace) -> int:
+    summaries = [summarise(log) for log in read_logs(args, args.logs)]
+    if args.json:
+        for summary in summaries:
+            print(json.dumps(summary))
+        return 0
+    header = f"{'file':<28} {'axis':>4} {'set':>4} {'samples':>9} {'dt ms':>6} {'dur s':>8} " \
+             f"{'position mm':>19} {'vmax mm/min':>11} {'RMS effort':>12} {'noise':>8}"
+    print(header)
+    for s in summaries:
+        name = s["file"].rsplit("/", 1)[-1][:28]
+        noise = f"{s['noise_floor_rmse_A']:.4f}" if "noise_floor_rmse_A" in s else "-"
+        vmax = f"{s['speed_max_mm_min']:.0f}" if s["speed_max_mm_min"] is not None else "-"
+        print(
+            f"{name:<28} {s['axis']:>4} {s['dataset']:>4} {s['samples']:>9d} {s['sample_time_ms']:>6.2f} "
+            f"{s['duration_s']:>8.1f} {s['position_min_mm']:>9.2f}..{s['position_max_mm']:<8.2f} {vmax:>11} "
+            f"{s['effort_rms']:>10.4f} {s['effort_unit']} {noise:>8}"
+        )
+    return 0
