@@ -1,0 +1,223 @@
+"""Read and write axis logs in any supported format, chosen by file extension.
+
+========== ================== ============================================
+format     extensions         reader options
+========== ================== ============================================
+``csv``    ``.csv``           ``columns``, ``sample_time``
+``parquet`` ``.parquet .pq``  ``columns``, ``sample_time``
+``mcap``   ``.mcap``          ``columns``, ``topic``
+``emps``   ``.mat``           none (EMPS benchmark files; read only)
+========== ================== ============================================
+
+:func:`read_log` validates what it reads (uniform time base, finite values),
+so every log it returns is ready for :func:`greybox.data.prepare.prepare`.
+:func:`write_log` writes atomically and never overwrites the file a log was
+read from.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import tempfile
+from pathlib import Path
+from typing import Mapping, Sequence
+
+from ..errors import GreyboxError, LogError
+from .log import AxisLog
+from .units import CANONICAL_NAMES, UNIT_FACTORS, parse_column_name
+from .validate import check_finite, check_time
+
+__all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS"]
+
+#: File extensions of each format.
+FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",), "emps": (".mat",)}
+
+# format -> (module, reader, writer or None, reader options)
+_HANDLERS = {
+    "csv": ("csv_io", "read_csv", "write_csv", ("columns", "sample_time")),
+    "parquet": ("parquet_io", "read_parquet", "write_parquet", ("columns", "sample_time")),
+    "mcap": ("mcap_io", "read_mcap", "write_mcap", ("columns", "topic")),
+    "emps": ("emps", "read_emps", None, ()),
+}
+
+
+def format_of(path, fmt: str | None = None) -> str:
+    """Return the format name of a file: ``fmt`` if given, else from the extension.
+
+    Raises
+    ------
+    LogError
+        For an unknown format name or extension.
+    """
+    if fmt is not None:
+        if fmt not in FORMATS:
+            raise LogError(path, f"unknown log format '{fmt}'; known: {', '.join(FORMATS)}")
+        return fmt
+    suffix = Path(path).suffix.lower()
+    for name, suffixes in FORMATS.items():
+        if suffix in suffixes:
+            return name
+    known = ", ".join(s for suffixes in FORMATS.values() for s in suffixes)
+    raise LogError(path, f"unknown log file extension '{suffix}'; known: {known} (or give the format explicitly)")
+
+
+def _handler(fmt: str, index: int):
+    module = importlib.import_module(f"{__package__}.{_HANDLERS[fmt][0]}")
+    return getattr(module, _HANDLERS[fmt][index])
+
+
+def read_log(
+    path,
+    *,
+    columns: Mapping[str, str] | None = None,
+    topic: str | None = None,
+    sample_time: float | None = None,
+    time_tolerance: float = 0.25,
+    fmt: str | None = None,
+) -> AxisLog:
+    """Read and validate one axis log.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Log file; the format follows from the extension (see module docstring).
+    columns : mapping of str to str, optional
+        ``{canonical_name: name_in_file}`` for columns (CSV, Parquet) or message
+        fields (MCAP) not named by the greybox convention, e.g.
+        ``{"position_mm": "X1_ActualPosition", "current_A": "X1_CurrentFeedback"}``.
+        A key may carry any supported unit (``"position_um"``, ``"velocity_mm_min"``).
+    topic : str, optional
+        MCAP channel to read; required when the file has several.
+    sample_time : float, optional
+        Sample time [s] for CSV/Parquet files without a time column; time is
+        then ``row_index * sample_time`` from 0 s.
+    time_tolerance : float, default 0.25
+        Allowed deviation of a time step from the nominal step (fraction).
+    fmt : {"csv", "parquet", "mcap", "emps"}, optional
+        Format, overriding the extension.
+
+    Returns
+    -------
+    AxisLog
+        Channels in canonical units (s, mm, mm/s, mm/s^2, A or N); ``source`` is ``path``.
+
+    Raises
+    ------
+    LogError
+        For a missing, empty or unreadable file, an unknown extension, an
+        option that does not apply to the format, or content that fails
+        validation (see :func:`greybox.data.validate.check_time`).
+    """
+    path = os.fspath(path)
+    fmt = format_of(path, fmt)
+    if not os.path.exists(path):
+        raise LogError(path, "no such file")
+    if os.path.isdir(path):
+        raise LogError(path, "is a directory, not a log file")
+    if os.path.getsize(path) == 0:
+        raise LogError(path, "empty file (0 bytes)")
+    given = {"columns": columns, "topic": topic, "sample_time": sample_time}
+    accepted = _HANDLERS[fmt][3]
+    for option, value in given.items():
+        if value is not None and option not in accepted:
+            raise LogError(path, f"option '{option}' does not apply to {fmt} files")
+    options = {option: given[option] for option in accepted}
+    try:
+        log = _handler(fmt, 1)(path, **options)
+    except OSError as exc:
+        raise LogError(path, f"cannot read the file ({exc.strerror or exc})") from None
+    check_time(log.time, source=path, tolerance=time_tolerance)
+    check_finite(log)
+    return log
+
+
+def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None) -> None:
+    """Write an axis log atomically.
+
+    The data go to a temporary file in the target directory, which then
+    replaces ``path`` in one step, so a reader never sees a half-written file.
+
+    Parameters
+    ----------
+    log : AxisLog or sequence of AxisLog
+        The log; MCAP also takes several logs of different axes (one channel each).
+    path : str or path-like
+        Output file; the format follows from the extension.
+    fmt : {"csv", "parquet", "mcap"}, optional
+        Format, overriding the extension.
+
+    Raises
+    ------
+    LogError
+        For an unknown or read-only format, several logs for a one-log format,
+        or a ``path`` that is the file a log was read from.
+    """
+    path = os.fspath(path)
+    fmt = format_of(path, fmt)
+    if _HANDLERS[fmt][2] is None:
+        raise LogError(path, f"{fmt} files can be read but not written; write .csv, .parquet or .mcap")
+    logs = [log] if isinstance(log, AxisLog) else list(log)
+    if not logs:
+        raise LogError(path, "no log to write")
+    if fmt != "mcap" and len(logs) > 1:
+        raise LogError(path, f"a {fmt} file holds one log; write several axes to .mcap or to one file each")
+    for item in logs:
+        if item.source and os.path.exists(path) and os.path.exists(item.source) and os.path.samefile(path, item.source):
+            raise LogError(path, "refusing to overwrite the file the log was read from; choose another output path")
+    writer = _handler(fmt, 2)
+    directory = os.path.dirname(os.path.abspath(path))
+    handle, temporary = tempfile.mkstemp(dir=directory, prefix=f".{os.path.basename(path)}.", suffix=".tmp")
+    os.close(handle)
+    try:
+        writer(logs if fmt == "mcap" else logs[0], temporary)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
+
+
+def parse_column_mapping(text: str) -> dict[str, str]:
+    """Parse a command-line column mapping.
+
+    Parameters
+    ----------
+    text : str
+        Comma-separated ``canonical_name=name_in_file`` pairs, e.g.
+        ``"position_mm=X1_ActualPosition,current_A=X1_CurrentFeedback"``.
+        Spaces around names are ignored. Names in the file may contain ``=``
+        (the first ``=`` splits) but not commas.
+
+    Returns
+    -------
+    dict of str to str
+
+    Raises
+    ------
+    GreyboxError
+        For a pair without ``=``, an empty name, a repeated key or a key that
+        is not a quantity with a known unit.
+    """
+    mapping: dict[str, str] = {}
+    known = ", ".join(CANONICAL_NAMES.values())
+    for pair in text.split(","):
+        if not pair.strip():
+            continue
+        if "=" not in pair:
+            raise GreyboxError(f"column mapping: '{pair.strip()}' is not of the form canonical_name=column_in_file")
+        key, value = (part.strip() for part in pair.split("=", 1))
+        if not key or not value:
+            raise GreyboxError(f"column mapping: empty name in '{pair.strip()}'")
+        parsed = parse_column_name(key)
+        if parsed is None or parsed[1] not in UNIT_FACTORS[parsed[0]]:
+            raise GreyboxError(f"column mapping: '{key}' is not a quantity with a known unit; use e.g. {known}")
+        if key in mapping:
+            raise GreyboxError(f"column mapping: '{key}' is given twice")
+        mapping[key] = value
+    if not mapping:
+        raise GreyboxError("column mapping: no pairs given")
+    return mapping

@@ -1,0 +1,494 @@
+"""MCAP axis logs: JSON messages, one per sample, one channel per axis.
+
+Layout written by :func:`write_mcap` (documented for logger authors in
+``docs/log-formats.md``):
+
+* schema ``greybox.AxisSample``, schema encoding ``jsonschema`` (text in
+  :data:`AXIS_SAMPLE_SCHEMA`), message encoding ``json``;
+* one channel per axis, topic ``/axis/<axis>`` (``/axis`` without a name),
+  channel metadata ``axis``, ``dataset``, ``effort_unit`` and ``attrs`` (a JSON
+  object as text);
+* one message per sample: ``log_time = publish_time =`` sample time [ns];
+  fields ``position_mm``, ``current_A`` (or ``force_N``), optionally
+  ``velocity_mm_s``, ``acceleration_mm_s2`` and further numeric extras;
+* zstd-compressed chunks.
+
+:func:`read_mcap` reads any MCAP file whose channel carries JSON messages: the
+field names follow the same rules as CSV columns (unit suffixes, ``columns=``
+mapping). It walks the records itself, so that a file of millions of messages
+is decoded in bulk (one JSON parse per batch of chunks) rather than message by
+message, and so that a damaged file gives a :class:`~greybox.errors.LogError`.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import struct
+import zlib
+from typing import Iterable, Mapping, Sequence
+
+import numpy as np
+from numba import njit
+
+from ..errors import LogError
+from .log import AxisLog
+from .units import CANONICAL_NAMES, log_from_columns
+
+__all__ = ["AXIS_SAMPLE_SCHEMA", "SCHEMA_NAME", "read_mcap", "write_mcap", "topic_for"]
+
+#: Name of the message schema written by greybox.
+SCHEMA_NAME = "greybox.AxisSample"
+
+#: JSON schema of one sample message (schema encoding ``jsonschema``).
+AXIS_SAMPLE_SCHEMA = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "title": SCHEMA_NAME,
+    "description": "One sample of one machine-tool feed axis. The sample time is the message log_time in ns.",
+    "type": "object",
+    "properties": {
+        "position_mm": {"type": "number", "description": "axis position [mm]"},
+        "current_A": {"type": "number", "description": "motor current [A]"},
+        "force_N": {"type": "number", "description": "drive force [N], for logs without current"},
+        "velocity_mm_s": {"type": "number", "description": "axis velocity [mm/s]"},
+        "acceleration_mm_s2": {"type": "number", "description": "axis acceleration [mm/s^2]"},
+    },
+    "required": ["position_mm"],
+    "anyOf": [{"required": ["current_A"]}, {"required": ["force_N"]}],
+    "additionalProperties": {"type": "number", "description": "extra channel; the name ends in its unit"},
+}
+
+_MAGIC = b"\x89MCAP0\r\n"
+_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x03, 0x04, 0x05, 0x06, 0x0F
+_MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time u64
+_BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
+
+
+def topic_for(axis: str) -> str:
+    """Topic of an axis channel: ``/axis/<axis>``, or ``/axis`` for an unnamed axis."""
+    return f"/axis/{axis}" if axis else "/axis"
+
+
+# ---------------------------------------------------------------------- write
+def _sample_fields(log: AxisLog) -> list[tuple[str, np.ndarray]]:
+    fields = [(CANONICAL_NAMES["position"], log.position), (log.effort_column, log.effort)]
+    if log.velocity is not None:
+        fields.append((CANONICAL_NAMES["velocity"], log.velocity))
+    if log.acceleration is not None:
+        fields.append((CANONICAL_NAMES["acceleration"], log.acceleration))
+    fields.extend(log.extras.items())
+    return fields
+
+
+def _encode_messages(log: AxisLog, path) -> list[bytes]:
+    fields = _sample_fields(log)
+    for name, values in fields:
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise LogError(path, f"channel '{name}' holds {values[bad[0]]} at sample {bad[0]}; JSON messages carry finite numbers only")
+    template = "{" + ",".join(json.dumps(name).replace("%", "%%") + ":%r" for name, _ in fields) + "}"
+    columns = [values.tolist() for _, values in fields]
+    return [(template % row).encode() for row in zip(*columns)]
+
+
+def write_mcap(logs: AxisLog | Sequence[AxisLog], path) -> None:
+    """Write one or several axis logs to an MCAP file, one channel per log.
+
+    Parameters
+    ----------
+    logs : AxisLog or sequence of AxisLog
+        Logs of different axes (their topics ``/axis/<axis>`` must differ).
+        Times must be non-negative (MCAP time stamps are unsigned ns).
+    path : str or path-like
+        File to write. Written in place; :func:`greybox.data.io.write_log`
+        wraps this function to write atomically.
+
+    Raises
+    ------
+    LogError
+        For negative times, duplicate topics or non-finite values (JSON has no NaN).
+    """
+    from mcap.writer import CompressionType, Writer
+
+    runs = [logs] if isinstance(logs, AxisLog) else list(logs)
+    topics = [topic_for(log.axis) for log in runs]
+    if len(set(topics)) != len(topics):
+        raise LogError(path, f"several logs share a topic ({', '.join(topics)}); give each log its own axis name")
+    encoded = []
+    for log in runs:
+        if len(log) and log.time[0] < 0:
+            raise LogError(path, f"time starts at {log.time[0]} s; MCAP time stamps must be non-negative")
+        stamps = np.rint(log.time * 1e9).astype(np.uint64).tolist()
+        encoded.append((stamps, _encode_messages(log, path)))
+    with open(path, "wb") as stream:
+        writer = Writer(stream, compression=CompressionType.ZSTD)
+        writer.start(profile="", library="greybox")
+        schema_id = writer.register_schema(
+            name=SCHEMA_NAME, encoding="jsonschema", data=json.dumps(AXIS_SAMPLE_SCHEMA, indent=2).encode()
+        )
+        for log, topic, (stamps, messages) in zip(runs, topics, encoded):
+            metadata = {
+                "axis": log.axis,
+                "dataset": log.dataset,
+                "effort_unit": log.effort_unit,
+                "attrs": json.dumps(log.attrs),
+            }
+            channel_id = writer.register_channel(topic, "json", schema_id, metadata)
+            for stamp, message in zip(stamps, messages):
+                writer.add_message(channel_id, stamp, message, stamp)
+        writer.finish()
+
+
+# ----------------------------------------------------------------------- scan
+@njit(cache=True)
+def _read_u64(buf, pos):
+    value = np.uint64(0)
+    for k in range(8):
+        value |= np.uint64(buf[pos + k]) << np.uint64(8 * k)
+    return value
+
+
+@njit(cache=True)
+def scan_records(buf, start, stop):
+    """Split a byte range into MCAP records (opcode u8, length u64, content).
+
+    Parameters
+    ----------
+    buf : ndarray of uint8
+        File or decompressed chunk bytes.
+    start, stop : int
+        Byte range holding a sequence of whole records.
+
+    Returns
+    -------
+    opcodes : ndarray of uint8
+    offsets : ndarray of int64
+        Offset of each record's content in ``buf``.
+    lengths : ndarray of int64
+        Length of each record's content.
+    end : int
+        Where scanning stopped: ``stop`` when the range holds whole records
+        only; otherwise the start of the record that runs past ``stop``.
+    """
+    count = 0
+    pos = start
+    while pos + 9 <= stop:
+        length = _read_u64(buf, pos + 1)
+        if length > np.uint64(stop - pos - 9):
+            break
+        pos += 9 + np.int64(length)
+        count += 1
+    opcodes = np.empty(count, np.uint8)
+    offsets = np.empty(count, np.int64)
+    lengths = np.empty(count, np.int64)
+    pos = start
+    for k in range(count):
+        length = np.int64(_read_u64(buf, pos + 1))
+        opcodes[k] = buf[pos]
+        offsets[k] = pos + 9
+        lengths[k] = length
+        pos += 9 + length
+    return opcodes, offsets, lengths, pos
+
+
+@njit(cache=True)
+def join_slices(buf, offsets, lengths, separator):
+    """Concatenate ``buf[offsets[k]:offsets[k] + lengths[k]]``, one ``separator`` byte between slices.
+
+    Returns
+    -------
+    ndarray of uint8
+    """
+    n = offsets.shape[0]
+    total = max(n - 1, 0)
+    for k in range(n):
+        total += lengths[k]
+    out = np.empty(total, np.uint8)
+    pos = 0
+    for k in range(n):
+        if k:
+            out[pos] = separator
+            pos += 1
+        begin = offsets[k]
+        for j in range(lengths[k]):
+            out[pos + j] = buf[begin + j]
+        pos += lengths[k]
+    return out
+
+
+# ----------------------------------------------------------------------- read
+class _Records:
+    """Little-endian reader of one record's fields (raises on running short)."""
+
+    def __init__(self, data: bytes, path):
+        self.data, self.pos, self.path = data, 0, path
+
+    def take(self, size: int) -> bytes:
+        if self.pos + size > len(self.data):
+            raise LogError(self.path, "corrupt MCAP file: a record is shorter than its fields")
+        chunk = self.data[self.pos:self.pos + size]
+        self.pos += size
+        return chunk
+
+    def uint(self, size: int) -> int:
+        return int.from_bytes(self.take(size), "little")
+
+    def string(self) -> str:
+        try:
+            return self.take(self.uint(4)).decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise LogError(self.path, f"corrupt MCAP file: invalid text in a record ({exc.reason})") from None
+
+    def string_map(self) -> dict[str, str]:
+        inner = _Records(self.take(self.uint(4)), self.path)
+        pairs = {}
+        while inner.pos < len(inner.data):
+            key = inner.string()
+            pairs[key] = inner.string()
+        return pairs
+
+
+class _Channel:
+    def __init__(self, content: bytes, path):
+        fields = _Records(content, path)
+        self.id = fields.uint(2)
+        self.schema_id = fields.uint(2)
+        self.topic = fields.string()
+        self.message_encoding = fields.string()
+        self.metadata = fields.string_map()
+
+
+def _decompress(content: bytes, path) -> bytes:
+    fields = _Records(content, path)
+    fields.take(16)  # message start and end time
+    size = fields.uint(8)
+    crc = fields.uint(4)
+    compression = fields.string()
+    records = fields.take(fields.uint(8))
+    try:
+        if compression == "":
+            data = records
+        elif compression == "zstd":
+            import zstandard
+
+            data = zstandard.ZstdDecompressor().decompress(records, max_output_size=size)
+        elif compression == "lz4":
+            import lz4.frame
+
+            data = lz4.frame.decompress(records)
+        else:
+            raise LogError(path, f"MCAP chunk compression '{compression}' is not supported (use zstd, lz4 or none)")
+    except LogError:
+        raise
+    except Exception as exc:  # the decompressors raise their own error types
+        raise LogError(path, f"corrupt MCAP file: a {compression} chunk does not decompress ({exc})") from None
+    if len(data) != size or (crc and zlib.crc32(data) != crc):
+        raise LogError(path, "corrupt MCAP file: a chunk fails its size or CRC check")
+    return data
+
+
+class _MessageCollector:
+    """Gathers the messages of one channel, parsing their JSON in batches."""
+
+    def __init__(self, path):
+        self.path = path
+        self.stamps: list[np.ndarray] = []
+        self.pending: list[np.ndarray] = []
+        self.pending_bytes = 0
+        self.pending_rows = 0
+        self.batches: list[tuple[int, dict]] = []
+
+    def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray) -> None:
+        if not offsets.size:
+            return
+        header = buf[offsets[:, None] + np.arange(6, 14)]
+        self.stamps.append(np.ascontiguousarray(header).view("<u8").ravel().copy())
+        text = join_slices(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER, 10)
+        self.pending.append(text)
+        self.pending_bytes += text.size
+        self.pending_rows += offsets.size
+        if self.pending_bytes >= _BATCH_BYTES:
+            self.flush()
+
+    def flush(self) -> None:
+        if not self.pending:
+            return
+        import pyarrow.json as pa_json
+
+        pieces = []
+        for piece in self.pending:
+            pieces.extend((piece.tobytes(), b"\n"))
+        text = b"".join(pieces[:-1])
+        rows = self.pending_rows
+        self.pending, self.pending_bytes, self.pending_rows = [], 0, 0
+        lines = text.count(b"\n") + 1
+        try:
+            table = pa_json.read_json(
+                io.BytesIO(text),
+                read_options=pa_json.ReadOptions(block_size=max(1 << 20, min(len(text) + 1, 1 << 24))),
+                parse_options=pa_json.ParseOptions(newlines_in_values=lines != rows),
+            )
+        except Exception as exc:  # pyarrow.ArrowInvalid and friends
+            raise LogError(self.path, f"messages are not valid JSON objects ({str(exc).splitlines()[0]})") from None
+        if table.num_rows != rows:
+            raise LogError(self.path, f"{rows} messages gave {table.num_rows} JSON objects; each message must hold one object")
+        self.batches.append((rows, {name: table.column(name) for name in table.column_names}))
+
+    def columns(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        import pyarrow as pa
+        import pyarrow.compute as pc
+
+        self.flush()
+        stamps = np.concatenate(self.stamps) if self.stamps else np.empty(0, np.uint64)
+        names = list(dict.fromkeys(name for _, batch in self.batches for name in batch))
+        table = {}
+        for name in names:
+            parts = []
+            for rows, batch in self.batches:
+                column = batch.get(name)
+                if column is None:
+                    parts.append(np.full(rows, np.nan))
+                elif pa.types.is_integer(column.type) or pa.types.is_floating(column.type) or pa.types.is_boolean(column.type) or pa.types.is_null(column.type):
+                    parts.append(pc.cast(column, pa.float64()).to_numpy())
+                else:
+                    parts = None
+                    break
+            table[name] = np.concatenate(parts) if parts is not None else np.empty(0, dtype=object)
+        order = np.argsort(stamps, kind="stable")
+        if np.any(order != np.arange(order.size)):
+            stamps = stamps[order]
+            table = {name: values[order] if values.dtype != object else values for name, values in table.items()}
+        return stamps, table
+
+
+def _match(channels: Mapping[int, _Channel], topic: str | None) -> _Channel | None:
+    """The channel to read as far as known so far, or None (not seen yet, or ambiguous)."""
+    if topic is None:
+        return next(iter(channels.values())) if len(channels) == 1 else None
+    return next((channel for channel in channels.values() if channel.topic == topic), None)
+
+
+def _choose(channels: Mapping[int, _Channel], topic: str | None, path) -> _Channel:
+    topics = ", ".join(sorted(channel.topic for channel in channels.values()))
+    if not channels:
+        raise LogError(path, "the MCAP file has no channels")
+    if topic is None:
+        if len(channels) > 1:
+            raise LogError(path, f"the MCAP file has several channels; choose one with topic= ({topics})")
+        return next(iter(channels.values()))
+    for channel in channels.values():
+        if channel.topic == topic:
+            return channel
+    raise LogError(path, f"no channel with topic '{topic}'; topics in the file: {topics}")
+
+
+def _walk(data: bytes, path) -> Iterable[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """Yield (buffer, opcodes, offsets, lengths) for the data section, chunk by chunk."""
+    if len(data) < 2 * len(_MAGIC) or data[: len(_MAGIC)] != _MAGIC:
+        raise LogError(path, "not an MCAP file (the file does not start with the MCAP magic bytes)")
+    if data[-len(_MAGIC):] != _MAGIC:
+        raise LogError(path, "truncated MCAP file: it does not end with the MCAP magic bytes (was the logger stopped before closing it?)")
+    buf = np.frombuffer(data, np.uint8)
+    stop = len(data) - len(_MAGIC)
+    opcodes, offsets, lengths, end = scan_records(buf, len(_MAGIC), stop)
+    if end != stop:
+        raise LogError(path, f"corrupt or truncated MCAP file: the record at byte {end} runs past the end of the file")
+    data_end = np.flatnonzero(opcodes == _OP_DATA_END)
+    if not data_end.size:
+        raise LogError(path, "corrupt MCAP file: no data-end record")
+    last = int(data_end[0])
+    opcodes, offsets, lengths = opcodes[:last], offsets[:last], lengths[:last]
+    chunks = np.flatnonzero(opcodes == _OP_CHUNK)
+    begin = 0
+    for index in list(chunks) + [opcodes.size]:
+        if index > begin:
+            yield buf, opcodes[begin:index], offsets[begin:index], lengths[begin:index]
+        if index < opcodes.size:
+            raw = _decompress(data[offsets[index]:offsets[index] + lengths[index]], path)
+            inner = np.frombuffer(raw, np.uint8)
+            ops, offs, lens, end = scan_records(inner, 0, inner.size)
+            if end != inner.size:
+                raise LogError(path, "corrupt MCAP file: a chunk holds a partial record")
+            yield inner, ops, offs, lens
+        begin = index + 1
+
+
+def read_mcap(
+    path,
+    *,
+    topic: str | None = None,
+    columns: Mapping[str, str] | None = None,
+    sample_time: float | None = None,
+) -> AxisLog:
+    """Read one axis channel of an MCAP file with JSON messages.
+
+    Parameters
+    ----------
+    path : str or path-like
+        MCAP file.
+    topic : str, optional
+        Channel to read; required when the file has several channels (the
+        error lists them).
+    columns : mapping of str to str, optional
+        ``{canonical_name: message_field}`` for fields not named by the
+        greybox convention, e.g. ``{"position_mm": "pos", "current_A": "iq"}``.
+    sample_time : float, optional
+        Not applicable (time comes from ``log_time``); giving it is an error.
+
+    Returns
+    -------
+    AxisLog
+        Time [s] = ``log_time`` / 1e9, messages in ``log_time`` order; base
+        channels converted to canonical units, other numeric fields as extras;
+        axis, dataset, effort unit and attrs from the channel metadata (axis
+        defaults to the last part of the topic).
+
+    Raises
+    ------
+    LogError
+        For a file that is not MCAP, truncated or corrupt, an ambiguous or
+        unknown topic, non-JSON messages, or missing fields.
+    """
+    with open(path, "rb") as stream:
+        data = stream.read()
+    channels: dict[int, _Channel] = {}
+    collector = _MessageCollector(path)
+    for buf, opcodes, offsets, lengths in _walk(data, path):
+        for k in np.flatnonzero(opcodes == _OP_CHANNEL):
+            channel = _Channel(buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), path)
+            channels.setdefault(channel.id, channel)
+        chosen = _match(channels, topic)
+        is_message = opcodes == _OP_MESSAGE
+        if chosen is None or not is_message.any():
+            continue
+        offs, lens = offsets[is_message], lengths[is_message]
+        if np.any(lens < _MESSAGE_HEADER):
+            raise LogError(path, "corrupt MCAP file: a message record is shorter than its header")
+        ids = buf[offs].astype(np.uint16) | (buf[offs + 1].astype(np.uint16) << 8)
+        mine = ids == chosen.id
+        collector.add(buf, offs[mine], lens[mine])
+    channel = _choose(channels, topic, path)
+    if channel.message_encoding != "json":
+        raise LogError(
+            path,
+            f"channel '{channel.topic}' has message encoding '{channel.message_encoding}'; greybox reads JSON messages",
+        )
+    stamps, table = collector.columns()
+    if not stamps.size:
+        raise LogError(path, f"channel '{channel.topic}' has no messages")
+    metadata = channel.metadata
+    try:
+        attrs = json.loads(metadata.get("attrs", "{}"))
+    except json.JSONDecodeError:
+        raise LogError(path, f"channel '{channel.topic}': metadata 'attrs' is not JSON text") from None
+    return log_from_columns(
+        table,
+        source=path,
+        columns=columns,
+        time=stamps * 1e-9,
+        sample_time=sample_time,
+        effort_unit=metadata.get("effort_unit"),
+        axis=metadata.get("axis", channel.topic.rstrip("/").rsplit("/", 1)[-1]),
+        dataset=metadata.get("dataset", ""),
+        attrs=attrs if isinstance(attrs, dict) else {"attrs": attrs},
+    )
