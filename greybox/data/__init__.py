@@ -2,6 +2,7 @@
 
 from .io import parse_column_mapping, read_log, write_log
 from .log import AxisLog, as_log_list
+from .prepare import default_cutoff, derive, prepare, resample, trim
 from .validate import check_finite, check_time
 
 __all__ = [
@@ -12,4 +13,9 @@ __all__ = [
     "parse_column_mapping",
     "check_time",
     "check_finite",
+    "prepare",
+    "derive",
+    "resample",
+    "trim",
+    "default_cutoff",
 ]

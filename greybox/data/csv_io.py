@@ -1,0 +1,121 @@
+"""CSV axis logs: one row per sample, one column per channel, unit suffix in each header.
+
+Written by :func:`write_csv`::
+
+    # greybox {"axis": "X", "dataset": "A", "effort_unit": "A", "attrs": {...}}
+    time_s,position_mm,velocity_mm_s,current_A,truth_friction_A
+    0.0,12.5,0.0,0.31,0.02
+    ...
+
+Read by :func:`read_csv`: leading lines starting with ``#`` are comments; a
+``# greybox {...}`` comment restores the metadata. The delimiter is detected
+from the header line (comma, semicolon or tab); with a semicolon delimiter a
+decimal comma is accepted. Column names follow :mod:`greybox.data.units`.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from typing import Mapping
+
+import pandas as pd
+
+from ..errors import LogError
+from .log import AxisLog
+from .units import log_from_columns
+
+__all__ = ["read_csv", "write_csv"]
+
+_METADATA_TAG = "# greybox "
+
+
+def _preamble(path) -> tuple[int, dict, str]:
+    """Count leading comment lines, parse greybox metadata, return the header line."""
+    comments, metadata = 0, {}
+    try:
+        with open(path, encoding="utf-8", newline="") as stream:
+            for line in stream:
+                if not line.startswith("#"):
+                    return comments, metadata, line
+                if line.startswith(_METADATA_TAG):
+                    try:
+                        metadata = json.loads(line[len(_METADATA_TAG):])
+                    except json.JSONDecodeError as exc:
+                        raise LogError(path, f"line {comments + 1}: greybox metadata is not valid JSON ({exc.msg})") from None
+                comments += 1
+    except UnicodeDecodeError as exc:
+        raise LogError(path, f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None
+    return comments, metadata, ""
+
+
+def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: float | None = None) -> AxisLog:
+    """Read a CSV axis log.
+
+    Parameters
+    ----------
+    path : str or path-like
+        CSV file with a header row.
+    columns : mapping of str to str, optional
+        ``{canonical_name: header}`` for headers not named by the convention.
+    sample_time : float, optional
+        Sample time [s] for files without a time column.
+
+    Returns
+    -------
+    AxisLog
+        Not yet validated; :func:`greybox.data.io.read_log` validates.
+
+    Raises
+    ------
+    LogError
+        For a file without header or data rows, malformed rows, or columns
+        that do not give the required channels (see :func:`~greybox.data.units.log_from_columns`).
+    """
+    comments, metadata, header = _preamble(path)
+    if not header.strip():
+        raise LogError(path, "no header row (the file holds only comments or blank lines)")
+    delimiter = max((",", ";", "\t"), key=header.count)
+    decimal = "."
+    if delimiter == ";":
+        with open(path, encoding="utf-8") as stream:
+            lines = stream.readlines()[comments + 1:comments + 2]
+        if lines and "," in lines[0]:
+            decimal = ","
+    try:
+        frame = pd.read_csv(
+            path, skiprows=comments, sep=delimiter, decimal=decimal, engine="c", low_memory=False, encoding="utf-8"
+        )
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, csv.Error) as exc:
+        raise LogError(path, f"malformed CSV ({str(exc).strip().splitlines()[0]})") from None
+    if frame.empty:
+        raise LogError(path, "no data rows (the file holds only a header)")
+    table = {str(name).strip(): frame[name].to_numpy() for name in frame.columns}
+    return log_from_columns(
+        table,
+        source=path,
+        columns=columns,
+        sample_time=sample_time,
+        effort_unit=metadata.get("effort_unit"),
+        axis=str(metadata.get("axis", "")),
+        dataset=str(metadata.get("dataset", "")),
+        attrs=metadata.get("attrs", {}),
+    )
+
+
+def write_csv(log: AxisLog, path) -> None:
+    """Write an axis log as CSV with canonical headers and a metadata comment.
+
+    Floats are written with the shortest text that reads back to the same
+    value, so a round trip is exact.
+
+    Parameters
+    ----------
+    log : AxisLog
+    path : str or path-like
+        Written in place; :func:`greybox.data.io.write_log` makes it atomic.
+    """
+    metadata = {"axis": log.axis, "dataset": log.dataset, "effort_unit": log.effort_unit, "attrs": log.attrs}
+    with open(path, "w", encoding="utf-8", newline="") as stream:
+        stream.write(_METADATA_TAG + json.dumps(metadata) + "\n")
+        log.to_frame().to_csv(stream, index=False, lineterminator="\n")

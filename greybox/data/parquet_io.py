@@ -1,0 +1,96 @@
+"""Parquet axis logs: canonical columns plus extras; metadata in the schema.
+
+:func:`write_parquet` writes the columns of :meth:`AxisLog.to_frame` (``time_s``,
+``position_mm``, ``velocity_mm_s``, ``acceleration_mm_s2``, ``current_A`` or
+``force_N``, extras) as float64, zstd-compressed, and stores
+``{"axis", "dataset", "effort_unit", "attrs"}`` as JSON under the key
+``greybox`` of the schema metadata. :func:`read_parquet` reads any Parquet
+file whose column names follow :mod:`greybox.data.units` (or a ``columns=``
+mapping); the metadata is optional.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Mapping
+
+from ..errors import LogError
+from .log import AxisLog
+from .units import log_from_columns
+
+__all__ = ["read_parquet", "write_parquet"]
+
+_METADATA_KEY = b"greybox"
+
+
+def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time: float | None = None) -> AxisLog:
+    """Read a Parquet axis log.
+
+    Parameters
+    ----------
+    path : str or path-like
+    columns : mapping of str to str, optional
+        ``{canonical_name: column}`` for columns not named by the convention.
+    sample_time : float, optional
+        Sample time [s] for files without a time column.
+
+    Returns
+    -------
+    AxisLog
+        Not yet validated; :func:`greybox.data.io.read_log` validates.
+
+    Raises
+    ------
+    LogError
+        For a file that is not Parquet, holds no rows, or lacks required columns.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+    except (pa.ArrowException, OSError) as exc:
+        raise LogError(path, f"not a readable Parquet file ({str(exc).strip().splitlines()[0]})") from None
+    if table.num_rows == 0:
+        raise LogError(path, "no data rows")
+    raw = (table.schema.metadata or {}).get(_METADATA_KEY)
+    try:
+        metadata = json.loads(raw) if raw else {}
+    except json.JSONDecodeError:
+        raise LogError(path, "the greybox schema metadata is not valid JSON") from None
+    arrays = {}
+    for name in table.column_names:
+        column = table.column(name)
+        numeric = pa.types.is_integer(column.type) or pa.types.is_floating(column.type) or pa.types.is_boolean(column.type)
+        arrays[name] = column.to_numpy() if numeric else column.to_numpy(zero_copy_only=False).astype(object)
+    return log_from_columns(
+        arrays,
+        source=path,
+        columns=columns,
+        sample_time=sample_time,
+        effort_unit=metadata.get("effort_unit"),
+        axis=str(metadata.get("axis", "")),
+        dataset=str(metadata.get("dataset", "")),
+        attrs=metadata.get("attrs", {}),
+    )
+
+
+def write_parquet(log: AxisLog, path) -> None:
+    """Write an axis log as Parquet (float64 columns, zstd, metadata in the schema).
+
+    Parameters
+    ----------
+    log : AxisLog
+    path : str or path-like
+        Written in place; :func:`greybox.data.io.write_log` makes it atomic.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    frame = log.to_frame()
+    metadata = {"axis": log.axis, "dataset": log.dataset, "effort_unit": log.effort_unit, "attrs": log.attrs}
+    table = pa.table(
+        {name: frame[name].to_numpy() for name in frame.columns},
+        metadata={_METADATA_KEY: json.dumps(metadata).encode()},
+    )
+    pq.write_table(table, path, compression="zstd")
