@@ -103,3 +103,184 @@ def test_compiled_scan_and_join_agree_with_plain_python():
     assert end == 5 + len(records)
     joined = join_slices(buf, offsets, lengths, 10).tobytes()
     assert joined == b"\n".join(data[o:o + n] for o, n in zip(ref[1], ref[2]))
+
+
+def _write_with_mcap_library(path, messages, *, encoding="json", **writer_options):
+    """Write (log_time_ns, bytes) messages on /axis/X with the mcap package's Writer."""
+    from mcap.writer import Writer
+
+    with open(path, "wb") as stream:
+        writer = Writer(stream, **writer_options)
+        writer.start()
+        schema_id = writer.register_schema("greybox.AxisSample", "jsonschema", b'{"type": "object"}')
+        channel_id = writer.register_channel("/axis/X", encoding, schema_id, {"axis": "X"})
+        for stamp, data in messages:
+            writer.add_message(channel_id, log_time=stamp, data=data, publish_time=stamp)
+        writer.finish()
+
+
+def _sample_messages(n=300, *, indent=None):
+    return [
+        (k * 1_000_000, json.dumps({"position_um": 1000.0 * k, "current_mA": 500.0, "temperature_C": 20.0 + k}, indent=indent).encode())
+        for k in range(n)
+    ]
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {},
+        {"use_chunking": False},
+        {"compression": "lz4"},
+        {"compression": "none", "chunk_size": 512},
+    ],
+    ids=["zstd-chunks", "no-chunks", "lz4", "uncompressed-small-chunks"],
+)
+def test_files_of_other_writers_read_with_unit_conversion(tmp_path, options):
+    from mcap.writer import CompressionType
+
+    if "compression" in options:
+        options = {**options, "compression": {"lz4": CompressionType.LZ4, "none": CompressionType.NONE}[options["compression"]]}
+    path = tmp_path / "other.mcap"
+    _write_with_mcap_library(path, _sample_messages(), **options)
+    log = read_log(path)
+    k = np.arange(300)
+    np.testing.assert_allclose(log.time, k * 1e-3, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(log.position, k * 1.0)  # 1000 um per sample = 1 mm
+    np.testing.assert_allclose(log.current, 0.5)  # 500 mA
+    assert np.array_equal(log.extras["temperature_C"], 20.0 + k)
+    assert log.axis == "X"
+
+
+def test_pretty_printed_messages_and_field_mapping(tmp_path):
+    path = tmp_path / "pretty.mcap"
+    messages = [
+        (k * 2_000_000, json.dumps({"pos": 0.1 * k, "iq": -1.0}, indent=2).encode()) for k in range(100)
+    ]
+    _write_with_mcap_library(path, messages)
+    log = read_log(path, columns={"position_m": "pos", "current_A": "iq"})
+    np.testing.assert_allclose(log.position, 100.0 * np.arange(100))  # 0.1 m = 100 mm
+    assert np.all(log.current == -1.0)
+
+
+def test_messages_out_of_time_order_are_sorted(tmp_path):
+    path = tmp_path / "unordered.mcap"
+    messages = _sample_messages(50)
+    _write_with_mcap_library(path, messages[25:] + messages[:25])
+    log = read_log(path)
+    assert np.all(np.diff(log.time) > 0)
+    np.testing.assert_allclose(log.position, np.arange(50.0))
+
+
+def _fails(path, *fragments, **options):
+    with pytest.raises(LogError) as error:
+        read_log(path, **options)
+    message = str(error.value)
+    assert message.startswith(str(path) + ": "), message
+    for fragment in fragments:
+        assert fragment in message, message
+    return message
+
+
+def test_random_bytes_are_not_mcap(tmp_path):
+    path = tmp_path / "noise.mcap"
+    path.write_bytes(np.random.default_rng(0).bytes(5000))
+    _fails(path, "not an MCAP file")
+
+
+def test_truncated_file(tmp_path, make_log):
+    path = tmp_path / "axis.mcap"
+    write_log(make_log(), path)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    _fails(path, "truncated")
+
+
+def test_truncated_file_that_ends_with_the_magic_bytes(tmp_path, make_log):
+    path = tmp_path / "axis.mcap"
+    write_log(make_log(), path)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2] + data[:8])
+    _fails(path, "corrupt or truncated", "runs past the end")
+
+
+def test_corrupt_chunk(tmp_path, make_log):
+    path = tmp_path / "axis.mcap"
+    write_log(make_log(), path)
+    data = bytearray(path.read_bytes())
+    middle = len(data) // 3
+    data[middle:middle + 64] = np.random.default_rng(1).bytes(64)
+    path.write_bytes(bytes(data))
+    _fails(path, "corrupt")
+
+
+def test_messages_that_are_not_json(tmp_path):
+    path = tmp_path / "binary.mcap"
+    _write_with_mcap_library(path, [(k * 1_000_000, b"\x01\x02 not json") for k in range(10)])
+    _fails(path, "not valid JSON")
+
+
+def test_channel_with_another_encoding(tmp_path):
+    path = tmp_path / "proto.mcap"
+    _write_with_mcap_library(path, [(k * 1_000_000, b"\x08\x01") for k in range(10)], encoding="protobuf")
+    _fails(path, "message encoding 'protobuf'")
+
+
+def test_missing_field(tmp_path):
+    path = tmp_path / "nocurrent.mcap"
+    _write_with_mcap_library(path, [(k * 1_000_000, json.dumps({"position_mm": 1.0}).encode()) for k in range(10)])
+    _fails(path, "missing required column 'current_A'")
+
+
+def test_field_missing_in_some_messages_is_reported_as_non_finite(tmp_path):
+    path = tmp_path / "holes.mcap"
+    messages = [(k * 1_000_000, json.dumps({"position_mm": 1.0, "current_A": 2.0}).encode()) for k in range(20)]
+    messages[7] = (7_000_000, json.dumps({"position_mm": 1.0}).encode())
+    _write_with_mcap_library(path, messages)
+    _fails(path, "channel 'current_A'", "t = 0.007")
+
+
+def test_repeated_time_stamp(tmp_path):
+    path = tmp_path / "repeat.mcap"
+    messages = _sample_messages(20)
+    messages[10] = (messages[9][0], messages[10][1])
+    _write_with_mcap_library(path, messages)
+    _fails(path, "time repeats at sample 10")
+
+
+def test_writer_refuses_what_mcap_cannot_hold(tmp_path, make_log):
+    log = make_log(n=20)
+    with pytest.raises(LogError, match="non-negative"):
+        write_log(log.replace(time=log.time - 1.0), tmp_path / "negative.mcap")
+    with pytest.raises(LogError, match="finite numbers"):
+        write_log(log.replace(extras={"bad_A": np.full(20, np.nan)}), tmp_path / "nan.mcap")
+    with pytest.raises(LogError, match="share a topic"):
+        write_log([log, log], tmp_path / "twice.mcap")
+    assert list(tmp_path.iterdir()) == []  # nothing half-written is left behind
+
+
+def _doc_text():
+    from pathlib import Path
+
+    return (Path(__file__).resolve().parents[1] / "docs" / "log-formats.md").read_text(encoding="utf-8")
+
+
+def test_documented_schema_is_the_written_schema():
+    import re
+
+    from greybox.data.mcap_io import AXIS_SAMPLE_SCHEMA
+
+    (block,) = re.findall(r"```json\n(.*?)```", _doc_text(), re.S)
+    assert json.loads(block) == AXIS_SAMPLE_SCHEMA
+
+
+def test_documented_example_logger_writes_a_loadable_file(tmp_path, monkeypatch):
+    import re
+
+    (code,) = [block for block in re.findall(r"```python\n(.*?)```", _doc_text(), re.S) if "Writer(" in block]
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "docs/log-formats.md", "exec"), {})
+    log = read_log(tmp_path / "axis_X.mcap")
+    assert (len(log), log.axis, log.dataset, log.effort_unit) == (5000, "X", "shop-floor", "A")
+    assert log.sample_time == pytest.approx(0.002)
+    np.testing.assert_allclose(log.position, 100 + 50 * np.sin(0.4 * np.pi * log.time), atol=1e-9)

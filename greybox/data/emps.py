@@ -45,10 +45,11 @@ def read_emps(path) -> AxisLog:
         For a file that is not a MATLAB file or lacks a required variable.
     """
     from scipy.io import loadmat
+    from scipy.io.matlab import MatReadError
 
     try:
         variables = loadmat(path)
-    except (ValueError, TypeError, NotImplementedError, OSError) as exc:
+    except (MatReadError, ValueError, TypeError, NotImplementedError, OSError, EOFError) as exc:
         raise LogError(path, f"not a readable MATLAB .mat file ({exc})") from None
     missing = [name for name in EMPS_VARIABLES if name not in variables]
     if missing:
