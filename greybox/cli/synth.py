@@ -1,0 +1,108 @@
+"""``greybox synth``: write synthetic axis logs of the twin machine as MCAP files."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import GreyboxError
+from ..twin.cutting import CuttingSpec
+from ..twin.datasets import ESSENTIAL_TRUTH_CHANNELS, synthesize
+from ..twin.effects import EFFECTS, effect_parameters
+from ..twin.noise import CurrentNoise
+from ..twin.trajectories import DATASETS, DEFAULT_DATASETS
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "synth",
+        help="write synthetic axis logs (datasets A-D, P) of the twin machine",
+        description=(
+            "Simulate the synthetic feed axis (24-element Maxwell-slip friction, position-dependent, "
+            "inertia, AR(1) current noise) along the trajectories of Rüppel et al. (2024, Table 1) and "
+            "write one MCAP file per dataset, DIR/<axis>_<dataset>.mcap. Datasets: "
+            + "; ".join(f"{k}: {v}" for k, v in DATASETS.items()) + "."
+        ),
+    )
+    parser.add_argument("--axis", required=True, metavar="AXES", help="axis or comma-separated axes: X, Y or X,Y")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
+    parser.add_argument("--seed", required=True, type=int, metavar="N", help="master seed (non-negative integer)")
+    parser.add_argument("--datasets", default=",".join(DEFAULT_DATASETS), metavar="IDS",
+                        help=f"comma-separated dataset ids from {', '.join(DATASETS)} (default %(default)s)")
+    parser.add_argument("--effect", metavar="NAME",
+                        help=f"add one hidden effect, kept as truth_effect_A: {', '.join(EFFECTS)}")
+    parser.add_argument("--strength", type=float, metavar="A",
+                        help="strength of the hidden effect [A] (default 0.2)")
+    parser.add_argument("--effect-param", action="append", default=[], metavar="KEY=VALUE",
+                        help="further effect parameter, e.g. period_mm=5 (repeatable)")
+    parser.add_argument("--cutting", action="store_true",
+                        help="inject a milling-like cutting load, kept as truth_process_A")
+    parser.add_argument("--cutting-strength", type=float, default=CuttingSpec.strength_A, metavar="A",
+                        help="mean process current [A] at 1000 mm/min feed (default %(default)s)")
+    parser.add_argument("--spindle-rpm", type=float, default=CuttingSpec.spindle_rpm, metavar="RPM",
+                        help="spindle speed [1/min] of the tooth-passing ripple (default %(default)s)")
+    parser.add_argument("--teeth", type=int, default=CuttingSpec.teeth, metavar="Z",
+                        help="number of cutter teeth (default %(default)s)")
+    parser.add_argument("--duration", type=float, metavar="S",
+                        help="length [s] of the random datasets A, C (default 120) and P (default 60); "
+                             "B and D always cross the travel once back and forth per speed")
+    parser.add_argument("--noise-std", type=float, default=CurrentNoise.std_A, metavar="A",
+                        help="standard deviation [A] of the AR(1) current noise (default %(default)s)")
+    parser.add_argument("--truth", choices=("all", "essential"), default="all",
+                        help="truth channels to write: all, or only noise-free current and injected "
+                             "components (compact files; default %(default)s)")
+    parser.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
+    parser.set_defaults(run=run)
+
+
+def _parse_value(text: str):
+    lowered = text.strip().lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        return float(text)
+    except ValueError:
+        raise GreyboxError(f"effect parameter value {text!r} is not a number (or true/false)") from None
+
+
+def _effect_options(args: argparse.Namespace) -> dict:
+    if args.effect is None:
+        if args.strength is not None or args.effect_param:
+            raise GreyboxError("--strength and --effect-param need --effect NAME")
+        return {}
+    if args.effect not in EFFECTS:
+        raise GreyboxError(f"unknown hidden effect {args.effect!r}; choose from {', '.join(EFFECTS)}")
+    params = {}
+    for item in args.effect_param:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise GreyboxError(f"--effect-param {item!r}: expected KEY=VALUE")
+        key = key.strip()
+        if key not in effect_parameters(args.effect):
+            known = ", ".join(effect_parameters(args.effect)) or "none"
+            raise GreyboxError(f"effect {args.effect!r} has no parameter {key!r}; its parameters: {known}")
+        params[key] = _parse_value(value)
+    options = {"effect": args.effect, "effect_params": params}
+    if args.strength is not None:
+        options["effect_strength"] = args.strength
+    return options
+
+
+def run(args: argparse.Namespace) -> int:
+    axes = [a.strip().upper() for a in args.axis.split(",") if a.strip()]
+    datasets = [d.strip().upper() for d in args.datasets.split(",") if d.strip()]
+    if not axes or not datasets:
+        raise GreyboxError("give at least one axis (--axis) and one dataset (--datasets)")
+    options = _effect_options(args)
+    if args.cutting:
+        options["cutting"] = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm,
+                                         teeth=args.teeth)
+    synthesize(
+        axes, args.seed, args.out, datasets,
+        force=args.force,
+        truth_channels=ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None,
+        progress=print,
+        duration_s=args.duration,
+        noise=CurrentNoise(std_A=args.noise_std),
+        **options,
+    )
+    return 0

@@ -1,0 +1,73 @@
+"""``greybox synth`` and :func:`greybox.twin.synthesize`: files, refusal to overwrite, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from greybox.cli import main
+from greybox.data.io import read_log
+from greybox.errors import GreyboxError
+from greybox.twin import ESSENTIAL_TRUTH_CHANNELS, make_dataset, synthesize
+
+
+def test_synth_writes_one_file_per_dataset(tmp_path, capsys):
+    out = tmp_path / "twin"
+    status = main(["synth", "--axis", "X,Y", "--out", str(out), "--seed", "3", "--datasets", "A,P",
+                   "--duration", "6", "--effect", "position_periodic_force", "--strength", "0.15",
+                   "--effect-param", "period_mm=5", "--cutting"])
+    assert status == 0
+    assert sorted(p.name for p in out.iterdir()) == ["X_A.mcap", "X_P.mcap", "Y_A.mcap", "Y_P.mcap"]
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert len(lines) == 4 and lines[0].startswith("X_A:") and "noise floor" in lines[0]
+    log = read_log(out / "Y_A.mcap")
+    expected = make_dataset("Y", "A", seed=3, duration_s=6.0, effect="position_periodic_force",
+                            effect_strength=0.15, effect_params={"period_mm": 5.0}, cutting=True)
+    assert log.axis == "Y" and log.dataset == "A" and log.attrs["seed"] == 3
+    assert log.attrs["effect"] == {"name": "position_periodic_force", "strength_A": 0.15, "period_mm": 5.0,
+                                   "phase_rad": 0.0}
+    np.testing.assert_array_equal(log.current, expected.current)
+    np.testing.assert_array_equal(log.position, expected.position)
+    np.testing.assert_allclose(log.time, expected.time, atol=1e-9)
+    for name in expected.extras:
+        np.testing.assert_allclose(log.extras[name], expected.extras[name], atol=0.5e-6 + 1e-12)
+
+
+def test_synth_refuses_to_overwrite_without_force(tmp_path, capsys):
+    args = ["synth", "--axis", "X", "--out", str(tmp_path), "--seed", "1", "--datasets", "D,A", "--duration", "4"]
+    target = tmp_path / "X_A.mcap"
+    target.write_bytes(b"user data")
+    assert main(args) == 2
+    error = capsys.readouterr().err
+    assert "X_A.mcap" in error and "--force" in error and "exists" in error
+    assert target.read_bytes() == b"user data"
+    assert not (tmp_path / "X_D.mcap").exists()  # nothing written at all
+    assert main(args + ["--force"]) == 0
+    assert read_log(target).dataset == "A"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--axis", "Z"], "unknown axis 'Z'"),
+    (["--axis", "X", "--datasets", "A,Q"], "unknown dataset 'Q'"),
+    (["--axis", "X", "--effect", "cogging"], "unknown hidden effect 'cogging'"),
+    (["--axis", "X", "--strength", "0.1"], "need --effect"),
+    (["--axis", "X", "--effect", "thermal_drift", "--effect-param", "tau=2"], "no parameter 'tau'"),
+    (["--axis", "X", "--effect", "thermal_drift", "--effect-param", "time_constant_s=fast"], "not a number"),
+    (["--axis", "X", "--seed", "-2"], "seed must be a non-negative integer"),
+    (["--axis", "X", "--duration", "0"], "duration must be positive"),
+])
+def test_synth_errors_are_one_line_messages(tmp_path, capsys, args, message):
+    argv = ["synth", "--out", str(tmp_path / "o"), "--seed", "0", *args]
+    assert main(argv) == 2
+    error = capsys.readouterr().err
+    assert message in error and "Traceback" not in error
+    assert not any((tmp_path / "o").glob("*.mcap"))
+
+
+def test_synthesize_keeps_only_the_requested_truth_channels(tmp_path):
+    paths = synthesize("X", 5, tmp_path, ["D"], truth_channels=ESSENTIAL_TRUTH_CHANNELS, cutting=True)
+    log = read_log(paths[0])
+    assert set(log.extras) == {"truth_current_A", "truth_process_A"}
+    with pytest.raises(GreyboxError, match="unknown truth channel"):
+        synthesize("X", 5, tmp_path / "b", ["D"], truth_channels=["truth_speed_A"])
+    assert not (tmp_path / "b").exists()
