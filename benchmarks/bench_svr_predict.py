@@ -1,0 +1,61 @@
+"""Time the batched RBF expansion against scikit-learn's SVR.predict.
+
+Prints one JSON line: n_samples, n_support, sklearn_s, batched_s, speedup,
+max_abs_diff (largest |difference| of the two predictions) and max_abs_pred,
+plus blas_threads (threads the matrix product was allowed; libsvm uses one).
+
+    python benchmarks/bench_svr_predict.py --n-samples 200000 --n-train 4000 --threads 1
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+from sklearn.svm import SVR
+from threadpoolctl import threadpool_limits
+
+from greybox.models.rbf import rbf_expansion
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n-samples", type=int, default=200_000, help="samples to predict")
+    parser.add_argument("--n-train", type=int, default=4000, help="training samples (most become support vectors)")
+    parser.add_argument("--n-features", type=int, default=2)
+    parser.add_argument("--threads", type=int, default=None, help="BLAS threads for the batched version")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+
+    rng = np.random.default_rng(args.seed)
+    X = rng.standard_normal((args.n_train, args.n_features))
+    y = np.sin(2.0 * X[:, 0]) + 0.3 * X[:, -1] ** 2 + 0.05 * rng.standard_normal(args.n_train)
+    gamma = 2.0
+    svr = SVR(kernel="rbf", C=10.0, epsilon=0.005, gamma=gamma).fit(X, y)
+    X_new = rng.standard_normal((args.n_samples, args.n_features))
+
+    start = time.perf_counter()
+    expected = svr.predict(X_new)
+    sklearn_s = time.perf_counter() - start
+
+    with threadpool_limits(limits=args.threads):
+        start = time.perf_counter()
+        got = rbf_expansion(X_new, svr.support_vectors_, svr.dual_coef_.ravel(), svr.intercept_[0], gamma)
+        batched_s = time.perf_counter() - start
+
+    print(json.dumps({
+        "n_samples": args.n_samples,
+        "n_support": int(svr.support_vectors_.shape[0]),
+        "sklearn_s": round(sklearn_s, 4),
+        "batched_s": round(batched_s, 4),
+        "speedup": round(sklearn_s / batched_s, 2),
+        "max_abs_diff": float(np.max(np.abs(got - expected))),
+        "max_abs_pred": float(np.max(np.abs(expected))),
+        "blas_threads": args.threads or "default",
+    }))
+
+
+if __name__ == "__main__":
+    main()
