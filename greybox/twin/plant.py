@@ -42,6 +42,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import GreyboxError
+from .axes import axis_geometry
 
 __all__ = [
     "PlantParameters",
@@ -180,8 +181,6 @@ def default_plant_parameters(axis: str = "X", travel_mm=None) -> PlantParameters
     travel_mm : tuple of float, optional
         Travel [mm] for the preload profile; default the axis' travel.
     """
-    from .axes import axis_geometry
-
     geometry = axis_geometry(axis)
     travel = tuple(travel_mm) if travel_mm is not None else geometry.travel_mm
     if geometry.name == "X":
