@@ -1,0 +1,244 @@
+"""Compiled time-stepping kernels of the dynamic friction models.
+
+All kernels are compiled with numba (``@njit(cache=True)``, no fastmath, so
+that results are reproducible and agree with the plain-Python references in
+the tests). They take the velocity sequence [mm/s] of one run sampled at a
+constant step ``sample_time`` [s], start from a given state and return the
+state after the last sample, so that a long log can be processed in chunks
+that carry the state across.
+
+Sample ``j`` uses the state *before* its update (explicit output equation):
+the friction reported at ``t_j`` is computed from ``z(t_j)`` and the rate
+applied over the step ``[t_j, t_j + T]``.
+
+GMS element modes (``int8``): ``0`` sticking, ``+1`` slipping in the positive
+direction, ``-1`` slipping in the negative direction.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["gms_friction_kernel", "gms_trajectory_kernel", "lugre_trajectory_kernel"]
+
+
+@njit(cache=True)
+def _gms_step(v, sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate):
+    """Advance every GMS element over one forward-Euler step (in place).
+
+    Parameters
+    ----------
+    v : float
+        Velocity held over the step [mm/s].
+    sample_time : float
+        Step T [s].
+    c_dt : float
+        ``C * T`` [mm]: slip rate constant times the step.
+    alpha : ndarray, shape (N,)
+        Element fractions (sum 1).
+    s_inf, s_drop : float
+        ``s_inf`` and ``s_0 - s_inf`` of the Stribeck curve [mm].
+    inv_v_s : float
+        ``1 / v_s`` [s/mm].
+    z : ndarray, shape (N,)
+        Element deflections [mm]; overwritten with the values after the step.
+    mode : ndarray of int8, shape (N,)
+        Element modes; overwritten with the modes after the step.
+    rate : ndarray, shape (N,)
+        Overwritten with the applied rates ``(z_new - z_old) / T`` [mm/s].
+    """
+    s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
+    inv_s = 1.0 / s
+    if v > 0.0:
+        d = 1
+    elif v < 0.0:
+        d = -1
+    else:
+        d = 0
+    fd = float(d)
+    v_dt = v * sample_time
+    for i in range(alpha.shape[0]):
+        z_old = z[i]
+        m = mode[i]
+        if m != 0 and m != d:
+            m = 0  # velocity reversed or stopped: the element sticks again
+        s_i = alpha[i] * s
+        if m == 0:
+            z_new = z_old + v_dt
+            if d != 0 and fd * z_new >= s_i:
+                m = d  # break-away: the deflection reached s_i(v)
+                if fd * z_old < s_i:
+                    z_new = fd * s_i
+                else:
+                    z_new = z_old + c_dt * (alpha[i] * fd - z_old * inv_s)
+        else:
+            z_new = z_old + c_dt * (alpha[i] * fd - z_old * inv_s)
+        rate[i] = (z_new - z_old) / sample_time
+        z[i] = z_new
+        mode[i] = m
+
+
+@njit(cache=True)
+def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0):
+    """Friction of the Generalized Maxwell-Slip model, forward Euler at a constant step.
+
+    Parameters
+    ----------
+    velocity : ndarray, shape (n,)
+        Velocity [mm/s].
+    sample_time : float
+        Step T [s].
+    alpha : ndarray, shape (N,)
+        Element fractions, positive, summing to 1.
+    k : ndarray, shape (N,)
+        Element stiffnesses [A/mm].
+    sigma : float
+        Total micro-damping [A s/mm]; element i gets ``alpha_i * sigma``.
+    s_0, s_inf : float
+        Stribeck curve at rest and at high speed [mm] (deflection at break-away).
+    v_s : float
+        Stribeck velocity [mm/s].
+    c : float
+        Slip rate constant C [mm/s]; element i relaxes with ``alpha_i * C``.
+    mu : float
+        Viscous coefficient [A s/mm].
+    z0 : ndarray, shape (N,)
+        Initial element deflections [mm].
+    mode0 : ndarray of int8, shape (N,)
+        Initial element modes.
+
+    Returns
+    -------
+    friction : ndarray, shape (n,)
+        ``sum_i (k_i z_i + alpha_i sigma dz_i/dt) + mu v`` [A].
+    z_end : ndarray, shape (N,)
+        Deflections after the last step [mm].
+    mode_end : ndarray of int8, shape (N,)
+        Modes after the last step.
+    """
+    n = velocity.shape[0]
+    n_el = alpha.shape[0]
+    z = z0.copy()
+    mode = mode0.copy()
+    rate = np.empty(n_el)
+    damping = sigma * alpha
+    friction = np.empty(n)
+    c_dt = c * sample_time
+    s_drop = s_0 - s_inf
+    inv_v_s = 1.0 / v_s
+    for j in range(n):
+        v = velocity[j]
+        f = mu * v
+        for i in range(n_el):
+            f += k[i] * z[i]
+        _gms_step(v, sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate)
+        for i in range(n_el):
+            f += damping[i] * rate[i]
+        friction[j] = f
+    return friction, z, mode
+
+
+@njit(cache=True)
+def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, mode0, z_out, mode_out, w_out):
+    """Element states of the GMS model over a run (forward Euler, constant step).
+
+    The element deflections do not depend on the stiffnesses ``k_i``, the
+    damping ``sigma`` or the viscous coefficient, so the friction is linear in
+    those given this trajectory: ``F = z_out @ k + sigma * w_out + mu * v``.
+    The outputs are written into arrays given by the caller (they may be
+    column views of a regressor matrix).
+
+    Parameters
+    ----------
+    velocity : ndarray, shape (n,)
+        Velocity [mm/s].
+    sample_time, alpha, s_0, s_inf, v_s, c, z0, mode0
+        As in :func:`gms_friction_kernel`.
+    z_out : ndarray, shape (n, N)
+        Receives the deflection of each element at each sample, before its update [mm].
+    mode_out : ndarray of int8, shape (n, N)
+        Receives the mode of each element at each sample, before its update.
+    w_out : ndarray, shape (n,)
+        Receives ``sum_i alpha_i dz_i/dt`` over each step [mm/s].
+
+    Returns
+    -------
+    z_end : ndarray, shape (N,)
+        Deflections after the last step [mm].
+    mode_end : ndarray of int8, shape (N,)
+        Modes after the last step.
+    """
+    n = velocity.shape[0]
+    n_el = alpha.shape[0]
+    z = z0.copy()
+    mode = mode0.copy()
+    rate = np.empty(n_el)
+    c_dt = c * sample_time
+    s_drop = s_0 - s_inf
+    inv_v_s = 1.0 / v_s
+    for j in range(n):
+        for i in range(n_el):
+            z_out[j, i] = z[i]
+            mode_out[j, i] = mode[i]
+        _gms_step(velocity[j], sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate)
+        acc = 0.0
+        for i in range(n_el):
+            acc += alpha[i] * rate[i]
+        w_out[j] = acc
+    return z, mode
+
+
+@njit(cache=True)
+def lugre_trajectory_kernel(velocity, sample_time, sigma0, f_c, f_s, v_s, z0, z_out, z_dot_out):
+    """Bristle deflection of the LuGre model, exact zero-order-hold step.
+
+    With the velocity held at ``v`` over a step the bristle equation
+    ``dz/dt = v - lambda z`` with ``lambda = sigma0 |v| / g(v)`` is linear with
+    a constant coefficient, and its exact solution over the step is
+    ``z(T) = z e^{-lambda T} + v (1 - e^{-lambda T}) / lambda``. It is stable
+    and accurate for any bristle stiffness, unlike forward Euler, which
+    diverges once ``lambda T > 2``.
+
+    Parameters
+    ----------
+    velocity : ndarray, shape (n,)
+        Velocity [mm/s].
+    sample_time : float
+        Step T [s].
+    sigma0 : float
+        Bristle stiffness [A/mm].
+    f_c, f_s : float
+        Coulomb and static friction levels of ``g(v) = f_c + (f_s - f_c) exp(-|v|/v_s)`` [A].
+    v_s : float
+        Stribeck velocity [mm/s].
+    z0 : float
+        Initial bristle deflection [mm].
+    z_out : ndarray, shape (n,)
+        Receives the bristle deflection at each sample, before its update [mm].
+    z_dot_out : ndarray, shape (n,)
+        Receives ``dz/dt = v - lambda z`` at each sample [mm/s].
+
+    Returns
+    -------
+    z_end : float
+        Deflection after the last step [mm].
+    """
+    n = velocity.shape[0]
+    z = z0
+    inv_v_s = 1.0 / v_s
+    for j in range(n):
+        v = velocity[j]
+        speed = abs(v)
+        g = f_c + (f_s - f_c) * math.exp(-speed * inv_v_s)
+        lam = sigma0 * speed / g
+        z_out[j] = z
+        z_dot_out[j] = v - lam * z
+        x = lam * sample_time
+        if x > 0.0:
+            z = z * math.exp(-x) - v * math.expm1(-x) / lam
+        else:
+            z = z + v * sample_time
+    return z

@@ -1,0 +1,72 @@
+"""Plain-Python reference implementations of the compiled friction kernels.
+
+Written directly from the equations in docs/friction-models.md (and
+../shared/DESIGN.md), one sample and one element at a time, without numba, so
+that the tests can check the kernels against them. benchmarks/bench_gms.py
+times :func:`gms_reference` as the plain-Python baseline.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+def gms_reference(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0=None, mode0=None,
+                  slip_law="design"):
+    """GMS friction by forward Euler; returns ``(friction, z_history, mode_history, z_end, mode_end)``.
+
+    ``slip_law="design"`` is the slip law of DESIGN.md,
+    ``dz/dt = alpha_i C (sgn(v) - z / s_i)``. ``slip_law="sgn(1-z/s)"`` is
+    the form ``sgn(v) alpha_i C (1 - z / s_i)`` found in several public
+    implementations, which runs away for negative velocities.
+    """
+    n_el = len(alpha)
+    z = [0.0] * n_el if z0 is None else [float(value) for value in z0]
+    mode = [0] * n_el if mode0 is None else [int(value) for value in mode0]
+    friction, z_history, mode_history = [], [], []
+    for v in velocity:
+        v = float(v)
+        s = s_inf + (s_0 - s_inf) * math.exp(-abs(v) / v_s)
+        d = (v > 0.0) - (v < 0.0)
+        z_history.append(list(z))
+        mode_history.append(list(mode))
+        f = mu * v
+        for i in range(n_el):
+            f += k[i] * z[i]
+        for i in range(n_el):
+            s_i = alpha[i] * s
+            if slip_law == "design":
+                slip_rate = alpha[i] * c * (d - z[i] / s_i)
+            else:
+                slip_rate = d * alpha[i] * c * (1.0 - z[i] / s_i)
+            if mode[i] != 0 and mode[i] != d:
+                mode[i] = 0
+            if mode[i] == 0:
+                z_new = z[i] + v * sample_time
+                if d != 0 and d * z_new >= s_i:
+                    mode[i] = d
+                    z_new = d * s_i if d * z[i] < s_i else z[i] + sample_time * slip_rate
+            else:
+                z_new = z[i] + sample_time * slip_rate
+            f += alpha[i] * sigma * (z_new - z[i]) / sample_time
+            z[i] = z_new
+        friction.append(f)
+    return friction, z_history, mode_history, z, mode
+
+
+def lugre_reference(velocity, sample_time, sigma0, sigma1, sigma2, f_c, f_s, v_s, z0=0.0):
+    """LuGre friction with the exact zero-order-hold step; returns ``(friction, z_history, z_end)``."""
+    z = float(z0)
+    friction, z_history = [], []
+    for v in velocity:
+        v = float(v)
+        g = f_c + (f_s - f_c) * math.exp(-abs(v) / v_s)
+        lam = sigma0 * abs(v) / g
+        z_history.append(z)
+        friction.append(sigma0 * z + sigma1 * (v - lam * z) + sigma2 * v)
+        if lam > 0.0:
+            decay = math.exp(-lam * sample_time)
+            z = z * decay + v * (1.0 - decay) / lam
+        else:
+            z = z + v * sample_time
+    return friction, z_history, z
