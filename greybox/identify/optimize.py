@@ -1,0 +1,206 @@
+"""Bounded local searches and seeded multi-start for parameter identification.
+
+A problem is given as a residual function ``residuals(theta) -> r`` of the
+internal parameter vector ``theta`` (for instance logarithms of positive
+parameters), with box bounds on ``theta``; its cost is ``r @ r``. Two local
+searches are offered:
+
+- ``"nelder-mead"``: the bounded Nelder-Mead simplex of
+  :func:`scipy.optimize.minimize` on the cost (the method used by
+  Tjahjowidodo et al. for friction identification); derivative-free and robust
+  to the kinks that stick/slip switching puts into the cost;
+- ``"least-squares"``: bounded trust-region least squares
+  (:func:`scipy.optimize.least_squares`, method ``trf``) on the residuals with
+  a finite-difference Jacobian.
+
+:func:`multistart` runs the local search from the initial guess and from
+perturbed copies drawn with ``numpy.random.default_rng(random_state)``, so the
+same seed always gives the same result.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import least_squares, minimize
+from threadpoolctl import threadpool_limits
+
+from .progress import ProgressEvent
+
+__all__ = ["METHODS", "SearchResult", "local_search", "multistart"]
+
+#: Names of the local search methods.
+METHODS = ("nelder-mead", "least-squares")
+
+#: Relative finite-difference step of the least-squares Jacobian (in the units of theta).
+_DIFF_STEP = 1e-3
+
+
+@dataclass
+class SearchResult:
+    """Best point found by a search.
+
+    Attributes
+    ----------
+    x : ndarray
+        Best internal parameter vector evaluated.
+    cost : float
+        Its cost ``r @ r``.
+    n_evaluations : int
+        Number of residual evaluations.
+    start : int
+        Index of the start that found ``x`` (0 = the initial guess).
+    """
+
+    x: np.ndarray
+    cost: float
+    n_evaluations: int
+    start: int = 0
+
+
+class _TrackedResiduals:
+    """Residual function that remembers the best point and reports progress."""
+
+    def __init__(self, residuals, stage, start, n_starts, progress, best_so_far):
+        self.residuals = residuals
+        self.stage = stage
+        self.start = start
+        self.n_starts = n_starts
+        self.progress = progress
+        self.stage_best = best_so_far
+        self.n_evaluations = 0
+        self.best_x = None
+        self.best_cost = np.inf
+        self.last_cost = np.inf
+
+    def __call__(self, theta):
+        r = self.residuals(theta)
+        cost = float(r @ r)
+        if not np.isfinite(cost):
+            cost = np.inf
+        self.n_evaluations += 1
+        self.last_cost = cost
+        if cost < self.best_cost:
+            self.best_cost = cost
+            self.best_x = np.array(theta, dtype=float)
+        self.stage_best = min(self.stage_best, cost)
+        if self.progress is not None:
+            self.progress(ProgressEvent(self.stage, self.start, self.n_starts, self.n_evaluations,
+                                        cost, self.stage_best))
+        return r
+
+    def cost(self, theta):
+        r = self(theta)
+        return float(r @ r) if np.all(np.isfinite(r)) else np.inf
+
+    def finish(self):
+        if self.progress is not None:
+            self.progress(ProgressEvent(self.stage, self.start, self.n_starts, self.n_evaluations,
+                                        self.last_cost, self.stage_best, done=True))
+
+
+def _check_bounds(x0, lower, upper):
+    x0 = np.asarray(x0, dtype=float)
+    lower = np.asarray(lower, dtype=float)
+    upper = np.asarray(upper, dtype=float)
+    if not (x0.shape == lower.shape == upper.shape) or np.any(lower >= upper):
+        raise ValueError("bounds must have the shape of x0 and lower < upper")
+    return np.clip(x0, lower, upper), lower, upper
+
+
+def local_search(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, scale,
+                 method: str = "nelder-mead", max_iter: int = 500, stage: str = "fit",
+                 progress=None, start: int = 0, n_starts: int = 1,
+                 best_so_far: float = np.inf) -> SearchResult:
+    """One bounded local search from ``x0``.
+
+    Parameters
+    ----------
+    residuals : callable
+        ``residuals(theta) -> ndarray``; the cost is the sum of squares.
+    x0 : array_like, shape (p,)
+        Starting point (clipped into the bounds).
+    lower, upper : array_like, shape (p,)
+        Box bounds on ``theta``.
+    scale : array_like, shape (p,)
+        Typical change of each coordinate: the edge lengths of the initial
+        Nelder-Mead simplex, and the variable scaling of least squares.
+    method : {"nelder-mead", "least-squares"}
+        Local search (see the module notes).
+    max_iter : int, default 500
+        Nelder-Mead iterations, or least-squares residual evaluations
+        (without those of the finite-difference Jacobian).
+    stage, start, n_starts, best_so_far
+        Labels and running best for the progress events.
+    progress : callable, optional
+        Receives a :class:`ProgressEvent` after every evaluation.
+
+    Returns
+    -------
+    SearchResult
+        The best point evaluated during the search.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
+    x0, lower, upper = _check_bounds(x0, lower, upper)
+    scale = np.broadcast_to(np.asarray(scale, dtype=float), x0.shape)
+    tracked = _TrackedResiduals(residuals, stage, start, n_starts, progress, best_so_far)
+    # the residuals are tall-and-thin products: threaded BLAS only adds contention there
+    with threadpool_limits(limits=1, user_api="blas"):
+        if method == "nelder-mead":
+            simplex = np.tile(x0, (x0.size + 1, 1))
+            for j in range(x0.size):
+                step = scale[j] if x0[j] + scale[j] <= upper[j] else -scale[j]
+                simplex[j + 1, j] = np.clip(x0[j] + step, lower[j], upper[j])
+            minimize(tracked.cost, x0, method="Nelder-Mead", bounds=list(zip(lower, upper)),
+                     options={"maxiter": int(max_iter), "initial_simplex": simplex,
+                              "xatol": 1e-4, "fatol": 1e-10})
+        else:
+            least_squares(tracked, x0, bounds=(lower, upper), method="trf", x_scale=scale,
+                          diff_step=_DIFF_STEP, max_nfev=int(max_iter))
+    tracked.finish()
+    return SearchResult(tracked.best_x, tracked.best_cost, tracked.n_evaluations, start)
+
+
+def multistart(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, scale,
+               n_starts: int = 1, random_state=0, method: str = "nelder-mead",
+               max_iter: int = 500, stage: str = "fit", progress=None) -> SearchResult:
+    """Bounded local searches from ``x0`` and from seeded perturbations of it.
+
+    Start 0 is ``x0`` itself; start ``j > 0`` is ``x0 + scale * N(0, 1)``
+    clipped into the bounds, drawn from ``numpy.random.default_rng(random_state)``.
+
+    Parameters
+    ----------
+    residuals, x0, lower, upper, scale, method, max_iter, stage, progress
+        As in :func:`local_search`.
+    n_starts : int, default 1
+        Number of local searches.
+    random_state : int or None, default 0
+        Seed of the perturbations.
+
+    Returns
+    -------
+    SearchResult
+        The best point over all starts; ``n_evaluations`` is the total.
+    """
+    if n_starts < 1:
+        raise ValueError(f"n_starts must be at least 1, got {n_starts}")
+    x0, lower, upper = _check_bounds(x0, lower, upper)
+    scale = np.broadcast_to(np.asarray(scale, dtype=float), x0.shape)
+    rng = np.random.default_rng(random_state)
+    starts = [x0] + [np.clip(x0 + scale * rng.standard_normal(x0.size), lower, upper)
+                     for _ in range(n_starts - 1)]
+    best = None
+    total = 0
+    for index, start in enumerate(starts):
+        result = local_search(residuals, start, lower, upper, scale=scale, method=method,
+                              max_iter=max_iter, stage=stage, progress=progress, start=index,
+                              n_starts=n_starts, best_so_far=np.inf if best is None else best.cost)
+        total += result.n_evaluations
+        if best is None or result.cost < best.cost:
+            best = result
+    best.n_evaluations = total
+    return best
