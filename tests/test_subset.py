@@ -62,3 +62,25 @@ def test_small_input_returned_whole_and_bad_input_rejected():
         coverage_subset(np.zeros((5, 2)), 0)
     with pytest.raises(ValueError, match="NaN"):
         coverage_subset(np.array([[0.0, np.nan], [1.0, 2.0], [3.0, 4.0]]), 2)
+
+
+def test_accuracy_vs_subset_size_reports_each_size():
+    from greybox.data.log import AxisLog
+    from greybox.models.subset import accuracy_vs_subset_size
+    from greybox.models.svr import SVRCurrentModel
+
+    def run(seed, n=8000):
+        rng = np.random.default_rng(seed)
+        t = np.arange(n) * 0.002
+        p = 200.0 + 150.0 * np.sin(2 * np.pi * 0.13 * t) + 30.0 * np.sin(2 * np.pi * 0.71 * t + seed)
+        v = 150.0 * 2 * np.pi * 0.13 * np.cos(2 * np.pi * 0.13 * t) + 30.0 * 2 * np.pi * 0.71 * np.cos(
+            2 * np.pi * 0.71 * t + seed)
+        current = np.tanh(v / 40.0) + 0.4 * np.sin(2 * np.pi * p / 120.0) + 0.01 * rng.standard_normal(n)
+        return AxisLog(time=t, position=p, effort=current, velocity=v, acceleration=np.zeros(n))
+
+    model = SVRCurrentModel(C=3.0, epsilon=0.01, gamma=5.0, optimize=False)
+    rows = accuracy_vs_subset_size(model, [run(1), run(2)], run(3), [30, 600])
+    assert [r["n_subset"] for r in rows] == [30, 600]
+    assert all(r["n"] == 8000 and r["fit_seconds"] >= 0 for r in rows)
+    assert rows[1]["rmse"] < 0.5 * rows[0]["rmse"]
+    assert model.get_params()["n_subset"] == 2000  # the given model is left untouched

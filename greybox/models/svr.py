@@ -1,0 +1,472 @@
+"""Support vector regression of the motor current: the paper's data-driven benchmark.
+
+:class:`SVRCurrentModel` is the pure SVR model of Rüppel et al. (2024, eq. 9),
+
+    I = J * a + offset + f(p, v),
+
+with an RBF-kernel support vector regression ``f`` of position ``p`` [mm] and
+velocity ``v`` [mm/s], both standardised. The inertia ``J`` [A s^2/mm] and
+the ``offset`` [A] come first, from one linear least-squares fit of the
+current to a Coulomb + viscous proxy,
+
+    I ~ J a + F_c sgn(v) + mu v + offset,
+
+over the samples in motion (|v| above 1 % of the largest speed, so that
+``sgn(v)`` is defined). Only ``J`` and ``offset`` are kept; the SVR then
+learns all of the friction, ``f = I - J a - offset``, including its
+Coulomb, viscous and position-dependent parts. Fitting ``J`` inside the SVR
+instead would let the kernel trade inertia against friction, and ``J a`` is
+not a function of ``(p, v)``.
+
+The machinery shared with the grey-box model
+(:class:`greybox.models.gmssvr.GMSSVRModel`) is :func:`fit_svr_expansion`:
+standardise the inputs, choose the hyperparameters (C, epsilon, gamma) by
+Bayesian optimisation over a time-blocked cross-validation, train on a
+subset that covers the (p, v) plane, and keep the kernel expansion as plain
+arrays (support vectors, dual coefficients, intercept), evaluated by
+:func:`greybox.models.rbf.rbf_expansion`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+
+from ..data.log import AxisLog
+from ..errors import ParameterError
+from ..identify.bayes import minimize_log_uniform
+from ..identify.cv import blocked_folds
+from ..identify.progress import ProgressEvent
+from .base import CurrentModel
+from .rbf import rbf_expansion
+from .subset import coverage_subset
+
+__all__ = [
+    "SVRCurrentModel",
+    "SVRExpansion",
+    "fit_svr_expansion",
+    "inertia_offset_proxy",
+    "default_bounds",
+    "hyperparameters_table",
+    "HYPERPARAMETERS",
+]
+
+#: Names of the SVR hyperparameters, in the order of the paper's Table 2.
+HYPERPARAMETERS = ("epsilon", "C", "gamma")
+
+#: At most this many test samples per cross-validation fold are predicted
+#: (an even stride through the fold), to bound the cost of one evaluation.
+MAX_TEST_SAMPLES_PER_FOLD = 20_000
+
+
+def default_bounds(target_std: float) -> dict[str, tuple[float, float]]:
+    """Search intervals of the hyperparameters for a target of spread ``target_std``.
+
+    Parameters
+    ----------
+    target_std : float
+        Standard deviation of the SVR's target [A].
+
+    Returns
+    -------
+    dict
+        ``epsilon`` in ``[1e-3, 0.5] * target_std`` [A], ``C`` in
+        ``[1e-2, 1e2] * target_std`` [A] (larger C makes libsvm's training
+        time explode without a visible gain), ``gamma`` in ``[1e-2, 1e3]``
+        [1/(standardised unit)^2].
+    """
+    scale = float(target_std) if np.isfinite(target_std) and target_std > 0 else 1.0
+    return {
+        "epsilon": (1e-3 * scale, 0.5 * scale),
+        "C": (1e-2 * scale, 1e2 * scale),
+        "gamma": (1e-2, 1e3),
+    }
+
+
+def _default_value(name: str, target_std: float, n_features: int) -> float:
+    """Hyperparameter used when it is neither given nor optimised."""
+    scale = float(target_std) if np.isfinite(target_std) and target_std > 0 else 1.0
+    return {"epsilon": 0.05 * scale, "C": 3.0 * scale, "gamma": 1.0 / n_features}[name]
+
+
+@dataclass
+class SVRExpansion:
+    """A fitted RBF support vector regression as plain arrays.
+
+    Attributes
+    ----------
+    input_mean, input_scale : ndarray, shape (n_features,)
+        Standardisation of the inputs: ``x_std = (x - mean) / scale``.
+    support_vectors : ndarray, shape (n_support, n_features)
+        In standardised coordinates.
+    dual_coef : ndarray, shape (n_support,)
+        Dual coefficients [unit of the target].
+    intercept : float
+        [unit of the target].
+    hyperparameters : dict
+        ``epsilon`` and ``C`` [unit of the target], ``gamma`` [1/(standardised unit)^2].
+    optimised : list of str
+        Names of the hyperparameters chosen by the Bayesian optimisation.
+    cv_rmse : float
+        Cross-validated RMSE at the chosen hyperparameters [unit of the
+        target]; NaN when nothing was optimised.
+    history : list of dict
+        Every evaluation of the optimisation: hyperparameters and ``cv_rmse``.
+    n_train : int
+        Number of training samples (the subset).
+    """
+
+    input_mean: np.ndarray
+    input_scale: np.ndarray
+    support_vectors: np.ndarray
+    dual_coef: np.ndarray
+    intercept: float
+    hyperparameters: dict[str, float]
+    optimised: list[str] = field(default_factory=list)
+    cv_rmse: float = float("nan")
+    history: list[dict[str, float]] = field(default_factory=list)
+    n_train: int = 0
+
+    def predict(self, X) -> np.ndarray:
+        """Evaluate the regression at raw (unscaled) inputs ``X``, shape (n, n_features)."""
+        scaled = (np.asarray(X, dtype=np.float64) - self.input_mean) / self.input_scale
+        return rbf_expansion(scaled, self.support_vectors, self.dual_coef, self.intercept,
+                             self.hyperparameters["gamma"])
+
+
+def _train(X, y, hyper: Mapping[str, float]):
+    """Train libsvm on standardised ``X``; return (support vectors, dual coefficients, intercept)."""
+    from sklearn.svm import SVR
+
+    svr = SVR(kernel="rbf", C=hyper["C"], epsilon=hyper["epsilon"], gamma=hyper["gamma"], cache_size=500)
+    svr.fit(X, y)
+    return svr.support_vectors_.copy(), svr.dual_coef_.ravel().copy(), float(svr.intercept_[0])
+
+
+def fit_svr_expansion(
+    X,
+    y,
+    coverage,
+    run_lengths: Sequence[int],
+    *,
+    fixed: Mapping[str, float | None],
+    n_subset: int,
+    optimize: bool,
+    n_calls: int,
+    cv_folds: int,
+    cv_blocks: int,
+    bounds: Mapping[str, tuple[float, float]] | None,
+    random_state: int,
+    progress: Callable[[ProgressEvent], None] | None = None,
+    stage: str = "SVR hyperparameters",
+) -> SVRExpansion:
+    """Standardise, choose hyperparameters, train on a covering subset.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n_samples, n_features)
+        Raw inputs, the runs concatenated in order.
+    y : ndarray, shape (n_samples,)
+        Target [A].
+    coverage : ndarray, shape (n_samples, k)
+        Features whose plane the training subset must cover (position and
+        velocity), see :func:`greybox.models.subset.coverage_subset`.
+    run_lengths : sequence of int
+        Samples per run, so that cross-validation blocks never span runs.
+    fixed : dict
+        ``{name: value or None}`` for ``epsilon``, ``C``, ``gamma``; a value
+        is kept as given, ``None`` is optimised (or defaulted, see below).
+    n_subset : int
+        Training samples (in every fold and in the final fit).
+    optimize : bool
+        Optimise the ``None`` hyperparameters; when false they take
+        defaults: ``epsilon = 0.05 std(y)``, ``C = 3 std(y)``,
+        ``gamma = 1 / n_features``.
+    n_calls, cv_folds, cv_blocks : int
+        Bayesian optimisation budget and cross-validation layout
+        (see :func:`greybox.identify.cv.blocked_folds`).
+    bounds : dict, optional
+        Search intervals overriding :func:`default_bounds`.
+    random_state : int
+        Seed of the subsets and of the optimisation.
+    progress : callable, optional
+        Receives a :class:`~greybox.identify.progress.ProgressEvent` per
+        evaluation; its cost is the CV mean squared error over ``var(y)``.
+    stage : str
+        Stage name in the progress events.
+
+    Returns
+    -------
+    SVRExpansion
+    """
+    X = np.asarray(X, dtype=np.float64)
+    y = np.asarray(y, dtype=np.float64)
+    n_features = X.shape[1]
+    mean = X.mean(axis=0)
+    scale = X.std(axis=0)
+    scale[~(scale > 0)] = 1.0
+    Xs = (X - mean) / scale
+    target_std = float(np.std(y))
+    variance = target_std**2 if target_std > 0 else 1.0
+
+    unknown = [name for name in fixed if name not in HYPERPARAMETERS]
+    if unknown:
+        raise ParameterError(f"unknown SVR hyperparameter(s) {unknown}; expected {HYPERPARAMETERS}")
+    hyper: dict[str, float] = {}
+    for name in HYPERPARAMETERS:
+        value = fixed.get(name)
+        if value is not None:
+            smallest_allowed = 0.0 if name == "epsilon" else np.nextafter(0.0, 1.0)
+            if not (np.isfinite(value) and value >= smallest_allowed):
+                kind = "non-negative" if name == "epsilon" else "positive"
+                raise ParameterError(f"SVR hyperparameter {name} must be {kind} and finite, got {value}")
+            hyper[name] = float(value)
+    free = [name for name in HYPERPARAMETERS if name not in hyper]
+
+    history: list[dict[str, float]] = []
+    cv_rmse = float("nan")
+    optimised: list[str] = []
+    if optimize and free:
+        search = dict(default_bounds(target_std))
+        search.update(bounds or {})
+        folds = blocked_folds(run_lengths, n_folds=cv_folds, n_blocks=cv_blocks)
+        prepared = []
+        for k, (train, test) in enumerate(folds):
+            chosen = train[coverage_subset(coverage[train], n_subset, random_state=random_state + k)]
+            step = max(1, test.size // MAX_TEST_SAMPLES_PER_FOLD)
+            prepared.append((chosen, test[::step]))
+
+        best = [np.inf]
+
+        def objective(params: dict[str, float]) -> float:
+            trial = {**hyper, **params}
+            squared, count = 0.0, 0
+            for chosen, test in prepared:
+                sv, alpha, b = _train(Xs[chosen], y[chosen], trial)
+                error = rbf_expansion(Xs[test], sv, alpha, b, trial["gamma"]) - y[test]
+                squared += float(error @ error)
+                count += test.size
+            return float(np.sqrt(squared / count))
+
+        def report(i: int, params: dict[str, float], value: float) -> None:
+            best[0] = min(best[0], value)
+            if progress is not None:
+                progress(ProgressEvent(stage=stage, start=0, n_starts=1, evaluation=i + 1,
+                                       cost=value**2 / variance, best=best[0] ** 2 / variance,
+                                       done=i + 1 == n_calls))
+
+        chosen_params, trials = minimize_log_uniform(
+            objective, {name: search[name] for name in free}, n_calls=n_calls,
+            random_state=random_state, progress=report)
+        hyper.update(chosen_params)
+        optimised = list(free)
+        history = [{**{k: v for k, v in t.items() if k != "objective"}, "cv_rmse": t["objective"]} for t in trials]
+        cv_rmse = min(t["objective"] for t in trials)
+    else:
+        for name in free:
+            hyper[name] = _default_value(name, target_std, n_features)
+
+    chosen = coverage_subset(coverage, n_subset, random_state=random_state)
+    sv, alpha, b = _train(Xs[chosen], y[chosen], hyper)
+    return SVRExpansion(
+        input_mean=mean, input_scale=scale, support_vectors=sv, dual_coef=alpha, intercept=b,
+        hyperparameters={name: hyper[name] for name in HYPERPARAMETERS}, optimised=optimised,
+        cv_rmse=cv_rmse, history=history, n_train=int(chosen.size),
+    )
+
+
+def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) -> tuple[float, float]:
+    """Inertia and offset from a Coulomb + viscous least-squares proxy.
+
+    Fits ``I ~ J a + F_c sgn(v) + mu v + offset`` over the samples with
+    ``|v| > 0.01 max|v|`` of all runs (all samples if fewer than 4 move).
+
+    Parameters
+    ----------
+    runs : list of AxisLog
+        Prepared runs.
+    inertia : float, optional
+        Known J [A s^2/mm]; then only the other proxy terms are fitted.
+
+    Returns
+    -------
+    J : float
+        Inertia [A s^2/mm] (or [N s^2/mm] for force logs).
+    offset : float
+        Constant effort [A] (e.g. a weight share on an inclined axis).
+    """
+    v = np.concatenate([run.velocity for run in runs])
+    a = np.concatenate([run.acceleration for run in runs])
+    effort = np.concatenate([run.effort for run in runs])
+    moving = np.abs(v) > 0.01 * np.max(np.abs(v))
+    if np.count_nonzero(moving) < 4:
+        moving = np.ones(v.shape, dtype=bool)
+    if inertia is not None:
+        if not np.isfinite(inertia):
+            raise ParameterError(f"inertia must be finite, got {inertia}")
+        effort = effort - inertia * a
+    design = np.column_stack((np.sign(v), v, np.ones_like(v), a))[moving]
+    if inertia is not None:
+        design = design[:, :3]
+    # Scale the columns so that mm/s and mm/s^2 do not make the problem ill-conditioned.
+    norms = np.linalg.norm(design, axis=0)
+    norms[norms == 0] = 1.0
+    coef, *_ = np.linalg.lstsq(design / norms, effort[moving], rcond=None)
+    coef = coef / norms
+    J = float(inertia) if inertia is not None else float(coef[3])
+    return J, float(coef[2])
+
+
+class SVRCurrentModel(CurrentModel):
+    """Pure SVR current model (benchmark): ``I = J a + offset + f(p, v)``.
+
+    Parameters
+    ----------
+    inertia : float, optional
+        Inertia J [A s^2/mm], e.g. from the drive's commissioning; identified
+        with the offset by the Coulomb + viscous proxy when None.
+    C : float, optional
+        SVR regularisation [A]; optimised (or defaulted) when None.
+    epsilon : float, optional
+        Width of the SVR's insensitive tube [A]; optimised when None.
+    gamma : float, optional
+        RBF kernel parameter [1/(standardised unit)^2]; optimised when None.
+    n_subset : int, default 2000
+        Training samples, chosen to cover the (p, v) plane evenly
+        (SVR training time grows roughly with its square).
+    optimize : bool, default True
+        Choose the hyperparameters left None by Bayesian optimisation
+        (log-uniform priors, time-blocked cross-validation); when false
+        they take the defaults of :func:`fit_svr_expansion`.
+    n_calls : int, default 25
+        Evaluations of the Bayesian optimisation.
+    cv_folds : int, default 3
+        Cross-validation folds.
+    cv_blocks : int, default 12
+        Contiguous time blocks dealt to the folds (never spanning runs).
+    bounds : dict, optional
+        Search intervals ``{name: (low, high)}`` replacing
+        :func:`default_bounds` (which scale with the spread of the target).
+    random_state : int, default 0
+        Seed of subset choice and optimisation.
+
+    Attributes
+    ----------
+    J_ : float
+        Inertia [A s^2/mm].
+    offset_ : float
+        Constant current [A].
+    input_mean_, input_scale_ : ndarray, shape (2,)
+        Standardisation of (position [mm], velocity [mm/s]).
+    support_vectors_ : ndarray, shape (n_support, 2)
+        Standardised support vectors.
+    dual_coef_ : ndarray, shape (n_support,)
+        Dual coefficients [A].
+    intercept_ : float
+        [A].
+    C_, epsilon_, gamma_ : float
+        Hyperparameters used.
+    optimised_ : list of str
+        Hyperparameters chosen by the optimisation.
+    cv_rmse_ : float
+        Cross-validated RMSE at the chosen hyperparameters [A] (NaN if none were optimised).
+    search_history_ : list of dict
+        Every evaluation of the optimisation.
+    n_train_ : int
+        Size of the training subset.
+    """
+
+    #: Names of the model inputs, in the order of the columns of the support vectors.
+    input_names = ("position_mm", "velocity_mm_s")
+
+    def __init__(self, inertia=None, C=None, epsilon=None, gamma=None, n_subset=2000, optimize=True,
+                 n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
+        self.inertia = inertia
+        self.C = C
+        self.epsilon = epsilon
+        self.gamma = gamma
+        self.n_subset = n_subset
+        self.optimize = optimize
+        self.n_calls = n_calls
+        self.cv_folds = cv_folds
+        self.cv_blocks = cv_blocks
+        self.bounds = bounds
+        self.random_state = random_state
+
+    def _inputs(self, run: AxisLog) -> np.ndarray:
+        return np.column_stack((run.position, run.velocity))
+
+    def _fit_runs(self, runs, progress) -> None:
+        self.J_, self.offset_ = inertia_offset_proxy(runs, self.inertia)
+        X = np.concatenate([self._inputs(run) for run in runs])
+        target = np.concatenate([run.effort - self.J_ * run.acceleration for run in runs]) - self.offset_
+        fit = fit_svr_expansion(
+            X, target, X, [len(run) for run in runs],
+            fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
+            n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
+            cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=self.bounds,
+            random_state=self.random_state, progress=progress)
+        _store_expansion(self, fit)
+
+    def _friction_run(self, run: AxisLog) -> np.ndarray:
+        return _expansion_of(self).predict(self._inputs(run))
+
+    def _n_params(self) -> int:
+        return int(self.dual_coef_.size) + 3  # dual coefficients, intercept, J, offset
+
+    def hyperparameters_table(self) -> dict[str, object]:
+        """The SVR settings as in the paper's Table 2.
+
+        Returns
+        -------
+        dict
+            ``kernel`` ("rbf"), ``epsilon`` [A], ``C`` [A], ``gamma``
+            [1/(standardised unit)^2], ``n_support``, ``n_train``,
+            ``optimised`` (names chosen by Bayesian optimisation) and
+            ``cv_rmse`` [A].
+        """
+        return hyperparameters_table(self)
+
+
+def _store_expansion(model, fit: SVRExpansion) -> None:
+    """Copy a fitted expansion into a model's learned attributes (arrays and floats only)."""
+    model.input_mean_ = fit.input_mean
+    model.input_scale_ = fit.input_scale
+    model.support_vectors_ = fit.support_vectors
+    model.dual_coef_ = fit.dual_coef
+    model.intercept_ = fit.intercept
+    model.epsilon_ = fit.hyperparameters["epsilon"]
+    model.C_ = fit.hyperparameters["C"]
+    model.gamma_ = fit.hyperparameters["gamma"]
+    model.optimised_ = list(fit.optimised)
+    model.cv_rmse_ = fit.cv_rmse
+    model.search_history_ = list(fit.history)
+    model.n_train_ = fit.n_train
+
+
+def _expansion_of(model) -> SVRExpansion:
+    """Rebuild the expansion from a model's learned attributes."""
+    return SVRExpansion(
+        input_mean=model.input_mean_, input_scale=model.input_scale_,
+        support_vectors=model.support_vectors_, dual_coef=model.dual_coef_, intercept=model.intercept_,
+        hyperparameters={"epsilon": model.epsilon_, "C": model.C_, "gamma": model.gamma_},
+    )
+
+
+def hyperparameters_table(model) -> dict[str, object]:
+    """Table-2 style summary of a fitted SVR-based model (see :meth:`SVRCurrentModel.hyperparameters_table`)."""
+    from sklearn.utils.validation import check_is_fitted
+
+    check_is_fitted(model)
+    return {
+        "kernel": "rbf",
+        "epsilon": model.epsilon_,
+        "C": model.C_,
+        "gamma": model.gamma_,
+        "n_support": int(model.dual_coef_.size),
+        "n_train": model.n_train_,
+        "optimised": list(model.optimised_),
+        "cv_rmse": model.cv_rmse_,
+    }

@@ -1,0 +1,101 @@
+"""The SVR benchmark current model I = J a + offset + f(p, v)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+
+from greybox.data.log import AxisLog
+from greybox.errors import LogError
+from greybox.models.svr import SVRCurrentModel, default_bounds, inertia_offset_proxy
+
+J_TRUE = 2e-4  # A s^2/mm
+OFFSET_TRUE = 0.1  # A
+
+
+def sweep_run(seed, n=6000, dt=0.002, ripple=0.3, noise=0.02):
+    """Multi-sine motion over ~0..400 mm; current = inertia + friction + ripple(p) + offset."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * dt
+    freq = rng.uniform(0.1, 0.4, 3)
+    phase = rng.uniform(0.0, 2 * np.pi, 3)
+    amp = np.array([120.0, 50.0, 20.0])
+    arg = 2 * np.pi * freq[:, None] * t + phase[:, None]
+    p = 200.0 + (amp[:, None] * np.sin(arg)).sum(0)
+    v = (amp[:, None] * 2 * np.pi * freq[:, None] * np.cos(arg)).sum(0)
+    a = (-amp[:, None] * (2 * np.pi * freq[:, None]) ** 2 * np.sin(arg)).sum(0)
+    friction = 0.8 * np.tanh(v / 30.0) + 0.003 * v + ripple * np.sin(2 * np.pi * p / 150.0)
+    current = J_TRUE * a + friction + OFFSET_TRUE + noise * rng.standard_normal(n)
+    return AxisLog(time=t, position=p, effort=current,
+                   velocity=v, acceleration=a, extras={"truth_friction_A": friction})
+
+
+FIXED = dict(C=3.0, epsilon=0.01, gamma=5.0, optimize=False, n_subset=800)
+
+
+def rmse(a, b):
+    return float(np.sqrt(np.mean((a - b) ** 2)))
+
+
+def test_proxy_recovers_inertia_and_offset_of_a_coulomb_viscous_axis():
+    runs = [sweep_run(s, ripple=0.0, noise=0.0) for s in (1, 2)]
+    # Replace the smooth tanh by an exact Coulomb step: the proxy then is the truth.
+    runs = [r.replace(effort=J_TRUE * r.acceleration + 0.8 * np.sign(r.velocity) + 0.003 * r.velocity
+                      + OFFSET_TRUE) for r in runs]
+    J, offset = inertia_offset_proxy(runs)
+    assert J == pytest.approx(J_TRUE, rel=1e-9)
+    assert offset == pytest.approx(OFFSET_TRUE, rel=1e-9)
+    J, offset = inertia_offset_proxy(runs, inertia=3e-4)
+    assert J == 3e-4
+
+
+def test_learns_a_position_dependent_friction_a_position_blind_model_cannot():
+    # 40 s runs: long enough for the (p, v) curves to cover the plane.
+    train = [sweep_run(1, n=20000), sweep_run(2, n=20000)]
+    test = sweep_run(3, n=20000)
+    model = SVRCurrentModel(**FIXED).fit(train)
+    # Same model, same data, but the position channel carries no information.
+    blind = SVRCurrentModel(**FIXED).fit([r.replace(position=np.zeros(len(r))) for r in train])
+    error = rmse(model.predict(test), test.current)
+    blind_error = rmse(blind.predict(test.replace(position=np.zeros(len(test)))), test.current)
+    # The ripple (amplitude 0.3 A, rms 0.21 A) is what the blind model misses.
+    assert blind_error > 0.18
+    assert error < 0.3 * blind_error
+    # Friction + inertia + offset add up to the prediction.
+    np.testing.assert_allclose(model.J_ * test.acceleration + model.friction(test) + model.offset_,
+                               model.predict(test), atol=1e-12)
+
+
+def test_predict_concatenates_runs_in_order():
+    model = SVRCurrentModel(**FIXED).fit(sweep_run(1))
+    a, b = sweep_run(4, n=500), sweep_run(5, n=300)
+    both = model.predict([a, b])
+    assert both.shape == (800,)
+    np.testing.assert_array_equal(both[:500], model.predict(a))
+    np.testing.assert_array_equal(both[500:], model.predict(b))
+
+
+def test_bayesian_optimisation_chooses_free_hyperparameters_within_bounds():
+    train = [sweep_run(1, n=3000), sweep_run(2, n=3000)]
+    model = SVRCurrentModel(C=3.0, n_subset=250, n_calls=5, cv_folds=2, cv_blocks=6).fit(train)
+    table = model.hyperparameters_table()
+    assert table["kernel"] == "rbf" and table["C"] == 3.0
+    assert table["optimised"] == ["epsilon", "gamma"]
+    assert len(model.search_history_) == 5
+    target = np.concatenate([r.current - model.J_ * r.acceleration for r in train]) - model.offset_
+    bounds = default_bounds(np.std(target))
+    for name in ("epsilon", "gamma"):
+        assert bounds[name][0] <= table[name] <= bounds[name][1]
+        assert all(bounds[name][0] <= h[name] <= bounds[name][1] for h in model.search_history_)
+    assert table["cv_rmse"] == min(h["cv_rmse"] for h in model.search_history_)
+    assert 0 < table["n_support"] <= table["n_train"] == 250
+    # Seeded: the same settings give the same model.
+    again = clone(model).fit(train)
+    np.testing.assert_array_equal(again.dual_coef_, model.dual_coef_)
+
+
+def test_unprepared_log_is_refused():
+    run = sweep_run(1, n=100)
+    with pytest.raises(LogError, match="not prepared"):
+        SVRCurrentModel(**FIXED).fit(run.replace(acceleration=None))
