@@ -22,7 +22,6 @@ message, and so that a damaged file gives a :class:`~greybox.errors.LogError`.
 
 from __future__ import annotations
 
-import io
 import json
 import struct
 import zlib
@@ -61,7 +60,8 @@ AXIS_SAMPLE_SCHEMA = {
 _MAGIC = b"\x89MCAP0\r\n"
 _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x03, 0x04, 0x05, 0x06, 0x0F
 _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time u64
-_BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
+_BATCH_BYTES = 64 << 20  # JSON text parsed per call of the bulk parser
+_BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
 
 
 def topic_for(axis: str) -> str:
@@ -209,9 +209,7 @@ def join_slices(buf, offsets, lengths, separator):
         if k:
             out[pos] = separator
             pos += 1
-        begin = offsets[k]
-        for j in range(lengths[k]):
-            out[pos + j] = buf[begin + j]
+        out[pos:pos + lengths[k]] = buf[offsets[k]:offsets[k] + lengths[k]]
         pos += lengths[k]
     return out
 
@@ -313,52 +311,61 @@ class _MessageCollector:
     def flush(self) -> None:
         if not self.pending:
             return
+        import pyarrow as pa
         import pyarrow.json as pa_json
 
+        newline = np.array([10], np.uint8)
         pieces = []
         for piece in self.pending:
-            pieces.extend((piece.tobytes(), b"\n"))
-        text = b"".join(pieces[:-1])
+            pieces.extend((piece, newline))
+        text = np.concatenate(pieces[:-1])
         rows = self.pending_rows
         self.pending, self.pending_bytes, self.pending_rows = [], 0, 0
-        lines = text.count(b"\n") + 1
+        lines = int(np.count_nonzero(text == 10)) + 1
         try:
             table = pa_json.read_json(
-                io.BytesIO(text),
-                read_options=pa_json.ReadOptions(block_size=max(1 << 20, min(len(text) + 1, 1 << 24))),
+                pa.BufferReader(pa.py_buffer(text)),
+                read_options=pa_json.ReadOptions(block_size=_BLOCK_BYTES),
                 parse_options=pa_json.ParseOptions(newlines_in_values=lines != rows),
             )
         except Exception as exc:  # pyarrow.ArrowInvalid and friends
             raise LogError(self.path, f"messages are not valid JSON objects ({str(exc).splitlines()[0]})") from None
         if table.num_rows != rows:
             raise LogError(self.path, f"{rows} messages gave {table.num_rows} JSON objects; each message must hold one object")
-        self.batches.append((rows, {name: table.column(name) for name in table.column_names}))
+        self.batches.append((rows, {name: _as_array(table.column(name)) for name in table.column_names}))
 
     def columns(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-        import pyarrow as pa
-        import pyarrow.compute as pc
-
+        """Time stamps [ns] and field columns, in log_time order (missing values NaN)."""
         self.flush()
         stamps = np.concatenate(self.stamps) if self.stamps else np.empty(0, np.uint64)
+        self.stamps = []
         names = list(dict.fromkeys(name for _, batch in self.batches for name in batch))
         table = {}
         for name in names:
-            parts = []
-            for rows, batch in self.batches:
-                column = batch.get(name)
-                if column is None:
-                    parts.append(np.full(rows, np.nan))
-                elif pa.types.is_integer(column.type) or pa.types.is_floating(column.type) or pa.types.is_boolean(column.type) or pa.types.is_null(column.type):
-                    parts.append(pc.cast(column, pa.float64()).to_numpy())
-                else:
-                    parts = None
-                    break
-            table[name] = np.concatenate(parts) if parts is not None else np.empty(0, dtype=object)
-        order = np.argsort(stamps, kind="stable")
-        if np.any(order != np.arange(order.size)):
+            parts = [batch.pop(name, None) for _, batch in self.batches]
+            if all(part is None or part.dtype == np.float64 for part in parts):
+                parts = [np.full(rows, np.nan) if part is None else part for (rows, _), part in zip(self.batches, parts)]
+            else:
+                parts = [np.full(rows, None, object) if part is None else part.astype(object) for (rows, _), part in zip(self.batches, parts)]
+            table[name] = np.concatenate(parts)
+            del parts
+        self.batches = []
+        if np.any(stamps[1:] < stamps[:-1]):
+            order = np.argsort(stamps, kind="stable")
             stamps = stamps[order]
-            table = {name: values[order] if values.dtype != object else values for name, values in table.items()}
+            table = {name: values[order] for name, values in table.items()}
         return stamps, table
+
+
+def _as_array(column) -> np.ndarray:
+    """A pyarrow column as float64 (nulls as NaN), or as objects when it is not numeric."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    kind = column.type
+    if pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind) or pa.types.is_null(kind):
+        return pc.cast(column, pa.float64()).to_numpy()
+    return column.to_numpy().astype(object)
 
 
 def _match(channels: Mapping[int, _Channel], topic: str | None) -> _Channel | None:
@@ -413,6 +420,29 @@ def _walk(data: bytes, path) -> Iterable[tuple[np.ndarray, np.ndarray, np.ndarra
         begin = index + 1
 
 
+def _collect(path, topic: str | None) -> tuple[dict[int, _Channel], _MessageCollector]:
+    """Walk the file once: every channel record, and the messages of the channel to read."""
+    with open(path, "rb") as stream:
+        data = stream.read()
+    channels: dict[int, _Channel] = {}
+    collector = _MessageCollector(path)
+    for buf, opcodes, offsets, lengths in _walk(data, path):
+        for k in np.flatnonzero(opcodes == _OP_CHANNEL):
+            channel = _Channel(buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), path)
+            channels.setdefault(channel.id, channel)
+        chosen = _match(channels, topic)
+        is_message = opcodes == _OP_MESSAGE
+        if chosen is None or not is_message.any():
+            continue
+        offs, lens = offsets[is_message], lengths[is_message]
+        if np.any(lens < _MESSAGE_HEADER):
+            raise LogError(path, "corrupt MCAP file: a message record is shorter than its header")
+        ids = buf[offs].astype(np.uint16) | (buf[offs + 1].astype(np.uint16) << 8)
+        mine = ids == chosen.id
+        collector.add(buf, offs[mine], lens[mine])
+    return channels, collector
+
+
 def read_mcap(
     path,
     *,
@@ -449,24 +479,7 @@ def read_mcap(
         For a file that is not MCAP, truncated or corrupt, an ambiguous or
         unknown topic, non-JSON messages, or missing fields.
     """
-    with open(path, "rb") as stream:
-        data = stream.read()
-    channels: dict[int, _Channel] = {}
-    collector = _MessageCollector(path)
-    for buf, opcodes, offsets, lengths in _walk(data, path):
-        for k in np.flatnonzero(opcodes == _OP_CHANNEL):
-            channel = _Channel(buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), path)
-            channels.setdefault(channel.id, channel)
-        chosen = _match(channels, topic)
-        is_message = opcodes == _OP_MESSAGE
-        if chosen is None or not is_message.any():
-            continue
-        offs, lens = offsets[is_message], lengths[is_message]
-        if np.any(lens < _MESSAGE_HEADER):
-            raise LogError(path, "corrupt MCAP file: a message record is shorter than its header")
-        ids = buf[offs].astype(np.uint16) | (buf[offs + 1].astype(np.uint16) << 8)
-        mine = ids == chosen.id
-        collector.add(buf, offs[mine], lens[mine])
+    channels, collector = _collect(path, topic)
     channel = _choose(channels, topic, path)
     if channel.message_encoding != "json":
         raise LogError(

@@ -269,7 +269,7 @@ def log_from_columns(
         values = _numeric(table[column])
         if values is None:
             raise LogError(source, f"column '{column}' ({quantity}) is not numeric{_first_text(table[column])}")
-        return values * factor if factor != 1.0 else values.copy()
+        return values * factor if factor != 1.0 else values
 
     if time is not None:
         if sample_time is not None:

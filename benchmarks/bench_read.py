@@ -1,0 +1,123 @@
+"""Benchmark of read_log on a one-hour 500 Hz axis log in MCAP, CSV and Parquet.
+
+Synthesises a log (1.8 M samples at the default one hour and 2 ms: position,
+velocity, current and three extra channels, full-precision floats), writes it
+in each format to a temporary directory, then reads each file with
+:func:`greybox.data.read_log` in a fresh Python subprocess. Reported per
+format: read time [s] (wall clock around ``read_log``, validation included),
+peak memory [MB] as the subprocess's peak resident set size (``VmHWM`` in
+``/proc/self/status``, Linux; ``ru_maxrss`` would include the parent's
+memory, which a forked child inherits in that figure), so it includes the
+interpreter and the imported libraries; ``<fmt>_base_mb`` is the peak after
+the imports, before reading. Also file size [MB] and write time [s]. The
+read time includes the lazy imports a fresh process needs for that format
+(pyarrow, numba and its cached kernels for MCAP).
+
+Usage::
+
+    python benchmarks/bench_read.py            # table
+    python benchmarks/bench_read.py --json     # one JSON line
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from greybox.data import AxisLog, read_log, write_log
+
+_CHILD = r"""
+import json, sys, time
+def peak_kb():
+    with open("/proc/self/status") as status:
+        return next(int(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+from greybox.data import read_log
+base = peak_kb()
+start = time.perf_counter()
+log = read_log(sys.argv[1])
+seconds = time.perf_counter() - start
+print(json.dumps({"n": len(log), "seconds": seconds, "peak_kb": peak_kb(), "base_kb": base}))
+"""
+
+
+def synthetic_log(duration_s: float = 3600.0, sample_time: float = 0.002, seed: int = 0) -> AxisLog:
+    """A back-and-forth stroke of a feed axis with a friction-like current and three extras."""
+    rng = np.random.default_rng(seed)
+    time = np.arange(int(round(duration_s / sample_time))) * sample_time
+    phase = 2 * np.pi * time / 8.0
+    position = 200.0 + 150.0 * np.sin(phase) + 0.5 * np.sin(7.3 * phase)  # mm
+    velocity = np.gradient(position, sample_time)  # mm/s
+    current = 1.2 * np.tanh(velocity / 2.0) + 0.004 * velocity + rng.normal(0.0, 0.05, time.size)  # A
+    return AxisLog(
+        time=time,
+        position=position,
+        effort=current,
+        velocity=velocity,
+        axis="X",
+        dataset="bench",
+        extras={
+            "truth_friction_A": 1.2 * np.tanh(velocity / 2.0),
+            "setpoint_position_mm": position + rng.normal(0.0, 1e-3, time.size),
+            "motor_temperature_C": 40.0 + 0.001 * time + rng.normal(0.0, 0.02, time.size),
+        },
+        attrs={"seed": seed, "benchmark": "bench_read"},
+    )
+
+
+def _read_in_subprocess(path: Path) -> dict:
+    output = subprocess.run([sys.executable, "-c", _CHILD, str(path)], check=True, capture_output=True, text=True)
+    return json.loads(output.stdout.strip().splitlines()[-1])
+
+
+def run(duration_s: float = 3600.0, sample_time: float = 0.002) -> dict:
+    """Write the synthetic log in each format and time a fresh-process read of each."""
+    log = synthetic_log(duration_s, sample_time)
+    result: dict = {"n_samples": len(log), "n_channels": 3 + len(log.extras)}
+    with tempfile.TemporaryDirectory() as folder:
+        warm = Path(folder) / "warm.mcap"  # compile and cache the numba kernels once
+        write_log(log.select(slice(0, 1000)), warm)
+        read_log(warm)
+        for fmt in ("mcap", "parquet", "csv"):
+            path = Path(folder) / f"bench.{fmt}"
+            start = time.perf_counter()
+            write_log(log, path)
+            result[f"{fmt}_write_s"] = round(time.perf_counter() - start, 2)
+            result[f"{fmt}_file_mb"] = round(path.stat().st_size / 1e6, 1)
+            child = _read_in_subprocess(path)
+            if child["n"] != len(log):
+                raise RuntimeError(f"{fmt}: read {child['n']} samples, wrote {len(log)}")
+            result[f"{fmt}_read_s"] = round(child["seconds"], 2)
+            result[f"{fmt}_peak_mb"] = round(child["peak_kb"] / 1024, 0)
+            result[f"{fmt}_base_mb"] = round(child["base_kb"] / 1024, 0)
+    return result
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=3600.0, help="log duration [s] (default 3600)")
+    parser.add_argument("--sample-time", type=float, default=0.002, help="sample time [s] (default 0.002)")
+    parser.add_argument("--json", action="store_true", help="print one JSON line")
+    args = parser.parse_args(argv)
+    result = run(args.duration, args.sample_time)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"{result['n_samples']} samples, {result['n_channels']} channels")
+        print(f"{'format':8} {'read s':>8} {'peak MB':>8} {'base MB':>8} {'file MB':>8} {'write s':>8}")
+        for fmt in ("mcap", "parquet", "csv"):
+            print(
+                f"{fmt:8} {result[fmt + '_read_s']:8.2f} {result[fmt + '_peak_mb']:8.0f} "
+                f"{result[fmt + '_base_mb']:8.0f} {result[fmt + '_file_mb']:8.1f} {result[fmt + '_write_s']:8.2f}"
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
