@@ -1,0 +1,442 @@
+"""Generalized Maxwell-Slip (GMS) friction with inertia, forward Euler at the log's step.
+
+Model (see docs/friction-models.md), elements ``i = 1..N`` sharing the Stribeck
+curve ``s(v) = s_inf + (s_0 - s_inf) exp(-|v|/v_s)`` scaled by ``alpha_i``:
+
+- stick: ``z_i[k+1] = z_i[k] + T v[k]`` until ``|z_i|`` reaches ``alpha_i s(v)``
+  in the direction of motion (the element breaks away, ``z_i`` is held at the
+  limit);
+- slip: ``z_i[k+1] = z_i[k] + T alpha_i C (sgn(v) - z_i[k] / (alpha_i s(v)))``
+  until the velocity reverses or stops, then the element sticks again;
+- ``I = J a + sum_i (k_i z_i + alpha_i sigma dz_i/dt) + mu v (+ I_0)``.
+
+Units with positions in mm and velocities in mm/s: ``z_i``, ``s_0``,
+``s_inf`` in mm (element deflections), ``k_i`` in A/mm, ``C`` in mm/s,
+``sigma`` and ``mu`` in A s/mm, ``J`` in A s^2/mm (replace A by N for force
+logs). In steady sliding every element sits at ``sgn(v) alpha_i s(v)``, so the
+friction is ``sgn(v) K s(v) + mu v`` with ``K = sum_i k_i alpha_i``.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..identify.initial import DEFAULT_DEFLECTION_MM, check_motion, presliding_deflection, static_initial_guess
+from ..identify.linear import bounded_lstsq
+from ..identify.optimize import METHODS, local_search, multistart
+from ..identify.static import velocity_range
+from ..models.base import CurrentModel
+from .kernels import gms_friction_kernel, gms_trajectory_kernel
+
+__all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_states"]
+
+#: Largest ``T C / min(s_0, s_inf)`` the identification allows: the slip step
+#: then relaxes monotonically (no overshoot), well inside the stability limit 2.
+MAX_SLIP_STEP_RATIO = 1.0
+
+#: Ratio of the largest to the smallest element fraction of the initial guess.
+_ALPHA_SPREAD = 20.0
+
+#: Bounds of the element-fraction logits (alpha_i proportional to exp(u_i), u_1 = 0).
+_LOGIT_BOUND = 6.0
+
+
+class GMSState(NamedTuple):
+    """State of the GMS elements between two samples.
+
+    Attributes
+    ----------
+    z : ndarray, shape (N,)
+        Element deflections [mm].
+    mode : ndarray of int8, shape (N,)
+        0 sticking, +1 / -1 slipping in the positive / negative direction.
+    """
+
+    z: np.ndarray
+    mode: np.ndarray
+
+    @classmethod
+    def at_rest(cls, n_elements: int) -> "GMSState":
+        """All elements relaxed (``z = 0``) and sticking."""
+        return cls(np.zeros(n_elements), np.zeros(n_elements, dtype=np.int8))
+
+
+def check_gms_parameters(alpha, k, C, sigma, s_0, s_inf, v_s, mu, sample_time=None) -> None:
+    """Raise :class:`ParameterError` unless the GMS parameters are valid (and stable at ``sample_time``).
+
+    Parameters
+    ----------
+    alpha : array_like, shape (N,)
+        Element fractions, positive, summing to 1.
+    k : array_like, shape (N,)
+        Element stiffnesses [A/mm], non-negative.
+    C : float
+        Slip rate constant [mm/s], positive.
+    sigma, mu : float
+        Micro-damping and viscous coefficient [A s/mm], non-negative.
+    s_0, s_inf : float
+        Stribeck curve at rest and at high speed [mm], positive.
+    v_s : float
+        Stribeck velocity [mm/s], positive.
+    sample_time : float, optional
+        Forward-Euler step [s]; if given, the slip step must be stable:
+        ``T C / min(s_0, s_inf) < 2`` (``C_i / s_i(v) = C / s(v)`` for every element
+        and ``s(v)`` lies between ``s_0`` and ``s_inf``).
+    """
+    alpha = np.asarray(alpha, dtype=float)
+    k = np.asarray(k, dtype=float)
+    if alpha.ndim != 1 or alpha.size < 1 or k.shape != alpha.shape:
+        raise ParameterError(f"GMS alpha and k must be 1-D of the same length N >= 1, got shapes "
+                             f"{alpha.shape} and {k.shape}")
+    if not np.all(np.isfinite(alpha)) or np.any(alpha <= 0.0):
+        raise ParameterError(f"GMS element fractions alpha must be positive, got {alpha.tolist()}")
+    if abs(alpha.sum() - 1.0) > 1e-9:
+        raise ParameterError(f"GMS element fractions alpha must sum to 1, they sum to {alpha.sum():.12g}")
+    if not np.all(np.isfinite(k)) or np.any(k < 0.0):
+        raise ParameterError(f"GMS stiffnesses k must be non-negative (negative stiffness is unstable), "
+                             f"got {k.tolist()} A/mm")
+    for name, value, unit in (("C", C, "mm/s"), ("s_0", s_0, "mm"), ("s_inf", s_inf, "mm"), ("v_s", v_s, "mm/s")):
+        if not (np.isfinite(value) and value > 0.0):
+            raise ParameterError(f"GMS parameter {name} must be positive and finite, got {value} {unit}")
+    for name, value in (("sigma", sigma), ("mu", mu)):
+        if not (np.isfinite(value) and value >= 0.0):
+            raise ParameterError(f"GMS parameter {name} must be non-negative, got {value} A s/mm")
+    if sample_time is not None:
+        if not (np.isfinite(sample_time) and sample_time > 0.0):
+            raise ParameterError(f"sample time must be positive, got {sample_time} s")
+        ratio = sample_time * C / min(s_0, s_inf)
+        if ratio >= 2.0:
+            raise ParameterError(
+                f"GMS forward-Euler slip step is unstable at T = {sample_time * 1e3:.4g} ms: "
+                f"T*C/min(s_0, s_inf) = {ratio:.4g} >= 2 (C = {C:.6g} mm/s, min(s_0, s_inf) = "
+                f"{min(s_0, s_inf):.6g} mm); use a step below {2.0 * min(s_0, s_inf) / C * 1e3:.4g} ms "
+                "or parameters identified at this step")
+
+
+def _as_state(state, n_elements: int) -> GMSState:
+    if state is None:
+        return GMSState.at_rest(n_elements)
+    z = np.array(state[0], dtype=float)
+    mode = np.array(state[1], dtype=np.int8)
+    if z.shape != (n_elements,) or mode.shape != (n_elements,) or np.any(np.abs(mode) > 1):
+        raise ParameterError(f"GMS state must hold {n_elements} deflections and modes in (-1, 0, 1)")
+    return GMSState(z, mode)
+
+
+def simulate_gms(velocity, sample_time, *, alpha, k, C, sigma, s_0, s_inf, v_s, mu, state=None):
+    """GMS friction of one run, forward Euler at a constant step.
+
+    Parameters
+    ----------
+    velocity : array_like, shape (n,)
+        Velocity [mm/s].
+    sample_time : float
+        Step T [s].
+    alpha, k, C, sigma, s_0, s_inf, v_s, mu
+        Parameters, see :func:`check_gms_parameters`.
+    state : GMSState or (z, mode), optional
+        State before the first sample; all elements at rest by default.
+
+    Returns
+    -------
+    friction : ndarray, shape (n,)
+        Friction [A].
+    state : GMSState
+        State after the last sample (the initial state of a following chunk).
+    """
+    alpha = np.ascontiguousarray(alpha, dtype=float)
+    k = np.ascontiguousarray(k, dtype=float)
+    check_gms_parameters(alpha, k, C, sigma, s_0, s_inf, v_s, mu, sample_time)
+    start = _as_state(state, alpha.size)
+    friction, z, mode = gms_friction_kernel(np.ascontiguousarray(velocity, dtype=float), float(sample_time),
+                                            alpha, k, float(sigma), float(s_0), float(s_inf), float(v_s),
+                                            float(C), float(mu), start.z, start.mode)
+    return friction, GMSState(z, mode)
+
+
+def gms_states(velocity, sample_time, *, alpha, C, s_0, s_inf, v_s, state=None):
+    """Element deflections and stick flags of the GMS model over one run.
+
+    Parameters
+    ----------
+    velocity : array_like, shape (n,)
+        Velocity [mm/s].
+    sample_time : float
+        Step T [s].
+    alpha, C, s_0, s_inf, v_s
+        Parameters, see :func:`check_gms_parameters` (the element states do
+        not depend on ``k``, ``sigma`` or ``mu``).
+    state : GMSState or (z, mode), optional
+        State before the first sample; all elements at rest by default.
+
+    Returns
+    -------
+    z : ndarray, shape (n, N)
+        Deflection of each element at each sample [mm].
+    stick : ndarray of bool, shape (n, N)
+        True where the element sticks.
+    w : ndarray, shape (n,)
+        ``sum_i alpha_i dz_i/dt`` [mm/s] (the damping term is ``sigma * w``).
+    state : GMSState
+        State after the last sample.
+    """
+    alpha = np.ascontiguousarray(alpha, dtype=float)
+    check_gms_parameters(alpha, np.zeros_like(alpha), C, 0.0, s_0, s_inf, v_s, 0.0, sample_time)
+    start = _as_state(state, alpha.size)
+    velocity = np.ascontiguousarray(velocity, dtype=float)
+    z = np.empty((velocity.size, alpha.size))
+    mode = np.empty((velocity.size, alpha.size), dtype=np.int8)
+    w = np.empty(velocity.size)
+    z_end, mode_end = gms_trajectory_kernel(velocity, float(sample_time), alpha, float(s_0), float(s_inf),
+                                            float(v_s), float(C), start.z, start.mode, z, mode, w)
+    return z, mode == 0, w, GMSState(z_end, mode_end)
+
+
+class _Regression:
+    """Separable least-squares problem of a GMS fit: regressors are rebuilt in place per trial shape.
+
+    Columns of the regressor matrix: ``z_1..z_N`` (element deflections),
+    ``w`` (damping term), ``v``, ``a`` (and ``1``); coefficients ``k_1..k_N``,
+    ``sigma``, ``mu``, ``J`` (and the offset).
+    """
+
+    def __init__(self, runs, n_elements: int, fit_offset: bool):
+        self.n_elements = n_elements
+        self.steps = [run.sample_time for run in runs]
+        self.velocities = [run.velocity for run in runs]
+        self.rows = np.cumsum([0] + [len(run) for run in runs])
+        n_cols = n_elements + 3 + int(fit_offset)
+        self.matrix = np.ones((self.rows[-1], n_cols))
+        self.matrix[:, n_elements + 1] = np.concatenate([run.velocity for run in runs])
+        self.matrix[:, n_elements + 2] = np.concatenate([run.acceleration for run in runs])
+        self.modes = np.empty((self.rows[-1], n_elements), dtype=np.int8)
+        self.target = np.concatenate([run.effort for run in runs])
+        self.norm = np.sqrt(self.target.size * max(np.var(self.target), np.finfo(float).tiny))
+        self.lower = np.zeros(n_cols)
+        self.lower[n_elements + 3:] = -np.inf
+        self.upper = np.full(n_cols, np.inf)
+
+    def solve(self, shape):
+        """Linear parameters and residuals over ``sqrt(n var(y))`` for ``shape = (alpha, s_0, s_inf, v_s, C)``."""
+        alpha, s_0, s_inf, v_s, c = shape
+        rest = GMSState.at_rest(self.n_elements)
+        n = self.n_elements
+        for step, velocity, r0, r1 in zip(self.steps, self.velocities, self.rows[:-1], self.rows[1:]):
+            gms_trajectory_kernel(velocity, step, alpha, s_0, s_inf, v_s, c, rest.z, rest.mode,
+                                  self.matrix[r0:r1, :n], self.modes[r0:r1], self.matrix[r0:r1, n])
+        x, residual = bounded_lstsq(self.matrix, self.target, self.lower, self.upper)
+        return x, residual / self.norm
+
+
+def _alpha_from_logits(logits: np.ndarray) -> np.ndarray:
+    e = np.exp(np.concatenate(([0.0], logits)) - max(0.0, float(np.max(logits, initial=0.0))))
+    return e / e.sum()
+
+
+class GMSModel(CurrentModel):
+    """Inertia + Generalized Maxwell-Slip friction (+ offset), the physical part of the grey-box model.
+
+    ``I = J a + sum_i (k_i z_i + alpha_i sigma dz_i/dt) + mu v + I_0``, forward
+    Euler at the step of each log (see the module notes for the element law
+    and units). Every run is simulated from rest.
+
+    Identification (separable least squares): the element trajectories depend
+    only on the *shape* parameters ``alpha``, ``s_0``, ``s_inf``, ``v_s``,
+    ``C``, and the effort is linear in ``k_i``, ``sigma``, ``mu``, ``J``
+    (non-negative) and ``I_0``, which are solved by linear least squares at
+    every trial shape. The shape is searched in stages:
+
+    1. static: Stribeck + viscous fit on the sliding samples (``s_0 / s_inf``,
+       ``v_s``), pre-sliding deflection from the travel after reversals;
+    2. pre-sliding: element fractions, a common scale of ``s_0`` and
+       ``s_inf``, and ``C``, multi-start from the initial guess;
+    3. joint: all shape parameters from the best of stage 2.
+
+    ``C`` is searched as ``r = T C / min(s_0, s_inf)`` in ``(0, 1]`` (``T``
+    the largest step of the runs), so the forward-Euler slip step is stable
+    and free of overshoot for every trial.
+
+    Parameters
+    ----------
+    n_elements : int, default 4
+        Number of Maxwell-slip elements N.
+    fit_offset : bool, default False
+        Fit a constant offset ``I_0`` [A].
+    method : {"nelder-mead", "least-squares"}, default "nelder-mead"
+        Local search (see :mod:`greybox.identify.optimize`).
+    n_starts : int, default 4
+        Starts of the pre-sliding stage (the first from the initial guess).
+    random_state : int or None, default 0
+        Seed of the perturbed starts.
+    max_iter : int, default 400
+        Iterations per start (Nelder-Mead) or residual evaluations (least squares).
+    staged : bool, default True
+        Run stage 2 before the joint search; if False, the multi-start search
+        runs on all shape parameters directly.
+
+    Attributes
+    ----------
+    alpha_ : ndarray, shape (N,)
+        Element fractions (sum 1).
+    k_ : ndarray, shape (N,)
+        Element stiffnesses [A/mm].
+    C_ : float
+        Slip rate constant [mm/s].
+    sigma_ : float
+        Micro-damping [A s/mm].
+    s0_, s_inf_ : float
+        Stribeck curve of the break-away deflection at rest and at high speed [mm].
+    v_s_ : float
+        Stribeck velocity [mm/s].
+    mu_ : float
+        Viscous coefficient [A s/mm].
+    J_ : float
+        Inertia [A s^2/mm].
+    offset_ : float
+        Offset [A]; 0 when not fitted.
+    cost_ : float
+        Final cost: mean squared error over the effort variance (NMSE / 100).
+    n_evaluations_ : int
+        Number of simulations run by the identification.
+    effort_unit_ : str
+        Unit of the effort the model was fitted on, "A" or "N".
+    """
+
+    def __init__(self, n_elements: int = 4, fit_offset: bool = False, method: str = "nelder-mead",
+                 n_starts: int = 4, random_state=0, max_iter: int = 400, staged: bool = True):
+        self.n_elements = n_elements
+        self.fit_offset = fit_offset
+        self.method = method
+        self.n_starts = n_starts
+        self.random_state = random_state
+        self.max_iter = max_iter
+        self.staged = staged
+
+    # ---------------------------------------------------------------- identification
+    def _shape(self, theta, max_step):
+        """``alpha, s_0, s_inf, v_s, C`` from ``theta = (u_2..u_N, log s_0, log s_inf, log v_s, log r)``."""
+        n = self.n_elements
+        alpha = _alpha_from_logits(theta[: n - 1])
+        s_0, s_inf, v_s, r = np.exp(theta[n - 1:])
+        return alpha, s_0, s_inf, v_s, r * min(s_0, s_inf) / max_step
+
+    def _fit_runs(self, runs, progress) -> None:
+        n = self.n_elements
+        if not (isinstance(n, (int, np.integer)) and n >= 1):
+            raise ParameterError(f"n_elements must be a positive integer, got {n!r}")
+        if self.method not in METHODS:
+            raise ParameterError(f"unknown method {self.method!r}; expected one of {METHODS}")
+        check_motion(runs)
+        regression = _Regression(runs, n, self.fit_offset)
+        max_step = max(regression.steps)
+
+        # stage 1: static levels and pre-sliding deflection
+        static = static_initial_guess(runs, fit_offset=self.fit_offset)
+        delta = presliding_deflection(runs, static) or DEFAULT_DEFLECTION_MM
+        v_lo, v_hi = velocity_range(np.concatenate([run.velocity for run in runs]))
+        logits = np.linspace(0.0, np.log(_ALPHA_SPREAD), n)[1:]
+        alpha = _alpha_from_logits(logits)
+        s_0 = delta / alpha.max()
+        ratio = np.clip(static["coulomb"] / static["static"], 0.05, 20.0) if static["static"] > 0 else 1.0
+        theta = np.concatenate((logits, np.log([s_0, s_0 * ratio, np.clip(static["v_s"], v_lo, v_hi), 0.5])))
+        full_lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND),
+                                     theta[n - 1:n + 1] - np.log(1e3), [np.log(v_lo), np.log(1e-3)]))
+        full_upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND),
+                                     theta[n - 1:n + 1] + np.log(1e3), [np.log(v_hi), np.log(MAX_SLIP_STEP_RATIO)]))
+        full_scale = np.concatenate((np.ones(n - 1), [0.5, 0.5, 0.5, 1.0]))
+
+        def full_residuals(t):
+            return regression.solve(self._shape(t, max_step))[1]
+
+        n_evaluations = 0
+        if self.staged:
+            # stage 2: fractions, common deflection scale, slip rate; v_s and s_0/s_inf kept
+            def expand(p):
+                return np.concatenate((p[: n - 1], theta[n - 1:n + 1] + p[n - 1], [theta[n + 1], p[n]]))
+
+            p0 = np.concatenate((logits, [0.0, theta[-1]]))
+            lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND), [-np.log(1e2), np.log(1e-3)]))
+            upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND), [np.log(1e2), np.log(MAX_SLIP_STEP_RATIO)]))
+            result = multistart(lambda p: full_residuals(expand(p)), p0, lower, upper,
+                                scale=np.concatenate((np.ones(n - 1), [0.5, 1.0])), n_starts=self.n_starts,
+                                random_state=self.random_state, method=self.method, max_iter=self.max_iter,
+                                stage="GMS pre-sliding", progress=progress)
+            n_evaluations += result.n_evaluations
+            # stage 3: all shape parameters from the best pre-sliding fit
+            result = local_search(full_residuals, expand(result.x), full_lower, full_upper, scale=full_scale,
+                                  method=self.method, max_iter=self.max_iter, stage="GMS joint",
+                                  progress=progress, best_so_far=result.cost)
+        else:
+            result = multistart(full_residuals, theta, full_lower, full_upper, scale=full_scale,
+                                n_starts=self.n_starts, random_state=self.random_state, method=self.method,
+                                max_iter=self.max_iter, stage="GMS", progress=progress)
+        n_evaluations += result.n_evaluations
+
+        shape = self._shape(result.x, max_step)
+        x, residual = regression.solve(shape)
+        alpha, s_0, s_inf, v_s, c = shape
+        self.alpha_ = alpha
+        self.k_ = x[:n].copy()
+        self.sigma_, self.mu_, self.J_ = (float(value) for value in x[n:n + 3])
+        self.offset_ = float(x[n + 3]) if self.fit_offset else 0.0
+        self.C_, self.s0_, self.s_inf_, self.v_s_ = float(c), float(s_0), float(s_inf), float(v_s)
+        self.cost_ = float(residual @ residual)
+        self.n_evaluations_ = int(n_evaluations)
+
+    # ---------------------------------------------------------------- prediction
+    def _parameters(self) -> dict:
+        return {"alpha": self.alpha_, "k": self.k_, "C": self.C_, "sigma": self.sigma_, "s_0": self.s0_,
+                "s_inf": self.s_inf_, "v_s": self.v_s_, "mu": self.mu_}
+
+    def _friction_run(self, run) -> np.ndarray:
+        return simulate_gms(run.velocity, run.sample_time, **self._parameters())[0]
+
+    def _n_params(self) -> int:
+        return 2 * len(self.alpha_) + 6 + int(self.fit_offset)
+
+    def predict_chunk(self, log, state=None):
+        """Predict one chunk of a run starting from a given state.
+
+        Splitting a run into consecutive chunks and passing each returned
+        state to the next chunk gives the same prediction as the whole run.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared chunk (at least two samples, for its step).
+        state : GMSState or (z, mode), optional
+            State before the chunk's first sample; at rest by default.
+
+        Returns
+        -------
+        current : ndarray, shape (n,)
+            ``J a + friction + offset`` [A].
+        state : GMSState
+            State after the chunk's last sample.
+        """
+        (run,) = self._check_predict_runs(log)
+        friction, end = simulate_gms(run.velocity, run.sample_time, **self._parameters(), state=state)
+        return self.J_ * run.acceleration + friction + self.offset_, end
+
+    def states(self, logs):
+        """Element deflections and stick flags over one or several runs (each from rest).
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs.
+
+        Returns
+        -------
+        z : ndarray, shape (n_samples, N)
+            Deflection of each element at each sample [mm].
+        stick : ndarray of bool, shape (n_samples, N)
+            True where the element sticks.
+        """
+        runs = self._check_predict_runs(logs)
+        parts = [gms_states(run.velocity, run.sample_time, alpha=self.alpha_, C=self.C_, s_0=self.s0_,
+                            s_inf=self.s_inf_, v_s=self.v_s_) for run in runs]
+        return np.vstack([p[0] for p in parts]), np.vstack([p[1] for p in parts])

@@ -1,0 +1,95 @@
+"""Stribeck + viscous friction with inertia, fitted by separable least squares."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..identify.initial import check_motion, samples_at_speed
+from ..identify.static import fit_stribeck
+from ..models.base import CurrentModel
+
+__all__ = ["StribeckModel", "stribeck_curve"]
+
+
+def stribeck_curve(velocity, s_0: float, s_inf: float, v_s: float) -> np.ndarray:
+    """Decaying Stribeck curve ``s(v) = s_inf + (s_0 - s_inf) exp(-|v| / v_s)``.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Velocity [mm/s].
+    s_0 : float
+        Value at rest (static friction level, or GMS break-away deflection).
+    s_inf : float
+        Value at high speed (Coulomb level), same unit as ``s_0``.
+    v_s : float
+        Stribeck velocity [mm/s], positive.
+
+    Returns
+    -------
+    ndarray
+        ``s(v)`` in the unit of ``s_0``; even in ``v``.
+    """
+    return s_inf + (s_0 - s_inf) * np.exp(-np.abs(np.asarray(velocity, dtype=float)) / v_s)
+
+
+class StribeckModel(CurrentModel):
+    """Inertia + Stribeck + viscous friction (+ offset).
+
+    ``I = J a + sgn(v) (F_c + (F_s - F_c) exp(-|v|/v_s)) + mu v + I_0``
+
+    A static (memoryless) model: the friction is a function of the present
+    velocity only. Fitted by separable nonlinear least squares of all samples:
+    a log-grid search and bounded refinement of ``v_s``, with ``J``, ``F_c``,
+    ``F_s``, ``mu`` (non-negative) and ``I_0`` solved by linear least squares
+    at each trial ``v_s``.
+
+    Parameters
+    ----------
+    fit_offset : bool, default False
+        Fit a constant offset ``I_0`` [A].
+    min_speed : float, default 0.0
+        Samples slower than this [mm/s] are left out of the fit.
+
+    Attributes
+    ----------
+    J_ : float
+        Inertia [A s^2/mm].
+    coulomb_ : float
+        Coulomb level ``F_c`` [A].
+    static_ : float
+        Static level ``F_s`` [A] (friction just above zero speed).
+    v_s_ : float
+        Stribeck velocity [mm/s].
+    viscous_ : float
+        Viscous coefficient ``mu`` [A s/mm].
+    offset_ : float
+        Offset [A]; 0 when not fitted.
+    effort_unit_ : str
+        Unit of the effort the model was fitted on, "A" or "N".
+    """
+
+    def __init__(self, fit_offset: bool = False, min_speed: float = 0.0):
+        self.fit_offset = fit_offset
+        self.min_speed = min_speed
+
+    def _fit_runs(self, runs, progress) -> None:
+        check_motion(runs)
+        v, a, y = samples_at_speed(runs, self.min_speed)
+        params = fit_stribeck(v, a, y, fit_offset=self.fit_offset)
+        self.J_ = params["J"]
+        self.coulomb_ = params["coulomb"]
+        self.static_ = params["static"]
+        self.v_s_ = params["v_s"]
+        self.viscous_ = params["viscous"]
+        self.offset_ = params["offset"]
+
+    def _friction_run(self, run) -> np.ndarray:
+        if not self.v_s_ > 0.0:
+            raise ParameterError(f"Stribeck velocity v_s must be positive, got {self.v_s_} mm/s")
+        v = run.velocity
+        return np.sign(v) * stribeck_curve(v, self.static_, self.coulomb_, self.v_s_) + self.viscous_ * v
+
+    def _n_params(self) -> int:
+        return 5 + int(self.fit_offset)
