@@ -1,0 +1,316 @@
+"""Saving and loading fitted models, without pickle.
+
+File format (format name ``greybox-model``, version 1)
+------------------------------------------------------
+A model file is a ZIP archive (any file name; ``.gbm`` by convention) with
+
+``model.json``
+    A JSON object::
+
+        {"format": "greybox-model", "format_version": 1,
+         "greybox_version": "0.1.0",
+         "model": {"kind": "gms",
+                   "params": {...},       # get_params(deep=False)
+                   "attributes": {...}}}  # learned attributes (names ending in "_")
+
+``arrays/NNN_<attribute>.npy``
+    One NumPy ``.npy`` file per array, referenced from the JSON as
+    ``{"__ndarray__": "arrays/NNN_<attribute>.npy"}`` and read back with
+    ``allow_pickle=False``.
+
+Values inside ``params`` and ``attributes`` are JSON numbers, strings,
+booleans, null, lists and objects with string keys, plus these tagged objects:
+``{"__ndarray__": member}`` (numeric, boolean or string arrays),
+``{"__tuple__": [...]}``, ``{"__float__": "nan" | "inf" | "-inf"}`` (strict
+JSON has no non-finite numbers) and ``{"__estimator__": {"kind", "params",
+"attributes"}}`` for a registered model nested in another (a fitted first
+stage, say). Floats are written with Python's shortest round-trip repr, and
+arrays byte for byte, so a loaded model predicts bit-identically.
+
+The class of a model is looked up by its ``kind`` in the explicit registry
+:data:`greybox.models.registry.MODEL_CLASSES`; nothing named in the file is ever
+imported. A file of a newer format version, of an unknown kind, or with
+parameters the class does not take is refused with a
+:class:`~greybox.errors.ModelFileError` naming the file. Files are written
+atomically (a temporary file in the same directory, then :func:`os.replace`),
+with fixed ZIP timestamps, so the same model always gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+import re
+import tempfile
+import zipfile
+import zlib
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelFileError
+from . import registry
+
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "save_model", "load_model"]
+
+#: Value of the ``format`` field of every model file.
+FORMAT_NAME = "greybox-model"
+#: Newest format version this greybox writes and reads.
+FORMAT_VERSION = 1
+
+_JSON_MEMBER = "model.json"
+_ARRAY_DIR = "arrays/"
+_ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+_ARRAY_KINDS = "biufcU"  # bool, integers, floats, complex, unicode: never object
+_ATTRIBUTE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*_$")
+
+
+# ------------------------------------------------------------------- writing
+class _Encoder:
+    """Turn parameter and attribute values into JSON values plus ``.npy`` members."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.arrays: dict[str, bytes] = {}
+
+    def fail(self, where: str, problem: str):
+        raise ModelFileError(f"{self.path}: cannot save {where}: {problem}")
+
+    def estimator(self, model, where: str) -> dict:
+        try:
+            kind = registry.model_kind(model)
+        except KeyError as error:
+            self.fail(where, str(error.args[0]))
+        params = model.get_params(deep=False)
+        learned = {name: value for name, value in vars(model).items() if _ATTRIBUTE_NAME.match(name)}
+        return {
+            "kind": kind,
+            "params": {name: self.value(value, f"{where}.{name}") for name, value in params.items()},
+            "attributes": {name: self.value(value, f"{where}.{name}") for name, value in sorted(learned.items())},
+        }
+
+    def value(self, value, where: str):
+        if value is None or isinstance(value, (bool, str)):
+            return value
+        if isinstance(value, (int, np.integer)) and not isinstance(value, np.bool_):
+            return int(value)
+        if isinstance(value, np.bool_):
+            return bool(value)
+        if isinstance(value, (float, np.floating)):
+            value = float(value)
+            return value if math.isfinite(value) else {"__float__": repr(value)}
+        if isinstance(value, np.ndarray):
+            return self.array(value, where)
+        if isinstance(value, tuple):
+            return {"__tuple__": [self.value(v, f"{where}[{i}]") for i, v in enumerate(value)]}
+        if isinstance(value, list):
+            return [self.value(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        if isinstance(value, dict):
+            for key in value:
+                if not isinstance(key, str):
+                    self.fail(where, f"dictionary key {key!r} is not a string")
+                if key.startswith("__") and key.endswith("__"):
+                    self.fail(where, f"dictionary key {key!r} is reserved")
+            return {key: self.value(v, f"{where}[{key!r}]") for key, v in value.items()}
+        if hasattr(value, "get_params"):
+            return {"__estimator__": self.estimator(value, where)}
+        self.fail(where, f"values of type {type(value).__name__} are not supported")
+
+    def array(self, array: np.ndarray, where: str) -> dict:
+        if array.dtype.kind not in _ARRAY_KINDS or array.dtype.fields is not None:
+            self.fail(where, f"arrays of dtype {array.dtype} are not supported")
+        label = re.sub(r"[^A-Za-z0-9_.-]+", "_", where)[:80]
+        member = f"{_ARRAY_DIR}{len(self.arrays):03d}_{label}.npy"
+        buffer = io.BytesIO()
+        np.save(buffer, array, allow_pickle=False)
+        self.arrays[member] = buffer.getvalue()
+        return {"__ndarray__": member}
+
+
+def _write_member(archive: zipfile.ZipFile, name: str, data: bytes) -> None:
+    info = zipfile.ZipInfo(name, date_time=_ZIP_TIME)
+    info.compress_type = zipfile.ZIP_DEFLATED
+    info.external_attr = 0o644 << 16
+    archive.writestr(info, data)
+
+
+def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
+    """Save a (fitted or unfitted) model to one file, atomically.
+
+    Parameters
+    ----------
+    model : estimator
+        An instance of a class in :data:`greybox.models.registry.MODEL_CLASSES`.
+        Its ``get_params(deep=False)`` and every attribute whose name ends in
+        ``_`` (the learned attributes) are saved; they may be numbers, strings,
+        booleans, None, lists, tuples, dicts with string keys, NumPy arrays
+        (not of object dtype) and registered models.
+    path : str or path-like
+        File to write (``.gbm`` by convention).
+    overwrite : bool, default False
+        Replace an existing file; otherwise an existing file is an error.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    ModelFileError
+        If the file exists and ``overwrite`` is false, the model is not
+        registered, or a value cannot be saved without pickle.
+    """
+    from .. import __version__
+
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise ModelFileError(f"{path}: file exists; refusing to overwrite it")
+    if path.is_dir():
+        raise ModelFileError(f"{path}: is a directory")
+    encoder = _Encoder(path)
+    document = {
+        "format": FORMAT_NAME,
+        "format_version": FORMAT_VERSION,
+        "greybox_version": __version__,
+        "model": encoder.estimator(model, "model"),
+    }
+    text = json.dumps(document, indent=1, allow_nan=False)
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        raise ModelFileError(f"{path}: directory {directory} does not exist")
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            with zipfile.ZipFile(stream, "w") as archive:
+                _write_member(archive, _JSON_MEMBER, text.encode("utf-8"))
+                for member, data in encoder.arrays.items():
+                    _write_member(archive, member, data)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.chmod(temporary, 0o644)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
+    return path
+
+
+# ------------------------------------------------------------------- reading
+class _Decoder:
+    """Rebuild values (and nested models) from the JSON and the ``.npy`` members."""
+
+    def __init__(self, path: Path, archive: zipfile.ZipFile):
+        self.path = path
+        self.archive = archive
+
+    def fail(self, problem: str):
+        raise ModelFileError(f"{self.path}: {problem}")
+
+    def estimator(self, entry, where: str):
+        if not isinstance(entry, dict) or not {"kind", "params", "attributes"} <= set(entry):
+            self.fail(f"{where} lacks kind, params or attributes")
+        kind = entry["kind"]
+        try:
+            cls = registry.model_class(kind)
+        except KeyError:
+            known = ", ".join(sorted(registry.MODEL_CLASSES))
+            self.fail(f"unknown model kind {kind!r} in {where} (this greybox knows: {known})")
+        params = entry["params"]
+        attributes = entry["attributes"]
+        if not isinstance(params, dict) or not isinstance(attributes, dict):
+            self.fail(f"params and attributes of {where} must be objects")
+        accepted = set(cls().get_params(deep=False))
+        unknown = sorted(set(params) - accepted)
+        if unknown:
+            self.fail(f"{kind} model in {where} has parameters this greybox does not know: {', '.join(unknown)}")
+        model = cls(**{name: self.value(value, f"{where}.{name}") for name, value in params.items()})
+        for name, value in attributes.items():
+            if not isinstance(name, str) or not _ATTRIBUTE_NAME.match(name):
+                self.fail(f"{where} has an invalid learned-attribute name {name!r}")
+            setattr(model, name, self.value(value, f"{where}.{name}"))
+        return model
+
+    def value(self, value, where: str):
+        if isinstance(value, list):
+            return [self.value(v, where) for v in value]
+        if not isinstance(value, dict):
+            return value
+        if len(value) == 1:
+            (tag, content), = value.items()
+            if tag == "__ndarray__":
+                return self.array(content, where)
+            if tag == "__tuple__" and isinstance(content, list):
+                return tuple(self.value(v, where) for v in content)
+            if tag == "__float__" and content in ("nan", "inf", "-inf"):
+                return float(content)
+            if tag == "__estimator__":
+                return self.estimator(content, where)
+        if any(key.startswith("__") and key.endswith("__") for key in value):
+            self.fail(f"unknown tagged value in {where}: {sorted(value)}")
+        return {key: self.value(v, f"{where}[{key!r}]") for key, v in value.items()}
+
+    def array(self, member, where: str) -> np.ndarray:
+        if not isinstance(member, str) or not member.startswith(_ARRAY_DIR):
+            self.fail(f"bad array reference in {where}: {member!r}")
+        try:
+            data = self.archive.read(member)
+        except KeyError:
+            self.fail(f"array {member} of {where} is missing")
+        try:
+            return np.load(io.BytesIO(data), allow_pickle=False)
+        except ValueError as error:
+            self.fail(f"array {member} of {where} cannot be read: {error}")
+
+
+def load_model(path: str | PathLike):
+    """Load a model saved by :func:`save_model`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Model file.
+
+    Returns
+    -------
+    estimator
+        A new instance of the saved model's class with its parameters and
+        learned attributes restored; it predicts exactly what the saved one did.
+
+    Raises
+    ------
+    ModelFileError
+        If the file is missing, not a greybox model file, of a newer format
+        version, of a model kind this greybox does not know, or damaged.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ModelFileError(f"{path}: no such model file")
+    try:
+        with zipfile.ZipFile(path) as archive:
+            try:
+                document = json.loads(archive.read(_JSON_MEMBER).decode("utf-8"))
+            except KeyError:
+                raise ModelFileError(f"{path}: not a greybox model file ({_JSON_MEMBER} missing)") from None
+            except (UnicodeDecodeError, json.JSONDecodeError) as error:
+                raise ModelFileError(f"{path}: {_JSON_MEMBER} is not valid JSON: {error}") from None
+            if not isinstance(document, dict) or document.get("format") != FORMAT_NAME:
+                raise ModelFileError(f"{path}: not a greybox model file (format is not {FORMAT_NAME!r})")
+            version = document.get("format_version")
+            if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+                raise ModelFileError(f"{path}: invalid format version {version!r}")
+            if version > FORMAT_VERSION:
+                raise ModelFileError(
+                    f"{path}: model file format version {version} was written by a newer greybox "
+                    f"({document.get('greybox_version', 'unknown version')}); this greybox reads versions "
+                    f"up to {FORMAT_VERSION}: upgrade greybox"
+                )
+            return _Decoder(path, archive).estimator(document.get("model"), "model")
+    except zipfile.BadZipFile:
+        raise ModelFileError(f"{path}: not a greybox model file (not a ZIP archive)") from None
+    except (zipfile.LargeZipFile, zlib.error, OSError, EOFError) as error:
+        raise ModelFileError(f"{path}: cannot read model file: {error}") from None

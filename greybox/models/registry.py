@@ -1,0 +1,49 @@
+"""The explicit registry of model classes that model files may name.
+
+A model file stores its model's ``kind`` (a key of :data:`MODEL_CLASSES`);
+loading looks the class up here. Nothing named in a file is ever imported, so
+a file cannot make greybox run code other than these classes' constructors.
+"""
+
+from __future__ import annotations
+
+from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from .svr import SVRCurrentModel
+
+__all__ = ["MODEL_CLASSES", "model_class", "model_kind"]
+
+#: Model kind (as written in model files and given to ``greybox train --model``) -> class.
+MODEL_CLASSES: dict[str, type] = {
+    "coulomb": CoulombModel,
+    "stribeck": StribeckModel,
+    "lugre": LuGreModel,
+    "gms": GMSModel,
+    "svr": SVRCurrentModel,
+}
+
+
+def model_class(kind: str) -> type:
+    """Return the class registered under ``kind``.
+
+    Raises
+    ------
+    KeyError
+        If no class is registered under that name.
+    """
+    if not isinstance(kind, str) or kind not in MODEL_CLASSES:
+        raise KeyError(f"unknown model kind {kind!r}; known: {', '.join(sorted(MODEL_CLASSES))}")
+    return MODEL_CLASSES[kind]
+
+
+def model_kind(model) -> str:
+    """Return the registered kind of ``model`` (its exact class, not a subclass).
+
+    Raises
+    ------
+    KeyError
+        If the model's class is not registered.
+    """
+    for kind, cls in MODEL_CLASSES.items():
+        if type(model) is cls:
+            return kind
+    raise KeyError(f"model class {type(model).__name__} is not registered in greybox.models.registry")

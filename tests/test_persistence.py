@@ -1,0 +1,277 @@
+"""Model files: round trip without pickle, format versioning, clear errors."""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import zipfile
+
+import numpy as np
+import pytest
+from sklearn.base import BaseEstimator
+
+from greybox.errors import ModelFileError
+from greybox.models import persistence, registry
+from greybox.models.persistence import FORMAT_VERSION, load_model, save_model
+
+
+class ToyModel(BaseEstimator):
+    """A small estimator with every kind of learned attribute a model file must hold."""
+
+    def __init__(self, gain=1.5, bounds=(0.0, 2.0), label="toy", first_stage=None):
+        self.gain = gain
+        self.bounds = bounds
+        self.label = label
+        self.first_stage = first_stage
+
+    def fit(self, x, y):
+        x = np.asarray(x, dtype=float)
+        self.coef_ = np.linalg.lstsq(np.column_stack([x, np.sin(x), np.ones_like(x)]), y, rcond=None)[0]
+        self.offset_ = float(np.mean(y) / 3.0)
+        self.n_iter_ = np.int64(7)
+        self.converged_ = np.bool_(True)
+        self.history_ = [0.1, 1 / 3, 2e-300]
+        self.info_ = {"states": np.arange(12, dtype=np.float32).reshape(3, 4), "note": "ok", "bounds": (1, 2)}
+        self.names_ = np.array(["z1", "z2"])
+        self.missing_ = float("nan")
+        self.limit_ = float("-inf")
+        return self
+
+    def predict(self, x):
+        x = np.asarray(x, dtype=float)
+        base = 0.0 if self.first_stage is None else self.first_stage.predict(x)
+        return self.gain * (self.coef_[0] * x + self.coef_[1] * np.sin(x) + self.coef_[2]) + self.offset_ + base
+
+
+@pytest.fixture(autouse=True)
+def toy_registered(monkeypatch):
+    monkeypatch.setitem(registry.MODEL_CLASSES, "toy", ToyModel)
+
+
+@pytest.fixture
+def data():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(-3, 3, 200)
+    return x, 2.0 * x + np.sin(x) / 7 + rng.normal(0, 0.1, 200)
+
+
+def _rewrite_json(path, change):
+    """Rewrite model.json inside a saved file with ``change(document)`` applied."""
+    with zipfile.ZipFile(path) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    document = json.loads(members["model.json"])
+    change(document)
+    members["model.json"] = json.dumps(document).encode()
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, content in members.items():
+            archive.writestr(name, content)
+
+
+def test_round_trip_predicts_bit_identically(tmp_path, data):
+    x, y = data
+    model = ToyModel(gain=1.0 / 3.0).fit(x, y)
+    path = save_model(model, tmp_path / "toy.gbm")
+    loaded = load_model(path)
+    assert type(loaded) is ToyModel
+    assert np.array_equal(loaded.predict(x), model.predict(x))
+    assert loaded.predict(x).tobytes() == model.predict(x).tobytes()
+    assert loaded.get_params() == model.get_params()
+    assert isinstance(loaded.bounds, tuple)
+
+
+def test_learned_attributes_keep_values_and_types(tmp_path, data):
+    model = ToyModel().fit(*data)
+    loaded = load_model(save_model(model, tmp_path / "toy.gbm"))
+    assert loaded.coef_.dtype == np.float64 and np.array_equal(loaded.coef_, model.coef_)
+    assert loaded.info_["states"].dtype == np.float32
+    assert np.array_equal(loaded.info_["states"], model.info_["states"])
+    assert loaded.info_["bounds"] == (1, 2) and loaded.info_["note"] == "ok"
+    assert loaded.history_ == model.history_  # exact floats, including 1/3 and a subnormal-range value
+    assert loaded.n_iter_ == 7 and loaded.converged_ is True
+    assert list(loaded.names_) == ["z1", "z2"]
+    assert math.isnan(loaded.missing_) and loaded.limit_ == float("-inf")
+
+
+def test_nested_fitted_model_round_trips(tmp_path, data):
+    x, y = data
+    first = ToyModel(gain=0.5).fit(x, y)
+    model = ToyModel(first_stage=first).fit(x, y - first.predict(x))
+    loaded = load_model(save_model(model, tmp_path / "two_stage.gbm"))
+    assert isinstance(loaded.first_stage, ToyModel)
+    assert loaded.predict(x).tobytes() == model.predict(x).tobytes()
+
+
+def test_unfitted_model_round_trips(tmp_path):
+    loaded = load_model(save_model(ToyModel(gain=3.0), tmp_path / "plain.gbm"))
+    assert loaded.get_params() == ToyModel(gain=3.0).get_params()
+    assert not hasattr(loaded, "coef_")
+
+
+def test_file_is_a_zip_with_readable_json_and_npy(tmp_path, data):
+    path = save_model(ToyModel().fit(*data), tmp_path / "toy.gbm")
+    with zipfile.ZipFile(path) as archive:
+        document = json.loads(archive.read("model.json"))
+        assert document["format"] == "greybox-model"
+        assert document["format_version"] == FORMAT_VERSION
+        assert document["model"]["kind"] == "toy"
+        assert document["model"]["params"]["gain"] == 1.5
+        member = document["model"]["attributes"]["coef_"]["__ndarray__"]
+        assert np.load(io.BytesIO(archive.read(member)), allow_pickle=False).shape == (3,)
+
+
+def test_same_model_gives_same_bytes(tmp_path, data):
+    model = ToyModel().fit(*data)
+    first = save_model(model, tmp_path / "a.gbm").read_bytes()
+    second = save_model(model, tmp_path / "b.gbm").read_bytes()
+    assert first == second
+
+
+def test_existing_file_is_not_overwritten_unless_asked(tmp_path, data):
+    path = tmp_path / "toy.gbm"
+    path.write_bytes(b"user data")
+    with pytest.raises(ModelFileError, match="toy.gbm.*exists"):
+        save_model(ToyModel(), path)
+    assert path.read_bytes() == b"user data"
+    save_model(ToyModel().fit(*data), path, overwrite=True)
+    assert isinstance(load_model(path), ToyModel)
+    assert [p.name for p in tmp_path.iterdir()] == ["toy.gbm"]  # no temporary files left
+
+
+def test_failed_write_leaves_old_file_and_no_temporary(tmp_path, data, monkeypatch):
+    path = save_model(ToyModel(gain=2.0), tmp_path / "toy.gbm")
+    before = path.read_bytes()
+
+    def broken_replace(source, target):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(persistence.os, "replace", broken_replace)
+    with pytest.raises(OSError, match="disk full"):
+        save_model(ToyModel().fit(*data), path, overwrite=True)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["toy.gbm"]
+
+
+def test_newer_format_version_is_refused(tmp_path):
+    path = save_model(ToyModel(), tmp_path / "future.gbm")
+    _rewrite_json(path, lambda d: d.update(format_version=FORMAT_VERSION + 1))
+    with pytest.raises(ModelFileError, match=r"future\.gbm.*newer greybox"):
+        load_model(path)
+
+
+def test_unknown_kind_is_refused(tmp_path):
+    path = save_model(ToyModel(), tmp_path / "alien.gbm")
+    _rewrite_json(path, lambda d: d["model"].update(kind="os.system"))
+    with pytest.raises(ModelFileError, match=r"alien\.gbm.*unknown model kind 'os.system'"):
+        load_model(path)
+
+
+def test_unknown_parameter_is_refused(tmp_path):
+    path = save_model(ToyModel(), tmp_path / "odd.gbm")
+    _rewrite_json(path, lambda d: d["model"]["params"].update(colour="red"))
+    with pytest.raises(ModelFileError, match=r"odd\.gbm.*colour"):
+        load_model(path)
+
+
+def test_pickled_array_member_is_refused(tmp_path, data):
+    path = save_model(ToyModel().fit(*data), tmp_path / "pickled.gbm")
+    with zipfile.ZipFile(path) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    member = json.loads(members["model.json"])["model"]["attributes"]["coef_"]["__ndarray__"]
+    buffer = io.BytesIO()
+    np.save(buffer, np.array([object()], dtype=object), allow_pickle=True)
+    members[member] = buffer.getvalue()
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, content in members.items():
+            archive.writestr(name, content)
+    with pytest.raises(ModelFileError, match=r"pickled\.gbm.*cannot be read"):
+        load_model(path)
+
+
+@pytest.mark.parametrize(
+    "content, message",
+    [(b"not a zip", "not a ZIP"), (None, "model.json missing"), (b"{broken", "not valid JSON")],
+)
+def test_damaged_files_are_refused(tmp_path, content, message):
+    path = tmp_path / "bad.gbm"
+    if content is None:
+        with zipfile.ZipFile(path, "w") as archive:
+            archive.writestr("other.txt", "x")
+    elif content.startswith(b"{"):
+        with zipfile.ZipFile(path, "w") as archive:
+            archive.writestr("model.json", content)
+    else:
+        path.write_bytes(content)
+    with pytest.raises(ModelFileError, match=rf"bad\.gbm.*{message}"):
+        load_model(path)
+
+
+def test_missing_file_is_refused(tmp_path):
+    with pytest.raises(ModelFileError, match=r"nothing\.gbm.*no such model file"):
+        load_model(tmp_path / "nothing.gbm")
+
+
+def test_values_that_need_pickle_are_refused_at_save(tmp_path, data):
+    model = ToyModel().fit(*data)
+    model.cache_ = np.array([object()], dtype=object)
+    with pytest.raises(ModelFileError, match=r"cache_.*dtype object"):
+        save_model(model, tmp_path / "toy.gbm")
+    model.cache_ = {1: 2.0}
+    with pytest.raises(ModelFileError, match="not a string"):
+        save_model(model, tmp_path / "toy.gbm")
+    assert not any(tmp_path.iterdir())
+
+
+def test_unregistered_class_is_refused(tmp_path):
+    class Unregistered(ToyModel):
+        pass
+
+    with pytest.raises(ModelFileError, match="Unregistered is not registered"):
+        save_model(Unregistered(), tmp_path / "x.gbm")
+
+
+# ------------------------------------------------------------ real models
+def _axis_run(seed: int, n: int = 1500, dt: float = 0.002):
+    """A prepared run: two-tone reversing motion, effort from inertia + Coulomb/viscous + noise [A]."""
+    from greybox.data.log import AxisLog
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * dt
+    w1, w2 = 2 * np.pi * 0.7, 2 * np.pi * 2.3
+    position = 20 * np.sin(w1 * t) + 2 * np.sin(w2 * t + seed)
+    velocity = 20 * w1 * np.cos(w1 * t) + 2 * w2 * np.cos(w2 * t + seed)
+    acceleration = -20 * w1**2 * np.sin(w1 * t) - 2 * w2**2 * np.sin(w2 * t + seed)
+    effort = 2e-3 * acceleration + 1.5 * np.tanh(velocity / 2.0) + 0.01 * velocity + rng.normal(0, 0.05, n)
+    return AxisLog(time=t, position=position, effort=effort, velocity=velocity, acceleration=acceleration,
+                   source=f"run{seed}.csv")
+
+
+def _real_models():
+    from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+
+    return [
+        CoulombModel(fit_offset=True),
+        CoulombModel(asymmetric=True),
+        StribeckModel(),
+        LuGreModel(n_starts=1, max_iter=40),
+        GMSModel(n_elements=3, n_starts=1, max_iter=40),
+    ]
+
+
+@pytest.mark.parametrize("model", _real_models(), ids=lambda m: type(m).__name__)
+def test_real_models_round_trip_bit_identically(tmp_path, model):
+    train, test = [_axis_run(0), _axis_run(1)], _axis_run(2)
+    model.fit(train)
+    loaded = load_model(save_model(model, tmp_path / "model.gbm"))
+    assert type(loaded) is type(model)
+    assert loaded.get_params() == model.get_params()
+    assert loaded.predict(test).tobytes() == model.predict(test).tobytes()
+    assert loaded.predict(train).tobytes() == model.predict(train).tobytes()
+
+
+def test_registry_names_every_friction_model():
+    from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+
+    for kind, cls in {"coulomb": CoulombModel, "stribeck": StribeckModel, "lugre": LuGreModel, "gms": GMSModel}.items():
+        assert registry.model_class(kind) is cls
+        assert registry.model_kind(cls()) == kind
