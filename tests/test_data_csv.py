@@ -112,3 +112,12 @@ def test_umich_cnc_mill_file_with_column_mapping():
     assert "Machining_Process" not in log.extras and "tool_condition" not in log.extras
     assert "Unnamed: 0" not in log.extras
     assert "Y1_CurrentFeedback" in log.extras and len(log.extras) == 44  # 47 numeric columns minus 3 mapped
+
+
+def test_single_word_suffix_is_taken_as_a_unit_unless_the_quantity_is_mapped(tmp_path):
+    path = tmp_path / "setpoint.csv"
+    path.write_text("time_s,position_setpoint,POS,current_A\n0,1,1,2\n0.1,2,2,3\n")
+    with pytest.raises(LogError, match="unknown unit 'setpoint' in column 'position_setpoint'"):
+        read_log(path)
+    log = read_log(path, columns={"position_mm": "POS"})
+    assert list(log.extras) == ["position_setpoint"]

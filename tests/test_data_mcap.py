@@ -250,7 +250,7 @@ def test_repeated_time_stamp(tmp_path):
 
 def test_writer_refuses_what_mcap_cannot_hold(tmp_path, make_log):
     log = make_log(n=20)
-    with pytest.raises(LogError, match="non-negative"):
+    with pytest.raises(LogError, match="time reaches -1.0 s; MCAP time stamps must be non-negative"):
         write_log(log.replace(time=log.time - 1.0), tmp_path / "negative.mcap")
     with pytest.raises(LogError, match="finite numbers"):
         write_log(log.replace(extras={"bad_A": np.full(20, np.nan)}), tmp_path / "nan.mcap")

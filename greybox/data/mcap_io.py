@@ -25,7 +25,7 @@ from __future__ import annotations
 import json
 import struct
 import zlib
-from typing import Iterable, Mapping, Sequence
+from typing import Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 from numba import njit
@@ -58,7 +58,7 @@ AXIS_SAMPLE_SCHEMA = {
 }
 
 _MAGIC = b"\x89MCAP0\r\n"
-_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x03, 0x04, 0x05, 0x06, 0x0F
+_OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x04, 0x05, 0x06, 0x0F
 _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time u64
 _BATCH_BYTES = 64 << 20  # JSON text parsed per call of the bulk parser
 _BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
@@ -80,15 +80,21 @@ def _sample_fields(log: AxisLog) -> list[tuple[str, np.ndarray]]:
     return fields
 
 
-def _encode_messages(log: AxisLog, path) -> list[bytes]:
-    fields = _sample_fields(log)
-    for name, values in fields:
+def _check_encodable(log: AxisLog, path) -> None:
+    for name, values in [("time_s", log.time)] + _sample_fields(log):
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise LogError(path, f"channel '{name}' holds {values[bad[0]]} at sample {bad[0]}; JSON messages carry finite numbers only")
+    if len(log) and log.time.min() < 0:
+        raise LogError(path, f"time reaches {log.time.min()} s; MCAP time stamps must be non-negative")
+
+
+def _encode_messages(log: AxisLog) -> Iterator[bytes]:
+    """One JSON object per sample; floats as their shortest exact text (``repr``)."""
+    fields = _sample_fields(log)
     template = "{" + ",".join(json.dumps(name).replace("%", "%%") + ":%r" for name, _ in fields) + "}"
     columns = [values.tolist() for _, values in fields]
-    return [(template % row).encode() for row in zip(*columns)]
+    return ((template % row).encode() for row in zip(*columns))
 
 
 def write_mcap(logs: AxisLog | Sequence[AxisLog], path) -> None:
@@ -114,19 +120,15 @@ def write_mcap(logs: AxisLog | Sequence[AxisLog], path) -> None:
     topics = [topic_for(log.axis) for log in runs]
     if len(set(topics)) != len(topics):
         raise LogError(path, f"several logs share a topic ({', '.join(topics)}); give each log its own axis name")
-    encoded = []
     for log in runs:
-        if len(log) and log.time[0] < 0:
-            raise LogError(path, f"time starts at {log.time[0]} s; MCAP time stamps must be non-negative")
-        stamps = np.rint(log.time * 1e9).astype(np.uint64).tolist()
-        encoded.append((stamps, _encode_messages(log, path)))
+        _check_encodable(log, path)
     with open(path, "wb") as stream:
         writer = Writer(stream, compression=CompressionType.ZSTD)
         writer.start(profile="", library="greybox")
         schema_id = writer.register_schema(
             name=SCHEMA_NAME, encoding="jsonschema", data=json.dumps(AXIS_SAMPLE_SCHEMA, indent=2).encode()
         )
-        for log, topic, (stamps, messages) in zip(runs, topics, encoded):
+        for log, topic in zip(runs, topics):
             metadata = {
                 "axis": log.axis,
                 "dataset": log.dataset,
@@ -134,7 +136,8 @@ def write_mcap(logs: AxisLog | Sequence[AxisLog], path) -> None:
                 "attrs": json.dumps(log.attrs),
             }
             channel_id = writer.register_channel(topic, "json", schema_id, metadata)
-            for stamp, message in zip(stamps, messages):
+            stamps = np.rint(log.time * 1e9).astype(np.uint64).tolist()
+            for stamp, message in zip(stamps, _encode_messages(log)):
                 writer.add_message(channel_id, stamp, message, stamp)
         writer.finish()
 

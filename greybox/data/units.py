@@ -93,7 +93,11 @@ def _unit_factor(quantity: str, unit: str | None, column: str, source) -> float:
         )
     if unit not in units:
         known = ", ".join(f"{quantity}_{u}" for u in units)
-        raise LogError(source, f"unknown unit '{unit}' in column '{column}'; known: {known}")
+        raise LogError(
+            source,
+            f"unknown unit '{unit}' in column '{column}'; known: {known} (if '{column}' is not the {quantity}, "
+            f"name the {quantity} column with columns={{'{CANONICAL_NAMES[quantity]}': ...}})",
+        )
     return units[unit]
 
 
