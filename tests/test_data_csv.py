@@ -121,3 +121,11 @@ def test_single_word_suffix_is_taken_as_a_unit_unless_the_quantity_is_mapped(tmp
         read_log(path)
     log = read_log(path, columns={"position_mm": "POS"})
     assert list(log.extras) == ["position_setpoint"]
+
+
+def test_byte_order_mark_and_comment_lines(tmp_path):
+    path = tmp_path / "excel.csv"
+    path.write_bytes("\ufeff# exported 2024-05-02\ntime_s;position_mm;current_A\n0;1,5;2\n0,002;1,5;2\n".encode("utf-8"))
+    log = read_log(path)
+    np.testing.assert_allclose(log.time, [0.0, 0.002])
+    np.testing.assert_allclose(log.position, [1.5, 1.5])

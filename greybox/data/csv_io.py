@@ -7,7 +7,8 @@ Written by :func:`write_csv`::
     0.0,12.5,0.0,0.31,0.02
     ...
 
-Read by :func:`read_csv`: leading lines starting with ``#`` are comments; a
+Read by :func:`read_csv` (UTF-8, with or without byte-order mark): leading
+lines starting with ``#`` are comments; a
 ``# greybox {...}`` comment restores the metadata. The delimiter is detected
 from the header line (comma, semicolon or tab); with a semicolon delimiter a
 decimal comma is accepted. Column names follow :mod:`greybox.data.units`.
@@ -34,7 +35,7 @@ def _preamble(path) -> tuple[int, dict, str]:
     """Count leading comment lines, parse greybox metadata, return the header line."""
     comments, metadata = 0, {}
     try:
-        with open(path, encoding="utf-8", newline="") as stream:
+        with open(path, encoding="utf-8-sig", newline="") as stream:
             for line in stream:
                 if not line.startswith("#"):
                     return comments, metadata, line
@@ -78,13 +79,13 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
     delimiter = max((",", ";", "\t"), key=header.count)
     decimal = "."
     if delimiter == ";":
-        with open(path, encoding="utf-8") as stream:
-            lines = stream.readlines()[comments + 1:comments + 2]
+        with open(path, encoding="utf-8-sig") as stream:
+            lines = [line for _, line in zip(range(comments + 2), stream)][comments + 1:]
         if lines and "," in lines[0]:
             decimal = ","
     try:
         frame = pd.read_csv(
-            path, skiprows=comments, sep=delimiter, decimal=decimal, engine="c", low_memory=False, encoding="utf-8"
+            path, skiprows=comments, sep=delimiter, decimal=decimal, engine="c", low_memory=False, encoding="utf-8-sig"
         )
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, csv.Error) as exc:
         raise LogError(path, f"malformed CSV ({str(exc).strip().splitlines()[0]})") from None

@@ -451,7 +451,6 @@ def read_mcap(
     *,
     topic: str | None = None,
     columns: Mapping[str, str] | None = None,
-    sample_time: float | None = None,
 ) -> AxisLog:
     """Read one axis channel of an MCAP file with JSON messages.
 
@@ -465,8 +464,6 @@ def read_mcap(
     columns : mapping of str to str, optional
         ``{canonical_name: message_field}`` for fields not named by the
         greybox convention, e.g. ``{"position_mm": "pos", "current_A": "iq"}``.
-    sample_time : float, optional
-        Not applicable (time comes from ``log_time``); giving it is an error.
 
     Returns
     -------
@@ -502,7 +499,6 @@ def read_mcap(
         source=path,
         columns=columns,
         time=stamps * 1e-9,
-        sample_time=sample_time,
         effort_unit=metadata.get("effort_unit"),
         axis=metadata.get("axis", channel.topic.rstrip("/").rsplit("/", 1)[-1]),
         dataset=metadata.get("dataset", ""),
