@@ -1,0 +1,168 @@
+"""``greybox train``: fit a current model to logs and save it to a model file."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import GreyboxError, ModelFileError
+from ..evaluate.metrics import metrics_table
+from ..models.persistence import load_model, save_model
+from ..models.registry import MODEL_CLASSES
+from ._options import add_log_arguments, read_logs
+
+#: Learned attributes that describe the fit rather than the model.
+_FIT_INFO = ("effort_unit_", "sample_time_", "n_samples_fit_", "cost_", "n_evaluations_")
+
+#: Units of the learned parameters, ``{E}`` standing for the effort unit (A or N).
+_UNITS = {
+    "J_": "{E} s^2/mm",
+    "offset_": "{E}",
+    "coulomb_": "{E}",
+    "coulomb_pos_": "{E}",
+    "coulomb_neg_": "{E}",
+    "static_": "{E}",
+    "viscous_": "{E} s/mm",
+    "viscous_pos_": "{E} s/mm",
+    "viscous_neg_": "{E} s/mm",
+    "v_s_": "mm/s",
+    "sigma0_": "{E}/mm",
+    "sigma1_": "{E} s/mm",
+    "alpha_": "-",
+    "k_": "{E}/mm",
+    "C_": "mm/s",
+    "sigma_": "{E} s/mm",
+    "mu_": "{E} s/mm",
+    "s0_": "mm",
+    "s_inf_": "mm",
+}
+
+#: Command-line options that set a model hyperparameter: option -> (parameter, value from args).
+_MODEL_OPTIONS = {
+    "--offset": ("fit_offset", lambda args: True if args.offset else None),
+    "--asymmetric": ("asymmetric", lambda args: True if args.asymmetric else None),
+    "--elements": ("n_elements", lambda args: args.elements),
+    "--seed": ("random_state", lambda args: args.seed),
+}
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "train",
+        help="fit a current model to logs and save it",
+        description="Read and prepare every training log as a separate run, fit the model to all runs, "
+        "print the training error and the identified parameters, and save the model file.",
+    )
+    parser.add_argument("--model", required=True, choices=sorted(MODEL_CLASSES), help="model kind")
+    parser.add_argument(
+        "--train", required=True, nargs="+", metavar="LOG", help="training logs (CSV, Parquet, MCAP or EMPS .mat)"
+    )
+    parser.add_argument("--out", required=True, metavar="MODEL", help="model file to write (.gbm)")
+    parser.add_argument("--force", action="store_true", help="overwrite MODEL if it exists")
+    model = parser.add_argument_group("model options")
+    model.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
+    model.add_argument(
+        "--asymmetric", action="store_true", help="separate Coulomb and viscous levels per direction (coulomb)"
+    )
+    model.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms, default 4)")
+    model.add_argument("--seed", type=int, metavar="N", help="seed of the multi-start identification (lugre, gms)")
+    parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
+    add_log_arguments(parser)
+    parser.set_defaults(run=run)
+
+
+def build_model(kind: str, args: argparse.Namespace):
+    """Return an unfitted model of ``kind`` with the hyperparameters given on the command line.
+
+    Raises
+    ------
+    GreyboxError
+        If an option does not apply to the model kind.
+    """
+    model = MODEL_CLASSES[kind]()
+    accepted = model.get_params(deep=False)
+    params = {}
+    for option, (name, value_of) in _MODEL_OPTIONS.items():
+        value = value_of(args)
+        if value is None:
+            continue
+        if name not in accepted:
+            raise GreyboxError(f"option {option} does not apply to the {kind} model")
+        params[name] = value
+    return model.set_params(**params)
+
+
+def _check_output(out: Path, inputs, force: bool) -> None:
+    """Refuse before any fitting when the model file cannot or must not be written."""
+    for source in inputs:
+        if out.exists() and os.path.exists(source) and os.path.samefile(out, source):
+            raise ModelFileError(f"{out}: is one of the training logs; refusing to overwrite it")
+    if out.exists() and not force:
+        raise ModelFileError(f"{out}: file exists; use --force to overwrite it")
+    if out.is_dir():
+        raise ModelFileError(f"{out}: is a directory")
+    if not out.parent.is_dir():
+        raise ModelFileError(f"{out}: directory {out.parent} does not exist")
+
+
+#: Arrays and lists longer than this are summarised by their shape, not printed.
+_MAX_PRINTED = 12
+
+
+def _format_value(value) -> str:
+    if isinstance(value, np.ndarray):
+        if value.size > _MAX_PRINTED:
+            return f"<array of shape {value.shape}>"
+        return "[" + ", ".join(f"{v:.6g}" for v in value.ravel()) + "]"
+    if isinstance(value, (list, tuple, dict)) and len(value) > _MAX_PRINTED:
+        return f"<{type(value).__name__} of {len(value)} items>"
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def describe_parameters(model) -> list[str]:
+    """Lines ``name = value unit`` of the identified parameters of a fitted model."""
+    unit = getattr(model, "effort_unit_", "A")
+    lines = []
+    for name, value in vars(model).items():
+        if not name.endswith("_") or name.startswith("_") or name in _FIT_INFO:
+            continue
+        suffix = _UNITS.get(name, "").format(E=unit)
+        lines.append(f"  {name[:-1]:<14} = {_format_value(value)} {suffix}".rstrip())
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    _check_output(out, args.train, args.force)
+    model = build_model(args.model, args)
+    runs = read_logs(args, args.train)
+    started = time.perf_counter()
+    model.fit(runs, progress=None if args.quiet else True)
+    elapsed = time.perf_counter() - started
+    unit = runs[0].effort_unit
+    print(f"trained {args.model} on {len(runs)} run(s), {sum(len(r) for r in runs)} samples, "
+          f"effort in {unit}, in {elapsed:.1f} s")
+    print(f"  {'run':<32} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7}")
+    predictions = [model.predict(run) for run in runs]
+    for path, run, prediction in zip(args.train, runs, predictions):
+        table = metrics_table(run.effort, prediction)
+        print(f"  {Path(path).name[-32:]:<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
+    if len(runs) > 1:
+        table = metrics_table(np.concatenate([r.effort for r in runs]), np.concatenate(predictions))
+        print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
+    print("  (RE = RMSE / mean |effort|)")
+    print("parameters:")
+    for line in describe_parameters(model):
+        print(line)
+    save_model(model, out, overwrite=args.force)
+    reloaded = load_model(out)
+    if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):
+        raise ModelFileError(f"{out}: the saved model does not reproduce the fitted model's predictions")
+    print(f"wrote {out}")
+    return 0

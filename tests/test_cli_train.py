@@ -1,0 +1,145 @@
+"""``greybox train`` on CSV, MCAP and EMPS logs: fit, report, save; refusals with clear messages."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import greybox.cli as cli
+from greybox.data.io import write_log
+from greybox.data.log import AxisLog
+from greybox.models.persistence import load_model
+
+EMPS = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "EMPS" / "DATA_EMPS.mat"
+
+# Coulomb + viscous + offset truth: J [A s^2/mm], Fc [A], Fv [A s/mm], offset [A]
+TRUTH = {"J_": 2e-3, "coulomb_pos_": 1.2, "viscous_pos_": 0.015, "offset_": -0.3}
+
+
+@pytest.fixture(autouse=True)
+def train_registered(monkeypatch):
+    if "train" not in cli.COMMANDS:
+        monkeypatch.setattr(cli, "COMMANDS", tuple(cli.COMMANDS) + ("train",))
+
+
+def _run(seed: int, n: int = 1500, dt: float = 0.002, with_motion: bool = True) -> AxisLog:
+    """A run whose current is exactly inertia + Coulomb + viscous + offset of its logged motion."""
+    t = np.arange(n) * dt
+    w1, w2 = 2 * np.pi * 0.6, 2 * np.pi * 1.9
+    position = 30 * np.sin(w1 * t) + 3 * np.sin(w2 * t + seed)
+    velocity = 30 * w1 * np.cos(w1 * t) + 3 * w2 * np.cos(w2 * t + seed)
+    acceleration = -30 * w1**2 * np.sin(w1 * t) - 3 * w2**2 * np.sin(w2 * t + seed)
+    current = (TRUTH["J_"] * acceleration + TRUTH["coulomb_pos_"] * np.sign(velocity)
+               + TRUTH["viscous_pos_"] * velocity + TRUTH["offset_"])
+    return AxisLog(time=t, position=position, effort=current, axis="X",
+                   velocity=velocity if with_motion else None,
+                   acceleration=acceleration if with_motion else None)
+
+
+def _train(capsys, *args):
+    status = cli.main(["train", *map(str, args)])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_csv_coulomb_recovers_the_truth_and_saves(tmp_path, capsys):
+    log_path = tmp_path / "run.csv"
+    write_log(_run(0), log_path)
+    out = tmp_path / "coulomb.gbm"
+    status, stdout, _ = _train(capsys, "--model", "coulomb", "--offset", "--train", log_path, "--out", out, "--quiet")
+    assert status == 0
+    model = load_model(out)
+    for name, value in TRUTH.items():
+        assert getattr(model, name) == pytest.approx(value, rel=1e-6)
+    assert "RE %" in stdout and "RE = RMSE / mean |effort|" in stdout
+    assert "J              = 0.002 A s^2/mm" in stdout
+    assert f"wrote {out}" in stdout
+
+
+def test_mcap_runs_train_a_gms_model_with_progress(tmp_path, capsys):
+    paths = []
+    for seed in (1, 2):
+        paths.append(tmp_path / f"run{seed}.mcap")
+        write_log(_run(seed, n=800), paths[-1])
+    out = tmp_path / "gms.gbm"
+    status, stdout, stderr = _train(capsys, "--model", "gms", "--elements", "2", "--train", *paths, "--out", out)
+    assert status == 0, stderr
+    assert "GMS" in stderr  # progress display
+    assert "all runs" in stdout and "run1.mcap" in stdout and "run2.mcap" in stdout
+    model = load_model(out)
+    assert model.n_elements == 2 and model.k_.shape == (2,)
+
+
+def test_same_seed_gives_identical_model_files(tmp_path, capsys):
+    log_path = tmp_path / "run.mcap"
+    write_log(_run(3, n=600), log_path)
+    files = []
+    for name in ("a.gbm", "b.gbm"):
+        files.append(tmp_path / name)
+        status, _, stderr = _train(capsys, "--model", "lugre", "--seed", "7", "--train", log_path, "--out", files[-1],
+                                   "--quiet")
+        assert status == 0 and stderr == ""
+    assert files[0].read_bytes() == files[1].read_bytes()
+
+
+def test_emps_file_gives_the_benchmark_mass(tmp_path, capsys):
+    out = tmp_path / "emps.gbm"
+    status, stdout, _ = _train(capsys, "--model", "coulomb", "--offset", "--cutoff-hz", "100",
+                               "--train", EMPS, "--out", out, "--quiet")
+    assert status == 0
+    model = load_model(out)
+    assert model.effort_unit_ == "N"
+    assert 1e3 * model.J_ == pytest.approx(95.1089, rel=0.02)  # published IDIM-LS mass [kg]
+    assert "N s^2/mm" in stdout
+
+
+def test_existing_model_is_kept_unless_forced(tmp_path, capsys):
+    log_path = tmp_path / "run.csv"
+    write_log(_run(0), log_path)
+    out = tmp_path / "model.gbm"
+    out.write_text("precious")
+    status, _, stderr = _train(capsys, "--model", "coulomb", "--train", log_path, "--out", out)
+    assert status == 2
+    assert str(out) in stderr and "--force" in stderr and "Traceback" not in stderr
+    assert out.read_text() == "precious"
+    status, _, _ = _train(capsys, "--model", "coulomb", "--train", log_path, "--out", out, "--force", "--quiet")
+    assert status == 0 and load_model(out).J_ > 0
+
+
+def test_training_log_is_never_overwritten(tmp_path, capsys):
+    log_path = tmp_path / "run.csv"
+    write_log(_run(0), log_path)
+    before = log_path.read_bytes()
+    status, _, stderr = _train(capsys, "--model", "coulomb", "--train", log_path, "--out", log_path, "--force")
+    assert status == 2 and "training logs" in stderr
+    assert log_path.read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (["--model", "gms", "--asymmetric"], "--asymmetric does not apply to the gms model"),
+        (["--model", "coulomb", "--elements", "3"], "--elements does not apply to the coulomb model"),
+    ],
+)
+def test_options_foreign_to_the_model_are_refused(tmp_path, capsys, arguments, message):
+    log_path = tmp_path / "run.csv"
+    write_log(_run(0), log_path)
+    status, _, stderr = _train(capsys, *arguments, "--train", log_path, "--out", tmp_path / "m.gbm")
+    assert status == 2 and message in stderr
+    assert not (tmp_path / "m.gbm").exists()
+
+
+def test_bad_logs_are_named(tmp_path, capsys):
+    missing = tmp_path / "missing.csv"
+    status, _, stderr = _train(capsys, "--model", "coulomb", "--train", missing, "--out", tmp_path / "m.gbm")
+    assert status == 2 and "missing.csv" in stderr and "Traceback" not in stderr
+    standing = _run(0, with_motion=False)
+    standing = standing.replace(position=np.full(len(standing), 5.0))
+    write_log(standing, tmp_path / "standing.csv")
+    status, _, stderr = _train(capsys, "--model", "coulomb", "--train", tmp_path / "standing.csv",
+                               "--out", tmp_path / "m.gbm")
+    assert status == 2 and "standing.csv" in stderr
+    assert not (tmp_path / "m.gbm").exists()
