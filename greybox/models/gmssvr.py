@@ -1,0 +1,258 @@
+"""The grey-box current model: GMS friction plus an SVR correction (Rüppel et al. 2024, eq. 8).
+
+Two stages:
+
+1. a :class:`~greybox.friction.GMSModel` (inertia + Generalized Maxwell-Slip
+   friction) is identified, and its parameters are then frozen;
+2. an RBF support vector regression learns the motor current from the
+   position ``p`` [mm], the frozen GMS model's current ``I_GMS`` [A] and its
+   element deflections ``z_1..z_N`` [mm], all standardised:
+
+       I = SVR(p, I_GMS, z_1, ..., z_N).
+
+As in the paper, the SVR's output is the current itself, not a residual: the
+GMS prediction is one of its inputs, which the kernel may correct in any
+direction, and the position input lets it learn the dependence of the
+friction on the position along the screw that the GMS model lacks. The
+hyperparameters, the training subset and the kernel evaluation are those of
+:mod:`greybox.models.svr`.
+
+The stages may be fitted on the same runs (:meth:`GMSSVRModel.fit`) or on
+different ones (:meth:`GMSSVRModel.fit_gms`, then
+:meth:`GMSSVRModel.fit_svr`), and :meth:`GMSSVRModel.fit_svr` also accepts a
+GMS model identified elsewhere (e.g. loaded from a model file).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Iterable
+
+import numpy as np
+from sklearn.base import clone
+from sklearn.utils.validation import check_is_fitted
+
+from ..data.log import AxisLog
+from ..errors import LogError, ParameterError
+from ..friction.gms import GMSModel
+from ..identify.progress import make_progress
+from .base import CurrentModel, check_runs
+from .svr import _expansion_of, _store_expansion, fit_svr_expansion, hyperparameters_table
+
+__all__ = ["GMSSVRModel"]
+
+
+class GMSSVRModel(CurrentModel):
+    """Grey-box current model ``I = SVR(p, I_GMS, z_1..z_N)`` with a frozen GMS stage.
+
+    Parameters
+    ----------
+    gms : GMSModel, optional
+        Settings of the first stage (an unfitted :class:`GMSModel`, cloned
+        before fitting); ``GMSModel()`` by default. To use a GMS model that
+        is already fitted, pass it to :meth:`fit_svr` instead.
+    C : float, optional
+        SVR regularisation [A]; optimised (or defaulted) when None.
+    epsilon : float, optional
+        Width of the SVR's insensitive tube [A]; optimised when None.
+    gamma : float, optional
+        RBF kernel parameter [1/(standardised unit)^2]; optimised when None.
+    n_subset : int, default 2000
+        SVR training samples, chosen to cover the (p, v) plane evenly.
+    optimize : bool, default True
+        Choose the hyperparameters left None by Bayesian optimisation over a
+        time-blocked cross-validation (see :func:`greybox.models.svr.fit_svr_expansion`).
+    n_calls : int, default 25
+        Evaluations of the Bayesian optimisation.
+    cv_folds : int, default 3
+        Cross-validation folds.
+    cv_blocks : int, default 12
+        Contiguous time blocks dealt to the folds (never spanning runs).
+    bounds : dict, optional
+        Search intervals ``{name: (low, high)}`` replacing
+        :func:`greybox.models.svr.default_bounds`.
+    random_state : int, default 0
+        Seed of subset choice and optimisation.
+
+    Attributes
+    ----------
+    gms_ : GMSModel
+        The frozen first stage.
+    J_, offset_ : float
+        Inertia [A s^2/mm] and offset [A] of the GMS stage; the friction
+        reported by :meth:`friction` is the prediction minus ``J_ a + offset_``.
+    input_mean_, input_scale_ : ndarray, shape (2 + N,)
+        Standardisation of (position [mm], I_GMS [A], z_1..z_N [mm]).
+    support_vectors_ : ndarray, shape (n_support, 2 + N)
+        Standardised support vectors.
+    dual_coef_ : ndarray, shape (n_support,)
+        Dual coefficients [A].
+    intercept_ : float
+        [A].
+    C_, epsilon_, gamma_ : float
+        Hyperparameters used.
+    optimised_ : list of str
+        Hyperparameters chosen by the optimisation.
+    cv_rmse_ : float
+        Cross-validated RMSE at the chosen hyperparameters [A] (NaN if none were optimised).
+    search_history_ : list of dict
+        Every evaluation of the optimisation.
+    n_train_ : int
+        Size of the SVR training subset.
+    """
+
+    def __init__(self, gms=None, C=None, epsilon=None, gamma=None, n_subset=2000, optimize=True, n_calls=25,
+                 cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
+        self.gms = gms
+        self.C = C
+        self.epsilon = epsilon
+        self.gamma = gamma
+        self.n_subset = n_subset
+        self.optimize = optimize
+        self.n_calls = n_calls
+        self.cv_folds = cv_folds
+        self.cv_blocks = cv_blocks
+        self.bounds = bounds
+        self.random_state = random_state
+
+    def __sklearn_is_fitted__(self) -> bool:
+        """Fitted once the SVR stage is (the GMS stage alone is not a usable model)."""
+        return hasattr(self, "dual_coef_")
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        """Names of the SVR inputs, in the order of the columns of the support vectors."""
+        check_is_fitted(self, "gms_")
+        return ("position_mm", "gms_current_A") + tuple(f"z{i + 1}_mm" for i in range(len(self.gms_.alpha_)))
+
+    # ---------------------------------------------------------------- fitting
+    def fit(self, logs: AxisLog | Iterable[AxisLog], progress=None) -> "GMSSVRModel":
+        """Fit both stages on the same prepared runs: :meth:`fit_gms`, then :meth:`fit_svr`.
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs (velocity [mm/s] and acceleration [mm/s^2] present).
+        progress : None, bool or callable, optional
+            See :meth:`greybox.models.base.CurrentModel.fit`.
+
+        Returns
+        -------
+        self
+        """
+        self.fit_gms(logs, progress=progress)
+        return self.fit_svr(logs, progress=progress)
+
+    def fit_gms(self, logs: AxisLog | Iterable[AxisLog], progress=None) -> "GMSSVRModel":
+        """Identify the GMS stage (a clone of ``gms``) and forget any fitted SVR stage.
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs.
+        progress : None, bool or callable, optional
+            See :meth:`greybox.models.base.CurrentModel.fit`.
+
+        Returns
+        -------
+        self
+        """
+        template = GMSModel() if self.gms is None else self.gms
+        if not isinstance(template, GMSModel):
+            raise ParameterError(f"gms must be a GMSModel or None, got {type(template).__name__}")
+        for name in [n for n in vars(self) if n.endswith("_") and not n.startswith("_")]:
+            delattr(self, name)
+        self.gms_ = clone(template).fit(logs, progress=progress)
+        return self
+
+    def fit_svr(self, logs: AxisLog | Iterable[AxisLog], progress=None, gms: GMSModel | None = None
+                ) -> "GMSSVRModel":
+        """Fit the SVR stage with the GMS stage frozen.
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs; may differ from the runs the GMS stage was fitted on.
+        progress : None, bool or callable, optional
+            See :meth:`greybox.models.base.CurrentModel.fit`.
+        gms : GMSModel, optional
+            A fitted GMS model to freeze (a copy is kept as ``gms_``); by
+            default the one from :meth:`fit_gms`.
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ParameterError
+            If there is no fitted GMS stage.
+        LogError
+            If the runs' effort unit differs from the GMS stage's.
+        """
+        if gms is not None:
+            if not isinstance(gms, GMSModel):
+                raise ParameterError(f"gms must be a fitted GMSModel, got {type(gms).__name__}")
+            check_is_fitted(gms)
+            self.gms_ = copy.deepcopy(gms)
+        elif not hasattr(self, "gms_"):
+            raise ParameterError("no GMS stage: call fit_gms first, or pass a fitted GMSModel as gms=")
+        runs = check_runs(logs)
+        for run in runs:
+            if run.effort_unit != self.gms_.effort_unit_:
+                raise LogError(run.source or None, f"log carries effort in {run.effort_unit}, "
+                                                   f"the GMS stage was fitted on {self.gms_.effort_unit_}")
+        self.effort_unit_ = runs[0].effort_unit
+        self.sample_time_ = float(np.median([run.sample_time for run in runs]))
+        self.n_samples_fit_ = int(sum(len(run) for run in runs))
+        self.J_ = float(self.gms_.J_)
+        self.offset_ = float(self.gms_.offset_)
+
+        X = np.concatenate([self._inputs(run) for run in runs])
+        coverage = np.concatenate([np.column_stack((run.position, run.velocity)) for run in runs])
+        target = np.concatenate([run.effort for run in runs])
+        fit = fit_svr_expansion(
+            X, target, coverage, [len(run) for run in runs],
+            fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
+            n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
+            cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=self.bounds,
+            random_state=self.random_state, progress=make_progress(progress),
+            stage="GMS-SVR hyperparameters")
+        _store_expansion(self, fit)
+        return self
+
+    # ---------------------------------------------------------------- prediction
+    def _inputs(self, run: AxisLog) -> np.ndarray:
+        """SVR inputs of one run: position [mm], GMS current [A], deflections [mm]."""
+        z, _ = self.gms_.states(run)
+        return np.column_stack((run.position, self.gms_.predict(run), z))
+
+    def _friction_run(self, run: AxisLog) -> np.ndarray:
+        current = _expansion_of(self).predict(self._inputs(run))
+        return current - self.J_ * run.acceleration - self.offset_
+
+    def _n_params(self) -> int:
+        return int(self.dual_coef_.size) + 1 + self.gms_.n_params
+
+    def gms_predict(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
+        """Current of the frozen GMS stage alone [A], the runs concatenated."""
+        check_is_fitted(self, "gms_")
+        return self.gms_.predict(logs)
+
+    def states(self, logs: AxisLog | Iterable[AxisLog]) -> tuple[np.ndarray, np.ndarray]:
+        """GMS element deflections and stick flags (see :meth:`greybox.friction.GMSModel.states`).
+
+        Returns
+        -------
+        z : ndarray, shape (n_samples, N)
+            Deflection of each element [mm].
+        stick : ndarray of bool, shape (n_samples, N)
+            True where the element sticks.
+        """
+        check_is_fitted(self, "gms_")
+        return self.gms_.states(logs)
+
+    def hyperparameters_table(self) -> dict[str, object]:
+        """The SVR settings as in the paper's Table 2 (see
+        :meth:`greybox.models.svr.SVRCurrentModel.hyperparameters_table`)."""
+        return hyperparameters_table(self)

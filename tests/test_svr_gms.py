@@ -1,0 +1,105 @@
+"""The grey-box model GMS + SVR (eq. 8) with a frozen GMS stage."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sklearn.exceptions import NotFittedError
+
+from greybox.data.log import AxisLog
+from greybox.errors import ParameterError
+from greybox.friction.gms import GMSModel, simulate_gms
+from greybox.models.gmssvr import GMSSVRModel
+
+TRUTH_GMS = dict(alpha=np.array([0.1, 0.2, 0.3, 0.4]), k=np.full(4, 80.0), C=2.0, sigma=0.01,
+                 s_0=0.01, s_inf=0.006, v_s=5.0, mu=0.003)
+RIPPLE_A = 0.3  # amplitude of the position-dependent friction the GMS model cannot represent
+
+
+def gms_run(seed, n=20000, ripple=RIPPLE_A, noise=0.02):
+    """Multi-sine motion; current = inertia + GMS friction + ripple(position) + noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * 0.002
+    freq = rng.uniform(0.1, 0.4, 3)
+    phase = rng.uniform(0.0, 2 * np.pi, 3)
+    amp = np.array([120.0, 50.0, 20.0])
+    arg = 2 * np.pi * freq[:, None] * t + phase[:, None]
+    p = 200.0 + (amp[:, None] * np.sin(arg)).sum(0)
+    v = (amp[:, None] * 2 * np.pi * freq[:, None] * np.cos(arg)).sum(0)
+    a = (-amp[:, None] * (2 * np.pi * freq[:, None]) ** 2 * np.sin(arg)).sum(0)
+    friction, _ = simulate_gms(v, 0.002, **TRUTH_GMS)
+    current = 2e-4 * a + friction + ripple * np.sin(2 * np.pi * p / 150.0) + noise * rng.standard_normal(n)
+    return AxisLog(time=t, position=p, effort=current, velocity=v, acceleration=a)
+
+
+def quick_gms():
+    return GMSModel(n_starts=1, max_iter=60)
+
+
+SVR_FIXED = dict(C=3.0, epsilon=0.01, gamma=1.0, optimize=False, n_subset=800)
+
+
+def rmse(a, b):
+    return float(np.sqrt(np.mean((a - b) ** 2)))
+
+
+@pytest.fixture(scope="module")
+def fitted():
+    train = [gms_run(1), gms_run(2)]
+    return GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit(train), train
+
+
+def test_beats_gms_alone_on_position_dependent_friction(fitted):
+    model, _ = fitted
+    test = gms_run(3)
+    gms_error = rmse(model.gms_predict(test), test.current)
+    error = rmse(model.predict(test), test.current)
+    # The GMS stage misses the ripple (rms 0.21 A); the SVR recovers most of it.
+    assert gms_error > 0.8 * RIPPLE_A / np.sqrt(2)
+    assert error < 0.5 * gms_error
+    np.testing.assert_allclose(model.J_ * test.acceleration + model.friction(test) + model.offset_,
+                               model.predict(test), atol=1e-9)
+
+
+def test_inputs_are_position_gms_current_and_states(fitted):
+    model, train = fitted
+    n_elements = len(model.gms_.alpha_)
+    assert model.input_names == ("position_mm", "gms_current_A") + tuple(f"z{i}_mm" for i in range(1, 5))
+    assert model.support_vectors_.shape[1] == 2 + n_elements
+    z, stick = model.states(train)
+    assert z.shape == stick.shape == (sum(len(r) for r in train), n_elements)
+    z_gms, stick_gms = model.gms_.states(train)
+    np.testing.assert_array_equal(z, z_gms)
+    np.testing.assert_array_equal(stick, stick_gms)
+    # The SVR stage was trained on standardised inputs: mean and scale of the training columns.
+    X = np.concatenate([np.column_stack((r.position, model.gms_.predict(r), model.gms_.states(r)[0]))
+                        for r in train])
+    np.testing.assert_allclose(model.input_mean_, X.mean(0), rtol=1e-10, atol=1e-12)
+
+
+def test_stages_on_different_data_keep_the_gms_frozen():
+    first, second = gms_run(4, n=8000), gms_run(5, n=8000)
+    model = GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit_gms(first)
+    k_before = model.gms_.k_.copy()
+    model.fit_svr(second)
+    np.testing.assert_array_equal(model.gms_.k_, k_before)
+    assert model.n_samples_fit_ == len(second)
+
+    external = quick_gms().fit(first)
+    other = GMSSVRModel(**SVR_FIXED).fit_svr(second, gms=external)
+    assert other.gms_ is not external
+    np.testing.assert_array_equal(other.gms_.k_, external.k_)
+    np.testing.assert_array_equal(other.predict(second), model.predict(second))
+
+
+def test_incomplete_models_are_refused():
+    run = gms_run(6, n=3000)
+    with pytest.raises(ParameterError, match="fit_gms"):
+        GMSSVRModel(**SVR_FIXED).fit_svr(run)
+    with pytest.raises(ParameterError, match="GMSModel"):
+        GMSSVRModel(gms="gms", **SVR_FIXED).fit(run)
+    half = GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit_gms(run)
+    with pytest.raises(NotFittedError):
+        half.predict(run)
+    with pytest.raises(NotFittedError):
+        GMSSVRModel(**SVR_FIXED).fit_svr(run, gms=GMSModel())
