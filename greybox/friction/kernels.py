@@ -1,6 +1,6 @@
 """Compiled time-stepping kernels of the dynamic friction models.
 
-All kernels are compiled with numba (``@njit(cache=True)``, no fastmath, so
+All kernels are compiled with numba (``@njit(cache=True, error_model="numpy")``, no fastmath, so
 that results are reproducible and agree with the plain-Python references in
 the tests). They take the velocity sequence [mm/s] of one run sampled at a
 constant step ``sample_time`` [s], start from a given state and return the
@@ -25,7 +25,7 @@ from numba import njit
 __all__ = ["gms_friction_kernel", "gms_trajectory_kernel", "lugre_trajectory_kernel"]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _gms_step(v, sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate):
     """Advance every GMS element over one forward-Euler step (in place).
 
@@ -81,7 +81,7 @@ def _gms_step(v, sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate
         mode[i] = m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0):
     """Friction of the Generalized Maxwell-Slip model, forward Euler at a constant step.
 
@@ -141,7 +141,7 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
     return friction, z, mode
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, mode0, z_out, mode_out, w_out):
     """Element states of the GMS model over a run (forward Euler, constant step).
 
@@ -191,7 +191,7 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, 
     return z, mode
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def lugre_trajectory_kernel(velocity, sample_time, sigma0, f_c, f_s, v_s, z0, z_out, z_dot_out):
     """Bristle deflection of the LuGre model, exact zero-order-hold step.
 

@@ -1,0 +1,153 @@
+"""Speed of the compiled GMS kernel against plain Python and plain C, and GMS identification time.
+
+Usage::
+
+    python benchmarks/bench_gms.py [--json] [--steps 2000000] [--repeats 5] [--elements 4]
+
+- ``ns_per_step``: numba kernel :func:`greybox.friction.kernels.gms_friction_kernel`,
+  best of ``--repeats`` runs over ``--steps`` steps (compilation excluded);
+- ``python_ns_per_step``: the plain-Python reference of the tests
+  (``tests/friction_reference.py``) on ``--python-steps`` steps, best of 3;
+- ``c_ns_per_step``: ``benchmarks/gms_loop.c`` (the same recursion) compiled
+  with ``cc -O2`` at run time, best of ``--repeats``; ``null`` without a compiler.
+  ``c_max_abs_diff`` is its largest difference to the numba friction [A];
+- ``fit_seconds``: :class:`greybox.friction.GMSModel` with default settings on a
+  synthetic 500 Hz log of ``--fit-seconds-of-data`` seconds simulated by a GMS
+  truth plus noise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from friction_reference import gms_reference  # noqa: E402
+from friction_signals import STEP, motion_log, velocity_profile  # noqa: E402
+
+from greybox.friction import GMSModel  # noqa: E402
+from greybox.friction.gms import GMSState, simulate_gms  # noqa: E402
+from greybox.friction.kernels import gms_friction_kernel  # noqa: E402
+
+
+def parameters(n_elements: int) -> dict:
+    """GMS parameters of a ball-screw-like axis: break-away 0.02 mm, Coulomb level about 1 A."""
+    alpha = np.geomspace(1.0, 20.0, n_elements)
+    return {"alpha": alpha / alpha.sum(), "k": np.full(n_elements, 50.0), "sigma": 0.002, "s_0": 0.02,
+            "s_inf": 0.015, "v_s": 5.0, "C": 3.0, "mu": 0.005}
+
+
+def bench_velocity(n_steps: int) -> np.ndarray:
+    """Strokes of +-50 mm/s with a 7 Hz ripple: sliding, reversals and pre-sliding loops [mm/s]."""
+    t = np.arange(n_steps) * STEP
+    return 50.0 * np.sin(2 * np.pi * 0.5 * t) + 5.0 * np.sin(2 * np.pi * 7.0 * t)
+
+
+def time_numba(velocity, p, repeats):
+    rest = GMSState.at_rest(p["alpha"].size)
+    args = (STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["C"], p["mu"], rest.z, rest.mode)
+    gms_friction_kernel(velocity[:10], *args)  # compile (or load from the cache)
+    best = np.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        friction, _, _ = gms_friction_kernel(velocity, *args)
+        best = min(best, time.perf_counter() - start)
+    return best / velocity.size * 1e9, friction
+
+
+def time_python(velocity, p, numba_friction):
+    best = np.inf
+    for _ in range(3):
+        start = time.perf_counter()
+        friction = gms_reference(velocity, STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"],
+                                 p["C"], p["mu"])[0]
+        best = min(best, time.perf_counter() - start)
+    return best / velocity.size * 1e9, float(np.max(np.abs(np.asarray(friction) - numba_friction)))
+
+
+def time_c(velocity, p, repeats, numba_friction):
+    compiler = shutil.which("cc")
+    if compiler is None:
+        return None, None
+    with tempfile.TemporaryDirectory() as tmp:
+        exe = Path(tmp) / "gms_loop"
+        subprocess.run([compiler, "-O2", "-o", str(exe), str(ROOT / "benchmarks" / "gms_loop.c"), "-lm"], check=True)
+        velocity.astype(np.float64).tofile(Path(tmp) / "v.bin")
+        args = [repr(float(x)) for x in (STEP, p["C"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["mu"])]
+        args += [str(p["alpha"].size)] + [repr(float(x)) for x in np.concatenate((p["alpha"], p["k"]))]
+        out = subprocess.run([str(exe), str(Path(tmp) / "v.bin"), str(Path(tmp) / "f.bin"), str(repeats), *args],
+                             check=True, capture_output=True, text=True)
+        friction = np.fromfile(Path(tmp) / "f.bin")
+    return float(out.stdout.strip()), float(np.max(np.abs(friction - numba_friction)))
+
+
+def time_fit(duration):
+    """Seconds to fit a default GMSModel on a synthetic log of ``duration`` seconds at 500 Hz."""
+    truth = dict(parameters(4), k=np.array([40.0, 60.0, 30.0, 45.0]))
+    velocity = velocity_profile(duration, seed=1)
+    log = motion_log(velocity)
+    friction, _ = simulate_gms(velocity, STEP, **truth)
+    noise = 0.02 * np.random.default_rng(0).standard_normal(velocity.size)
+    log = log.replace(effort=0.001 * log.acceleration + friction + noise)
+    model = GMSModel()
+    start = time.perf_counter()
+    model.fit(log)
+    seconds = time.perf_counter() - start
+    rmse = float(np.sqrt(np.mean((model.predict(log) - log.effort) ** 2)))
+    return seconds, len(log), model.n_evaluations_, rmse
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON line")
+    parser.add_argument("--steps", type=int, default=2_000_000)
+    parser.add_argument("--python-steps", type=int, default=20_000)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--elements", type=int, default=4)
+    parser.add_argument("--fit-seconds-of-data", type=float, default=180.0)
+    args = parser.parse_args(argv)
+
+    p = parameters(args.elements)
+    velocity = bench_velocity(args.steps)
+    ns, friction = time_numba(velocity, p, args.repeats)
+    py_ns, py_diff = time_python(velocity[: args.python_steps], p, friction[: args.python_steps])
+    c_ns, c_diff = time_c(velocity, p, args.repeats, friction)
+    fit_s, fit_n, fit_evals, fit_rmse = time_fit(args.fit_seconds_of_data)
+    result = {
+        "ns_per_step": round(ns, 3),
+        "python_ns_per_step": round(py_ns, 1),
+        "c_ns_per_step": None if c_ns is None else round(c_ns, 3),
+        "n_elements": args.elements,
+        "n_steps": args.steps,
+        "python_steps": args.python_steps,
+        "speedup_vs_python": round(py_ns / ns, 1),
+        "ratio_to_c": None if c_ns is None else round(ns / c_ns, 3),
+        "python_max_abs_diff": py_diff,
+        "c_max_abs_diff": c_diff,
+        "fit_seconds": round(fit_s, 2),
+        "fit_samples": fit_n,
+        "fit_evaluations": fit_evals,
+        "fit_rmse_A": round(fit_rmse, 5),
+    }
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"GMS N={args.elements}, {args.steps} steps: numba {ns:.2f} ns/step, plain Python {py_ns:.0f} ns/step "
+              f"({py_ns / ns:.0f}x), C -O2 " + ("n/a" if c_ns is None else f"{c_ns:.2f} ns/step (numba/C {ns / c_ns:.2f})"))
+        print(f"GMS identification on {fit_n} samples: {fit_s:.1f} s, {fit_evals} simulations, "
+              f"RMSE {fit_rmse:.4f} A (noise 0.02 A)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
