@@ -60,7 +60,7 @@ AXIS_SAMPLE_SCHEMA = {
 _MAGIC = b"\x89MCAP0\r\n"
 _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x04, 0x05, 0x06, 0x0F
 _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time u64
-_BATCH_BYTES = 64 << 20  # JSON text parsed per call of the bulk parser
+_BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
 _BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
 
 
