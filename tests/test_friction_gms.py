@@ -206,3 +206,13 @@ def test_ten_elements_and_least_squares():
     assert np.sqrt(np.mean(residual ** 2)) < 0.05 * np.std(log.effort)
     z, stick = model.states(log)
     assert z.shape == (len(log), 10)
+
+
+def test_single_element_without_stages():
+    params = dict(TRUTH, alpha=np.array([1.0]), k=np.array([45.0]))
+    log = synthetic_log(6.0, seed=12, params=params)
+    model = GMSModel(n_elements=1, staged=False, n_starts=2, max_iter=200).fit(log)
+    np.testing.assert_array_equal(model.alpha_, [1.0])
+    assert model.k_[0] * model.s_inf_ == pytest.approx(45.0 * TRUTH["s_inf"], rel=1e-3)
+    assert model.s0_ == pytest.approx(TRUTH["s_0"], rel=0.02)
+    assert model.n_params == 8
