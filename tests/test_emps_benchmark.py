@@ -1,0 +1,118 @@
+"""The EMPS benchmark script reproduces the published IDIM-LS results on the real data.
+
+Reference figures are the published ones (Janot, Gautier & Brunot 2019, "Data
+Set and Reference Models of EMPS"), typed in here independently of the script.
+Our preprocessing uses scipy's filters, whose edge handling differs slightly
+from MATLAB's, hence the tolerances: 2 % on parameters, 0.2 percentage points
+on relerr.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from greybox.friction import CoulombModel
+
+REPO = Path(__file__).resolve().parents[1]
+DATA = REPO.parent / "shared" / "data" / "real" / "EMPS"
+SCRIPT = REPO / "scripts" / "emps_benchmark.py"
+
+SYMMETRIC = {"M_kg": 95.1089, "Fv_N_s_per_m": 203.5034, "Fc_N": 20.3935, "offset_N": -3.1648}
+ASYMMETRIC = {"M_kg": 95.1540, "Fv_pos_N_s_per_m": 166.7061, "Fc_pos_N": 20.1440,
+              "Fv_neg_N_s_per_m": 240.4236, "Fc_neg_N": 20.6277}
+TRAIN_RELERR, TEST_RELERR, ASYM_TRAIN_RELERR = 4.0834, 5.9824, 3.1117
+CONDITION_NUMBER = 25.9883
+
+
+def _load_script():
+    spec = importlib.util.spec_from_file_location("emps_benchmark", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+bench = _load_script()
+
+
+@pytest.fixture(scope="module")
+def logs():
+    return {role: bench.benchmark_log(DATA / name) for role, name in
+            (("train", "DATA_EMPS.mat"), ("test", "DATA_EMPS_PULSES.mat"))}
+
+
+def test_idim_ls_reproduces_the_published_estimates(logs):
+    fit = bench.idim_ls(logs["train"])
+    for name, published in SYMMETRIC.items():
+        assert fit["params"][name] == pytest.approx(published, rel=0.02), name
+    assert fit["train_relerr"] == pytest.approx(TRAIN_RELERR, abs=0.2)
+    assert fit["condition_number"] == pytest.approx(CONDITION_NUMBER, rel=0.01)
+    test_relerr = bench.benchmark_relerr(logs["test"], fit["predict"](logs["test"]))
+    assert test_relerr == pytest.approx(TEST_RELERR, abs=0.2)
+
+
+def test_asymmetric_idim_ls_reproduces_the_published_estimates(logs):
+    fit = bench.idim_ls(logs["train"], asymmetric=True)
+    for name, published in ASYMMETRIC.items():
+        assert fit["params"][name] == pytest.approx(published, rel=0.02), name
+    assert fit["train_relerr"] == pytest.approx(ASYM_TRAIN_RELERR, abs=0.2)
+
+
+def test_scoring_a_full_rate_prediction_equals_the_decimated_least_squares_residual(logs):
+    # decimation is linear: decimating X @ theta equals the decimated columns times theta
+    fit = bench.idim_ls(logs["train"])
+    scored = bench.benchmark_relerr(logs["train"], fit["predict"](logs["train"]))
+    assert scored == pytest.approx(fit["train_relerr"], rel=1e-9)
+    assert bench.benchmark_relerr(logs["train"], logs["train"].effort) == 0.0
+
+
+def test_greybox_coulomb_model_matches_the_published_estimates(logs):
+    model = CoulombModel(fit_offset=True).fit(logs["train"])
+    ours = {"M_kg": 1e3 * model.J_, "Fv_N_s_per_m": 1e3 * model.viscous_pos_, "Fc_N": model.coulomb_pos_,
+            "offset_N": model.offset_}
+    for name, published in SYMMETRIC.items():
+        assert ours[name] == pytest.approx(published, rel=0.02), name
+    assert bench.benchmark_relerr(logs["test"], model.predict(logs["test"])) == pytest.approx(TEST_RELERR, abs=0.2)
+
+
+def test_benchmark_samples_and_the_2ms_grid(logs):
+    full = logs["train"]
+    assert len(full) == 24841 - 49
+    assert bench.decimate_benchmark(full.effort).size == 2480
+    coarse = bench.benchmark_log(DATA / "DATA_EMPS.mat", step_ms=2)
+    assert coarse.sample_time == pytest.approx(0.002, rel=1e-4)
+    assert coarse.time[0] == full.time[0]
+    assert np.isin(coarse.time, full.time).all()
+
+
+def test_script_writes_json_markdown_and_plot(tmp_path):
+    out, md, png = tmp_path / "emps.json", tmp_path / "emps.md", tmp_path / "emps.png"
+    result = subprocess.run(
+        [sys.executable, str(SCRIPT), "--json", str(out), "--markdown", str(md), "--plot", str(png),
+         "--models", "coulomb_idim_ls", "coulomb", "stribeck", "--quiet"],
+        capture_output=True, text=True, cwd=tmp_path, timeout=300,
+    )
+    assert result.returncode == 0, result.stderr
+    models = json.loads(out.read_text())["models"]
+    assert list(models) == ["coulomb_idim_ls", "coulomb", "stribeck"]
+    for entry in models.values():
+        assert 0 < entry["train_relerr"] < 10 and 0 < entry["test_relerr"] < 10
+        assert entry["params"]
+    assert models["coulomb_idim_ls"]["params"]["M_kg"] == pytest.approx(SYMMETRIC["M_kg"], rel=0.02)
+    assert "| `stribeck` |" in md.read_text()
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
+
+
+def test_missing_data_folder_is_reported(tmp_path, capsys):
+    status = bench.main(["--json", str(tmp_path / "x.json"), "--data", str(tmp_path / "nowhere")])
+    stderr = capsys.readouterr().err
+    assert status == 2
+    assert "nowhere" in stderr and "Traceback" not in stderr
+    assert not (tmp_path / "x.json").exists()
