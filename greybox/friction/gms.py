@@ -323,6 +323,26 @@ class GMSModel(CurrentModel):
         s_0, s_inf, v_s, r = np.exp(theta[n - 1:])
         return alpha, s_0, s_inf, v_s, r * min(s_0, s_inf) / max_step
 
+    def _initial_shape(self, runs):
+        """Stage 1: initial shape vector and its bounds from a static fit and the reversals.
+
+        Returns ``theta = (u_2..u_N, log s_0, log s_inf, log v_s, log r)`` and
+        its lower and upper bounds.
+        """
+        n = self.n_elements
+        static = static_initial_guess(runs, fit_offset=self.fit_offset)
+        delta = presliding_deflection(runs, static) or DEFAULT_DEFLECTION_MM
+        v_lo, v_hi = velocity_range(np.concatenate([run.velocity for run in runs]))
+        logits = np.linspace(0.0, np.log(_ALPHA_SPREAD), n)[1:]
+        s_0 = delta / _alpha_from_logits(logits).max()  # the largest element breaks away after delta
+        ratio = np.clip(static["coulomb"] / static["static"], 0.05, 20.0) if static["static"] > 0 else 1.0
+        theta = np.concatenate((logits, np.log([s_0, s_0 * ratio, np.clip(static["v_s"], v_lo, v_hi), 0.5])))
+        lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND), theta[n - 1:n + 1] - np.log(1e3),
+                                [np.log(v_lo), np.log(1e-3)]))
+        upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND), theta[n - 1:n + 1] + np.log(1e3),
+                                [np.log(v_hi), np.log(MAX_SLIP_STEP_RATIO)]))
+        return theta, lower, upper
+
     def _fit_runs(self, runs, progress) -> None:
         n = self.n_elements
         if not (isinstance(n, (int, np.integer)) and n >= 1):
@@ -332,20 +352,7 @@ class GMSModel(CurrentModel):
         check_motion(runs)
         regression = _Regression(runs, n, self.fit_offset)
         max_step = max(regression.steps)
-
-        # stage 1: static levels and pre-sliding deflection
-        static = static_initial_guess(runs, fit_offset=self.fit_offset)
-        delta = presliding_deflection(runs, static) or DEFAULT_DEFLECTION_MM
-        v_lo, v_hi = velocity_range(np.concatenate([run.velocity for run in runs]))
-        logits = np.linspace(0.0, np.log(_ALPHA_SPREAD), n)[1:]
-        alpha = _alpha_from_logits(logits)
-        s_0 = delta / alpha.max()
-        ratio = np.clip(static["coulomb"] / static["static"], 0.05, 20.0) if static["static"] > 0 else 1.0
-        theta = np.concatenate((logits, np.log([s_0, s_0 * ratio, np.clip(static["v_s"], v_lo, v_hi), 0.5])))
-        full_lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND),
-                                     theta[n - 1:n + 1] - np.log(1e3), [np.log(v_lo), np.log(1e-3)]))
-        full_upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND),
-                                     theta[n - 1:n + 1] + np.log(1e3), [np.log(v_hi), np.log(MAX_SLIP_STEP_RATIO)]))
+        theta, full_lower, full_upper = self._initial_shape(runs)
         full_scale = np.concatenate((np.ones(n - 1), [0.5, 0.5, 0.5, 1.0]))
 
         def full_residuals(t):
@@ -357,7 +364,7 @@ class GMSModel(CurrentModel):
             def expand(p):
                 return np.concatenate((p[: n - 1], theta[n - 1:n + 1] + p[n - 1], [theta[n + 1], p[n]]))
 
-            p0 = np.concatenate((logits, [0.0, theta[-1]]))
+            p0 = np.concatenate((theta[: n - 1], [0.0, theta[-1]]))
             lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND), [-np.log(1e2), np.log(1e-3)]))
             upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND), [np.log(1e2), np.log(MAX_SLIP_STEP_RATIO)]))
             result = multistart(lambda p: full_residuals(expand(p)), p0, lower, upper,
