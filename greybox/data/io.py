@@ -1,13 +1,13 @@
 """Read and write axis logs in any supported format, chosen by file extension.
 
-========== ================== ============================================
-format     extensions         reader options
-========== ================== ============================================
-``csv``    ``.csv``           ``columns``, ``sample_time``
-``parquet`` ``.parquet .pq``  ``columns``, ``sample_time``
-``mcap``   ``.mcap``          ``columns``, ``topic``
-``emps``   ``.mat``           none (EMPS benchmark files; read only)
-========== ================== ============================================
+=========== ===================== ===========================================
+format      extensions            reader options
+=========== ===================== ===========================================
+``csv``     ``.csv``              ``columns``, ``sample_time``
+``parquet`` ``.parquet``, ``.pq`` ``columns``, ``sample_time``
+``mcap``    ``.mcap``             ``columns``, ``topic``
+``emps``    ``.mat``              none (EMPS benchmark files; read only)
+=========== ===================== ===========================================
 
 :func:`read_log` validates what it reads (uniform time base, finite values),
 so every log it returns is ready for :func:`greybox.data.prepare.prepare`.
