@@ -192,9 +192,12 @@ def test_metrics_by_regime_pools_runs():
     result = metrics_by_regime([first, second], predictions, THRESHOLDS)
     pooled = metrics_table(np.concatenate([first.effort, second.effort]), np.concatenate(predictions))
     assert result["all"] == pooled
+    assert metrics_by_regime([first, second], np.concatenate(predictions), THRESHOLDS) == result
     assert result["constant_feed"]["n"] == 2 * 250 + 250
     with pytest.raises(ValueError, match="predictions"):
         metrics_by_regime([first, second], predictions[:1], THRESHOLDS)
+    with pytest.raises(ValueError, match="prediction of"):
+        metrics_by_regime([first, second], np.concatenate(predictions)[:-1], THRESHOLDS)
 
 
 def test_empty_regime_gives_nan_metrics():

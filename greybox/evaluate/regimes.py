@@ -212,7 +212,9 @@ def metrics_by_regime(
     logs : AxisLog or sequence of AxisLog
         Prepared runs; their ``effort`` is the measured value [A or N].
     predictions : array_like or sequence of array_like
-        Modelled effort, one array per run, same unit and length as the run.
+        Modelled effort, same unit: one array per run, or one 1-D array of
+        all runs concatenated in order (what a model's ``predict`` returns
+        for a list of runs).
     thresholds : RegimeThresholds, optional
         Defaults to :meth:`RegimeThresholds.from_logs` of all runs together,
         so that every run is split by the same thresholds.
@@ -225,8 +227,12 @@ def metrics_by_regime(
         samples has ``n == 0`` and nan metrics.
     """
     runs = as_log_list(logs)
-    if isinstance(logs, AxisLog):
-        predictions = [predictions]
+    if isinstance(logs, AxisLog) or (isinstance(predictions, np.ndarray) and predictions.ndim == 1):
+        joined = np.asarray(predictions, dtype=np.float64)
+        lengths = [len(run) for run in runs]
+        if joined.shape[0] != sum(lengths):
+            raise ValueError(f"runs of {sum(lengths)} samples in all but a prediction of {joined.shape[0]}")
+        predictions = np.split(joined, np.cumsum(lengths)[:-1])
     predictions = [np.asarray(p, dtype=np.float64).ravel() for p in predictions]
     if len(predictions) != len(runs):
         raise ValueError(f"{len(runs)} runs but {len(predictions)} predictions")
