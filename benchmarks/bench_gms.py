@@ -5,11 +5,13 @@ Usage::
     python benchmarks/bench_gms.py [--json] [--steps 2000000] [--repeats 5] [--elements 4]
 
 - ``ns_per_step``: numba kernel :func:`greybox.friction.kernels.gms_friction_kernel`,
-  best of ``--repeats`` runs over ``--steps`` steps (compilation excluded);
+  best of ``--repeats`` runs over ``--steps`` steps (compilation excluded),
+  interleaved with the C runs;
 - ``python_ns_per_step``: the plain-Python reference of the tests
   (``tests/friction_reference.py``) on ``--python-steps`` steps, best of 3;
 - ``c_ns_per_step``: ``benchmarks/gms_loop.c`` (the same recursion) compiled
-  with ``cc -O2`` at run time, best of ``--repeats``; ``null`` without a compiler.
+  with ``cc -O2`` at run time, best of ``--repeats`` (timed inside the C program,
+  file input and output excluded); ``null`` without a compiler.
   ``c_max_abs_diff`` is its largest difference to the numba friction [A];
 - ``fit_seconds``: :class:`greybox.friction.GMSModel` with default settings on a
   synthetic 500 Hz log of ``--fit-seconds-of-data`` seconds simulated by a GMS
@@ -53,42 +55,48 @@ def bench_velocity(n_steps: int) -> np.ndarray:
     return 50.0 * np.sin(2 * np.pi * 0.5 * t) + 5.0 * np.sin(2 * np.pi * 7.0 * t)
 
 
-def time_numba(velocity, p, repeats):
+def numba_runner(velocity, p):
+    """Callable timing one run of the numba kernel [ns/step]; the kernel is compiled (or loaded) first."""
     rest = GMSState.at_rest(p["alpha"].size)
     args = (STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["C"], p["mu"], rest.z, rest.mode)
-    gms_friction_kernel(velocity[:10], *args)  # compile (or load from the cache)
-    best = np.inf
-    for _ in range(repeats):
+    gms_friction_kernel(velocity[:10], *args)
+    output = {}
+
+    def run():
         start = time.perf_counter()
-        friction, _, _ = gms_friction_kernel(velocity, *args)
-        best = min(best, time.perf_counter() - start)
-    return best / velocity.size * 1e9, friction
+        output["friction"], _, _ = gms_friction_kernel(velocity, *args)
+        return (time.perf_counter() - start) / velocity.size * 1e9
+
+    return run, output
 
 
-def time_python(velocity, p, numba_friction):
+def c_runner(velocity, p, workdir: Path):
+    """Callable timing one run of benchmarks/gms_loop.c built with ``cc -O2`` [ns/step]; ``None`` without cc."""
+    compiler = shutil.which("cc")
+    if compiler is None:
+        return None, None
+    exe = workdir / "gms_loop"
+    subprocess.run([compiler, "-O2", "-o", str(exe), str(ROOT / "benchmarks" / "gms_loop.c"), "-lm"], check=True)
+    velocity.astype(np.float64).tofile(workdir / "v.bin")
+    args = [repr(float(x)) for x in (STEP, p["C"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["mu"])]
+    args += [str(p["alpha"].size)] + [repr(float(x)) for x in np.concatenate((p["alpha"], p["k"]))]
+    command = [str(exe), str(workdir / "v.bin"), str(workdir / "f.bin"), "1", *args]
+
+    def run():
+        return float(subprocess.run(command, check=True, capture_output=True, text=True).stdout.strip())
+
+    return run, lambda: np.fromfile(workdir / "f.bin")
+
+
+def time_python(velocity, p):
+    """Best of 3 runs of the plain-Python reference [ns/step] and its friction."""
     best = np.inf
     for _ in range(3):
         start = time.perf_counter()
         friction = gms_reference(velocity, STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"],
                                  p["C"], p["mu"])[0]
         best = min(best, time.perf_counter() - start)
-    return best / velocity.size * 1e9, float(np.max(np.abs(np.asarray(friction) - numba_friction)))
-
-
-def time_c(velocity, p, repeats, numba_friction):
-    compiler = shutil.which("cc")
-    if compiler is None:
-        return None, None
-    with tempfile.TemporaryDirectory() as tmp:
-        exe = Path(tmp) / "gms_loop"
-        subprocess.run([compiler, "-O2", "-o", str(exe), str(ROOT / "benchmarks" / "gms_loop.c"), "-lm"], check=True)
-        velocity.astype(np.float64).tofile(Path(tmp) / "v.bin")
-        args = [repr(float(x)) for x in (STEP, p["C"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["mu"])]
-        args += [str(p["alpha"].size)] + [repr(float(x)) for x in np.concatenate((p["alpha"], p["k"]))]
-        out = subprocess.run([str(exe), str(Path(tmp) / "v.bin"), str(Path(tmp) / "f.bin"), str(repeats), *args],
-                             check=True, capture_output=True, text=True)
-        friction = np.fromfile(Path(tmp) / "f.bin")
-    return float(out.stdout.strip()), float(np.max(np.abs(friction - numba_friction)))
+    return best / velocity.size * 1e9, np.asarray(friction)
 
 
 def time_fit(duration):
@@ -119,9 +127,18 @@ def main(argv=None) -> int:
 
     p = parameters(args.elements)
     velocity = bench_velocity(args.steps)
-    ns, friction = time_numba(velocity, p, args.repeats)
-    py_ns, py_diff = time_python(velocity[: args.python_steps], p, friction[: args.python_steps])
-    c_ns, c_diff = time_c(velocity, p, args.repeats, friction)
+    run_numba, numba_out = numba_runner(velocity, p)
+    with tempfile.TemporaryDirectory() as tmp:
+        run_c, c_friction = c_runner(velocity, p, Path(tmp))
+        ns, c_ns = np.inf, np.inf
+        for _ in range(args.repeats):  # interleaved, so that both see the same machine load
+            ns = min(ns, run_numba())
+            if run_c is not None:
+                c_ns = min(c_ns, run_c())
+        c_diff = None if run_c is None else float(np.max(np.abs(c_friction() - numba_out["friction"])))
+    c_ns = None if run_c is None else c_ns
+    py_ns, py_friction = time_python(velocity[: args.python_steps], p)
+    py_diff = float(np.max(np.abs(py_friction - numba_out["friction"][: args.python_steps])))
     fit_s, fit_n, fit_evals, fit_rmse = time_fit(args.fit_seconds_of_data)
     result = {
         "ns_per_step": round(ns, 3),

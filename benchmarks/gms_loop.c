@@ -25,26 +25,23 @@ static void gms_friction(const double *velocity, long n, double T, int n_el, con
                          const double *k, double sigma, double s_0, double s_inf, double v_s,
                          double c, double mu, double *z, signed char *mode, double *friction)
 {
-    double rate[MAX_ELEMENTS], damping[MAX_ELEMENTS];
+    double damping[MAX_ELEMENTS];
     const double c_dt = c * T, s_drop = s_0 - s_inf, inv_v_s = 1.0 / v_s;
     for (int i = 0; i < n_el; i++)
         damping[i] = sigma * alpha[i];
     for (long j = 0; j < n; j++) {
         const double v = velocity[j];
-        double f = mu * v;
-        for (int i = 0; i < n_el; i++)
-            f += k[i] * z[i];
         const double s = s_inf + s_drop * exp(-fabs(v) * inv_v_s);
         const double inv_s = 1.0 / s;
         const int d = v > 0.0 ? 1 : (v < 0.0 ? -1 : 0);
         const double fd = (double)d, v_dt = v * T;
+        double f = mu * v;
         for (int i = 0; i < n_el; i++) {
-            const double z_old = z[i];
+            const double z_old = z[i], s_i = alpha[i] * s;
             int m = mode[i];
+            double z_new;
             if (m != 0 && m != d)
                 m = 0;
-            const double s_i = alpha[i] * s;
-            double z_new;
             if (m == 0) {
                 z_new = z_old + v_dt;
                 if (d != 0 && fd * z_new >= s_i) {
@@ -57,12 +54,10 @@ static void gms_friction(const double *velocity, long n, double T, int n_el, con
             } else {
                 z_new = z_old + c_dt * (alpha[i] * fd - z_old * inv_s);
             }
-            rate[i] = (z_new - z_old) / T;
+            f += k[i] * z_old + damping[i] * ((z_new - z_old) / T);
             z[i] = z_new;
             mode[i] = (signed char)m;
         }
-        for (int i = 0; i < n_el; i++)
-            f += damping[i] * rate[i];
         friction[j] = f;
     }
 }

@@ -26,59 +26,50 @@ __all__ = ["gms_friction_kernel", "gms_trajectory_kernel", "lugre_trajectory_ker
 
 
 @njit(cache=True, error_model="numpy")
-def _gms_step(v, sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate):
-    """Advance every GMS element over one forward-Euler step (in place).
+def _gms_element_step(z_old, mode, d, v_dt, s_i, alpha_i, c_dt, inv_s):
+    """One forward-Euler step of one GMS element.
 
     Parameters
     ----------
-    v : float
-        Velocity held over the step [mm/s].
-    sample_time : float
-        Step T [s].
+    z_old : float
+        Deflection before the step [mm].
+    mode : int
+        Mode before the step (0 stick, +1/-1 slip).
+    d : int
+        ``sgn(v)`` of the velocity held over the step.
+    v_dt : float
+        ``v T``: travel over the step [mm].
+    s_i : float
+        ``alpha_i s(v)``: break-away deflection of the element [mm].
+    alpha_i : float
+        Element fraction.
     c_dt : float
-        ``C * T`` [mm]: slip rate constant times the step.
-    alpha : ndarray, shape (N,)
-        Element fractions (sum 1).
-    s_inf, s_drop : float
-        ``s_inf`` and ``s_0 - s_inf`` of the Stribeck curve [mm].
-    inv_v_s : float
-        ``1 / v_s`` [s/mm].
-    z : ndarray, shape (N,)
-        Element deflections [mm]; overwritten with the values after the step.
-    mode : ndarray of int8, shape (N,)
-        Element modes; overwritten with the modes after the step.
-    rate : ndarray, shape (N,)
-        Overwritten with the applied rates ``(z_new - z_old) / T`` [mm/s].
+        ``C T`` [mm].
+    inv_s : float
+        ``1 / s(v)`` [1/mm].
+
+    Returns
+    -------
+    z_new : float
+        Deflection after the step [mm].
+    mode : int
+        Mode after the step.
     """
-    s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
-    inv_s = 1.0 / s
-    if v > 0.0:
-        d = 1
-    elif v < 0.0:
-        d = -1
-    else:
-        d = 0
     fd = float(d)
-    v_dt = v * sample_time
-    for i in range(alpha.shape[0]):
-        z_old = z[i]
-        m = mode[i]
-        if m != 0 and m != d:
-            m = 0  # velocity reversed or stopped: the element sticks again
-        s_i = alpha[i] * s
-        if m == 0:
-            z_new = z_old + v_dt
-            if d != 0 and fd * z_new >= s_i:
-                m = d  # break-away: the deflection reached s_i(v)
-                if fd * z_old < s_i:
-                    z_new = fd * s_i
-                else:
-                    z_new = z_old + c_dt * (alpha[i] * fd - z_old * inv_s)
-        else:
-            z_new = z_old + c_dt * (alpha[i] * fd - z_old * inv_s)
-        rate[i] = (z_new - z_old) / sample_time
-        z[i] = z_new
-        mode[i] = m
+    if mode != 0 and mode != d:
+        mode = 0  # velocity reversed or stopped: the element sticks again
+    if mode == 0:
+        z_new = z_old + v_dt
+        if d != 0 and fd * z_new >= s_i:
+            mode = d  # break-away: the deflection reached s_i(v)
+            if fd * z_old < s_i:
+                z_new = fd * s_i
+            else:
+                z_new = z_old + c_dt * (alpha_i * fd - z_old * inv_s)
+    else:
+        # T C_i (sgn(v) - z / s_i) with C_i = alpha_i C, s_i = alpha_i s
+        z_new = z_old + c_dt * (alpha_i * fd - z_old * inv_s)
+    return z_new, mode
 
 
 @njit(cache=True, error_model="numpy")
@@ -113,17 +104,15 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
     Returns
     -------
     friction : ndarray, shape (n,)
-        ``sum_i (k_i z_i + alpha_i sigma dz_i/dt) + mu v`` [A].
+        ``mu v + sum_i (k_i z_i + alpha_i sigma dz_i/dt)`` [A].
     z_end : ndarray, shape (N,)
         Deflections after the last step [mm].
     mode_end : ndarray of int8, shape (N,)
         Modes after the last step.
     """
     n = velocity.shape[0]
-    n_el = alpha.shape[0]
     z = z0.copy()
     mode = mode0.copy()
-    rate = np.empty(n_el)
     damping = sigma * alpha
     friction = np.empty(n)
     c_dt = c * sample_time
@@ -131,12 +120,17 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
     inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
+        s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
+        inv_s = 1.0 / s
+        d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
+        v_dt = v * sample_time
         f = mu * v
-        for i in range(n_el):
-            f += k[i] * z[i]
-        _gms_step(v, sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate)
-        for i in range(n_el):
-            f += damping[i] * rate[i]
+        for i in range(alpha.shape[0]):
+            z_old = z[i]
+            z_new, m = _gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
+            f += k[i] * z_old + damping[i] * ((z_new - z_old) / sample_time)
+            z[i] = z_new
+            mode[i] = m
         friction[j] = f
     return friction, z, mode
 
@@ -172,22 +166,27 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, 
         Modes after the last step.
     """
     n = velocity.shape[0]
-    n_el = alpha.shape[0]
     z = z0.copy()
     mode = mode0.copy()
-    rate = np.empty(n_el)
     c_dt = c * sample_time
     s_drop = s_0 - s_inf
     inv_v_s = 1.0 / v_s
     for j in range(n):
-        for i in range(n_el):
-            z_out[j, i] = z[i]
+        v = velocity[j]
+        s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
+        inv_s = 1.0 / s
+        d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
+        v_dt = v * sample_time
+        w = 0.0
+        for i in range(alpha.shape[0]):
+            z_old = z[i]
+            z_out[j, i] = z_old
             mode_out[j, i] = mode[i]
-        _gms_step(velocity[j], sample_time, c_dt, alpha, s_inf, s_drop, inv_v_s, z, mode, rate)
-        acc = 0.0
-        for i in range(n_el):
-            acc += alpha[i] * rate[i]
-        w_out[j] = acc
+            z_new, m = _gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
+            w += alpha[i] * ((z_new - z_old) / sample_time)
+            z[i] = z_new
+            mode[i] = m
+        w_out[j] = w
     return z, mode
 
 
