@@ -122,6 +122,8 @@ def test_training_log_is_never_overwritten(tmp_path, capsys):
     [
         (["--model", "gms", "--asymmetric"], "--asymmetric does not apply to the gms model"),
         (["--model", "coulomb", "--elements", "3"], "--elements does not apply to the coulomb model"),
+        (["--model", "lugre", "--set", "colour=red"], "has no hyperparameter 'colour'"),
+        (["--model", "lugre", "--set", "n_starts"], "NAME=VALUE"),
     ],
 )
 def test_options_foreign_to_the_model_are_refused(tmp_path, capsys, arguments, message):
@@ -143,3 +145,22 @@ def test_bad_logs_are_named(tmp_path, capsys):
                                "--out", tmp_path / "m.gbm")
     assert status == 2 and "standing.csv" in stderr
     assert not (tmp_path / "m.gbm").exists()
+
+
+def test_gmssvr_stages_take_their_own_logs(tmp_path, capsys):
+    first, second = tmp_path / "stage1.mcap", tmp_path / "stage2.csv"
+    write_log(_run(4, n=600), first)
+    write_log(_run(5, n=600), second)
+    out = tmp_path / "gmssvr.gbm"
+    fixed = ["--set", "C=1.0", "--set", "epsilon=0.01", "--set", "gamma=0.5", "--set", "n_subset=300"]
+    status, stdout, stderr = _train(capsys, "--model", "gmssvr", "--train", first, "--stage2", second,
+                                    *fixed, "--out", out, "--quiet")
+    assert status == 0, stderr
+    assert "stage1.mcap" in stdout and "stage2.csv" in stdout
+    assert "gms.k" in stdout  # the frozen GMS stage is listed with its parameters
+    model = load_model(out)
+    assert model.gms_.n_samples_fit_ == 600  # GMS stage fitted on --train alone
+    assert (model.C_, model.epsilon_, model.gamma_, model.n_subset) == (1.0, 0.01, 0.5, 300)
+    status, _, stderr = _train(capsys, "--model", "gms", "--train", first, "--stage2", second,
+                               "--out", tmp_path / "x.gbm")
+    assert status == 2 and "--stage2 does not apply to the gms model" in stderr

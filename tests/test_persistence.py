@@ -269,9 +269,13 @@ def test_real_models_round_trip_bit_identically(tmp_path, model):
     assert loaded.predict(train).tobytes() == model.predict(train).tobytes()
 
 
-def test_registry_names_every_friction_model():
+def test_registry_names_every_current_model():
     from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+    from greybox.models.gmssvr import GMSSVRModel
+    from greybox.models.svr import SVRCurrentModel
 
-    for kind, cls in {"coulomb": CoulombModel, "stribeck": StribeckModel, "lugre": LuGreModel, "gms": GMSModel}.items():
+    expected = {"coulomb": CoulombModel, "stribeck": StribeckModel, "lugre": LuGreModel, "gms": GMSModel,
+                "svr": SVRCurrentModel, "gmssvr": GMSSVRModel}
+    for kind, cls in expected.items():
         assert registry.model_class(kind) is cls
         assert registry.model_kind(cls()) == kind

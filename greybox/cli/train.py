@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import time
 from pathlib import Path
@@ -12,34 +13,29 @@ import numpy as np
 from ..errors import GreyboxError, ModelFileError
 from ..evaluate.metrics import metrics_table
 from ..models.persistence import load_model, save_model
-from ..models.registry import MODEL_CLASSES
+from ..models.registry import MODEL_CLASSES, model_kind
 from ._options import add_log_arguments, read_logs
 
 #: Learned attributes that describe the fit rather than the model.
 _FIT_INFO = ("effort_unit_", "sample_time_", "n_samples_fit_", "cost_", "n_evaluations_")
 
-#: Units of the learned parameters, ``{E}`` standing for the effort unit (A or N).
+_SVR_UNITS = {"C_": "{E}", "epsilon_": "{E}", "gamma_": "1/(standardised unit)^2", "intercept_": "{E}",
+              "cv_rmse_": "{E}"}
+
+#: Units of the learned parameters per model kind, ``{E}`` standing for the effort unit (A or N).
 _UNITS = {
-    "J_": "{E} s^2/mm",
-    "offset_": "{E}",
-    "coulomb_": "{E}",
-    "coulomb_pos_": "{E}",
-    "coulomb_neg_": "{E}",
-    "static_": "{E}",
-    "viscous_": "{E} s/mm",
-    "viscous_pos_": "{E} s/mm",
-    "viscous_neg_": "{E} s/mm",
-    "v_s_": "mm/s",
-    "sigma0_": "{E}/mm",
-    "sigma1_": "{E} s/mm",
-    "alpha_": "-",
-    "k_": "{E}/mm",
-    "C_": "mm/s",
-    "sigma_": "{E} s/mm",
-    "mu_": "{E} s/mm",
-    "s0_": "mm",
-    "s_inf_": "mm",
+    "coulomb": {"coulomb_pos_": "{E}", "coulomb_neg_": "{E}", "viscous_pos_": "{E} s/mm",
+                "viscous_neg_": "{E} s/mm"},
+    "stribeck": {"coulomb_": "{E}", "static_": "{E}", "v_s_": "mm/s", "viscous_": "{E} s/mm"},
+    "lugre": {"sigma0_": "{E}/mm", "sigma1_": "{E} s/mm", "viscous_": "{E} s/mm", "coulomb_": "{E}",
+              "static_": "{E}", "v_s_": "mm/s"},
+    "gms": {"alpha_": "-", "k_": "{E}/mm", "C_": "mm/s", "sigma_": "{E} s/mm", "mu_": "{E} s/mm", "s0_": "mm",
+            "s_inf_": "mm", "v_s_": "mm/s"},
+    "svr": _SVR_UNITS,
+    "gmssvr": _SVR_UNITS,
 }
+#: Units of the parameters every current model has.
+_COMMON_UNITS = {"J_": "{E} s^2/mm", "offset_": "{E}"}
 
 #: Command-line options that set a model hyperparameter: option -> (parameter, value from args).
 _MODEL_OPTIONS = {
@@ -61,6 +57,12 @@ def add_parser(subparsers) -> None:
     parser.add_argument(
         "--train", required=True, nargs="+", metavar="LOG", help="training logs (CSV, Parquet, MCAP or EMPS .mat)"
     )
+    parser.add_argument(
+        "--stage2",
+        nargs="+",
+        metavar="LOG",
+        help="gmssvr only: logs for the SVR stage; the GMS stage is then fitted on --train alone",
+    )
     parser.add_argument("--out", required=True, metavar="MODEL", help="model file to write (.gbm)")
     parser.add_argument("--force", action="store_true", help="overwrite MODEL if it exists")
     model = parser.add_argument_group("model options")
@@ -70,6 +72,14 @@ def add_parser(subparsers) -> None:
     )
     model.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms, default 4)")
     model.add_argument("--seed", type=int, metavar="N", help="seed of the multi-start identification (lugre, gms)")
+    model.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="set any model hyperparameter, e.g. --set n_starts=8 or --set C=2.0 (repeatable; VALUE is read as "
+        "a JSON number, true, false or null, else as text)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
@@ -93,6 +103,17 @@ def build_model(kind: str, args: argparse.Namespace):
         if name not in accepted:
             raise GreyboxError(f"option {option} does not apply to the {kind} model")
         params[name] = value
+    for setting in args.set:
+        name, sep, text = setting.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise GreyboxError(f"--set expects NAME=VALUE, got {setting!r}")
+        if name not in accepted:
+            raise GreyboxError(f"the {kind} model has no hyperparameter {name!r}; it has: {', '.join(sorted(accepted))}")
+        try:
+            params[name] = json.loads(text)
+        except json.JSONDecodeError:
+            params[name] = text
     return model.set_params(**params)
 
 
@@ -125,32 +146,53 @@ def _format_value(value) -> str:
     return str(value)
 
 
-def describe_parameters(model) -> list[str]:
-    """Lines ``name = value unit`` of the identified parameters of a fitted model."""
+def describe_parameters(model, prefix: str = "") -> list[str]:
+    """Lines ``name = value unit`` of the identified parameters of a fitted model.
+
+    A fitted model nested in another (the GMS stage of a GMS+SVR model) is
+    listed below it, its names prefixed with the attribute name.
+    """
     unit = getattr(model, "effort_unit_", "A")
+    units = {**_COMMON_UNITS, **_UNITS.get(model_kind(model), {})}
     lines = []
     for name, value in vars(model).items():
         if not name.endswith("_") or name.startswith("_") or name in _FIT_INFO:
             continue
-        suffix = _UNITS.get(name, "").format(E=unit)
-        lines.append(f"  {name[:-1]:<14} = {_format_value(value)} {suffix}".rstrip())
+        if hasattr(value, "get_params"):
+            lines += describe_parameters(value, prefix=f"{prefix}{name[:-1]}.")
+            continue
+        suffix = units.get(name, "").format(E=unit)
+        lines.append(f"  {prefix + name[:-1]:<14} = {_format_value(value)} {suffix}".rstrip())
     return lines
+
+
+def _fit(model, args: argparse.Namespace):
+    """Fit ``model`` as the options say; return the paths and runs it was fitted on."""
+    progress = None if args.quiet else True
+    if args.stage2 and not hasattr(model, "fit_svr"):
+        raise GreyboxError(f"option --stage2 does not apply to the {args.model} model")
+    runs = read_logs(args, args.train)
+    if not args.stage2:
+        model.fit(runs, progress=progress)
+        return list(args.train), runs
+    second = read_logs(args, args.stage2)
+    model.fit_gms(runs, progress=progress).fit_svr(second, progress=progress)
+    return list(args.train) + list(args.stage2), runs + second
 
 
 def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
-    _check_output(out, args.train, args.force)
+    _check_output(out, list(args.train) + list(args.stage2 or ()), args.force)
     model = build_model(args.model, args)
-    runs = read_logs(args, args.train)
     started = time.perf_counter()
-    model.fit(runs, progress=None if args.quiet else True)
+    paths, runs = _fit(model, args)
     elapsed = time.perf_counter() - started
     unit = runs[0].effort_unit
     print(f"trained {args.model} on {len(runs)} run(s), {sum(len(r) for r in runs)} samples, "
           f"effort in {unit}, in {elapsed:.1f} s")
     print(f"  {'run':<32} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7}")
     predictions = [model.predict(run) for run in runs]
-    for path, run, prediction in zip(args.train, runs, predictions):
+    for path, run, prediction in zip(paths, runs, predictions):
         table = metrics_table(run.effort, prediction)
         print(f"  {Path(path).name[-32:]:<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     if len(runs) > 1:

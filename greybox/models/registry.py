@@ -8,6 +8,7 @@ a file cannot make greybox run code other than these classes' constructors.
 from __future__ import annotations
 
 from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from .gmssvr import GMSSVRModel
 from .svr import SVRCurrentModel
 
 __all__ = ["MODEL_CLASSES", "model_class", "model_kind"]
@@ -19,6 +20,7 @@ MODEL_CLASSES: dict[str, type] = {
     "lugre": LuGreModel,
     "gms": GMSModel,
     "svr": SVRCurrentModel,
+    "gmssvr": GMSSVRModel,
 }
 
 
