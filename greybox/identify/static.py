@@ -32,9 +32,10 @@ def velocity_range(velocity: np.ndarray) -> tuple[float, float]:
     """Search range of the Stribeck velocity ``v_s`` [mm/s] for given data.
 
     From 1e-3 to 1 times the largest speed in the data (the 99.9th percentile
-    of ``|v|``, robust to single outliers).
+    of ``|v|``, robust to single outliers; the maximum if fewer samples move).
     """
-    v_max = float(np.percentile(np.abs(velocity), 99.9))
+    speed = np.abs(velocity)
+    v_max = float(np.percentile(speed, 99.9)) or float(np.max(speed, initial=0.0))
     if not v_max > 0.0:
         raise ValueError("the velocity is zero throughout: friction cannot be identified")
     return 1e-3 * v_max, v_max
