@@ -103,3 +103,17 @@ def test_incomplete_models_are_refused():
         half.predict(run)
     with pytest.raises(NotFittedError):
         GMSSVRModel(**SVR_FIXED).fit_svr(run, gms=GMSModel())
+
+
+def test_residual_target_falls_back_to_the_gms_stage_far_from_the_training_data(fitted):
+    model, train = fitted
+    residual = GMSSVRModel(gms=quick_gms(), target="residual", **SVR_FIXED).fit_svr(train, gms=model.gms_)
+    test = gms_run(3)
+    assert rmse(residual.predict(test), test.current) < 0.5 * rmse(model.gms_predict(test), test.current)
+    # 10 m away from the travel the kernel terms vanish: the prediction is I_GMS + intercept,
+    # while the "current" target collapses to its intercept alone.
+    far = test.replace(position=test.position + 1e4)
+    np.testing.assert_allclose(residual.predict(far), model.gms_predict(far) + residual.intercept_, atol=1e-9)
+    np.testing.assert_allclose(model.predict(far), model.intercept_, atol=1e-9)
+    with pytest.raises(ParameterError, match="target"):
+        GMSSVRModel(target="force", **SVR_FIXED).fit_svr(train, gms=model.gms_)

@@ -99,3 +99,17 @@ def test_unprepared_log_is_refused():
     run = sweep_run(1, n=100)
     with pytest.raises(LogError, match="not prepared"):
         SVRCurrentModel(**FIXED).fit(run.replace(acceleration=None))
+
+
+def test_an_optimum_at_the_end_of_its_interval_is_reported():
+    from greybox.models.svr import _near_bound
+
+    assert _near_bound(1.0, (1.0, 100.0)) and _near_bound(99.0, (1.0, 100.0))
+    assert not _near_bound(10.0, (1.0, 100.0))
+    train = [sweep_run(1, n=2000), sweep_run(2, n=2000)]
+    # An interval too narrow to leave its ends: whatever is chosen sits at one.
+    model = SVRCurrentModel(C=3.0, epsilon=0.01, n_subset=150, n_calls=2, cv_folds=2, cv_blocks=4,
+                            bounds={"gamma": (0.5, 0.5000001)})
+    with pytest.warns(UserWarning, match="gamma = 0.5 ended at the end of its search interval"):
+        model.fit(train)
+    assert model.hyperparameters_table()["at_bounds"] == ["gamma"]

@@ -8,16 +8,20 @@ Compatibility (scikit-optimize 0.10.2 with numpy 2.4 and scikit-learn 1.9):
 the ask/tell :class:`skopt.Optimizer` with its default Gaussian-process
 surrogate (Matern 5/2 kernel, Gaussian noise, ``gp_hedge`` acquisition) runs
 without error or deprecation warning; the removed numpy aliases (``np.int``
-and the like) are not used by that path. Two things do need care and are
+and the like) are not used by that path. Three things do need care and are
 handled here: skopt accepts only an integer seed (or a legacy
-``RandomState``), not a :class:`numpy.random.Generator`; and a non-finite
+``RandomState``), not a :class:`numpy.random.Generator`; a non-finite
 objective value (e.g. a diverged fit) breaks the surrogate fit, so it is
-replaced by a finite penalty.
+replaced by a finite penalty; and when the surrogate proposes a point it has
+already evaluated (typically a corner of the box), skopt draws a random
+point instead and says so in a ``UserWarning`` per occurrence, which is
+silenced (the point actually evaluated is in the history).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Callable, Mapping
 
 import numpy as np
@@ -110,7 +114,10 @@ def minimize_log_uniform(
     worst_finite = -math.inf
     best_value, best_params = math.inf, None
     for i in range(n_calls):
-        point = optimizer.ask()
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="The objective has been evaluated at point",
+                                    category=UserWarning)
+            point = optimizer.ask()
         # Guard against the surrogate's optimiser stepping a hair outside the box.
         params = {name: float(np.clip(v, *bounds[name])) for name, v in zip(names, point)}
         value = float(objective(params))

@@ -10,10 +10,15 @@ Two stages:
 
        I = SVR(p, I_GMS, z_1, ..., z_N).
 
-As in the paper, the SVR's output is the current itself, not a residual: the
-GMS prediction is one of its inputs, which the kernel may correct in any
-direction, and the position input lets it learn the dependence of the
-friction on the position along the screw that the GMS model lacks. The
+As in the paper, the SVR's output is by default the current itself
+(``target="current"``): the GMS prediction is one of its inputs, which the
+kernel may correct in any direction, and the position input lets it learn
+the dependence of the friction on the position along the screw that the GMS
+model lacks. Far from its training data an RBF expansion falls back to its
+intercept, so such a model cannot predict positions or currents it has not
+seen. With ``target="residual"`` the SVR (same inputs) learns only
+``I - I_GMS`` and the prediction is ``I_GMS + SVR(...)``, which falls back to
+the GMS model (plus a constant) outside the training range. The
 hyperparameters, the training subset and the kernel evaluation are those of
 :mod:`greybox.models.svr`.
 
@@ -39,11 +44,16 @@ from ..identify.progress import make_progress
 from .base import CurrentModel, check_runs
 from .svr import _expansion_of, _store_expansion, fit_svr_expansion, hyperparameters_table
 
-__all__ = ["GMSSVRModel"]
+__all__ = ["GMSSVRModel", "TARGETS"]
+
+#: What the SVR stage may learn: the current (paper) or the GMS stage's residual.
+TARGETS = ("current", "residual")
 
 
 class GMSSVRModel(CurrentModel):
     """Grey-box current model ``I = SVR(p, I_GMS, z_1..z_N)`` with a frozen GMS stage.
+
+    With ``target="residual"``: ``I = I_GMS + SVR(p, I_GMS, z_1..z_N)``.
 
     Parameters
     ----------
@@ -57,6 +67,9 @@ class GMSSVRModel(CurrentModel):
         Width of the SVR's insensitive tube [A]; optimised when None.
     gamma : float, optional
         RBF kernel parameter [1/(standardised unit)^2]; optimised when None.
+    target : {"current", "residual"}, default "current"
+        What the SVR learns: the current (the paper's eq. 8), or the
+        residual ``I - I_GMS`` of the GMS stage, added back in prediction.
     n_subset : int, default 2000
         SVR training samples, chosen to cover the (p, v) plane evenly.
     optimize : bool, default True
@@ -86,7 +99,7 @@ class GMSSVRModel(CurrentModel):
     support_vectors_ : ndarray, shape (n_support, 2 + N)
         Standardised support vectors.
     dual_coef_ : ndarray, shape (n_support,)
-        Dual coefficients [A].
+        Dual coefficients [A] (of the current or of the residual, see ``target``).
     intercept_ : float
         [A].
     C_, epsilon_, gamma_ : float
@@ -97,16 +110,19 @@ class GMSSVRModel(CurrentModel):
         Cross-validated RMSE at the chosen hyperparameters [A] (NaN if none were optimised).
     search_history_ : list of dict
         Every evaluation of the optimisation.
+    at_bounds_ : list of str
+        Optimised hyperparameters that ended at an end of their search interval.
     n_train_ : int
         Size of the SVR training subset.
     """
 
-    def __init__(self, gms=None, C=None, epsilon=None, gamma=None, n_subset=2000, optimize=True, n_calls=25,
-                 cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
+    def __init__(self, gms=None, C=None, epsilon=None, gamma=None, target="current", n_subset=2000,
+                 optimize=True, n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
         self.gms = gms
         self.C = C
         self.epsilon = epsilon
         self.gamma = gamma
+        self.target = target
         self.n_subset = n_subset
         self.optimize = optimize
         self.n_calls = n_calls
@@ -157,6 +173,7 @@ class GMSSVRModel(CurrentModel):
         -------
         self
         """
+        self._check_target()
         template = GMSModel() if self.gms is None else self.gms
         if not isinstance(template, GMSModel):
             raise ParameterError(f"gms must be a GMSModel or None, got {type(template).__name__}")
@@ -190,6 +207,7 @@ class GMSSVRModel(CurrentModel):
         LogError
             If the runs' effort unit differs from the GMS stage's.
         """
+        self._check_target()
         if gms is not None:
             if not isinstance(gms, GMSModel):
                 raise ParameterError(f"gms must be a fitted GMSModel, got {type(gms).__name__}")
@@ -210,9 +228,11 @@ class GMSSVRModel(CurrentModel):
 
         X = np.concatenate([self._inputs(run) for run in runs])
         coverage = np.concatenate([np.column_stack((run.position, run.velocity)) for run in runs])
-        target = np.concatenate([run.effort for run in runs])
+        y = np.concatenate([run.effort for run in runs])
+        if self.target == "residual":
+            y = y - X[:, 1]
         fit = fit_svr_expansion(
-            X, target, coverage, [len(run) for run in runs],
+            X, y, coverage, [len(run) for run in runs],
             fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
             n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
             cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=self.bounds,
@@ -221,6 +241,10 @@ class GMSSVRModel(CurrentModel):
         _store_expansion(self, fit)
         return self
 
+    def _check_target(self) -> None:
+        if self.target not in TARGETS:
+            raise ParameterError(f"target must be one of {TARGETS}, got {self.target!r}")
+
     # ---------------------------------------------------------------- prediction
     def _inputs(self, run: AxisLog) -> np.ndarray:
         """SVR inputs of one run: position [mm], GMS current [A], deflections [mm]."""
@@ -228,7 +252,10 @@ class GMSSVRModel(CurrentModel):
         return np.column_stack((run.position, self.gms_.predict(run), z))
 
     def _friction_run(self, run: AxisLog) -> np.ndarray:
-        current = _expansion_of(self).predict(self._inputs(run))
+        inputs = self._inputs(run)
+        current = _expansion_of(self).predict(inputs)
+        if self.target == "residual":
+            current = current + inputs[:, 1]
         return current - self.J_ * run.acceleration - self.offset_
 
     def _n_params(self) -> int:

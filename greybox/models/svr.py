@@ -5,18 +5,17 @@
     I = J * a + offset + f(p, v),
 
 with an RBF-kernel support vector regression ``f`` of position ``p`` [mm] and
-velocity ``v`` [mm/s], both standardised. The inertia ``J`` [A s^2/mm] and
-the ``offset`` [A] come first, from one linear least-squares fit of the
-current to a Coulomb + viscous proxy,
+velocity ``v`` [mm/s], both standardised. The inertia ``J`` [A s^2/mm]
+(unless given) and the ``offset`` [A] come first, from one linear
+least-squares fit of the current to a Coulomb + viscous proxy,
 
     I ~ J a + F_c sgn(v) + mu v + offset,
 
 over the samples in motion (|v| above 1 % of the largest speed, so that
 ``sgn(v)`` is defined). Only ``J`` and ``offset`` are kept; the SVR then
 learns all of the friction, ``f = I - J a - offset``, including its
-Coulomb, viscous and position-dependent parts. Fitting ``J`` inside the SVR
-instead would let the kernel trade inertia against friction, and ``J a`` is
-not a function of ``(p, v)``.
+Coulomb, viscous and position-dependent parts. ``J a`` has to be taken out
+first because the kernel does not see the acceleration.
 
 The machinery shared with the grey-box model
 (:class:`greybox.models.gmssvr.GMSSVRModel`) is :func:`fit_svr_expansion`:
@@ -29,6 +28,7 @@ arrays (support vectors, dual coefficients, intercept), evaluated by
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
@@ -114,6 +114,10 @@ class SVRExpansion:
         target]; NaN when nothing was optimised.
     history : list of dict
         Every evaluation of the optimisation: hyperparameters and ``cv_rmse``.
+    at_bounds : list of str
+        Optimised hyperparameters that ended at an end of their search
+        interval (within 1 % of its width in log scale): the optimum may lie
+        outside it.
     n_train : int
         Number of training samples (the subset).
     """
@@ -127,6 +131,7 @@ class SVRExpansion:
     optimised: list[str] = field(default_factory=list)
     cv_rmse: float = float("nan")
     history: list[dict[str, float]] = field(default_factory=list)
+    at_bounds: list[str] = field(default_factory=list)
     n_train: int = 0
 
     def predict(self, X) -> np.ndarray:
@@ -228,6 +233,7 @@ def fit_svr_expansion(
     history: list[dict[str, float]] = []
     cv_rmse = float("nan")
     optimised: list[str] = []
+    at_bounds: list[str] = []
     if optimize and free:
         search = dict(default_bounds(target_std))
         search.update(bounds or {})
@@ -264,6 +270,12 @@ def fit_svr_expansion(
         optimised = list(free)
         history = [{**{k: v for k, v in t.items() if k != "objective"}, "cv_rmse": t["objective"]} for t in trials]
         cv_rmse = min(t["objective"] for t in trials)
+        at_bounds = [name for name in free if _near_bound(hyper[name], search[name])]
+        if at_bounds:
+            warnings.warn(
+                f"{stage}: {', '.join(f'{n} = {hyper[n]:.3g}' for n in at_bounds)} ended at the end of "
+                "its search interval; the optimum may lie outside (widen it with bounds=)",
+                UserWarning, stacklevel=3)
     else:
         for name in free:
             hyper[name] = _default_value(name, target_std, n_features)
@@ -273,8 +285,15 @@ def fit_svr_expansion(
     return SVRExpansion(
         input_mean=mean, input_scale=scale, support_vectors=sv, dual_coef=alpha, intercept=b,
         hyperparameters={name: hyper[name] for name in HYPERPARAMETERS}, optimised=optimised,
-        cv_rmse=cv_rmse, history=history, n_train=int(chosen.size),
+        cv_rmse=cv_rmse, history=history, at_bounds=at_bounds, n_train=int(chosen.size),
     )
+
+
+def _near_bound(value: float, interval: tuple[float, float], fraction: float = 0.01) -> bool:
+    """True if ``value`` lies within ``fraction`` of the log-width of ``interval`` from one of its ends."""
+    low, high = np.log(interval[0]), np.log(interval[1])
+    margin = fraction * (high - low)
+    return bool(np.log(value) <= low + margin or np.log(value) >= high - margin)
 
 
 def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) -> tuple[float, float]:
@@ -374,6 +393,8 @@ class SVRCurrentModel(CurrentModel):
         Cross-validated RMSE at the chosen hyperparameters [A] (NaN if none were optimised).
     search_history_ : list of dict
         Every evaluation of the optimisation.
+    at_bounds_ : list of str
+        Optimised hyperparameters that ended at an end of their search interval.
     n_train_ : int
         Size of the training subset.
     """
@@ -424,8 +445,9 @@ class SVRCurrentModel(CurrentModel):
         dict
             ``kernel`` ("rbf"), ``epsilon`` [A], ``C`` [A], ``gamma``
             [1/(standardised unit)^2], ``n_support``, ``n_train``,
-            ``optimised`` (names chosen by Bayesian optimisation) and
-            ``cv_rmse`` [A].
+            ``optimised`` (names chosen by Bayesian optimisation),
+            ``at_bounds`` (those that ended at an end of their search
+            interval) and ``cv_rmse`` [A].
         """
         return hyperparameters_table(self)
 
@@ -443,6 +465,7 @@ def _store_expansion(model, fit: SVRExpansion) -> None:
     model.optimised_ = list(fit.optimised)
     model.cv_rmse_ = fit.cv_rmse
     model.search_history_ = list(fit.history)
+    model.at_bounds_ = list(fit.at_bounds)
     model.n_train_ = fit.n_train
 
 
@@ -468,5 +491,6 @@ def hyperparameters_table(model) -> dict[str, object]:
         "n_support": int(model.dual_coef_.size),
         "n_train": model.n_train_,
         "optimised": list(model.optimised_),
+        "at_bounds": list(model.at_bounds_),
         "cv_rmse": model.cv_rmse_,
     }
