@@ -1,0 +1,118 @@
+"""``greybox predict``: the process share of the current of a cutting log, and its force."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import GreyboxError
+from ._options import add_log_arguments
+
+#: Output extensions accepted for the table and for the picture.
+_PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (np.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, got {text}")
+    return value
+
+
+def add_parser(subparsers) -> None:
+    from ..models.chunked import DEFAULT_CHUNK_S
+
+    parser = subparsers.add_parser(
+        "predict",
+        help="process current (and force) of a cutting log from a model trained on air cuts",
+        description="Run a model trained on air cuts over a log recorded while cutting and write, per "
+        "sample, the measured current, the model current (inertia + friction) and the process current "
+        "= measured - model; with --axis-config also the process force in N. The model runs over chunks "
+        "of --chunk-s seconds carrying its state, so long logs need little working memory.",
+    )
+    parser.add_argument("model", metavar="MODEL", help="model file written by 'greybox train' (.gbm)")
+    parser.add_argument("log", metavar="LOG", help="cutting log (CSV, Parquet, MCAP or EMPS .mat)")
+    parser.add_argument("--out", required=True, metavar="OUT",
+                        help="table to write: .csv, .parquet or .mcap (MCAP: one message per sample, "
+                        "topic /process/<axis>)")
+    parser.add_argument("--axis-config", metavar="TOML",
+                        help="axis metadata (torque constant, screw lead, gear ratio, efficiency, channel "
+                        "names); adds force_process_N (see examples/axis_x.toml)")
+    parser.add_argument("--plot", metavar="PNG", help="also draw measured, model and process current (and force)")
+    parser.add_argument("--chunk-s", type=_positive_seconds, default=DEFAULT_CHUNK_S, metavar="S",
+                        help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
+    parser.add_argument("--force", action="store_true", help="overwrite OUT and PNG if they exist")
+    add_log_arguments(parser)
+    parser.set_defaults(run=run)
+
+
+def _read_log(args: argparse.Namespace, channels: dict):
+    """Read and prepare the log; column mapping from the axis metadata, overridden by --columns."""
+    from ..data.io import parse_column_mapping, read_log
+    from ..data.prepare import prepare
+
+    columns = dict(channels)
+    if args.columns:
+        columns.update(parse_column_mapping(args.columns))
+    log = read_log(args.log, columns=columns or None, topic=args.topic, sample_time=args.sample_time,
+                   time_tolerance=args.time_tolerance)
+    (prepared,) = prepare([log], cutoff_hz=args.cutoff_hz, sample_time=args.resample)
+    return prepared
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..data.axis_config import read_axis_config
+    from ..evaluate.process import predict_process
+    from ..evaluate.process_io import check_output_path, output_format, write_process
+    from ..models.chunked import chunk_slices, samples_per_chunk
+    from ..models.persistence import load_model
+
+    inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else [])
+    out = Path(args.out)
+    output_format(out)
+    check_output_path(out, overwrite=args.force, protect=inputs)
+    if args.plot:
+        plot = Path(args.plot)
+        if plot.suffix.lower() not in _PLOT_SUFFIXES:
+            raise GreyboxError(f"{plot}: unknown picture extension '{plot.suffix}'; use {', '.join(_PLOT_SUFFIXES)}")
+        if plot.resolve() == out.resolve():
+            raise GreyboxError(f"{plot}: --plot and --out name the same file")
+        check_output_path(plot, overwrite=args.force, protect=inputs)
+    config = read_axis_config(args.axis_config) if args.axis_config else None
+    model = load_model(args.model)
+    log = _read_log(args, config.channels if config else {})
+
+    started = time.perf_counter()
+    result = predict_process(model, log, axis_config=config, chunk_s=args.chunk_s)
+    elapsed = time.perf_counter() - started
+    result.attrs.update({"model_file": str(args.model), "log_file": str(args.log)})
+    n_chunks = len(chunk_slices(len(log), samples_per_chunk(log.sample_time, args.chunk_s)))
+    unit = result.effort_unit
+    noun = "current" if unit == "A" else "force"
+    process = result.process
+    print(f"predicted {Path(args.log).name} with the {result.attrs['model_kind']} model {Path(args.model).name}: "
+          f"{len(log)} samples, {log.duration:.1f} s, {n_chunks} chunk(s) of {args.chunk_s:g} s, "
+          f"in {elapsed:.2f} s")
+    print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} {unit}, "
+          f"process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")
+    if unit == "A" and result.force is not None:
+        print(f"  force    rms process {_rms(result.force):.4g} N, largest |process| {np.max(np.abs(result.force)):.4g} N "
+              f"({result.force_constant_N_per_A:.6g} N/A from {Path(args.axis_config).name})")
+    write_process(result, out, overwrite=args.force, protect=inputs)
+    print(f"wrote {out}")
+    if args.plot:
+        from ..evaluate.process_plot import plot_process
+
+        plot_process(result, args.plot)
+        print(f"wrote {args.plot}")
+    return 0
+
+
+def _rms(values: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(values))))

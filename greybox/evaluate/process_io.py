@@ -1,0 +1,202 @@
+"""Writing the process table of ``greybox predict``: CSV, Parquet or MCAP, atomically.
+
+The columns are those of :meth:`greybox.evaluate.process.ProcessResult.columns`
+(``time_s``, ``current_measured_A``, ``current_model_A``, ``current_process_A``,
+``force_process_N`` with axis metadata, ``position_mm``, ``velocity_mm_s``).
+
+* CSV: a ``# greybox {...}`` metadata comment, then a header row and one row
+  per sample, floats as their shortest exact text.
+* Parquet: float64 columns, zstd, the metadata as JSON under the schema key
+  ``greybox``.
+* MCAP: one channel ``/process/<axis>`` (``/process`` without a name), schema
+  ``greybox.ProcessSample`` (JSON schema), one JSON message per sample at
+  ``log_time = publish_time =`` the sample time [ns], holding every column
+  but ``time_s``; measured, modelled and process current (and force) can be
+  overlaid in an MCAP viewer's plot panel.
+
+The metadata (axis, effort unit, attrs) follow the conventions of
+:mod:`greybox.data.csv_io`, :mod:`greybox.data.parquet_io` and
+:mod:`greybox.data.mcap_io`, so ``greybox.data.io.read_log`` reads an output
+back given a column mapping for the effort, e.g.
+``columns={"current_A": "current_process_A"}``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import GreyboxError
+from .process import ProcessResult
+
+__all__ = ["OUTPUT_FORMATS", "PROCESS_SCHEMA_NAME", "output_format", "check_output_path", "write_process"]
+
+#: Output formats by file extension.
+OUTPUT_FORMATS = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet", ".mcap": "mcap"}
+
+#: Schema name of the MCAP messages.
+PROCESS_SCHEMA_NAME = "greybox.ProcessSample"
+
+_DESCRIPTIONS = {
+    "current_measured_A": "measured motor current [A]",
+    "current_model_A": "model current: inertia + friction, trained on air cuts [A]",
+    "current_process_A": "process share: measured - model [A]",
+    "force_measured_N": "measured drive force [N]",
+    "force_model_N": "model force: inertia + friction, trained on air cuts [N]",
+    "force_process_N": "process force the drive exerts on the table [N]",
+    "position_mm": "axis position [mm]",
+    "velocity_mm_s": "axis velocity [mm/s]",
+}
+
+
+def output_format(path) -> str:
+    """Format name of an output file from its extension.
+
+    Raises
+    ------
+    GreyboxError
+        For an extension other than .csv, .parquet, .pq or .mcap.
+    """
+    suffix = Path(path).suffix.lower()
+    if suffix not in OUTPUT_FORMATS:
+        raise GreyboxError(f"{path}: unknown output extension '{suffix}'; write .csv, .parquet or .mcap")
+    return OUTPUT_FORMATS[suffix]
+
+
+def _metadata(result: ProcessResult) -> dict:
+    return {"axis": result.axis, "dataset": "", "effort_unit": result.effort_unit, "attrs": result.attrs}
+
+
+def _write_csv(result: ProcessResult, path) -> None:
+    columns = result.columns()
+    with open(path, "w", encoding="utf-8", newline="") as stream:
+        stream.write("# greybox " + json.dumps(_metadata(result)) + "\n")
+        stream.write(",".join(columns) + "\n")
+        text = [values.tolist() for values in columns.values()]
+        template = ",".join(["%r"] * len(columns)) + "\n"
+        for row in zip(*text):
+            stream.write(template % row)
+
+
+def _write_parquet(result: ProcessResult, path) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.table({name: np.asarray(values, dtype=np.float64) for name, values in result.columns().items()},
+                     metadata={b"greybox": json.dumps(_metadata(result)).encode()})
+    pq.write_table(table, path, compression="zstd")
+
+
+def _schema(fields) -> dict:
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": PROCESS_SCHEMA_NAME,
+        "description": "Measured, modelled and process current of one sample of one feed axis "
+                       "(greybox predict). The sample time is the message log_time in ns.",
+        "type": "object",
+        "properties": {name: {"type": "number", "description": _DESCRIPTIONS.get(name, name)} for name in fields},
+        "required": list(fields),
+    }
+
+
+def _write_mcap(result: ProcessResult, path) -> None:
+    from mcap.writer import CompressionType, Writer
+
+    columns = result.columns()
+    time = columns.pop("time_s")
+    if time.size and time.min() < 0:
+        raise GreyboxError(f"{path}: time reaches {time.min()} s; MCAP time stamps must be non-negative")
+    template = "{" + ",".join(json.dumps(name).replace("%", "%%") + ":%r" for name in columns) + "}"
+    rows = zip(*(values.tolist() for values in columns.values()))
+    stamps = np.rint(time * 1e9).astype(np.uint64).tolist()
+    metadata = _metadata(result)
+    with open(path, "wb") as stream:
+        writer = Writer(stream, compression=CompressionType.ZSTD)
+        writer.start(profile="", library="greybox")
+        schema_id = writer.register_schema(name=PROCESS_SCHEMA_NAME, encoding="jsonschema",
+                                           data=json.dumps(_schema(columns), indent=2).encode())
+        channel_id = writer.register_channel(
+            f"/process/{result.axis}" if result.axis else "/process", "json", schema_id,
+            {"axis": result.axis, "dataset": "", "effort_unit": result.effort_unit,
+             "attrs": json.dumps(metadata["attrs"])})
+        for stamp, row in zip(stamps, rows):
+            writer.add_message(channel_id, stamp, (template % row).encode(), stamp)
+        writer.finish()
+
+
+_WRITERS = {"csv": _write_csv, "parquet": _write_parquet, "mcap": _write_mcap}
+
+
+def write_process(result: ProcessResult, path, *, overwrite: bool = False, protect=()) -> Path:
+    """Write a process table atomically; the format follows the extension.
+
+    Parameters
+    ----------
+    result : ProcessResult
+        What :func:`greybox.evaluate.process.predict_process` returned.
+    path : str or path-like
+        Output file (.csv, .parquet/.pq or .mcap).
+    overwrite : bool, default False
+        Replace an existing ``path``.
+    protect : iterable of path-like
+        Files that must never be replaced (the inputs), whatever ``overwrite``.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    GreyboxError
+        For an unknown extension, non-finite values, an existing file without
+        ``overwrite``, a protected file, or a missing directory.
+    """
+    path = Path(path)
+    fmt = output_format(path)
+    check_output_path(path, overwrite=overwrite, protect=protect)
+    for name, values in result.columns().items():
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise GreyboxError(f"{path}: column '{name}' is not finite at sample {bad[0]}")
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(handle)
+    try:
+        _WRITERS[fmt](result, temporary)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
+    return path
+
+
+def check_output_path(path, *, overwrite: bool = False, protect=()) -> None:
+    """Raise :class:`GreyboxError` unless ``path`` may be written.
+
+    Parameters
+    ----------
+    path : path-like
+        Output file.
+    overwrite : bool, default False
+        Whether an existing file may be replaced.
+    protect : iterable of path-like
+        Input files that must never be replaced.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise GreyboxError(f"{path}: is a directory")
+    if not path.parent.is_dir():
+        raise GreyboxError(f"{path}: directory {path.parent} does not exist")
+    if path.exists():
+        for source in protect:
+            if os.path.exists(source) and os.path.samefile(path, source):
+                raise GreyboxError(f"{path}: is an input of this command; refusing to overwrite it")
+        if not overwrite:
+            raise GreyboxError(f"{path}: file exists; use --force to overwrite it")
