@@ -54,3 +54,15 @@ def test_rejects_bad_bounds():
         minimize_log_uniform(bowl, {"a": (0.0, 1.0)}, n_calls=3)
     with pytest.raises(ValueError, match="empty"):
         minimize_log_uniform(bowl, {}, n_calls=3)
+
+
+def test_a_minimum_in_a_corner_is_found_without_skopt_repeat_warnings():
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        best, history = minimize_log_uniform(lambda p: p["a"], {"a": (1e-2, 1e2)}, n_calls=12,
+                                             n_initial_points=3, random_state=0)
+    assert not [w for w in caught if "evaluated at point" in str(w.message)]
+    assert best["a"] < 1.1e-2
+    assert len(history) == 12
