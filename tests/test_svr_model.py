@@ -113,3 +113,15 @@ def test_an_optimum_at_the_end_of_its_interval_is_reported():
     with pytest.warns(UserWarning, match="gamma = 0.5 ended at the end of its search interval"):
         model.fit(train)
     assert model.hyperparameters_table()["at_bounds"] == ["gamma"]
+
+
+def test_bad_settings_are_refused_with_a_clear_error():
+    from greybox.errors import ParameterError
+
+    run = sweep_run(1, n=500)
+    with pytest.raises(ParameterError, match="unknown SVR hyperparameter"):
+        SVRCurrentModel(bounds={"nu": (0.1, 0.9)}, n_calls=2).fit(run)
+    with pytest.raises(ParameterError, match="C must be positive"):
+        SVRCurrentModel(C=-1.0, optimize=False).fit(run)
+    with pytest.raises(ParameterError, match="random_state"):
+        SVRCurrentModel(random_state=None, optimize=False).fit(run)

@@ -206,6 +206,8 @@ def fit_svr_expansion(
     -------
     SVRExpansion
     """
+    if not isinstance(random_state, (int, np.integer)) or isinstance(random_state, bool):
+        raise ParameterError(f"random_state must be an integer seed, got {random_state!r}")
     X = np.asarray(X, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     n_features = X.shape[1]
@@ -216,7 +218,7 @@ def fit_svr_expansion(
     target_std = float(np.std(y))
     variance = target_std**2 if target_std > 0 else 1.0
 
-    unknown = [name for name in fixed if name not in HYPERPARAMETERS]
+    unknown = [name for name in list(fixed) + list(bounds or {}) if name not in HYPERPARAMETERS]
     if unknown:
         raise ParameterError(f"unknown SVR hyperparameter(s) {unknown}; expected {HYPERPARAMETERS}")
     hyper: dict[str, float] = {}
