@@ -60,6 +60,12 @@ def test_chunked_equals_one_shot(models, cut_log, kind):
     np.testing.assert_allclose(chunked, one_shot, rtol=0, atol=1e-10)
 
 
+def test_gmssvr_with_residual_target(models, train_log, cut_log):
+    model = MODEL_CLASSES["gmssvr"](**{**QUICK["gmssvr"], "target": "residual"}).fit(train_log)
+    np.testing.assert_allclose(predict_chunked(model, cut_log, chunk_s=CHUNK_S), model.predict(cut_log),
+                               rtol=0, atol=1e-10)
+
+
 @pytest.mark.parametrize("kind", ["lugre", "gms", "gmssvr"])
 def test_restarting_the_state_at_each_chunk_would_differ(models, cut_log, kind):
     """The equality above rests on the carried state: chunks each started at rest differ."""

@@ -150,11 +150,10 @@ def _gmssvr_current(model, run: AxisLog, step: float, state):
     inputs = np.column_stack((run.position, gms_current, z))
     current = rbf_expansion((inputs - model.input_mean_) / model.input_scale_, model.support_vectors_,
                             model.dual_coef_, model.intercept_, model.gamma_)
-    target = getattr(model, "target", "current")
-    if target == "residual":
+    if model.target == "residual":
         current = current + gms_current
-    elif target != "current":
-        raise ParameterError(f"GMS+SVR model with unknown target {target!r}")
+    elif model.target != "current":
+        raise ParameterError(f"GMS+SVR model with unknown target {model.target!r}")
     return current, end
 
 
