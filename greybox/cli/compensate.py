@@ -1,0 +1,289 @@
+"""``greybox compensate``: compare friction models by the tracking error of a position loop with feed-forward."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+from ..errors import GreyboxError, ModelFileError
+
+__all__ = ["add_parser", "run"]
+
+#: Plants given by name rather than by a model file.
+TWIN_PLANTS = {"twin-x": "X", "twin-y": "Y"}
+
+#: Generated references.
+STROKE_REFERENCES = ("low", "high")
+
+#: Step [s] of generated references when no feed-forward model says otherwise.
+DEFAULT_REFERENCE_STEP_S = 0.002
+
+
+def add_parser(subparsers) -> None:
+    from ..control.references import STROKES_MM
+    from ..models.registry import MODEL_CLASSES
+
+    parser = subparsers.add_parser(
+        "compensate",
+        help="compare friction models by the tracking error of a position loop with their feed-forward",
+        description="Simulate a PID position loop around a plant (the synthetic axis, or an identified GMS/LuGre "
+        "model) with feed-forward of the inertia plus each friction model, one set of PID gains for all, on a "
+        "low-stroke and a high-stroke filtered random reference (or references given as logs), and write a table "
+        "of RMS and peak tracking error per model and reference (Tjahjowidodo et al. 2005, Tables 2 and 3) with "
+        "plots of the tracking error.",
+    )
+    parser.add_argument("--plant", required=True, metavar="PLANT",
+                        help="twin-X, twin-Y (the synthetic axis's truth plant) or a gms/lugre model file")
+    parser.add_argument("--models", nargs="+", default=[], metavar="MODEL", help="feed-forward model files (.gbm)")
+    parser.add_argument("--fit", metavar="KINDS",
+                        help=f"fit these model kinds for feed-forward, comma-separated ({', '.join(MODEL_CLASSES)}), "
+                        "on --train logs or, for a twin plant, on its synthetic datasets A and P")
+    parser.add_argument("--train", nargs="+", metavar="LOG", help="training logs for --fit")
+    parser.add_argument("--train-duration", type=float, default=60.0, metavar="S",
+                        help="length [s] of each synthetic training dataset of a twin plant (default 60)")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    parser.add_argument("--force", action="store_true", help="overwrite existing report files in DIR")
+    group = parser.add_argument_group("references")
+    group.add_argument("--reference", nargs="+", default=list(STROKE_REFERENCES), metavar="REF",
+                       help=f"low ({STROKES_MM['low']:g} mm stroke), high ({STROKES_MM['high']:g} mm stroke) or a "
+                       "log whose position is the reference (default: low high)")
+    group.add_argument("--duration", type=float, default=60.0, metavar="S",
+                       help="length [s] of the generated references (default 60)")
+    group.add_argument("--seed", type=int, default=0, metavar="N",
+                       help="seed of the references, the synthetic training data and the disturbance (default 0)")
+    group.add_argument("--start", type=float, metavar="MM",
+                       help="start position [mm] of the generated references (default: the middle of the twin's "
+                       "measurement window, 0 for a model plant)")
+    group.add_argument("--reference-step", type=float, metavar="S",
+                       help="step [s] of the generated references (default: the feed-forward models' sample time, "
+                       "else 0.002)")
+    group = parser.add_argument_group("loop")
+    group.add_argument("--inertia", default="plant", metavar="J",
+                       help="inertia of the feed-forward: 'plant' (the plant's, for every row; default), 'model' "
+                       "(each model's own) or a value [A s^2/mm]")
+    group.add_argument("--bandwidth", type=float, metavar="HZ",
+                       help="closed-loop bandwidth [Hz] of the PID pole placement (default 0.1 / (2 pi T))")
+    group.add_argument("--controller-period", type=float, metavar="S",
+                       help="controller period [s], a divisor of the reference step (default: at most 0.25 ms)")
+    group.add_argument("--current-limit", type=float, default=10.0, metavar="A",
+                       help="saturation of the motor current [A] (default 10)")
+    group.add_argument("--resolution", type=float, default=1e-4, metavar="MM",
+                       help="encoder resolution [mm] (default 0.0001)")
+    group.add_argument("--disturbance-std", type=float, default=0.0, metavar="A",
+                       help="standard deviation [A] of an AR(1) disturbance current (default 0: none)")
+    parser.add_argument("--quiet", action="store_true", help="no progress messages")
+    from ._options import add_log_arguments
+
+    add_log_arguments(parser)
+    parser.set_defaults(run=run)
+
+
+def _say(args, text: str) -> None:
+    if not args.quiet:
+        print(text, flush=True)
+
+
+def _load(path: str):
+    from ..models.persistence import load_model
+
+    if not os.path.isfile(path):
+        raise ModelFileError(f"{path}: no such model file")
+    return load_model(path)
+
+
+def _plant(args):
+    from ..control.plants import ModelPlant, TwinPlant
+
+    key = args.plant.strip().lower()
+    if key in TWIN_PLANTS:
+        return TwinPlant.for_axis(TWIN_PLANTS[key])
+    if not os.path.isfile(args.plant):
+        raise GreyboxError(f"{args.plant}: not a model file; the plant is twin-X, twin-Y or a gms/lugre model file")
+    try:
+        return ModelPlant(_load(args.plant), name=Path(args.plant).stem)
+    except GreyboxError as error:
+        raise GreyboxError(f"{args.plant}: {error}") from None
+
+
+def _fit_kinds(args) -> list[str]:
+    from ..models.registry import MODEL_CLASSES
+
+    if not args.fit:
+        if args.train:
+            raise GreyboxError("--train needs --fit KINDS")
+        return []
+    kinds = [kind.strip().lower() for kind in args.fit.split(",") if kind.strip()]
+    unknown = [kind for kind in kinds if kind not in MODEL_CLASSES]
+    if unknown or not kinds:
+        raise GreyboxError(f"unknown model kind {', '.join(unknown) or repr(args.fit)}; "
+                           f"choose from {', '.join(MODEL_CLASSES)}")
+    return list(dict.fromkeys(kinds))
+
+
+def _training_runs(args, plant):
+    from ..control.plants import TwinPlant
+    from ..data.prepare import prepare
+    from ..twin import make_dataset
+
+    if args.train:
+        from ._options import read_logs
+
+        return read_logs(args, args.train)
+    if not isinstance(plant, TwinPlant) or plant.axis is None:
+        raise GreyboxError("--fit with a model plant needs training logs: give --train LOG ...")
+    axis = plant.axis
+    _say(args, f"synthesising training data: axis {axis}, datasets A and P, {args.train_duration:g} s each, "
+               f"seed {args.seed}")
+    return prepare([make_dataset(axis, dataset, args.seed, duration_s=args.train_duration) for dataset in "AP"])
+
+
+def _models(args, plant) -> dict:
+    from ..models.registry import MODEL_CLASSES, model_kind
+
+    entries = []
+    for path in args.models:
+        model = _load(path)
+        entries.append((model_kind(model), Path(path).stem, model))
+    kinds = _fit_kinds(args)
+    if kinds:
+        runs = _training_runs(args, plant)
+        for kind in kinds:
+            started = time.perf_counter()
+            model = MODEL_CLASSES[kind]().fit(runs)
+            _say(args, f"fitted {kind} on {len(runs)} run(s) in {time.perf_counter() - started:.1f} s")
+            entries.append((kind, "fitted", model))
+    if not entries:
+        raise GreyboxError("no feed-forward model: give --models FILE ... or --fit KINDS")
+    counts = {}
+    for kind, _, _ in entries:
+        counts[kind] = counts.get(kind, 0) + 1
+    models = {}
+    for kind, origin, model in entries:
+        name = kind if counts[kind] == 1 else f"{kind} ({origin})"
+        if name in models:
+            raise GreyboxError(f"two feed-forward models are both named {name!r}; give distinct file names")
+        models[name] = model
+    return models
+
+
+def _feedforwards(args, plant, models: dict) -> list:
+    from ..control.feedforward import InertiaFeedForward, ModelFeedForward
+
+    choice = args.inertia.strip().lower()
+    if choice == "plant":
+        inertia = plant.inertia_A_s2_mm
+    elif choice == "model":
+        inertia = None
+    else:
+        try:
+            inertia = float(choice)
+        except ValueError:
+            raise GreyboxError(f"--inertia must be 'plant', 'model' or a number [A s^2/mm], got {args.inertia!r}"
+                               ) from None
+    baseline = InertiaFeedForward(plant.inertia_A_s2_mm if inertia is None else inertia)
+    return [baseline] + [ModelFeedForward(model, inertia, name) for name, model in models.items()]
+
+
+def _reference_step(args, models: dict) -> float:
+    if args.reference_step is not None:
+        return args.reference_step
+    steps = {round(float(model.sample_time_), 12) for model in models.values()}
+    return steps.pop() if len(steps) == 1 else DEFAULT_REFERENCE_STEP_S
+
+
+def _references(args, plant, step: float) -> list:
+    from ..control.plants import TwinPlant
+    from ..control.references import reference_from_log, stroke_reference
+    from ..twin import axis_geometry
+
+    if args.start is not None:
+        start = args.start
+    elif isinstance(plant, TwinPlant) and plant.axis is not None:
+        start = axis_geometry(plant.axis).window_centre_mm
+    else:
+        start = 0.0
+    references = []
+    for value in args.reference:
+        if value in STROKE_REFERENCES:
+            references.append(stroke_reference(value, args.duration, args.seed, sample_time_s=step, start_mm=start))
+        else:
+            from ._options import read_logs
+
+            if not os.path.isfile(value):
+                raise GreyboxError(f"{value}: no such log; --reference takes low, high or log files")
+            (log,) = read_logs(args, [value])
+            references.append(reference_from_log(log))
+    names = [reference.name for reference in references]
+    if len(set(names)) != len(names):
+        raise GreyboxError(f"references with the same name: {', '.join(names)}")
+    return references
+
+
+def _reference_names(args) -> list[str]:
+    return [f"{value}-stroke" if value in STROKE_REFERENCES else Path(value).stem for value in args.reference]
+
+
+def _check_output(args) -> None:
+    """Refuse before any work when the report must not or cannot be written."""
+    from ..control.report import report_paths
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise GreyboxError(f"{out}: exists and is not a directory")
+    targets = report_paths(_reference_names(args), out)
+    inputs = [p for p in [args.plant, *args.models, *(args.train or ()), *args.reference] if os.path.exists(p)]
+    for target in targets:
+        if target.exists() and any(os.path.samefile(target, source) for source in inputs):
+            raise GreyboxError(f"{target}: is one of the inputs; refusing to overwrite it")
+    existing = [str(path) for path in targets if path.exists()]
+    if existing and not args.force:
+        raise GreyboxError(f"{existing[0]}: file exists ({len(existing)} of {len(targets)} report files exist); "
+                           "nothing was written. Choose another directory or pass --force to overwrite")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..control.loop import compare_feedforwards, controller_periods
+    from ..control.report import comparison_rows, write_report
+    from ..control.tuning import default_bandwidth_hz, pole_placement_gains
+    from ..twin import CurrentNoise
+
+    _check_output(args)
+    plant = _plant(args)
+    models = _models(args, plant)
+    feedforwards = _feedforwards(args, plant, models)
+    references = _references(args, plant, _reference_step(args, models))
+    step = references[0].sample_time
+    period = step / controller_periods(step, args.controller_period)
+    bandwidth = args.bandwidth if args.bandwidth is not None else default_bandwidth_hz(period)
+    gains = pole_placement_gains(plant.inertia_A_s2_mm, bandwidth)
+    _say(args, f"plant {plant.name}, controller period {period * 1e3:g} ms, bandwidth {bandwidth:.3g} Hz: "
+               f"kp = {gains.kp:.4g} A/mm, ki = {gains.ki:.4g} A/(mm s), kd = {gains.kd:.4g} A s/mm")
+    if args.disturbance_std < 0:
+        raise GreyboxError(f"--disturbance-std must be non-negative, got {args.disturbance_std} A")
+    disturbance = CurrentNoise(args.disturbance_std) if args.disturbance_std > 0 else None
+    started = time.perf_counter()
+    results = compare_feedforwards(plant, references, feedforwards, gains, controller_period_s=args.controller_period,
+                                   current_limit_A=args.current_limit, resolution_mm=args.resolution,
+                                   disturbance=disturbance, seed=args.seed)
+    _say(args, f"simulated {len(results)} closed-loop runs in {time.perf_counter() - started:.1f} s")
+    print(f"  {'reference':<16} {'feed-forward':<16} {'RMS um':>10} {'max um':>10} {'vs none %':>10}")
+    for row in comparison_rows(results):
+        relative = f"{100.0 * row['rms_vs_none']:.1f}" if row["rms_vs_none"] == row["rms_vs_none"] else ""
+        print(f"  {row['reference'][:16]:<16} {row['feedforward'][:16]:<16} {1e3 * row['rms_error_mm']:>10.4g} "
+              f"{1e3 * row['peak_error_mm']:>10.4g} {relative:>10}")
+    settings = {
+        "plant": plant.describe(),
+        "feedforwards": [ff.describe() for ff in feedforwards],
+        "references": [{"name": r.name, "duration_s": r.duration, "step_s": r.sample_time, **r.attrs}
+                       for r in references],
+        "bandwidth_hz": bandwidth,
+        "model_files": list(args.models),
+        "fitted": args.fit,
+        "training_logs": list(args.train or ()),
+    }
+    written = write_report(results, args.out, settings=settings, force=args.force)
+    for path in written:
+        _say(args, f"wrote {path}")
+    return 0
