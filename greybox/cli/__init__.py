@@ -16,7 +16,7 @@ import sys
 from ..errors import GreyboxError
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
-COMMANDS = ("synth", "info", "plot", "train")
+COMMANDS = ("synth", "info", "plot", "train", "compensate")
 
 
 def build_parser() -> argparse.ArgumentParser:
