@@ -105,7 +105,8 @@ def markdown_table(rows: list[dict]) -> str:
         lines.append(
             f"| {row['model']} | {row['test']} | {row['air_test_rmse_A']:.4f} | {row['process_rmse_A']:.4f} "
             f"| {row['correlation']:.3f} ({row['correlation_ceiling']:.3f}) | {row['process_rmse_in_cut_A']:.4f} "
-            f"| {row['force_rmse_N']:.1f} | {row['mean_cut_force_true_N']:.1f} / {row['mean_cut_force_estimated_N']:.1f} |"
+            f"| {row['force_rmse_N']:.1f} "
+            f"| {row['mean_cut_force_true_N']:.1f} / {row['mean_cut_force_estimated_N']:.1f} |"
         )
     return "\n".join(lines) + "\n"
 

@@ -75,7 +75,8 @@ def test_channels_table(tmp_path):
 @pytest.mark.parametrize("text, message", [
     ("torque_constant_Nm_per_A = 1.0\nscrew_lead_mm = 10\ngear_ratio = 1\n", "missing efficiency"),
     ("screw_lead_mm = 10\ngear_ratio = 1\nefficiency = 0.9\n", "missing torque_constant_Nm_per_A"),
-    (VALID.replace("screw_lead_mm", "screw_lead_m"), "'screw_lead_m': unit not accepted; give the screw lead h as 'screw_lead_mm'"),
+    (VALID.replace("screw_lead_mm", "screw_lead_m"),
+     "'screw_lead_m': unit not accepted; give the screw lead h as 'screw_lead_mm'"),
     (VALID.replace("screw_lead_mm", "screw_lead"), "'screw_lead': no unit in the key"),
     (VALID.replace("torque_constant_Nm_per_A", "torque_constant_mNm_per_A"), "unit not accepted"),
     (VALID.replace("screw_lead_mm = 5.0", 'screw_lead_mm = "5 mm"'), "must be a number .* got the text '5 mm'"),

@@ -26,3 +26,28 @@ def test_process_error_equals_the_air_cut_residual():
     assert np.max(np.abs(error - residual_air)) <= CURRENT_RESOLUTION_A + 1e-12
     # the process current stands out of the air-cut error: it is recovered with positive correlation
     assert np.corrcoef(result.process, truth)[0, 1] > 0.5
+
+
+def test_thinned_picture_keeps_single_sample_peaks():
+    """Long logs are drawn as per-bin minimum and maximum, so a one-sample spike survives thinning."""
+    import matplotlib
+    import matplotlib.pyplot
+
+    matplotlib.use("Agg")
+    from greybox.evaluate.process import ProcessResult
+    from greybox.evaluate.process_plot import envelope_indices, plot_process
+
+    n = 10_001
+    time = np.arange(n) * 0.002
+    measured = np.zeros(n)
+    measured[4321] = 5.0
+    result = ProcessResult(time=time, position=np.zeros(n), velocity=np.zeros(n), measured=measured,
+                           model=np.zeros(n), force=763.4 * measured, force_constant_N_per_A=763.4)
+    assert envelope_indices(n, 20_000).size == n
+    figure = plot_process(result, max_points=500)
+    process_axes = figure.axes[2]
+    drawn = process_axes.lines[0].get_ydata()
+    assert drawn.size <= 502 and drawn.max() == 5.0
+    assert process_axes.get_ylabel() == "process current [A]"
+    assert [axes.get_ylabel() for axes in process_axes.child_axes] == ["process force [N]"]
+    matplotlib.pyplot.close(figure)

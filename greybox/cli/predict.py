@@ -102,7 +102,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} {unit}, "
           f"process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")
     if unit == "A" and result.force is not None:
-        print(f"  force    rms process {_rms(result.force):.4g} N, largest |process| {np.max(np.abs(result.force)):.4g} N "
+        print(f"  force    rms process {_rms(result.force):.4g} N, "
+              f"largest |process| {np.max(np.abs(result.force)):.4g} N "
               f"({result.force_constant_N_per_A:.6g} N/A from {Path(args.axis_config).name})")
     write_process(result, out, overwrite=args.force, protect=inputs)
     print(f"wrote {out}")
