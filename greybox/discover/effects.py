@@ -1,0 +1,359 @@
+"""The library of candidate effects: named parametric terms with physical regressors.
+
+Each :class:`Effect` turns a prepared run into regressor columns, so that the
+effect's current is ``columns @ coefficients`` [A, or N for force logs]. Some
+effects also have one *shape* parameter that enters nonlinearly (a period in
+position, a time constant, a Stribeck velocity); the discovery workflow scans
+it over :meth:`Effect.shape_grid` and refines it by least squares.
+
+With the direction of motion ``d = tanh(v / v_e)`` (``v_e`` the
+:class:`EffectContext`'s velocity scale), ``u`` the position scaled to
+``[-1, 1]`` over the position range of the training data, ``t`` the time since
+the start of the run and ``x``, ``v``, ``a`` position [mm], velocity [mm/s]
+and acceleration [mm/s^2]:
+
+========================== =========================================== ================
+name                       columns                                     shape
+========================== =========================================== ================
+direction_asymmetry        ``max(d, 0)``                               -
+constant_offset            ``1``                                       -
+position_trend             ``u d``, ``(3 u^2 - 1) / 2 * d``            -
+position_periodic_friction ``sin(2 pi x / P) d``, ``cos(2 pi x / P) d`` ``P`` [mm]
+position_periodic_force    ``sin(2 pi x / P)``, ``cos(2 pi x / P)``    ``P`` [mm]
+thermal_drift              ``(1 - exp(-t / tau)) d``                   ``tau`` [s]
+inertia_mismatch           ``a``                                       -
+viscous_friction           ``v``                                       -
+stribeck                   ``exp(-|v| / v_s) d``                       ``v_s`` [mm/s]
+load_dependent_friction    ``|a| d``                                   -
+========================== =========================================== ================
+
+The names are those of the synthetic axis's hidden effects
+(:data:`greybox.twin.EFFECTS`), plus ``stribeck`` and
+``load_dependent_friction`` (friction growing with the axial load, here the
+inertial load ``|a|``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..data.log import AxisLog
+from ..errors import GreyboxError
+
+__all__ = ["EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "effect", "period_grid", "period_scan",
+           "default_velocity_scale"]
+
+#: Periods are scanned at this many points per periodogram resolution ``1 / range``.
+_PERIOD_OVERSAMPLING = 4
+#: Shortest period: this many samples per period at the median moving speed.
+_SAMPLES_PER_PERIOD = 4
+#: Most periods a scan tries (the frequency step grows beyond that).
+_MAX_PERIODS = 4000
+#: Points of the logarithmic grids of time constants and Stribeck velocities.
+_LOG_GRID_POINTS = 24
+
+
+def default_velocity_scale(runs: Sequence[AxisLog]) -> float:
+    """Velocity scale ``v_e`` [mm/s] of the direction factor ``tanh(v / v_e)``.
+
+    1 % of the 99th percentile of ``|v|`` over all runs: small against the
+    feed speeds, large against velocity noise at rest.
+    """
+    speed = np.concatenate([np.abs(run.velocity) for run in runs])
+    scale = 0.01 * float(np.percentile(speed, 99.0))
+    if not scale > 0.0:
+        raise GreyboxError("the velocity is zero throughout: effects cannot be scaled to the motion")
+    return scale
+
+
+@dataclass(frozen=True)
+class EffectContext:
+    """Scales the effect regressors depend on, fixed from the training runs.
+
+    Parameters
+    ----------
+    velocity_scale_mm_s : float
+        ``v_e`` of the direction factor ``d = tanh(v / v_e)`` [mm/s].
+    position_range_mm : tuple of float
+        Lower and upper position [mm] mapped to ``u = -1`` and ``u = +1``.
+    """
+
+    velocity_scale_mm_s: float
+    position_range_mm: tuple[float, float]
+
+    @classmethod
+    def from_runs(cls, runs: Sequence[AxisLog], velocity_scale_mm_s: float | None = None) -> "EffectContext":
+        """Context of prepared training runs (``v_e`` by :func:`default_velocity_scale` unless given)."""
+        low = float(min(np.min(run.position) for run in runs))
+        high = float(max(np.max(run.position) for run in runs))
+        if not high > low:
+            raise GreyboxError("the position does not change: position effects cannot be scaled")
+        scale = default_velocity_scale(runs) if velocity_scale_mm_s is None else float(velocity_scale_mm_s)
+        if not scale > 0.0:
+            raise GreyboxError(f"velocity scale must be positive, got {scale} mm/s")
+        return cls(scale, (low, high))
+
+    def direction(self, run: AxisLog) -> np.ndarray:
+        """Smoothed direction of motion ``tanh(v / v_e)`` (-1 ... 1)."""
+        return np.tanh(run.velocity / self.velocity_scale_mm_s)
+
+    def unit_position(self, run: AxisLog) -> np.ndarray:
+        """Position scaled to ``u`` in [-1, 1] over the context's range."""
+        low, high = self.position_range_mm
+        return (2.0 * run.position - low - high) / (high - low)
+
+
+@dataclass(frozen=True)
+class ShapeParameter:
+    """The nonlinear parameter of an effect.
+
+    Parameters
+    ----------
+    name : str
+        Name with its unit, e.g. ``"period_mm"``.
+    scale : {"frequency", "log"}
+        How the scan steps: uniformly in ``1 / shape`` or in ``log(shape)``.
+    grid : callable
+        ``grid(runs, context) -> ndarray`` of the scanned values.
+    """
+
+    name: str
+    scale: str
+    grid: Callable[[Sequence[AxisLog], EffectContext], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A named candidate effect: regressor columns and the physical parameters they give.
+
+    Parameters
+    ----------
+    name : str
+        Name users see (see the module table).
+    summary : str
+        One line saying what the effect is physically.
+    column_names : tuple of str
+        Names of the regressor columns.
+    build : callable
+        ``build(run, context, shape) -> ndarray (n, n_columns)``.
+    describe : callable
+        ``describe(coefficients, context, shape, unit) -> dict`` of physical parameters.
+    shape : ShapeParameter or None
+        The nonlinear parameter, if any.
+    weight : callable or None
+        Periodic effects only: ``weight(run, context) -> ndarray (n,)``, the
+        factor of their sine and cosine (1 for a force, the direction for a
+        friction), for scans over the period.
+    """
+
+    name: str
+    summary: str
+    column_names: tuple[str, ...]
+    build: Callable[[AxisLog, EffectContext, float | None], np.ndarray]
+    describe: Callable[[np.ndarray, EffectContext, float | None, str], dict]
+    shape: ShapeParameter | None = None
+    weight: Callable[[AxisLog, EffectContext], np.ndarray] | None = None
+
+    @property
+    def n_columns(self) -> int:
+        """Number of linear coefficients."""
+        return len(self.column_names)
+
+    def check_shape(self, shape: float | None) -> float | None:
+        """Return ``shape`` as a float (None for effects without one), or raise :class:`GreyboxError`."""
+        if self.shape is None:
+            if shape is not None:
+                raise GreyboxError(f"effect {self.name!r} has no shape parameter, got {shape!r}")
+            return None
+        if shape is None or not np.isfinite(shape) or shape <= 0.0:
+            raise GreyboxError(f"effect {self.name!r} needs a positive {self.shape.name}, got {shape!r}")
+        return float(shape)
+
+    def columns(self, run: AxisLog, context: EffectContext, shape: float | None = None) -> np.ndarray:
+        """Regressor columns of one prepared run, shape ``(n, n_columns)``."""
+        columns = self.build(run, context, self.check_shape(shape))
+        return np.asarray(columns, dtype=float).reshape(len(run), self.n_columns)
+
+    def current(self, run: AxisLog, context: EffectContext, coefficients, shape: float | None = None
+                ) -> np.ndarray:
+        """The effect's current ``columns @ coefficients`` over one run [A, or N]."""
+        return self.columns(run, context, shape) @ np.asarray(coefficients, dtype=float)
+
+    def parameters(self, coefficients, context: EffectContext, shape: float | None = None,
+                   unit: str = "A") -> dict[str, float]:
+        """Physical parameters from fitted coefficients; names end in their unit (``unit`` = A or N)."""
+        return self.describe(np.asarray(coefficients, dtype=float), context, self.check_shape(shape), unit)
+
+    def shape_grid(self, runs: Sequence[AxisLog], context: EffectContext) -> np.ndarray | None:
+        """Values of the shape parameter a scan tries (None without one)."""
+        return None if self.shape is None else self.shape.grid(runs, context)
+
+    def shape_bracket(self, shape: float, grid: np.ndarray) -> tuple[float, float]:
+        """Interval around ``shape`` one grid step wide on either side (in the grid's own scale), inside the grid."""
+        if self.shape.scale == "frequency":
+            frequencies = 1.0 / grid
+            step = float(np.max(np.abs(np.diff(frequencies)))) if grid.size > 1 else 0.5 / shape
+            low_f = max(1.0 / shape - step, float(frequencies.min()))
+            high_f = min(1.0 / shape + step, float(frequencies.max()))
+            return 1.0 / high_f, 1.0 / low_f
+        ratio = float(np.exp(np.max(np.abs(np.diff(np.log(grid)))))) if grid.size > 1 else 2.0
+        return max(shape / ratio, float(grid.min())), min(shape * ratio, float(grid.max()))
+
+
+# ----------------------------------------------------------------- grids
+def period_scan(runs: Sequence[AxisLog], context: EffectContext) -> tuple[float, np.ndarray]:
+    """Spatial frequency step [1/mm] and periods [mm] scanned for the position-periodic effects.
+
+    The frequencies ``1 / P`` are the integer multiples of the step
+    ``1 / (4 R)`` (four points per periodogram resolution ``1 / R``, ``R``
+    the position range of the training data) from ``1 / R`` up to
+    ``1 / P_min``, ``P_min`` giving 4 samples per period at the median moving
+    speed; with more than 4000 periods the step grows. Periods come longest first.
+    """
+    low, high = context.position_range_mm
+    span = high - low
+    steps = np.concatenate([np.abs(np.diff(run.position)) for run in runs])
+    moving = steps[steps > 0.0]
+    p_min = _SAMPLES_PER_PERIOD * float(np.median(moving)) if moving.size else span / 4.0
+    f_low, f_high = 1.0 / span, 1.0 / min(p_min, span / 4.0)
+    step = max(1.0 / (_PERIOD_OVERSAMPLING * span), f_high / _MAX_PERIODS)
+    multiples = np.arange(int(np.ceil(f_low / step - 1e-9)), int(np.floor(f_high / step + 1e-9)) + 1)
+    return step, 1.0 / (multiples * step)
+
+
+def period_grid(runs: Sequence[AxisLog], context: EffectContext) -> np.ndarray:
+    """Periods [mm] scanned for the position-periodic effects (see :func:`period_scan`)."""
+    return period_scan(runs, context)[1]
+
+
+def _time_constant_grid(runs, context) -> np.ndarray:
+    longest = max(run.time[-1] - run.time[0] for run in runs)
+    return np.geomspace(longest / 50.0, 10.0 * longest, _LOG_GRID_POINTS)
+
+
+def _stribeck_velocity_grid(runs, context) -> np.ndarray:
+    """From three velocity scales ``v_e`` (below, a Stribeck curve mimics the direction factor's smoothing) to the top speed."""
+    speed = np.concatenate([np.abs(run.velocity) for run in runs])
+    top = float(np.percentile(speed, 99.9))
+    return np.geomspace(min(max(1e-3 * top, 3.0 * context.velocity_scale_mm_s), 0.5 * top), top, _LOG_GRID_POINTS)
+
+
+# ----------------------------------------------------------------- columns and parameters
+def _elapsed(run: AxisLog) -> np.ndarray:
+    return run.time - run.time[0]
+
+
+def _legendre_2(u):
+    return 0.5 * (3.0 * u * u - 1.0)
+
+
+def _friction_weight(run, context):
+    return context.direction(run)
+
+
+def _force_weight(run, context):
+    return np.ones(len(run))
+
+
+def _periodic(weight):
+    def build(run, context, period):
+        phase = 2.0 * np.pi * run.position / period
+        return np.column_stack((np.sin(phase), np.cos(phase))) * weight(run, context)[:, None]
+    return build
+
+
+def _amplitude_phase(coefficients, context, period, unit):
+    sine, cosine = coefficients
+    return {"period_mm": period, f"amplitude_{unit}": float(np.hypot(sine, cosine)),
+            "phase_rad": float(np.arctan2(cosine, sine))}
+
+
+def _trend_parameters(coefficients, context, shape, unit):
+    low, high = context.position_range_mm
+    linear, quadratic = coefficients
+    return {f"slope_{unit}_per_mm": float(2.0 * linear / (high - low)),
+            f"change_over_range_{unit}": float(2.0 * linear),
+            f"end_rise_{unit}": float(1.5 * quadratic),
+            "range_low_mm": low, "range_high_mm": high}
+
+
+def _single(key):
+    def describe(coefficients, context, shape, unit):
+        return {key.format(E=unit): float(coefficients[0])}
+    return describe
+
+
+def _with_shape(key, shape_key):
+    def describe(coefficients, context, shape, unit):
+        return {key.format(E=unit): float(coefficients[0]), shape_key: shape}
+    return describe
+
+
+_PERIOD = ShapeParameter("period_mm", "frequency", period_grid)
+
+_LIBRARY = (
+    Effect("direction_asymmetry", "friction differs with the direction of motion",
+           ("positive_direction",),
+           lambda run, c, s: np.maximum(c.direction(run), 0.0),
+           _single("level_difference_{E}")),
+    Effect("constant_offset", "constant effort: gravity, weight compensation or a current bias",
+           ("one",),
+           lambda run, c, s: np.ones(len(run)),
+           _single("offset_{E}")),
+    Effect("position_trend", "friction changing smoothly along the travel",
+           ("trend_linear", "trend_quadratic"),
+           lambda run, c, s: np.column_stack((c.unit_position(run), _legendre_2(c.unit_position(run))))
+           * c.direction(run)[:, None],
+           _trend_parameters),
+    Effect("position_periodic_friction", "friction periodic in position, flipping with the direction "
+           "(ball-screw preload ripple)",
+           ("sin_friction", "cos_friction"),
+           _periodic(_friction_weight), _amplitude_phase, _PERIOD, _friction_weight),
+    Effect("position_periodic_force", "force periodic in position, the same in both directions (cogging)",
+           ("sin_force", "cos_force"),
+           _periodic(_force_weight), _amplitude_phase, _PERIOD, _force_weight),
+    Effect("thermal_drift", "friction changing with the time since the start of the run",
+           ("drift",),
+           lambda run, c, s: (1.0 - np.exp(-_elapsed(run) / s)) * c.direction(run),
+           _with_shape("change_{E}", "time_constant_s"),
+           ShapeParameter("time_constant_s", "log", _time_constant_grid)),
+    Effect("inertia_mismatch", "inertia the model lacks (e.g. a workpiece on the table)",
+           ("acceleration",),
+           lambda run, c, s: run.acceleration,
+           _single("extra_inertia_{E}_s2_per_mm")),
+    Effect("viscous_friction", "friction proportional to the velocity",
+           ("velocity",),
+           lambda run, c, s: run.velocity,
+           _single("extra_viscous_{E}_s_per_mm")),
+    Effect("stribeck", "friction excess at low speed, decaying with the speed",
+           ("stribeck",),
+           lambda run, c, s: np.exp(-np.abs(run.velocity) / s) * c.direction(run),
+           _with_shape("excess_at_rest_{E}", "v_s_mm_s"),
+           ShapeParameter("v_s_mm_s", "log", _stribeck_velocity_grid)),
+    Effect("load_dependent_friction", "friction growing with the axial (inertial) load",
+           ("load",),
+           lambda run, c, s: np.abs(run.acceleration) * c.direction(run),
+           _single("friction_per_acceleration_{E}_s2_per_mm")),
+)
+
+#: The candidate effects by name.
+EFFECTS: dict[str, Effect] = {e.name: e for e in _LIBRARY}
+
+#: Effect names in library order.
+EFFECT_NAMES: tuple[str, ...] = tuple(EFFECTS)
+
+
+def effect(name: str) -> Effect:
+    """Return the library effect ``name``.
+
+    Raises
+    ------
+    GreyboxError
+        If there is no such effect.
+    """
+    if name not in EFFECTS:
+        raise GreyboxError(f"unknown effect {name!r}; the library has {', '.join(EFFECT_NAMES)}")
+    return EFFECTS[name]
