@@ -1,0 +1,343 @@
+"""A base current model plus named effect terms, fitted jointly.
+
+:class:`AugmentedModel` adds terms of the effect library
+(:mod:`greybox.discover.effects`) to a friction model and fits them together:
+
+1. the base model is identified by its own ``fit`` (its nonlinear shape:
+   Stribeck velocity, GMS element fractions, ...);
+2. with that shape held, the base's linear parameters
+   (:mod:`greybox.discover.baselinear`: inertia, friction levels or
+   stiffnesses, viscous coefficient, offset) and the coefficients of all terms
+   are solved by one bounded least-squares fit, and the terms' own shape
+   parameters (period, time constant, Stribeck velocity) are refined by a
+   bounded scalar search of that fit's residual, one grid step around their
+   start value;
+3. with ``refit_base``, the base is identified again on the effort minus the
+   terms (its shape may now move), and step 2 is repeated.
+
+The prediction is ``J a + base friction + sum of terms + offset``. A
+``constant_offset`` term is reported in ``offset_`` and an
+``inertia_mismatch`` term in ``J_``; every other term belongs to what
+:meth:`~greybox.models.base.CurrentModel.friction` returns (so does a
+cogging-like ``position_periodic_force``, which is not friction strictly).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Iterable, Sequence
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+from sklearn.base import clone
+from sklearn.utils.validation import check_is_fitted
+from threadpoolctl import threadpool_limits
+
+from ..data.log import AxisLog
+from ..errors import GreyboxError, ParameterError
+from ..identify.linear import bounded_lstsq
+from ..identify.progress import make_progress
+from ..models.base import CurrentModel, check_runs
+from .baselinear import LinearPart, base_coefficients, base_linear_part, set_base_coefficients
+from .effects import Effect, EffectContext, effect, period_scan
+from .projection import Nuisance, PositionScan, added_squares
+
+__all__ = ["AugmentedModel", "normalise_effects"]
+
+#: Terms reported in the model's inertia and offset rather than in its friction.
+_INERTIA_TERM = "inertia_mismatch"
+_OFFSET_TERM = "constant_offset"
+
+
+def normalise_effects(effects) -> list[tuple[str, float | None]]:
+    """``effects`` as a list of ``(name, shape)`` pairs, checked against the library.
+
+    Parameters
+    ----------
+    effects : iterable
+        Items ``"name"`` or ``(name, shape)``; the shape (period [mm], time
+        constant [s] or Stribeck velocity [mm/s]) may be None for an effect
+        that has one, to let the fit choose it.
+
+    Raises
+    ------
+    GreyboxError
+        For an unknown effect, a bad shape, or an effect without a shape
+        parameter given twice.
+    """
+    pairs = []
+    for item in effects or ():
+        name, shape = (item, None) if isinstance(item, str) else tuple(item)
+        term = effect(name)
+        if shape is not None:
+            term.check_shape(shape)
+            shape = float(shape)
+        if term.shape is None and any(existing == name for existing, _ in pairs):
+            raise GreyboxError(f"effect {name!r} is given twice; only periodic effects may repeat")
+        pairs.append((name, shape))
+    return pairs
+
+
+class AugmentedModel(CurrentModel):
+    """Base current model plus effect terms, refitted jointly.
+
+    Parameters
+    ----------
+    base : CurrentModel, optional
+        Settings of the base model (unfitted, cloned before fitting);
+        ``GMSModel()`` by default. To start from a base already fitted to the
+        same runs, pass it to :meth:`fit_terms` instead.
+    effects : sequence, default ()
+        Terms to add: effect names or ``(name, shape)`` pairs, see
+        :func:`normalise_effects`. A periodic effect may appear more than once
+        (with different periods).
+    refine_shapes : bool, default True
+        Refine each term's shape parameter by least squares within one grid
+        step of its start value; otherwise keep it as given.
+    refit_base : bool, default True
+        After the first joint fit, identify the base model again on the
+        effort minus the terms, then fit jointly once more.
+    velocity_scale_mm_s : float, optional
+        ``v_e`` of the direction factor ``tanh(v / v_e)`` of the terms [mm/s];
+        1 % of the 99th percentile of the training speed by default.
+
+    Attributes
+    ----------
+    base_ : CurrentModel
+        The fitted base model, holding the jointly fitted linear parameters.
+    effects_ : list of dict
+        One entry per term: ``name``, ``shape`` (or None), ``coefficients``
+        (one per column of the effect) and ``parameters`` (physical values,
+        names ending in their unit).
+    velocity_scale_mm_s_ : float
+        ``v_e`` used [mm/s].
+    position_range_mm_ : tuple of float
+        Position range of the training runs [mm], the scale of ``position_trend``.
+    J_ : float
+        Inertia [A s^2/mm]: the base's plus an ``inertia_mismatch`` term.
+    offset_ : float
+        Offset [A]: the base's plus a ``constant_offset`` term.
+    effort_unit_ : str
+        "A" or "N".
+    """
+
+    def __init__(self, base=None, effects=(), refine_shapes: bool = True, refit_base: bool = True,
+                 velocity_scale_mm_s: float | None = None):
+        self.base = base
+        self.effects = effects
+        self.refine_shapes = refine_shapes
+        self.refit_base = refit_base
+        self.velocity_scale_mm_s = velocity_scale_mm_s
+
+    # ---------------------------------------------------------------- fitting
+    def _template(self):
+        if self.base is None:
+            from ..friction import GMSModel
+
+            return GMSModel()
+        if not isinstance(self.base, CurrentModel) or isinstance(self.base, AugmentedModel):
+            raise ParameterError(f"base must be a current model other than AugmentedModel, "
+                                 f"got {type(self.base).__name__}")
+        return self.base
+
+    def _fit_runs(self, runs, progress) -> None:
+        base = clone(self._template()).fit(runs, progress=progress)
+        self._fit_terms(runs, base, progress)
+
+    def fit_terms(self, logs: AxisLog | Iterable[AxisLog], base, progress=None) -> "AugmentedModel":
+        """Fit the terms jointly with a base model already fitted to the same runs.
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs the base was fitted on.
+        base : CurrentModel
+            The fitted base (a copy is kept; its settings should match ``self.base``,
+            which is used when ``refit_base`` identifies it again).
+        progress : None, bool or callable, optional
+            Passed to the base's ``fit`` when it is identified again.
+
+        Returns
+        -------
+        self
+        """
+        check_is_fitted(base)
+        runs = check_runs(logs)
+        self.effort_unit_ = runs[0].effort_unit
+        self.sample_time_ = float(np.median([run.sample_time for run in runs]))
+        self.n_samples_fit_ = int(sum(len(run) for run in runs))
+        self._fit_terms(runs, copy.deepcopy(base), make_progress(progress))
+        return self
+
+    def _fit_terms(self, runs: list[AxisLog], base, progress) -> None:
+        template = self._template()
+        context = EffectContext.from_runs(runs, self.velocity_scale_mm_s)
+        terms = [(effect(name), shape) for name, shape in normalise_effects(self.effects)]
+        target = np.concatenate([run.effort for run in runs])
+        shapes = [shape for _, shape in terms]
+        rounds = 2 if (self.refit_base and terms) else 1
+        with threadpool_limits(limits=1, user_api="blas"):
+            for round_ in range(rounds):
+                if round_ == 1:
+                    term_current = self._term_currents(runs, context, terms, shapes, coefficients)
+                    shifted = [run.replace(effort=run.effort - part) for run, part in zip(runs, term_current)]
+                    base = clone(template).fit(shifted, progress=progress)
+                part = _joined([base_linear_part(base, run) for run in runs])
+                shapes = [self._start_shape(term, shape, runs, context, part, target)
+                          for term, shape in zip([t for t, _ in terms], shapes)]
+                if self.refine_shapes:
+                    shapes = self._refine(runs, context, terms, shapes, part, target)
+                coefficients = self._solve(runs, context, terms, shapes, part, target)[0]
+                set_base_coefficients(base, coefficients[:part.columns.shape[1]])
+        self._store(base, context, terms, shapes, coefficients[part.columns.shape[1]:])
+
+    def _start_shape(self, term: Effect, shape, runs, context, part: LinearPart, target) -> float | None:
+        """The given shape, or the best of the effect's grid against the base's residual."""
+        if term.shape is None or shape is not None:
+            return shape
+        grid = term.shape_grid(runs, context)
+        nuisance = Nuisance(part.columns)
+        residual = nuisance.project((target - part.fixed)[:, None])
+        if term.shape.scale == "frequency":
+            weight = np.concatenate([term.weight(run, context) for run in runs])
+            position = np.concatenate([run.position for run in runs])
+            step = period_scan(runs, context)[0]
+            scan = PositionScan(position, weight, nuisance, residual, step, 1.0 / float(np.min(grid)))
+            scores = scan.reductions(grid)[:, 0]
+        else:
+            scores = [added_squares(np.concatenate([term.columns(run, context, g) for run in runs]),
+                                    residual, nuisance)[0] for g in grid]
+        return float(grid[int(np.argmax(scores))])
+
+    def _design(self, runs, context, terms, shapes) -> np.ndarray:
+        blocks = [np.concatenate([term.columns(run, context, shape) for run in runs])
+                  for (term, _), shape in zip(terms, shapes)]
+        return np.hstack(blocks) if blocks else np.empty((sum(len(run) for run in runs), 0))
+
+    def _solve(self, runs, context, terms, shapes, part: LinearPart, target):
+        extra = self._design(runs, context, terms, shapes)
+        matrix = np.hstack((part.columns, extra))
+        lower = np.concatenate((part.lower, np.full(extra.shape[1], -np.inf)))
+        upper = np.concatenate((part.upper, np.full(extra.shape[1], np.inf)))
+        if matrix.shape[1] == 0:
+            residual = part.fixed - target
+            return np.empty(0), float(residual @ residual)
+        x, residual = bounded_lstsq(matrix, target - part.fixed, lower, upper)
+        return x, float(residual @ residual)
+
+    def _refine(self, runs, context, terms, shapes, part, target) -> list:
+        shapes = list(shapes)
+        for i, (term, _) in enumerate(terms):
+            if term.shape is None:
+                continue
+            grid = term.shape_grid(runs, context)
+            low, high = term.shape_bracket(shapes[i], grid)
+            frequency = term.shape.scale == "frequency"
+            to_shape = (lambda s: 1.0 / s) if frequency else np.exp
+            bounds = (1.0 / high, 1.0 / low) if frequency else (np.log(low), np.log(high))
+
+            def cost(s, i=i):
+                trial = shapes[:i] + [float(to_shape(s))] + shapes[i + 1:]
+                return self._solve(runs, context, terms, trial, part, target)[1]
+
+            start = 1.0 / shapes[i] if frequency else np.log(shapes[i])
+            result = minimize_scalar(cost, bounds=bounds, method="bounded",
+                                     options={"xatol": 1e-4 * abs(bounds[1] - bounds[0])})
+            if result.fun < cost(start):
+                shapes[i] = float(to_shape(result.x))
+        return shapes
+
+    @staticmethod
+    def _term_currents(runs, context, terms, shapes, coefficients) -> list[np.ndarray]:
+        """Sum of the terms' currents per run, from the joint solution's term coefficients."""
+        n_base = len(coefficients) - sum(term.n_columns for term, _ in terms)
+        out = []
+        for run in runs:
+            total = np.zeros(len(run))
+            start = n_base
+            for (term, _), shape in zip(terms, shapes):
+                total += term.current(run, context, coefficients[start:start + term.n_columns], shape)
+                start += term.n_columns
+            out.append(total)
+        return out
+
+    def _store(self, base, context, terms, shapes, coefficients) -> None:
+        self.base_ = base
+        self.velocity_scale_mm_s_ = float(context.velocity_scale_mm_s)
+        self.position_range_mm_ = tuple(float(value) for value in context.position_range_mm)
+        self.effects_ = []
+        start = 0
+        for (term, _), shape in zip(terms, shapes):
+            values = coefficients[start:start + term.n_columns]
+            start += term.n_columns
+            self.effects_.append({
+                "name": term.name,
+                "shape": shape,
+                "coefficients": [float(value) for value in values],
+                "parameters": term.parameters(values, context, shape, self.effort_unit_),
+            })
+        self.J_ = float(base.J_) + sum(e["coefficients"][0] for e in self.effects_ if e["name"] == _INERTIA_TERM)
+        self.offset_ = float(base.offset_) + sum(e["coefficients"][0] for e in self.effects_
+                                                 if e["name"] == _OFFSET_TERM)
+
+    # ---------------------------------------------------------------- prediction
+    @property
+    def context(self) -> EffectContext:
+        """Scales of the effect regressors, fixed at fit time."""
+        check_is_fitted(self, "effects_")
+        return EffectContext(self.velocity_scale_mm_s_, tuple(self.position_range_mm_))
+
+    def _friction_run(self, run: AxisLog) -> np.ndarray:
+        total = self.base_.friction(run)
+        for entry in self.effects_:
+            if entry["name"] not in (_INERTIA_TERM, _OFFSET_TERM):
+                total = total + effect(entry["name"]).current(run, self.context, entry["coefficients"],
+                                                              entry["shape"])
+        return total
+
+    def _n_params(self) -> int:
+        own = sum(effect(e["name"]).n_columns + (e["shape"] is not None) for e in self.effects_)
+        return self.base_.n_params + own
+
+    def term_currents(self, logs: AxisLog | Iterable[AxisLog]) -> dict[str, np.ndarray]:
+        """The current of each term over the runs, concatenated [A, or N].
+
+        Returns
+        -------
+        dict
+            ``"<index>:<name>"`` (1-based, in the order of ``effects_``) -> current.
+        """
+        runs = self._check_predict_runs(logs)
+        return {f"{i + 1}:{e['name']}": np.concatenate([effect(e["name"]).current(run, self.context,
+                                                                                  e["coefficients"], e["shape"])
+                                                        for run in runs])
+                for i, e in enumerate(self.effects_)}
+
+    def linear_part(self, logs: AxisLog | Sequence[AxisLog]) -> LinearPart:
+        """The whole prediction as ``columns @ coefficients() + fixed`` at the fitted shapes.
+
+        Columns: the base's linear parameters, then every term's columns
+        (named ``"<effect>.<column>"``).
+        """
+        runs = self._check_predict_runs(logs)
+        part = _joined([base_linear_part(self.base_, run) for run in runs])
+        names, blocks = list(part.names), [part.columns]
+        for entry in self.effects_:
+            term = effect(entry["name"])
+            blocks.append(np.concatenate([term.columns(run, self.context, entry["shape"]) for run in runs]))
+            names += [f"{term.name}.{column}" for column in term.column_names]
+        n_extra = sum(block.shape[1] for block in blocks[1:])
+        return LinearPart(np.hstack(blocks), part.fixed, tuple(names),
+                          np.concatenate((part.lower, np.full(n_extra, -np.inf))),
+                          np.concatenate((part.upper, np.full(n_extra, np.inf))))
+
+    def coefficients(self) -> np.ndarray:
+        """Coefficients of :meth:`linear_part`'s columns."""
+        check_is_fitted(self, "effects_")
+        return np.concatenate([base_coefficients(self.base_)] + [e["coefficients"] for e in self.effects_])
+
+
+def _joined(parts: list[LinearPart]) -> LinearPart:
+    first = parts[0]
+    return LinearPart(np.vstack([p.columns for p in parts]), np.concatenate([p.fixed for p in parts]),
+                      first.names, first.lower, first.upper)

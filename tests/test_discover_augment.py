@@ -1,0 +1,111 @@
+"""AugmentedModel: a base friction model plus effect terms, fitted jointly."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from greybox.data.prepare import prepare
+from greybox.discover.augment import AugmentedModel
+from greybox.discover.baselinear import base_linear_part
+from greybox.discover.effects import effect
+from greybox.errors import GreyboxError
+from greybox.friction import CoulombModel, StribeckModel
+from greybox.models import registry
+from greybox.models.persistence import load_model, save_model
+from greybox.twin import make_dataset
+
+
+@pytest.fixture(scope="module")
+def stroke():
+    """A prepared random-window log (motion only; the tests set the effort)."""
+    return prepare([make_dataset("X", "A", seed=5, duration_s=20.0)])[0]
+
+
+def coulomb_current(run):
+    return 3e-4 * run.acceleration + 0.9 * np.sign(run.velocity) + 0.006 * run.velocity
+
+
+def test_joint_fit_is_one_least_squares_solve_over_base_and_terms(stroke):
+    rng = np.random.default_rng(0)
+    run = stroke.replace(effort=coulomb_current(stroke) + 0.1 + rng.normal(0, 0.05, len(stroke)))
+    model = AugmentedModel(base=CoulombModel(), effects=[("constant_offset", None), ("thermal_drift", 7.0)],
+                           refine_shapes=False, refit_base=False).fit(run)
+    context = model.context
+    columns = np.column_stack([base_linear_part(model.base_, run).columns,
+                               effect("constant_offset").columns(run, context),
+                               effect("thermal_drift").columns(run, context, 7.0)])
+    expected, *_ = np.linalg.lstsq(columns, run.effort, rcond=None)
+    np.testing.assert_allclose(model.coefficients(), expected, rtol=1e-8, atol=1e-12)
+    np.testing.assert_allclose(model.predict(run), columns @ expected, atol=1e-10)
+    # the constant term is reported in the offset, the rest of the prediction is inertia + friction
+    assert model.offset_ == pytest.approx(expected[3])
+    np.testing.assert_allclose(model.predict(run), model.J_ * run.acceleration + model.friction(run)
+                               + model.offset_, atol=1e-12)
+
+
+def test_inertia_mismatch_is_reported_in_the_inertia(stroke):
+    run = stroke.replace(effort=coulomb_current(stroke))
+    model = AugmentedModel(base=CoulombModel(), effects=["inertia_mismatch"]).fit(run)
+    assert model.J_ == pytest.approx(3e-4, rel=1e-6)
+    np.testing.assert_allclose(model.predict(run), run.effort, atol=1e-9)
+
+
+@pytest.mark.parametrize("name, period", [("position_periodic_friction", 6.0), ("position_periodic_force", 2.5)])
+def test_a_periodic_term_recovers_period_amplitude_and_phase(stroke, name, period):
+    context = AugmentedModel(base=CoulombModel()).fit(stroke.replace(effort=coulomb_current(stroke))).context
+    amplitude, phase = 0.08, -0.7
+    hidden = effect(name).current(stroke, context, amplitude * np.array([np.cos(phase), np.sin(phase)]), period)
+    rng = np.random.default_rng(1)
+    run = stroke.replace(effort=coulomb_current(stroke) + hidden + rng.normal(0, 0.03, len(stroke)))
+    model = AugmentedModel(base=CoulombModel(), effects=[(name, None)]).fit(run)
+    parameters = model.effects_[0]["parameters"]
+    assert parameters["period_mm"] == pytest.approx(period, rel=0.01)
+    assert parameters["amplitude_A"] == pytest.approx(amplitude, rel=0.05)
+    # the phase refers to x = 0, far outside the data: compare the currents instead
+    fitted = model.term_currents(run)[f"1:{name}"]
+    assert np.sqrt(np.mean((fitted - hidden) ** 2)) < 0.1 * np.sqrt(np.mean(hidden ** 2))
+
+
+def test_refit_base_moves_the_stribeck_shape_once_the_term_is_removed(stroke):
+    rng = np.random.default_rng(2)
+    hidden = 0.3 * np.sin(2 * np.pi * stroke.position / 6.0) * np.tanh(stroke.velocity / 0.3)
+    run = stroke.replace(effort=coulomb_current(stroke) + hidden + rng.normal(0, 0.03, len(stroke)))
+    fixed = AugmentedModel(base=StribeckModel(), effects=[("position_periodic_friction", 6.0)],
+                           refit_base=False).fit(run)
+    refit = AugmentedModel(base=StribeckModel(), effects=[("position_periodic_friction", 6.0)],
+                           refit_base=True).fit(run)
+    residual = [np.mean((run.effort - m.predict(run)) ** 2) for m in (fixed, refit)]
+    assert residual[1] <= residual[0] * (1 + 1e-9)
+
+
+def test_term_currents_add_up_to_the_prediction_minus_the_base(stroke):
+    rng = np.random.default_rng(3)
+    run = stroke.replace(effort=coulomb_current(stroke) + rng.normal(0, 0.05, len(stroke)))
+    model = AugmentedModel(base=CoulombModel(), effects=["direction_asymmetry", ("stribeck", 3.0)]).fit(run)
+    terms = model.term_currents(run)
+    assert list(terms) == ["1:direction_asymmetry", "2:stribeck"]
+    np.testing.assert_allclose(model.predict(run), model.base_.predict(run) + sum(terms.values()), atol=1e-12)
+
+
+def test_bad_effects_are_refused(stroke):
+    run = stroke.replace(effort=coulomb_current(stroke))
+    with pytest.raises(GreyboxError, match="unknown effect"):
+        AugmentedModel(base=CoulombModel(), effects=["gravity"]).fit(run)
+    with pytest.raises(GreyboxError, match="given twice"):
+        AugmentedModel(base=CoulombModel(), effects=["constant_offset", "constant_offset"]).fit(run)
+    with pytest.raises(GreyboxError, match="has no shape"):
+        AugmentedModel(base=CoulombModel(), effects=[("constant_offset", 2.0)]).fit(run)
+
+
+def test_saved_model_predicts_identically(stroke, tmp_path, monkeypatch):
+    monkeypatch.setitem(registry.MODEL_CLASSES, "augmented", AugmentedModel)
+    rng = np.random.default_rng(4)
+    run = stroke.replace(effort=coulomb_current(stroke) + rng.normal(0, 0.05, len(stroke)))
+    model = AugmentedModel(base=StribeckModel(fit_offset=True),
+                           effects=[("position_periodic_force", 2.5), "position_trend"]).fit(run)
+    path = save_model(model, tmp_path / "augmented.gbm")
+    loaded = load_model(path)
+    assert type(loaded) is AugmentedModel and type(loaded.base_) is StribeckModel
+    np.testing.assert_array_equal(loaded.predict(run), model.predict(run))
+    assert loaded.effects_ == model.effects_
