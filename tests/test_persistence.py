@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from sklearn.base import BaseEstimator
 
+from greybox import atomic
 from greybox.errors import ModelFileError
 from greybox.models import persistence, registry
 from greybox.models.persistence import FORMAT_VERSION, load_model, save_model
@@ -145,7 +146,7 @@ def test_failed_write_leaves_old_file_and_no_temporary(tmp_path, data, monkeypat
     def broken_replace(source, target):
         raise OSError("disk full")
 
-    monkeypatch.setattr(persistence.os, "replace", broken_replace)
+    monkeypatch.setattr(atomic.os, "replace", broken_replace)
     with pytest.raises(OSError, match="disk full"):
         save_model(ToyModel().fit(*data), path, overwrite=True)
     assert path.read_bytes() == before

@@ -23,13 +23,12 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 import re
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import write_text_atomic
 from ..errors import GreyboxError
 from ..evaluate.plots import save_figure
 from .loop import LoopResult
@@ -142,17 +141,6 @@ def plot_tracking_errors(results: list[LoopResult], reference_name: str, path=No
     return save_figure(figure, path)
 
 
-def _write_text(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-
-
 def _csv_text(rows: list[dict]) -> str:
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=list(rows[0]), lineterminator="\n")
@@ -200,12 +188,12 @@ def write_report(results: list[LoopResult], out_dir, *, settings: dict | None = 
                 "'none' feeds forward the inertia only. One set of PID gains for every row.", "",
                 "## Settings", "", f"- controller: {json.dumps(first)}"]
     markdown += [f"- {key}: {json.dumps(value)}" for key, value in settings.items()]
-    _write_text(targets[0], "\n".join(markdown) + "\n")
-    _write_text(targets[1], _csv_text(rows))
+    write_text_atomic(targets[0], "\n".join(markdown) + "\n")
+    write_text_atomic(targets[1], _csv_text(rows))
     strict_rows = [{key: (None if isinstance(value, float) and np.isnan(value) else value)
                     for key, value in row.items()} for row in rows]
     document = {"settings": {**settings, "controller": first}, "rows": strict_rows}
-    _write_text(targets[2], json.dumps(document, indent=2, allow_nan=False) + "\n")
+    write_text_atomic(targets[2], json.dumps(document, indent=2, allow_nan=False) + "\n")
     for name, path in zip(names, targets[len(REPORT_FILES):]):
         plot_tracking_errors(results, name, path)
     return targets

@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import importlib
 import os
-import tempfile
 from pathlib import Path
 from typing import Mapping, Sequence
 
+from ..atomic import atomic_output
 from ..errors import GreyboxError, LogError
 from .log import AxisLog
 from .units import CANONICAL_NAMES, UNIT_FACTORS, parse_column_name
@@ -166,19 +166,8 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
         if item.source and os.path.exists(path) and os.path.exists(item.source) and os.path.samefile(path, item.source):
             raise LogError(path, "refusing to overwrite the file the log was read from; choose another output path")
     writer = _handler(fmt, 2)
-    directory = os.path.dirname(os.path.abspath(path))
-    handle, temporary = tempfile.mkstemp(dir=directory, prefix=f".{os.path.basename(path)}.", suffix=".tmp")
-    os.close(handle)
-    try:
-        writer(logs if fmt == "mcap" else logs[0], temporary)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise
+    with atomic_output(os.path.abspath(path)) as temporary:
+        writer(logs if fmt == "mcap" else logs[0], str(temporary))
 
 
 def parse_column_mapping(text: str) -> dict[str, str]:

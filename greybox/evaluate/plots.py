@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_output
 from ..data.log import AxisLog
 
 __all__ = ["plot_log", "save_figure"]
@@ -37,15 +37,11 @@ def save_figure(figure, path: str | os.PathLike, *, dpi: int = 120) -> Path:
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
     try:
-        figure.savefig(tmp, dpi=dpi, format=path.suffix.lstrip(".") or "png")
-        os.replace(tmp, path)
+        with atomic_output(path) as temporary:
+            figure.savefig(temporary, dpi=dpi, format=path.suffix.lstrip(".") or "png")
     finally:
         plt.close(figure)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path
 
 

@@ -25,11 +25,11 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_output
 from ..errors import GreyboxError
 from .process import ProcessResult
 
@@ -162,18 +162,8 @@ def write_process(result: ProcessResult, path, *, overwrite: bool = False, prote
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise GreyboxError(f"{path}: column '{name}' is not finite at sample {bad[0]}")
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(handle)
-    try:
-        _WRITERS[fmt](result, temporary)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise
+    with atomic_output(path) as temporary:
+        _WRITERS[fmt](result, str(temporary))
     return path
 
 

@@ -41,9 +41,7 @@ from __future__ import annotations
 import io
 import json
 import math
-import os
 import re
-import tempfile
 import zipfile
 import zlib
 from os import PathLike
@@ -51,6 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_output
 from ..errors import ModelFileError
 from . import registry
 
@@ -182,21 +181,11 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
         raise ModelFileError(f"{path}: directory {directory} does not exist")
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            with zipfile.ZipFile(stream, "w") as archive:
-                _write_member(archive, _JSON_MEMBER, text.encode("utf-8"))
-                for member, data in encoder.arrays.items():
-                    _write_member(archive, member, data)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise
+    with atomic_output(path) as temporary:
+        with zipfile.ZipFile(temporary, "w") as archive:
+            _write_member(archive, _JSON_MEMBER, text.encode("utf-8"))
+            for member, data in encoder.arrays.items():
+                _write_member(archive, member, data)
     return path
 
 
