@@ -11,6 +11,14 @@ with ``s`` the moving RMS of the residual over a window (``level_window_s``,
 Simulated series therefore keep the residual's autocorrelation and where in
 the log it is large (near reversals, say). Runs are simulated separately,
 each from the stationary state.
+
+The coefficients fitted to a finite residual are uncertain; their
+large-sample distribution is normal with covariance ``sigma_w^2 Gamma_p^-1 / n``
+(``Gamma_p`` the autocovariance matrix of order ``p``, ``n`` the number of
+samples). Each simulated series draws its own coefficients from it, so that
+the simulated noise varies as much as noise consistent with the residual
+does (a fixed estimate would make the simulated low-frequency power too
+certain, and tests calibrated on it slightly too eager).
 """
 
 from __future__ import annotations
@@ -19,6 +27,7 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
+import scipy.linalg
 from scipy.ndimage import uniform_filter1d
 from scipy.signal import lfilter
 
@@ -82,11 +91,14 @@ class ResidualNoise:
         Standard deviation of ``w`` (the normalised process has unit variance).
     levels : tuple of ndarray
         Local level ``s`` [A] of each run.
+    ar_covariance : ndarray, shape (p, p)
+        Covariance of the fitted coefficients (zeros: treat them as exact).
     """
 
     ar: np.ndarray
     innovation_std: float
     levels: tuple
+    ar_covariance: np.ndarray | None = None
 
     @classmethod
     def fit(cls, residuals: Sequence[np.ndarray], sample_times: Sequence[float], *, max_order: int = 20,
@@ -122,7 +134,9 @@ class ResidualNoise:
         best = int(np.argmin(aic))
         # unit variance of the normalised process
         innovation_std = float(np.sqrt(variance[best] / covariance[0]))
-        return cls(coefficients[best].copy(), innovation_std, tuple(levels))
+        gamma = scipy.linalg.toeplitz(covariance[:best]) if best else np.zeros((0, 0))
+        ar_covariance = variance[best] * np.linalg.inv(gamma) / n if best else np.zeros((0, 0))
+        return cls(coefficients[best].copy(), innovation_std, tuple(levels), ar_covariance)
 
     @property
     def lag1_correlation(self) -> float:
@@ -131,14 +145,37 @@ class ResidualNoise:
             return 0.0
         return float(_ar_autocorrelation(self.ar, 1)[1])
 
+    def draw_coefficients(self, n_replicates: int, rng: np.random.Generator) -> np.ndarray:
+        """AR coefficients of each replicate, shape ``(n_replicates, p)``: stationary draws around ``ar``."""
+        if self.ar_covariance is None or self.ar.size == 0:
+            return np.tile(self.ar, (n_replicates, 1))
+        draws = np.empty((n_replicates, self.ar.size))
+        root = np.linalg.cholesky(self.ar_covariance + 1e-15 * np.eye(self.ar.size))
+        for i in range(n_replicates):
+            for _ in range(20):
+                candidate = self.ar + root @ rng.standard_normal(self.ar.size)
+                if _stationary(candidate):
+                    break
+            else:
+                candidate = self.ar
+            draws[i] = candidate
+        return draws
+
     def simulate(self, n_replicates: int, rng: np.random.Generator) -> list[np.ndarray]:
-        """Simulated noise, one array ``(n_i, n_replicates)`` per run [A]."""
-        denominator = np.concatenate(([1.0], -self.ar))
+        """Simulated noise, one array ``(n_i, n_replicates)`` per run [A].
+
+        Each replicate has its own coefficients (:meth:`draw_coefficients`),
+        the same in every run, and unit variance before the level is applied.
+        """
+        coefficients = self.draw_coefficients(n_replicates, rng)
         burn_in = 10 * self.ar.size + 200
         out = []
         for level in self.levels:
-            innovation = rng.standard_normal((level.size + burn_in, n_replicates)) * self.innovation_std
-            series = lfilter([1.0], denominator, innovation, axis=0)[burn_in:]
+            innovation = rng.standard_normal((level.size + burn_in, n_replicates))
+            series = np.empty((level.size, n_replicates))
+            for j, phi in enumerate(coefficients):
+                scale = _unit_variance_innovation(phi)
+                series[:, j] = lfilter([scale], np.concatenate(([1.0], -phi)), innovation[:, j])[burn_in:]
             out.append(series * level[:, None])
         return out
 
@@ -147,6 +184,19 @@ class ResidualNoise:
         level = np.concatenate(self.levels)
         return {"ar_order": int(self.ar.size), "lag1_correlation": self.lag1_correlation,
                 "rms": float(np.sqrt(np.mean(level ** 2)))}
+
+
+def _stationary(ar: np.ndarray) -> bool:
+    """True if the roots of the characteristic polynomial lie inside the unit circle (stationary AR)."""
+    return bool(np.all(np.abs(np.roots(np.concatenate(([1.0], -ar)))) < 1.0 - 1e-6)) if ar.size else True
+
+
+def _unit_variance_innovation(ar: np.ndarray) -> float:
+    """Innovation standard deviation that gives the AR process unit variance."""
+    if ar.size == 0:
+        return 1.0
+    response = lfilter([1.0], np.concatenate(([1.0], -ar)), np.r_[1.0, np.zeros(4000)])
+    return float(1.0 / np.sqrt(response @ response))
 
 
 def _ar_autocorrelation(ar: np.ndarray, max_lag: int) -> np.ndarray:

@@ -1,0 +1,184 @@
+"""``greybox discover``: find what a friction model misses, name it, add it, show the gap shrink."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..discover.effects import EFFECT_NAMES
+from ..discover.report import write_json, write_report
+from ..discover.workflow import discover
+from ..errors import GreyboxError, ModelFileError
+from ..identify.progress import ProgressPrinter
+from ..models.persistence import load_model, save_model
+from ..models.registry import model_class
+from ._options import add_log_arguments, read_logs
+
+#: Base models whose linear parameters the effects are refitted with.
+BASE_KINDS = ("coulomb", "stribeck", "lugre", "gms")
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "discover",
+        help="find, name and add the effects a friction model misses",
+        description="Fit the base model on the training logs, locate where its residual lies (by regime), "
+        "score a library of named effects against a null calibrated on simulated data with nothing missing, "
+        "add the winning effect and refit jointly (at most --max-effects times), and report the error on the "
+        "test logs before and after. Effects: " + ", ".join(EFFECT_NAMES) + ".",
+    )
+    parser.add_argument("--base", required=True, choices=BASE_KINDS, help="base model kind")
+    parser.add_argument("--train", required=True, nargs="+", metavar="LOG",
+                        help="training logs (CSV, Parquet, MCAP or EMPS .mat), each a separate run")
+    parser.add_argument("--test", required=True, nargs="+", metavar="LOG", help="test logs, each a separate run")
+    parser.add_argument("--json", required=True, metavar="OUT", help="JSON file of the findings to write")
+    parser.add_argument("--report", metavar="DIR", help="also write the JSON and residual plots into DIR")
+    parser.add_argument("--save-model", metavar="MODEL", help="save the augmented model to this file (.gbm)")
+    parser.add_argument("--force", action="store_true", help="overwrite MODEL if it exists")
+    workflow = parser.add_argument_group("discovery options")
+    workflow.add_argument("--effects", metavar="NAMES",
+                          help="comma-separated effects to consider (default: the whole library)")
+    workflow.add_argument("--max-effects", type=int, default=3, metavar="N", help="most effects to add (default 3)")
+    workflow.add_argument("--alpha", type=float, default=0.05,
+                          help="chance of naming an effect when nothing is missing (default 0.05)")
+    workflow.add_argument("--null-replicates", type=int, default=99, metavar="B",
+                          help="simulated null data sets per step (default 99)")
+    workflow.add_argument("--seed", type=int, default=0, help="seed of the null simulations (default 0)")
+    workflow.add_argument("--no-refit-base", action="store_true",
+                          help="keep the base model's nonlinear shape when effects are added (faster)")
+    model = parser.add_argument_group("base model options")
+    model.add_argument("--offset", action="store_true", help="base model fits a constant effort offset")
+    model.add_argument("--asymmetric", action="store_true",
+                       help="separate Coulomb and viscous levels per direction (coulomb)")
+    model.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms)")
+    model.add_argument("--model-seed", type=int, metavar="N", help="seed of the multi-start identification (lugre, gms)")
+    parser.add_argument("--quiet", action="store_true", help="no progress display")
+    add_log_arguments(parser)
+    parser.set_defaults(run=run)
+
+
+def _check_outputs(args) -> None:
+    """Refuse before any fitting when an output would overwrite an input or cannot be written."""
+    inputs = [Path(p) for p in list(args.train) + list(args.test)]
+    outputs = [Path(args.json)] + ([Path(args.save_model)] if args.save_model else [])
+    for out in outputs:
+        for source in inputs:
+            if out.exists() and source.exists() and os.path.samefile(out, source):
+                raise GreyboxError(f"{out}: is one of the input logs; refusing to overwrite it")
+        if out.is_dir():
+            raise GreyboxError(f"{out}: is a directory")
+        if not (out.parent if str(out.parent) else Path(".")).is_dir():
+            raise GreyboxError(f"{out}: directory {out.parent} does not exist")
+    if args.save_model and Path(args.save_model).exists() and not args.force:
+        raise ModelFileError(f"{args.save_model}: file exists; use --force to overwrite it")
+    if args.report and Path(args.report).exists() and not Path(args.report).is_dir():
+        raise GreyboxError(f"{args.report}: exists and is not a directory")
+
+
+def build_base(args: argparse.Namespace):
+    """Unfitted base model of kind ``args.base`` with the base-model options.
+
+    Raises
+    ------
+    GreyboxError
+        If an option does not apply to the model kind.
+    """
+    model = model_class(args.base)()
+    accepted = model.get_params(deep=False)
+    params = {}
+    for option, name, value in (("--offset", "fit_offset", True if args.offset else None),
+                                ("--asymmetric", "asymmetric", True if args.asymmetric else None),
+                                ("--elements", "n_elements", args.elements),
+                                ("--model-seed", "random_state", args.model_seed)):
+        if value is None:
+            continue
+        if name not in accepted:
+            raise GreyboxError(f"option {option} does not apply to the {args.base} model")
+        params[name] = value
+    return model.set_params(**params)
+
+
+def _candidates(text: str | None) -> tuple[str, ...]:
+    if not text:
+        return EFFECT_NAMES
+    names = tuple(name.strip() for name in text.split(",") if name.strip())
+    unknown = [name for name in names if name not in EFFECT_NAMES]
+    if unknown or not names:
+        raise GreyboxError(f"unknown effect {', '.join(unknown) or '(none given)'}; "
+                           f"choose from {', '.join(EFFECT_NAMES)}")
+    return names
+
+
+def _format_parameters(parameters: dict) -> str:
+    return ", ".join(f"{key} = {value:.5g}" if isinstance(value, float) else f"{key} = {value}"
+                     for key, value in parameters.items())
+
+
+def _print_summary(result) -> None:
+    unit = result.unit
+    print(f"verdict: {result.verdict}")
+    for index, entry in enumerate(result.effects, 1):
+        evidence = entry["evidence"]
+        print(f"  {index}. {entry['name']}: {_format_parameters(entry['parameters'])}")
+        print(f"     explains {100 * evidence['explained_fraction']:.2f} % of the residual at step "
+              f"{evidence['step']} (passes beyond {100 * (evidence['threshold_fraction'] or np.inf):.3f} %, "
+              f"p = {evidence['p_value']:.3f}); the joint refit {100 * evidence['refit_explained_fraction']:.2f} %")
+        if evidence["indistinguishable_from"]:
+            print(f"     the data cannot tell it apart from: {', '.join(evidence['indistinguishable_from'])}")
+    last = result.steps[-1]
+    if last.structure.passes:
+        where = sorted(last.families.items(), key=lambda item: -item[1]["explained_fraction"])
+        print("  structure no library effect explains remains (strongest along: "
+              + ", ".join(f"{name} {100 * value['explained_fraction']:.2f} %" for name, value in where[:3]
+                          if value["p_value"] <= last.alpha) + ")")
+    for rejected in result.rejected:
+        print(f"  {rejected['name']} passed but its joint refit explained no more than chance: dropped")
+    for label, gap in (("train", result.train), ("test", result.test)):
+        if not gap:
+            continue
+        change = 100 * (gap["rmse_after"] - gap["rmse_before"]) / gap["rmse_before"]
+        print(f"{label} RMSE {gap['rmse_before']:.5g} -> {gap['rmse_after']:.5g} {unit} ({change:+.1f} %), "
+              f"RE {gap['re_before']:.3f} -> {gap['re_after']:.3f} %")
+    print(f"  {'test regime':<16} {'n':>8} {'RMSE before':>12} {'after':>10}")
+    for name, row in result.test["regimes"].items():
+        if row["n"]:
+            print(f"  {name:<16} {row['n']:>8d} {row['rmse_before']:>12.5g} {row['rmse_after']:>10.5g}")
+    print("  (RE = RMSE / mean |effort|; before: base model alone; after: with the named effects)")
+
+
+def run(args: argparse.Namespace) -> int:
+    _check_outputs(args)
+    names = _candidates(args.effects)
+    base = build_base(args)
+    started = time.perf_counter()
+
+    def say(text: str) -> None:
+        if not args.quiet:
+            print(f"[{time.perf_counter() - started:6.1f} s] {text}", file=sys.stderr, flush=True)
+
+    say(f"reading {len(args.train)} training and {len(args.test)} test log(s)")
+    train = read_logs(args, args.train)
+    test = read_logs(args, args.test)
+    result = discover(base, train, test, candidates=names, max_effects=args.max_effects, alpha=args.alpha,
+                      n_null=args.null_replicates, seed=args.seed, refit_base=not args.no_refit_base,
+                      progress=say, fit_progress=None if args.quiet else ProgressPrinter(interval=5.0))
+    document = result.to_dict()
+    document["logs"] = {"train": [str(p) for p in args.train], "test": [str(p) for p in args.test]}
+    _print_summary(result)
+    print(f"wrote {write_json(document, args.json)}")
+    if args.report:
+        for path in write_report(result, args.report, document):
+            print(f"wrote {path}")
+    if args.save_model:
+        save_model(result.model, args.save_model, overwrite=args.force)
+        reloaded = load_model(args.save_model)
+        if not np.array_equal(reloaded.predict(test), result.model.predict(test)):
+            raise ModelFileError(f"{args.save_model}: the saved model does not reproduce the fitted model")
+        print(f"wrote {args.save_model}")
+    print(f"done in {time.perf_counter() - started:.1f} s")
+    return 0

@@ -1,0 +1,292 @@
+"""Validation of the discovery workflow on the synthetic axis: hidden effects, null data, gap closure.
+
+A *case* hides one library effect, scaled so that its RMS current is a given
+multiple of the noise RMS, in a training log (dataset A) and a test log
+(dataset C) of the synthetic axis, runs :func:`~greybox.discover.workflow.discover`
+and compares with an *oracle*: the base model plus the true term at its true
+shape, fitted jointly. Two plants:
+
+``"coulomb"``
+    The effort is a Coulomb + viscous + inertia current plus the hidden
+    effect, both computed from the logged motion (position, and velocity and
+    acceleration as prepared), plus the twin's measurement noise: the base
+    model class (Coulomb) is exactly right and the effects are exactly the
+    twin's functions of the motion the models see, so any naming beyond the
+    hidden effect is a false one.
+``"twin"``
+    The twin's own truth plant (24-element Maxwell-slip friction with lagged
+    Stribeck curve, preload profile along the travel, lead ripple) plus the
+    hidden effect. A base model may then legitimately find the plant's own
+    structure (the lead ripple as ``position_periodic_friction``, say): such
+    *background* effects are those named on the same log without a hidden
+    effect, and they are not counted as false.
+
+On the twin plant, its effects (:data:`greybox.twin.EFFECTS`) are hidden as
+the twin computes them from the true motion; ``stribeck`` and
+``load_dependent_friction``, which the twin does not have, are hidden as the
+library's own terms. *Null* data are the base model fitted to a log without a
+hidden effect, simulated on that log's motion, plus noise like its residual
+(:class:`~greybox.discover.noise.ResidualNoise`): nothing is missing from
+the model by construction, so any verdict but ``nothing_missing`` is a false
+positive.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from sklearn.base import clone
+
+from ..data.log import AxisLog
+from ..data.prepare import prepare
+from ..evaluate.metrics import rmse
+from ..twin import EFFECTS as TWIN_EFFECTS
+from ..twin import CurrentNoise, EffectInputs, axis_geometry, default_plant_parameters, make_dataset
+from ..twin import effect_current as twin_effect_current
+from .augment import AugmentedModel
+from .effects import EffectContext, effect
+from .noise import ResidualNoise
+from .workflow import discover
+
+__all__ = ["PLANTS", "TRUE_SHAPES", "HIDDEN_LIBRARY_TERMS", "ABSORBED", "StudyCase", "case_logs", "null_logs",
+           "run_case", "run_null", "summarise"]
+
+#: Plants a case may use.
+PLANTS = ("coulomb", "twin")
+
+#: Shape of every hidden effect that has one (the twin's defaults, and the hidden library terms').
+TRUE_SHAPES = {"position_periodic_force": 2.5, "position_periodic_friction": 20.0, "thermal_drift": 60.0,
+               "stribeck": 2.0}
+
+#: Library effects the twin lacks, hidden as the library's own term (coefficient 1 A before scaling).
+HIDDEN_LIBRARY_TERMS = ("stribeck", "load_dependent_friction")
+
+#: Effects a base model with an inertia and a viscous coefficient absorbs: nothing is missing.
+ABSORBED = ("inertia_mismatch", "viscous_friction")
+
+#: A named period within this relative distance of the true one counts as right.
+PERIOD_TOLERANCE = 0.05
+
+_NOISE_STD_A = CurrentNoise().std_A
+
+
+@dataclass(frozen=True)
+class StudyCase:
+    """One hidden effect at one strength on one seed.
+
+    Parameters
+    ----------
+    effect : str or None
+        Hidden effect (None: plain log).
+    ratio : float
+        RMS of the hidden current on the training log over the noise RMS (0.065 A).
+    seed : int
+        Seed of the logs (trajectories and noise).
+    plant : {"coulomb", "twin"}
+        See the module notes.
+    duration_s : float
+        Length of the training and test logs [s].
+    """
+
+    effect: str | None
+    ratio: float
+    seed: int
+    plant: str = "coulomb"
+    duration_s: float = 30.0
+
+
+def _coulomb_current(run: AxisLog) -> np.ndarray:
+    plant = default_plant_parameters("X")
+    coulomb = plant.static_friction_A * plant.coulomb_ratio
+    return plant.inertia_A_s2_mm * run.acceleration + coulomb * np.sign(run.velocity) \
+        + plant.viscous_A_s_mm * run.velocity
+
+
+def _library_current(name: str, run: AxisLog, context: EffectContext) -> np.ndarray:
+    term = effect(name)
+    return term.current(run, context, np.ones(term.n_columns), TRUE_SHAPES.get(name))
+
+
+def case_logs(case: StudyCase) -> tuple[AxisLog, AxisLog, dict]:
+    """Prepared training (dataset A) and test (dataset C) logs of a case, and what was hidden.
+
+    Returns
+    -------
+    train, test : AxisLog
+        Prepared logs; effort in A.
+    info : dict
+        ``strength`` (factor of the unit effect), ``effect_rms_A`` on the
+        training log, ``noise_rms_A``.
+    """
+    if case.plant not in PLANTS:
+        raise ValueError(f"unknown plant {case.plant!r}; choose from {PLANTS}")
+    twin_effect = case.effect if case.effect in TWIN_EFFECTS else None
+    raw = [make_dataset("X", dataset, case.seed, effect=twin_effect, effect_strength=1.0,
+                        duration_s=case.duration_s) for dataset in ("A", "C")]
+    runs = prepare(raw)
+    context = EffectContext.from_runs(runs[:1])
+    unit_effects = []
+    for log, run in zip(raw, runs):
+        if case.effect is None:
+            unit_effects.append(np.zeros(len(run)))
+        elif twin_effect is not None and case.plant == "twin":
+            unit_effects.append(log.extras["truth_effect_A"])
+        elif twin_effect is not None:
+            inputs = EffectInputs(run.time - run.time[0], run.position, run.velocity, run.acceleration,
+                                  axis_geometry("X").travel_mm)
+            unit_effects.append(twin_effect_current(twin_effect, inputs, 1.0))
+        else:
+            unit_effects.append(_library_current(case.effect, run, context))
+    unit_rms = float(np.sqrt(np.mean(unit_effects[0] ** 2)))
+    strength = case.ratio * _NOISE_STD_A / unit_rms if case.effect is not None else 0.0
+    out = []
+    for log, run, unit in zip(raw, runs, unit_effects):
+        if case.plant == "coulomb":
+            effort = _coulomb_current(run) + log.extras["truth_noise_A"] + strength * unit
+        else:
+            injected = log.extras.get("truth_effect_A", 0.0)
+            effort = log.effort - injected + strength * unit
+        out.append(run.replace(effort=effort))
+    info = {"strength": strength, "effect_rms_A": strength * unit_rms,
+            "noise_rms_A": float(np.std(raw[0].extras["truth_noise_A"]))}
+    return out[0], out[1], info
+
+
+def null_logs(base, train: AxisLog, test: AxisLog, seed: int) -> tuple[AxisLog, AxisLog]:
+    """Data with nothing missing: ``base`` fitted on ``train``, simulated on both logs' motion plus noise.
+
+    The noise is :class:`ResidualNoise` fitted to the base's residual on the
+    training log (AR with the residual's autocorrelation and local level),
+    drawn independently for each log.
+    """
+    model = clone(base).fit(train)
+    rng = np.random.default_rng([seed, 7919])
+    residual = train.effort - model.predict(train)
+    noise = ResidualNoise.fit([residual], [train.sample_time])
+    train_noise = noise.simulate(1, rng)[0][:, 0]
+    test_noise = ResidualNoise(noise.ar, noise.innovation_std, (np.full(len(test), noise.describe()["rms"]),))
+    return (train.replace(effort=model.predict(train) + train_noise),
+            test.replace(effort=model.predict(test) + test_noise.simulate(1, rng)[0][:, 0]))
+
+
+def _correct(case: StudyCase, entry: dict) -> bool:
+    if entry["name"] != case.effect:
+        return False
+    period = entry["parameters"].get("period_mm")
+    return period is None or abs(period / TRUE_SHAPES[case.effect] - 1.0) <= PERIOD_TOLERANCE
+
+
+def run_case(base, case: StudyCase, *, background: frozenset = frozenset(), n_null: int = 99,
+             refit_base: bool = True) -> dict:
+    """Run the workflow on one case and score it against the oracle.
+
+    Parameters
+    ----------
+    base : CurrentModel
+        Unfitted base model.
+    case : StudyCase
+        The case.
+    background : frozenset of str
+        Effects named on the same plant and seed without a hidden effect.
+    n_null : int, default 99
+        Null replicates per step.
+    refit_base : bool, default True
+        See :func:`discover`.
+
+    Returns
+    -------
+    dict
+        The case, ``verdict``, ``named`` (names), ``correct`` (the hidden
+        effect is named, a period within 5 %), ``first_correct``,
+        ``spurious`` (named effects neither hidden nor background),
+        ``rmse_before``/``rmse_after``/``rmse_oracle`` on the test log [A],
+        ``closure`` ((before - after) / (before - oracle), None when the
+        oracle closes less than 1 % of the RMSE) and ``seconds``.
+    """
+    started = time.perf_counter()
+    train, test, info = case_logs(case)
+    result = discover(base, train, test, n_null=n_null, seed=case.seed, refit_base=refit_base)
+    named = [entry["name"] for entry in result.effects]
+    row = {"effect": case.effect, "ratio": case.ratio, "seed": case.seed, "plant": case.plant, **info,
+           "verdict": result.verdict, "named": named,
+           "parameters": [entry["parameters"] for entry in result.effects],
+           "correct": any(_correct(case, entry) for entry in result.effects),
+           "first_correct": bool(result.effects) and _correct(case, result.effects[0]),
+           "spurious": [name for name in named if name != case.effect and name not in background],
+           "rmse_before": result.test["rmse_before"], "rmse_after": result.test["rmse_after"]}
+    row["rmse_oracle"] = row["closure"] = None
+    if case.effect is not None:
+        oracle = AugmentedModel(base=base, effects=[(case.effect, TRUE_SHAPES.get(case.effect))],
+                                refine_shapes=False, refit_base=refit_base).fit_terms(train, result.base_model)
+        row["rmse_oracle"] = rmse(test.effort, oracle.predict(test))
+        gain = row["rmse_before"] - row["rmse_oracle"]
+        if gain > 0.01 * row["rmse_before"]:
+            row["closure"] = (row["rmse_before"] - row["rmse_after"]) / gain
+    row["seconds"] = time.perf_counter() - started
+    return row
+
+
+def run_null(base, seed: int, *, plant: str = "coulomb", duration_s: float = 30.0, n_null: int = 99,
+             refit_base: bool = True) -> dict:
+    """Run the workflow on null data (:func:`null_logs`) of a plain log; return its verdict and names."""
+    started = time.perf_counter()
+    train, test, _ = case_logs(StudyCase(None, 0.0, seed, plant, duration_s))
+    null_train, null_test = null_logs(base, train, test, seed)
+    result = discover(base, null_train, null_test, n_null=n_null, seed=seed + 1000, refit_base=refit_base)
+    return {"seed": seed, "plant": plant, "verdict": result.verdict,
+            "named": [entry["name"] for entry in result.effects], "seconds": time.perf_counter() - started}
+
+
+def _wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of a proportion."""
+    if n == 0:
+        return float("nan"), float("nan")
+    p = successes / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return float(centre - half), float(centre + half)
+
+
+def summarise(cases: list[dict], nulls: list[dict], *, min_ratio: float = 0.5) -> dict:
+    """The study's figures.
+
+    Returns
+    -------
+    dict
+        ``false_positive``: rate of verdicts other than ``nothing_missing``
+        on null data with its 95 % interval; ``accuracy``: share of cases
+        with a hidden, not absorbed effect of RMS ratio >= ``min_ratio`` in
+        which it was named (and per effect); ``closure``: median and share
+        >= 0.8 of the gap closure over the cases where the effect was named;
+        ``by_effect_ratio``: accuracy per effect and ratio.
+    """
+    false = sum(row["verdict"] != "nothing_missing" for row in nulls)
+    eligible = [row for row in cases if row["effect"] is not None and row["effect"] not in ABSORBED
+                and row["ratio"] >= min_ratio]
+    named = sum(row["correct"] for row in eligible)
+    closures = [row["closure"] for row in eligible if row["correct"] and row["closure"] is not None]
+    by_effect = {}
+    for row in cases:
+        if row["effect"] is None:
+            continue
+        cell = by_effect.setdefault(row["effect"], {}).setdefault(f"{row['ratio']:g}", [])
+        cell.append(row)
+    return {
+        "false_positive": {"rate": false / len(nulls) if nulls else None, "n": len(nulls), "count": false,
+                           "interval_95": _wilson(false, len(nulls))},
+        "accuracy": {"rate": named / len(eligible) if eligible else None, "n": len(eligible), "count": named,
+                     "interval_95": _wilson(named, len(eligible)), "min_ratio": min_ratio},
+        "spurious_rate": (sum(bool(row["spurious"]) for row in eligible) / len(eligible)) if eligible else None,
+        "closure": {"median": float(np.median(closures)) if closures else None, "n": len(closures),
+                    "share_at_least_0.8": (float(np.mean(np.asarray(closures) >= 0.8)) if closures else None)},
+        "by_effect_ratio": {name: {ratio: {"n": len(rows), "named": sum(r["correct"] for r in rows),
+                                           "nothing_missing": sum(r["verdict"] == "nothing_missing" for r in rows),
+                                           "median_closure": (float(np.median([r["closure"] for r in rows
+                                                                               if r["closure"] is not None]))
+                                                              if any(r["closure"] is not None for r in rows)
+                                                              else None)}
+                                   for ratio, rows in cells.items()}
+                            for name, cells in by_effect.items()},
+    }

@@ -1,0 +1,87 @@
+"""``greybox discover`` on log files: JSON, report, model file, refusals."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+import pytest
+
+from greybox.cli import discover as discover_cli
+from greybox.data.io import write_log
+from greybox.discover.augment import AugmentedModel
+from greybox.discover.study import StudyCase, case_logs
+from greybox.errors import GreyboxError
+from greybox.models import registry
+from greybox.models.persistence import load_model
+
+
+def run_cli(argv):
+    parser = argparse.ArgumentParser(prog="greybox")
+    discover_cli.add_parser(parser.add_subparsers(dest="command"))
+    args = parser.parse_args(["discover", *argv])
+    return args.run(args)
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    directory = tmp_path_factory.mktemp("logs")
+    train, test, _ = case_logs(StudyCase("position_periodic_friction", 1.5, 3, "coulomb", 15.0))
+    paths = []
+    for name, log in (("train.csv", train), ("test.csv", test)):
+        raw = log.replace(acceleration=None, extras={}, attrs={})  # as logged: position, velocity, current
+        write_log(raw, directory / name)
+        paths.append(str(directory / name))
+    return paths
+
+
+def test_discover_writes_findings_report_and_model(logs, tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(registry.MODEL_CLASSES, "augmented", AugmentedModel)
+    out, model = tmp_path / "found.json", tmp_path / "model.gbm"
+    status = run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out),
+                      "--report", str(tmp_path / "report"), "--save-model", str(model), "--quiet",
+                      "--max-effects", "1"])
+    assert status == 0
+    document = json.loads(out.read_text())
+    assert document["verdict"] == "named"
+    assert document["effects"][0]["name"] == "position_periodic_friction"
+    assert document["logs"] == {"train": [logs[0]], "test": [logs[1]]}
+    assert document["test_rmse_after"] < document["test_rmse_before"]
+    for name in ("discovery.json", "residual_train.png", "residual_test.png", "evidence.png"):
+        assert (tmp_path / "report" / name).stat().st_size > 0
+    loaded = load_model(model)
+    assert type(loaded) is AugmentedModel and loaded.effects_[0]["name"] == "position_periodic_friction"
+    printed = capsys.readouterr().out
+    assert "verdict: named" in printed and "position_periodic_friction" in printed
+
+
+def test_outputs_never_overwrite_inputs_or_models(logs, tmp_path):
+    with pytest.raises(GreyboxError, match="input logs"):
+        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", logs[1], "--quiet"])
+    existing = tmp_path / "model.gbm"
+    existing.write_bytes(b"keep")
+    with pytest.raises(GreyboxError, match="file exists"):
+        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(tmp_path / "a.json"),
+                 "--save-model", str(existing), "--quiet"])
+    assert existing.read_bytes() == b"keep"
+
+
+def test_bad_options_are_refused(logs, tmp_path):
+    out = str(tmp_path / "a.json")
+    with pytest.raises(GreyboxError, match="unknown effect"):
+        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", out, "--effects", "gravity"])
+    with pytest.raises(GreyboxError, match="does not apply"):
+        run_cli(["--base", "stribeck", "--train", logs[0], "--test", logs[1], "--json", out, "--elements", "3"])
+    with pytest.raises(SystemExit):
+        run_cli(["--base", "svr", "--train", logs[0], "--test", logs[1], "--json", out])
+
+
+def test_effects_option_restricts_the_library(logs, tmp_path):
+    out = tmp_path / "a.json"
+    run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out), "--quiet",
+             "--effects", "constant_offset,thermal_drift"])
+    document = json.loads(out.read_text())
+    assert document["settings"]["candidates"] == ["constant_offset", "thermal_drift"]
+    assert all(entry["name"] in ("constant_offset", "thermal_drift") for entry in document["effects"])
+    assert np.isfinite(document["test_rmse_before"])

@@ -1,0 +1,96 @@
+"""The discovery workflow: a seeded small version of the validation study (scripts/discovery_study.py).
+
+Coulomb plant (the base model class is exactly right), 20 s logs: null data
+must give "nothing_missing", each hidden library effect must be named and
+close the test gap like the true term, effects the base absorbs must not be
+named, and structure outside the library must be reported as such.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from greybox.discover.effects import EFFECT_NAMES
+from greybox.discover.report import write_json
+from greybox.discover.study import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
+from greybox.discover.workflow import VERDICTS, discover
+from greybox.errors import GreyboxError
+from greybox.friction import CoulombModel
+
+DURATION_S = 20.0
+
+
+def test_null_data_give_nothing_missing():
+    rows = [run_null(CoulombModel(), seed, duration_s=DURATION_S) for seed in range(6)]
+    false = [row for row in rows if row["verdict"] != "nothing_missing"]
+    assert len(false) <= 1, false  # target <= 5 %: at most one of six by chance
+
+
+@pytest.mark.parametrize("name", [name for name in EFFECT_NAMES if name not in ABSORBED])
+def test_a_hidden_effect_is_named_first_and_closes_the_gap_like_the_true_term(name):
+    row = run_case(CoulombModel(), StudyCase(name, 1.0, 1, "coulomb", DURATION_S))
+    assert row["verdict"] == "named" and row["first_correct"], row
+    assert row["closure"] >= 0.8, row
+    assert row["rmse_after"] < row["rmse_before"]
+
+
+def test_effects_the_base_already_has_are_not_named():
+    row = run_case(CoulombModel(), StudyCase("inertia_mismatch", 1.0, 1, "coulomb", DURATION_S))
+    assert row["verdict"] == "nothing_missing" and row["closure"] is None
+    assert row["rmse_after"] == pytest.approx(row["rmse_before"])
+
+
+def test_structure_outside_the_library_is_reported_as_unexplained():
+    # friction that grows only while accelerating forwards: no library effect has this shape
+    train, test, _ = case_logs(StudyCase(None, 0.0, 1, "coulomb", DURATION_S))
+    add = lambda run: run.replace(effort=run.effort + 3e-4 * np.maximum(run.acceleration, 0.0))
+    result = discover(CoulombModel(), add(train), add(test), seed=1)
+    assert result.verdict == "unexplained_structure"
+    assert result.steps[-1].families["acceleration"]["p_value"] <= 0.05
+
+
+def test_the_json_document(tmp_path):
+    train, test, _ = case_logs(StudyCase("position_periodic_force", 1.5, 2, "coulomb", DURATION_S))
+    result = discover(CoulombModel(), train, test, seed=2, max_effects=1)
+    path = write_json(result.to_dict(), tmp_path / "out.json")
+    document = json.loads(path.read_text())
+    assert document["verdict"] in VERDICTS and document["verdict"] == "named"
+    (entry,) = document["effects"]
+    assert entry["name"] == "position_periodic_force"
+    assert entry["parameters"]["period_mm"] == pytest.approx(2.5, rel=0.02)
+    assert {"p_value", "explained_fraction", "threshold_fraction", "indistinguishable_from"} <= set(entry["evidence"])
+    assert document["test_rmse_after"] < document["test_rmse_before"]
+    assert set(document["test"]["regimes"]) >= {"all", "reversal", "constant_feed", "acceleration"}
+    assert len(document["steps"]) == 2 and document["steps"][0]["winner"] == "position_periodic_force"
+
+
+def test_bad_settings_are_refused():
+    train, test, _ = case_logs(StudyCase(None, 0.0, 0, "coulomb", 5.0))
+    with pytest.raises(GreyboxError, match="unknown effect"):
+        discover(CoulombModel(), train, test, candidates=["gravity"])
+    with pytest.raises(GreyboxError, match="can never pass"):
+        discover(CoulombModel(), train, test, n_null=10)
+
+
+def test_summary_counts():
+    cases = [
+        {"effect": "constant_offset", "ratio": 1.0, "correct": True, "closure": 0.9, "spurious": [],
+         "verdict": "named"},
+        {"effect": "constant_offset", "ratio": 0.25, "correct": False, "closure": None, "spurious": [],
+         "verdict": "nothing_missing"},
+        {"effect": "inertia_mismatch", "ratio": 1.0, "correct": False, "closure": None, "spurious": [],
+         "verdict": "nothing_missing"},
+        {"effect": "stribeck", "ratio": 0.5, "correct": False, "closure": None, "spurious": ["thermal_drift"],
+         "verdict": "named"},
+    ]
+    nulls = [{"verdict": "nothing_missing"}] * 19 + [{"verdict": "named"}]
+    summary = summarise(cases, nulls)
+    assert summary["false_positive"]["rate"] == pytest.approx(0.05)
+    assert summary["accuracy"]["n"] == 2 and summary["accuracy"]["rate"] == pytest.approx(0.5)
+    assert summary["closure"]["median"] == pytest.approx(0.9)
+    assert summary["spurious_rate"] == pytest.approx(0.5)
+    low, high = summary["false_positive"]["interval_95"]
+    assert low < 0.05 < high
