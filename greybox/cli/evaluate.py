@@ -1,0 +1,83 @@
+"""``greybox evaluate``: test saved models on logs, overall and per operating regime."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import GreyboxError
+from ..evaluate.experiments import evaluate_models
+from ..evaluate.regimes import REGIME_NAMES
+from ..evaluate.report import RE_NOTE, check_output_dir, records_json, write_evaluation_report, write_text_atomic
+from ..models.persistence import load_model
+from ._options import add_log_arguments, read_logs
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "evaluate",
+        help="test saved models on logs and report their errors",
+        description="Load model files, predict the current of every test log, and print RMSE, RE and NMSE per "
+        "model, overall and per operating regime (low/high velocity, reversals, constant feed, acceleration). "
+        "With --out, also write a report: metrics.json/csv, tables.md, figures and index.html.",
+    )
+    parser.add_argument("models", nargs="+", metavar="MODEL", help="model files written by 'greybox train'")
+    parser.add_argument("--test", required=True, nargs="+", metavar="LOG",
+                        help="test logs (CSV, Parquet, MCAP or EMPS .mat); their errors are pooled")
+    parser.add_argument("--out", metavar="DIR", help="write a report (tables, figures, HTML page) into DIR")
+    parser.add_argument("--json", metavar="FILE", help="write the metric records (with regimes) to FILE")
+    parser.add_argument("--force", action="store_true",
+                        help="write into a non-empty DIR and replace an existing FILE")
+    add_log_arguments(parser)
+    parser.set_defaults(run=run)
+
+
+def _model_names(paths) -> list[str]:
+    """Report names of the model files: their stems, or their paths where stems repeat."""
+    stems = [Path(p).stem for p in paths]
+    return [stem if stems.count(stem) == 1 else str(p) for stem, p in zip(stems, paths)]
+
+
+def _check_outputs(args) -> None:
+    """Refuse before any work when an output cannot or must not be written."""
+    inputs = [Path(p) for p in list(args.models) + list(args.test)]
+    if args.out:
+        check_output_dir(args.out, force=args.force)
+    if args.json:
+        target = Path(args.json)
+        if any(target.exists() and p.exists() and target.samefile(p) for p in inputs):
+            raise GreyboxError(f"{target}: is one of the inputs; refusing to overwrite it")
+        if target.exists() and not args.force:
+            raise GreyboxError(f"{target}: file exists; use --force to replace it")
+        if not target.parent.is_dir():
+            raise GreyboxError(f"{target}: directory {target.parent} does not exist")
+
+
+def _print_records(records, unit: str) -> None:
+    print(f"  {'model':<24} {'regime':<14} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7} {'NMSE %':>8}")
+    for record in records:
+        for regime in REGIME_NAMES:
+            m = record["regimes"][regime]
+            name = record["model"][-24:] if regime == "all" else ""
+            print(f"  {name:<24} {regime:<14} {m['n']:>8d} {m['rmse']:>10.4g} {m['re']:>7.2f} {m['nmse']:>8.2f}")
+    print(f"  ({RE_NOTE})")
+
+
+def run(args: argparse.Namespace) -> int:
+    _check_outputs(args)
+    names = _model_names(args.models)
+    models = dict(zip(names, (load_model(path) for path in args.models)))
+    runs = read_logs(args, args.test)
+    run_names = _model_names(args.test)
+    unit = runs[0].effort_unit
+    records, predictions = evaluate_models(models, runs, run_names)
+    print(f"evaluated {len(models)} model(s) on {len(runs)} log(s), {sum(len(r) for r in runs)} samples, "
+          f"effort in {unit}")
+    _print_records(records, unit)
+    if args.json:
+        path = write_text_atomic(args.json, records_json(records))
+        print(f"wrote {path}")
+    if args.out:
+        files = write_evaluation_report(args.out, records, predictions, runs, run_names)
+        print(f"wrote {files['html']}")
+    return 0

@@ -1,0 +1,294 @@
+"""Report figures comparing models with the measured current (PNG, matplotlib).
+
+- :func:`error_boxplot`: absolute error per model as box plots (the paper's
+  Figs. 3 and 5), one panel per axis or test set;
+- :func:`time_comparison`: measured and modelled current over time on each
+  test run, with a zoom on a reversal (the paper's Figs. 4 and 6);
+- :func:`residual_vs_position`: measured minus modelled current against the
+  position, by direction of motion: what a model misses along the screw.
+
+Every function takes the measured current of prepared runs and predictions
+keyed by model name (one array per run, or the runs concatenated), writes the
+figure with :func:`greybox.evaluate.plots.save_figure` and returns the path.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from ..data.log import AxisLog
+from .plots import save_figure
+from .report import MODEL_LABELS
+
+__all__ = ["MODEL_COLORS", "TIME_MODELS", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs",
+           "experiment_figures"]
+
+#: Line colours of the models, the same in every figure.
+MODEL_COLORS = {
+    "coulomb": "#8c564b",
+    "stribeck": "#ff7f0e",
+    "lugre": "#9467bd",
+    "gms": "#2ca02c",
+    "svr": "#d62728",
+    "gmssvr": "#1f77b4",
+    "noise_floor": "#7f7f7f",
+}
+_MEASURED = "#000000"
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _color(model: str, k: int) -> str:
+    return MODEL_COLORS.get(model, f"C{k % 10}")
+
+
+def split_runs(runs: Sequence[AxisLog], prediction) -> list[np.ndarray]:
+    """Split a prediction of concatenated runs into one array per run (a list passes through).
+
+    Raises
+    ------
+    ValueError
+        If the lengths do not match the runs.
+    """
+    if isinstance(prediction, np.ndarray) and prediction.ndim == 1:
+        lengths = [len(run) for run in runs]
+        if prediction.size != sum(lengths):
+            raise ValueError(f"runs of {sum(lengths)} samples in all but a prediction of {prediction.size}")
+        return np.split(prediction, np.cumsum(lengths)[:-1])
+    parts = [np.asarray(p, dtype=np.float64) for p in prediction]
+    if [p.size for p in parts] != [len(run) for run in runs]:
+        raise ValueError("the predictions do not match the runs in number or length")
+    return parts
+
+
+def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, object]]],
+                  path: str | os.PathLike, *, title: str = "Absolute error of the modelled current") -> Path:
+    """Box plots of ``|I_model - I|`` per model, one panel per entry of ``panels``.
+
+    Parameters
+    ----------
+    panels : sequence of (title, runs, predictions)
+        ``runs``: prepared runs whose ``effort`` is the measured current [A];
+        ``predictions``: ``{model: prediction}`` (concatenated or per run).
+    path : path-like
+        PNG file to write.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    pathlib.Path
+        Boxes span the quartiles, whiskers the 5th to 95th percentiles;
+        outliers are not drawn.
+    """
+    plt = _pyplot()
+    n_models = max(len(p[2]) for p in panels)
+    figure, axes = plt.subplots(1, len(panels), figsize=(max(5.0, 1.0 + 0.9 * n_models) * len(panels), 4.5),
+                                squeeze=False, layout="constrained")
+    for ax, (panel_title, runs, predictions) in zip(axes[0], panels):
+        measured = np.concatenate([run.effort for run in runs])
+        names = list(predictions)
+        errors = [np.abs(np.concatenate(split_runs(runs, predictions[name])) - measured) for name in names]
+        boxes = ax.boxplot(errors, whis=(5, 95), showfliers=False, patch_artist=True, widths=0.6)
+        for k, (patch, name) in enumerate(zip(boxes["boxes"], names)):
+            patch.set_facecolor(_color(name, k))
+            patch.set_alpha(0.6)
+        ax.set_xticks(range(1, len(names) + 1), [MODEL_LABELS.get(n, n) for n in names], rotation=30,
+                      ha="right")
+        ax.set_ylabel("absolute error [A]")
+        ax.set_title(panel_title)
+        ax.grid(True, axis="y", alpha=0.3)
+    figure.suptitle(title)
+    return save_figure(figure, path)
+
+
+def _zoom_window(run: AxisLog, width_s: float) -> tuple[float, float]:
+    """A window of ``width_s`` around the direction reversal nearest the middle of the run [s]."""
+    moving = np.abs(run.velocity) > 0.01 * max(float(np.max(np.abs(run.velocity))), 1e-12)
+    signs = np.sign(run.velocity[moving])
+    times = run.time[moving]
+    flips = times[1:][signs[1:] != signs[:-1]]
+    middle = 0.5 * (run.time[0] + run.time[-1])
+    centre = float(flips[np.argmin(np.abs(flips - middle))]) if flips.size else middle
+    start = max(float(run.time[0]), centre - 0.5 * width_s)
+    return start, min(float(run.time[-1]), start + width_s)
+
+
+def time_comparison(runs: Sequence[AxisLog], predictions: Mapping[str, object], path: str | os.PathLike, *,
+                    names: Sequence[str] | None = None, zoom_s: float = 4.0, max_points: int = 20_000,
+                    title: str = "Measured and modelled current") -> Path:
+    """Measured and modelled current over time, each run in full and zoomed on a reversal.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared test runs; their ``effort`` is the measured current [A].
+    predictions : dict
+        ``{model: prediction}`` (concatenated or per run) [A].
+    path : path-like
+        PNG file to write.
+    names : sequence of str, optional
+        Run names for the panel titles (default: the runs' dataset or source).
+    zoom_s : float, default 4.0
+        Width of the zoom window [s].
+    max_points : int, default 20000
+        Full-run curves are thinned to at most this many points for drawing.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    plt = _pyplot()
+    per_run = {model: split_runs(runs, p) for model, p in predictions.items()}
+    if names is None:
+        names = [run.dataset or (Path(run.source).stem if run.source else "") or f"run {i + 1}"
+                 for i, run in enumerate(runs)]
+    figure, axes = plt.subplots(len(runs), 2, figsize=(14, 3.6 * len(runs)), squeeze=False,
+                                gridspec_kw={"width_ratios": (2.2, 1)}, layout="constrained")
+    for i, run in enumerate(runs):
+        full, zoom = axes[i]
+        stride = max(1, int(np.ceil(len(run) / max_points)))
+        start, stop = _zoom_window(run, zoom_s)
+        window = (run.time >= start) & (run.time <= stop)
+        full.plot(run.time[::stride], run.effort[::stride], color=_MEASURED, lw=0.5, alpha=0.5, label="measured")
+        zoom.plot(run.time[window], run.effort[window], color=_MEASURED, lw=0.7, alpha=0.6, label="measured")
+        for k, (model, parts) in enumerate(per_run.items()):
+            style = {"color": _color(model, k), "lw": 0.9, "label": MODEL_LABELS.get(model, model)}
+            full.plot(run.time[::stride], parts[i][::stride], **style)
+            zoom.plot(run.time[window], parts[i][window], **style)
+        full.axvspan(start, stop, color="0.85", zorder=0)
+        full.set_title(f"{names[i]}: full run")
+        zoom.set_title(f"{names[i]}: {start:.1f} to {stop:.1f} s (around a reversal)")
+        for ax in (full, zoom):
+            ax.set_xlabel("time [s]")
+            ax.set_ylabel("current [A]")
+            ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(loc="upper right", fontsize="small", ncol=min(3, 1 + len(per_run)))
+    figure.suptitle(title)
+    return save_figure(figure, path)
+
+
+def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, object], path: str | os.PathLike,
+                         *, n_bins: int = 40, max_points: int = 20_000,
+                         title: str = "Residual against position, by direction of motion") -> Path:
+    """Measured minus modelled current against the position, one panel per model.
+
+    Samples moving in +/- direction are drawn in two colours (thinned to at
+    most ``max_points`` per panel, standstill left out), with the mean residual
+    of each direction in ``n_bins`` position bins as a line.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs (position [mm], velocity [mm/s], measured current [A]).
+    predictions : dict
+        ``{model: prediction}`` (concatenated or per run) [A].
+    path : path-like
+        PNG file to write.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    plt = _pyplot()
+    position = np.concatenate([run.position for run in runs])
+    velocity = np.concatenate([run.velocity for run in runs])
+    measured = np.concatenate([run.effort for run in runs])
+    standstill = 0.01 * max(float(np.max(np.abs(velocity))), 1e-12)
+    directions = (("+", velocity > standstill, "#1f77b4"), ("-", velocity < -standstill, "#ff7f0e"))
+    edges = np.linspace(position.min(), position.max(), n_bins + 1)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    n = len(predictions)
+    columns = min(3, n)
+    rows = int(np.ceil(n / columns))
+    figure, axes = plt.subplots(rows, columns, figsize=(5.2 * columns, 3.6 * rows), squeeze=False,
+                                sharex=True, sharey=True, layout="constrained")
+    for ax, (model, prediction) in zip(axes.ravel(), predictions.items()):
+        residual = measured - np.concatenate(split_runs(runs, prediction))
+        for label, mask, color in directions:
+            index = np.flatnonzero(mask)
+            shown = index[:: max(1, index.size // max_points)]
+            ax.plot(position[shown], residual[shown], ".", ms=1, color=color, alpha=0.25)
+            counts = np.histogram(position[index], edges)[0]
+            sums = np.histogram(position[index], edges, weights=residual[index])[0]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                ax.plot(centres, sums / counts, color=color, lw=1.8, label=f"mean, v {label}")
+        ax.axhline(0.0, color="0.3", lw=0.6)
+        ax.set_title(MODEL_LABELS.get(model, model))
+        ax.grid(True, alpha=0.3)
+    for ax in axes[-1]:
+        ax.set_xlabel("position [mm]")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("measured - model [A]")
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
+    axes[0, 0].legend(loc="upper right", fontsize="small")
+    figure.suptitle(title)
+    return save_figure(figure, path)
+
+
+#: Models drawn in the time-domain comparisons (the paper's Figs. 4 and 6), when present.
+TIME_MODELS = ("stribeck", "svr", "gms", "gmssvr")
+
+
+def experiment_figures(results, experiment, out_dir: str | os.PathLike) -> list[tuple[str, Path]]:
+    """The figures of one experiment over all axes: box plot, time comparisons, residual maps.
+
+    Parameters
+    ----------
+    results : sequence of greybox.evaluate.experiments.AxisResults
+        One per axis.
+    experiment : greybox.evaluate.experiments.Experiment
+    out_dir : path-like
+        Directory of the PNG files (``exp<n>_*.png``).
+
+    Returns
+    -------
+    list of (caption, path)
+    """
+    from .experiments import TRUTH_CHANNEL
+
+    out_dir = Path(out_dir)
+    n = experiment.number
+    test = "+".join(experiment.test)
+    figures = []
+    panels = []
+    for axis_results in results:
+        runs = [axis_results.logs[d] for d in experiment.test]
+        predictions = {m.name: [m.test_prediction[d] for d in experiment.test]
+                       for m in axis_results.experiments[n]}
+        if all(TRUTH_CHANNEL in run.extras for run in runs):
+            predictions["noise_floor"] = [run.extras[TRUTH_CHANNEL] for run in runs]
+        panels.append((f"axis {axis_results.axis}, test on {test}", runs, predictions))
+    figure_number = {1: "Fig. 3", 2: "Fig. 5"}.get(n, "")
+    path = error_boxplot(panels, out_dir / f"exp{n}_error_boxplot.png",
+                         title=f"Experiment {n}: absolute error on {test}")
+    figures.append((f"Experiment {n}: absolute error of each model on {test} "
+                    f"(boxes: quartiles, whiskers: 5th-95th percentile; like the paper's {figure_number})", path))
+    figure_number = {1: "Fig. 4", 2: "Fig. 6"}.get(n, "")
+    for axis_results, (_, runs, predictions) in zip(results, panels):
+        axis = axis_results.axis
+        shown = {m: predictions[m] for m in TIME_MODELS if m in predictions}
+        path = time_comparison(runs, shown, out_dir / f"exp{n}_time_{axis}.png",
+                               title=f"Experiment {n}, axis {axis}: measured and modelled current")
+        figures.append((f"Experiment {n}, axis {axis}: measured and modelled current on {test} "
+                        f"(like the paper's {figure_number})", path))
+        models = {m: p for m, p in predictions.items() if m != "noise_floor"}
+        path = residual_vs_position(runs, models, out_dir / f"exp{n}_residual_position_{axis}.png",
+                                    title=f"Experiment {n}, axis {axis}: residual against position on {test}")
+        figures.append((f"Experiment {n}, axis {axis}: measured minus modelled current against position, "
+                        f"by direction of motion, on {test}", path))
+    return figures

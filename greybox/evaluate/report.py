@@ -1,0 +1,587 @@
+"""Report files of model comparisons: metric records, tables in the paper's layout.
+
+A report is built from *metric records*, one per model, axis, experiment and
+side (``train`` or ``test``), as made by
+:func:`greybox.evaluate.experiments.metric_record`::
+
+    {"experiment": 1, "axis": "X", "model": "gms", "dataset": "test",
+     "rmse": 0.071, "re": 7.2, "logs": "C", "n": 60552, "nmse": ..., "max_error": ...,
+     "per_log": {"C": {"n": ..., "rmse": ..., "re": ...}}}
+
+with RMSE in A and RE in %. RE is RMSE / mean(|I|): the paper divides by
+the mean of the current, which is close to zero for an axis that moves both
+ways, so the mean *absolute* current is used (see ``DESIGN.md``).
+
+Files written by :func:`write_report`:
+
+``metrics.json``
+    The list of records (NaN written as null).
+``metrics.csv``
+    The same records without ``per_log``, one row each.
+``tables.md``
+    Markdown tables (:class:`Table`): one per experiment in the layout of
+    the paper's Tables 3 and 4 with the published figures beside ours, the
+    SVR hyperparameters like the paper's Table 2, the noise-floor ratio of the
+    grey-box model, the sole SVR's change from training to each test log, and
+    the fit times.
+``index.html``
+    Tables and figures on one page (:mod:`greybox.evaluate.html`).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Mapping, Sequence
+
+__all__ = [
+    "Table",
+    "MODEL_LABELS",
+    "PAPER_RE",
+    "PAPER_SOURCE",
+    "RE_NOTE",
+    "CSV_COLUMNS",
+    "write_text_atomic",
+    "check_output_dir",
+    "json_ready",
+    "records_json",
+    "write_metrics",
+    "write_evaluation_report",
+    "experiment_table",
+    "hyperparameter_table",
+    "noise_floor_ratios",
+    "noise_floor_table",
+    "svr_generalisation",
+    "svr_generalisation_table",
+    "timing_table",
+    "evaluation_table",
+    "regime_table",
+    "report_tables",
+    "tables_markdown",
+    "write_report",
+]
+
+#: How reports name the models.
+MODEL_LABELS = {
+    "coulomb": "Coulomb",
+    "stribeck": "Stribeck",
+    "lugre": "LuGre",
+    "gms": "GMS",
+    "svr": "SVR",
+    "gmssvr": "GMS+SVR",
+    "gmssvr_eq8": "GMS+SVR (eq. 8)",
+    "noise_floor": "noise floor (noise-free current)",
+}
+
+#: Published test RE [%] of Rüppel et al. (2024), keyed by (experiment, axis, model).
+#: Only the abstract's figures could be found: the grey-box model's error over
+#: the full working range, 7 % on the x-axis and 12 % on the y-axis
+#: (experiment 2, tested on C + D). The full Tables 3 and 4 were not retrieved.
+PAPER_RE: dict[tuple[int, str, str], float] = {
+    (2, "X", "gmssvr"): 7.0,
+    (2, "Y", "gmssvr"): 12.0,
+}
+
+#: Where the published figures come from, printed under every experiment table.
+PAPER_SOURCE = (
+    "Paper: Rüppel et al., J. Machine Engineering 24(1) 2024, measured on a Mazak VARIAXIS i-600. "
+    "Only the abstract's figures were available to us (GMS+SVR 7 % on the x-axis and 12 % on the "
+    "y-axis over the full working range, read here as experiment 2's test on C + D); the other cells of "
+    "the paper's Tables 3 and 4 could not be retrieved and are left blank (–) rather than guessed. "
+    "Our figures come from the synthetic axis, not from the paper's machine."
+)
+
+#: The definition of RE, printed wherever RE is.
+RE_NOTE = (
+    "RE = RMSE / mean(|I|) in %. The paper divides by the mean of I; for a signed current of an axis "
+    "moving both ways that mean is near zero, so the mean absolute current is used."
+)
+
+#: Columns of ``metrics.csv``, in order.
+CSV_COLUMNS = ("experiment", "axis", "model", "dataset", "logs", "n", "rmse", "re", "nmse", "max_error")
+
+
+@dataclass
+class Table:
+    """A titled table of text cells, rendered to Markdown here and to HTML in :mod:`greybox.evaluate.html`.
+
+    Attributes
+    ----------
+    title : str
+    header : list of str
+    rows : list of list of str
+    notes : list of str
+        Sentences printed under the table.
+    """
+
+    title: str
+    header: list[str]
+    rows: list[list[str]]
+    notes: list[str] = field(default_factory=list)
+
+    def to_markdown(self) -> str:
+        """The table as a Markdown section (``###`` title, pipe table, notes)."""
+        lines = [f"### {self.title}", "", "| " + " | ".join(self.header) + " |",
+                 "|" + "|".join("---" for _ in self.header) + "|"]
+        lines += ["| " + " | ".join(row) + " |" for row in self.rows]
+        if self.notes:
+            lines.append("")
+            lines += [f"{note}  " if i < len(self.notes) - 1 else note for i, note in enumerate(self.notes)]
+        return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------- writing files
+def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same directory.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+    """
+    path = Path(path)
+    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as stream:
+            stream.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes the file private; give it the usual mode
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+    return path
+
+
+def check_output_dir(out_dir: str | os.PathLike, *, force: bool = False) -> Path:
+    """Refuse a report directory that is a file, or that is not empty unless ``force``.
+
+    Called before any work, so that a long run never ends in a refusal.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    GreyboxError
+        If ``out_dir`` is a file, its parent does not exist, or it holds files
+        and ``force`` is false.
+    """
+    from ..errors import GreyboxError
+
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise GreyboxError(f"{out_dir}: is a file, not a directory")
+    if not out_dir.exists() and not out_dir.parent.is_dir():
+        raise GreyboxError(f"{out_dir}: parent directory {out_dir.parent} does not exist")
+    if out_dir.is_dir() and any(out_dir.iterdir()) and not force:
+        raise GreyboxError(f"{out_dir}: directory is not empty; use --force to write the report into it anyway")
+    return out_dir
+
+
+def json_ready(value):
+    """Replace non-finite floats by None, recursively (strict JSON has no NaN)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if hasattr(value, "item"):  # NumPy scalars
+        return json_ready(value.item())
+    return value
+
+
+def records_json(records: Sequence[Mapping]) -> str:
+    """Metric records as strict JSON text (non-finite numbers as null), one key per line."""
+    return json.dumps(json_ready(list(records)), indent=1, allow_nan=False) + "\n"
+
+
+def write_metrics(records: Sequence[Mapping], out_dir: str | os.PathLike) -> tuple[Path, Path]:
+    """Write ``metrics.json`` and ``metrics.csv`` into ``out_dir``.
+
+    Returns
+    -------
+    (Path, Path)
+        The JSON and the CSV file.
+    """
+    out_dir = Path(out_dir)
+    json_path = write_text_atomic(out_dir / "metrics.json", records_json(records))
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    for record in records:
+        writer.writerow({k: ("" if v is None else v) for k, v in json_ready(dict(record)).items()})
+    csv_path = write_text_atomic(out_dir / "metrics.csv", buffer.getvalue())
+    return json_path, csv_path
+
+
+# ---------------------------------------------------------------- tables
+def _number(value, digits: int) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    return f"{value:.{digits}f}"
+
+
+def _label(model: str) -> str:
+    return MODEL_LABELS.get(model, model)
+
+
+def _index(records: Iterable[Mapping]) -> dict[tuple, Mapping]:
+    return {(r["experiment"], r["axis"], r["model"], r["dataset"]): r for r in records}
+
+
+def _ordered(values: Iterable) -> list:
+    return list(dict.fromkeys(values))
+
+
+def experiment_table(records: Sequence[Mapping], experiment: int, *, title: str | None = None,
+                     training: Mapping[str, str] | None = None, notes: Sequence[str] = (),
+                     paper: Mapping[tuple[int, str, str], float] = PAPER_RE) -> Table:
+    """Train and test errors of every model of one experiment, axes side by side.
+
+    Rows are the models in the order of the records, the noise floor last;
+    per axis the columns are train RMSE [A], train RE [%], test RMSE [A],
+    test RE [%] and the paper's test RE [%].
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records (any experiments; those of ``experiment`` are used).
+    experiment : int
+    title : str, optional
+    training : dict, optional
+        ``{model: text}`` saying what each model was trained on (e.g.
+        ``"GMS on A, SVR on B"``); by default the ``logs`` of its train record.
+    notes : sequence of str, optional
+        Further sentences for under the table.
+    paper : dict, default :data:`PAPER_RE`
+        Published test RE [%] by (experiment, axis, model).
+
+    Returns
+    -------
+    Table
+    """
+    mine = [r for r in records if r["experiment"] == experiment]
+    axes = _ordered(r["axis"] for r in mine)
+    models = _ordered(r["model"] for r in mine if r["model"] != "noise_floor")
+    if any(r["model"] == "noise_floor" for r in mine):
+        models.append("noise_floor")
+    index = _index(mine)
+    header = ["model"]
+    for axis in axes:
+        header += [f"{axis} train RMSE [A]", f"{axis} train RE [%]", f"{axis} test RMSE [A]",
+                   f"{axis} test RE [%]", f"{axis} paper test RE [%]"]
+    rows = []
+    for model in models:
+        row = [_label(model)]
+        for axis in axes:
+            train = index.get((experiment, axis, model, "train"), {})
+            test = index.get((experiment, axis, model, "test"), {})
+            row += [_number(train.get("rmse"), 4), _number(train.get("re"), 2),
+                    _number(test.get("rmse"), 4), _number(test.get("re"), 2),
+                    _number(paper.get((experiment, axis, model)), 0)]
+        rows.append(row)
+    test_logs = _ordered(r.get("logs", "") for r in mine if r["dataset"] == "test")
+    default_title = f"Experiment {experiment}" + (f": test on {test_logs[0]}" if len(test_logs) == 1 else "")
+    trained = dict(training or {})
+    for r in mine:
+        if r["dataset"] == "train" and r["model"] != "noise_floor":
+            trained.setdefault(r["model"], r.get("logs", ""))
+    notes = [*notes, RE_NOTE, PAPER_SOURCE]
+    if trained:
+        notes.insert(0, "Trained on: " + "; ".join(f"{_label(m)} {trained[m]}" for m in models if m in trained)
+                     + ".")
+    return Table(title or default_title, header, rows, notes)
+
+
+def hyperparameter_table(rows: Sequence[Mapping]) -> Table:
+    """The SVR settings like the paper's Table 2: kernel, epsilon, C and gamma.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        ``experiment``, ``axis``, ``model`` and the keys of a model's
+        ``hyperparameters_table()`` (``kernel``, ``epsilon`` [A], ``C`` [A],
+        ``gamma``, ``n_support``, ``n_train``, ``optimised``, ``cv_rmse`` [A]).
+
+    Returns
+    -------
+    Table
+    """
+    header = ["experiment", "axis", "model", "kernel", "epsilon [A]", "C [A]", "gamma",
+              "support vectors", "training samples", "CV RMSE [A]", "optimised"]
+    body = []
+    for row in rows:
+        body.append([str(row.get("experiment", "")), str(row.get("axis", "")), _label(row.get("model", "")),
+                     "Gaussian (RBF)" if row.get("kernel") == "rbf" else str(row.get("kernel", "")),
+                     f"{row['epsilon']:.4g}", f"{row['C']:.4g}", f"{row['gamma']:.4g}",
+                     str(row.get("n_support", "")), str(row.get("n_train", "")),
+                     _number(row.get("cv_rmse"), 4), ", ".join(row.get("optimised", [])) or "none"])
+    notes = ["gamma in 1/(standardised unit)^2: every SVR input is standardised (zero mean, unit variance) "
+             "over the training data. Hyperparameters chosen by Bayesian optimisation (log-uniform priors) "
+             "over a time-blocked cross-validation, as the paper's Table 2 reports them."]
+    return Table("SVR hyperparameters (paper's Table 2)", header, body, notes)
+
+
+def noise_floor_ratios(records: Sequence[Mapping], model: str = "gmssvr") -> list[dict]:
+    """Test RE of ``model`` over the test RE of the noise-free current, per experiment and axis.
+
+    Returns
+    -------
+    list of dict
+        ``experiment``, ``axis``, ``model``, ``re`` [%], ``noise_re`` [%] and
+        ``ratio`` (1 is the best possible), for every experiment and axis
+        having both records.
+    """
+    index = _index(records)
+    result = []
+    for (experiment, axis, name, dataset), record in index.items():
+        if name != model or dataset != "test":
+            continue
+        floor = index.get((experiment, axis, "noise_floor", "test"))
+        if floor is None or not floor.get("re"):
+            continue
+        result.append({"experiment": experiment, "axis": axis, "model": model, "re": record["re"],
+                       "noise_re": floor["re"], "ratio": record["re"] / floor["re"]})
+    return result
+
+
+def noise_floor_table(records: Sequence[Mapping], model: str = "gmssvr", target: float = 1.5) -> Table:
+    """:func:`noise_floor_ratios` as a table, with the target ratio."""
+    rows = [[str(r["experiment"]), r["axis"], _number(r["re"], 2), _number(r["noise_re"], 2),
+             _number(r["ratio"], 2), "yes" if r["ratio"] <= target else "no"]
+            for r in noise_floor_ratios(records, model)]
+    header = ["experiment", "axis", f"{_label(model)} test RE [%]", "noise-floor test RE [%]", "ratio",
+              f"within {target:g}x"]
+    notes = ["The noise floor is the error of the noise-free current of the synthetic axis against the "
+             "measured (noisy) current: no model can do better on average.", RE_NOTE]
+    return Table(f"{_label(model)} against the noise floor", header, rows, notes)
+
+
+def svr_generalisation(records: Sequence[Mapping], model: str = "svr") -> list[dict]:
+    """How the sole SVR's error changes from its training data to each test log.
+
+    The paper found the sole SVR to lose accuracy on dataset D (the full
+    travel) although it fitted its training data well: overfitting. This
+    compares, per experiment and axis, the training RE with the RE on every
+    test log.
+
+    Returns
+    -------
+    list of dict
+        ``experiment``, ``axis``, ``model``, ``train_re`` [%], ``test_re``
+        ({log: RE [%]}), ``change`` ({log: test RE / train RE}) and
+        ``loses_accuracy_on`` (logs whose RE exceeds the training RE).
+    """
+    index = _index(records)
+    result = []
+    for (experiment, axis, name, dataset), train in index.items():
+        if name != model or dataset != "train":
+            continue
+        test = index.get((experiment, axis, model, "test"))
+        if test is None:
+            continue
+        parts = test.get("per_log") or {test.get("logs", "test"): {"re": test["re"]}}
+        test_re = {log: part["re"] for log, part in parts.items()}
+        change = {log: (re / train["re"] if train["re"] else math.nan) for log, re in test_re.items()}
+        result.append({"experiment": experiment, "axis": axis, "model": model, "train_re": train["re"],
+                       "test_re": test_re, "change": change,
+                       "loses_accuracy_on": [log for log, re in test_re.items() if re > train["re"]]})
+    return result
+
+
+def svr_generalisation_table(records: Sequence[Mapping], model: str = "svr") -> Table:
+    """:func:`svr_generalisation` as a table: one row per experiment, axis and test log."""
+    rows = []
+    for entry in svr_generalisation(records, model):
+        for log, re in entry["test_re"].items():
+            rows.append([str(entry["experiment"]), entry["axis"], _number(entry["train_re"], 2), log,
+                         _number(re, 2), _number(entry["change"][log], 2),
+                         "yes" if log in entry["loses_accuracy_on"] else "no"])
+    header = ["experiment", "axis", "train RE [%]", "test log", "test RE [%]", "test / train",
+              "loses accuracy"]
+    notes = ["The paper reports the sole SVR losing accuracy from its training data to dataset D "
+             "(overfitting). This table states what the synthetic data show; nothing is forced.", RE_NOTE]
+    return Table(f"Sole {_label(model)}: training against test accuracy", header, rows, notes)
+
+
+def timing_table(timings: Sequence[Mapping]) -> Table:
+    """The fits: rows of ``experiment``, ``axis``, ``model``, ``trained_on``, ``fit_seconds`` and ``notes``.
+
+    ``notes`` are the warnings a fit issued (e.g. a hyperparameter that ended
+    at the end of its search interval).
+    """
+    rows = [[str(t["experiment"]), t["axis"], _label(t["model"]), t.get("trained_on", ""),
+             "shared with an earlier fit" if t["fit_seconds"] == 0 else f"{t['fit_seconds']:.1f}",
+             " ".join(t.get("notes") or ())]
+            for t in timings]
+    notes = ["Wall time of each fit on this machine; a GMS+SVR time leaves out its GMS stage when that stage "
+             "was already identified for the GMS row (the same model on the same data)."]
+    return Table("Fits", ["experiment", "axis", "model", "trained on", "fit [s]", "notes"], rows, notes)
+
+
+def evaluation_table(records: Sequence[Mapping], title: str = "Test errors") -> Table:
+    """Errors of each evaluated model: samples, RMSE [A], RE [%], NMSE [%], largest error [A]."""
+    header = ["model", "test logs", "samples", "RMSE [A]", "RE [%]", "NMSE [%]", "max error [A]"]
+    rows = [[_label(r["model"]), r.get("logs", ""), str(r.get("n", "")), _number(r.get("rmse"), 4),
+             _number(r.get("re"), 2), _number(r.get("nmse"), 2), _number(r.get("max_error"), 4)] for r in records]
+    notes = [RE_NOTE, "NMSE = 100 mean((I_model - I)^2) / var(I) in % (Tjahjowidodo et al. 2005)."]
+    return Table(title, header, rows, notes)
+
+
+def regime_table(records: Sequence[Mapping], title: str = "RE per operating regime [%]") -> Table:
+    """RE [%] of each model in each operating regime (records carrying ``regimes``).
+
+    The regimes are those of :mod:`greybox.evaluate.regimes`; the header
+    gives each regime's share of the samples.
+    """
+    from .regimes import REGIME_NAMES
+
+    with_regimes = [r for r in records if r.get("regimes")]
+    header = ["model"]
+    for name in REGIME_NAMES:
+        share = ""
+        if with_regimes and with_regimes[0]["regimes"]["all"]["n"]:
+            share = f" ({100.0 * with_regimes[0]['regimes'][name]['n'] / with_regimes[0]['regimes']['all']['n']:.0f} %)"
+        header.append(name.replace("_", " ") + share)
+    rows = [[_label(r["model"])] + [_number(r["regimes"][name]["re"], 2) for name in REGIME_NAMES]
+            for r in with_regimes]
+    notes = ["Regimes (greybox.evaluate.regimes): low/high velocity split at 10 % of the robust top speed; "
+             "reversal: a window around each change of direction; constant feed; acceleration phases. "
+             "A sample may belong to several regimes; the header gives each regime's share of the samples.",
+             RE_NOTE]
+    return Table(title, header, rows, notes)
+
+
+def report_tables(records: Sequence[Mapping], hyperparameters: Sequence[Mapping] = (),
+                  timings: Sequence[Mapping] = (), *, titles: Mapping[int, str] | None = None,
+                  training: Mapping[int, Mapping[str, str]] | None = None,
+                  notes: Mapping[int, Sequence[str]] | None = None) -> list[Table]:
+    """Every table of a reproduction report, in reading order.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records.
+    hyperparameters : sequence of dict, optional
+        Rows for :func:`hyperparameter_table`.
+    timings : sequence of dict, optional
+        Rows for :func:`timing_table`.
+    titles : dict, optional
+        ``{experiment: title}``.
+    training : dict, optional
+        ``{experiment: {model: what it was trained on}}`` (see :func:`experiment_table`).
+    notes : dict, optional
+        ``{experiment: sentences}`` printed under the experiment's table.
+
+    Returns
+    -------
+    list of Table
+    """
+    titles = titles or {}
+    training = training or {}
+    notes = notes or {}
+    experiments = [e for e in _ordered(r["experiment"] for r in records) if e is not None]
+    tables = [experiment_table(records, e, title=titles.get(e), training=training.get(e), notes=notes.get(e, ()))
+              for e in experiments]
+    if hyperparameters:
+        tables.append(hyperparameter_table(hyperparameters))
+    if noise_floor_ratios(records):
+        tables.append(noise_floor_table(records))
+    if svr_generalisation(records):
+        tables.append(svr_generalisation_table(records))
+    if timings:
+        tables.append(timing_table(timings))
+    return tables
+
+
+def tables_markdown(tables: Sequence[Table], title: str = "greybox report", intro: str = "") -> str:
+    """All tables as one Markdown document."""
+    parts = [f"# {title}\n"]
+    if intro:
+        parts.append(intro.rstrip() + "\n")
+    parts += [table.to_markdown() for table in tables]
+    return "\n".join(parts)
+
+
+def write_report(out_dir: str | os.PathLike, records: Sequence[Mapping], tables: Sequence[Table],
+                 figures: Sequence[tuple[str, str | os.PathLike]] = (), *, title: str = "greybox report",
+                 intro: str = "") -> dict[str, Path]:
+    """Write ``metrics.json``, ``metrics.csv``, ``tables.md`` and ``index.html`` into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        Existing directory.
+    records : sequence of dict
+        Metric records.
+    tables : sequence of Table
+    figures : sequence of (caption, path)
+        PNG files already written (inside ``out_dir``), shown in the HTML page.
+    title, intro : str
+        Heading and first paragraph of ``tables.md`` and ``index.html``.
+
+    Returns
+    -------
+    dict
+        ``{"metrics_json", "metrics_csv", "tables", "html"}`` -> written file.
+    """
+    from .html import write_html
+
+    out_dir = Path(out_dir)
+    json_path, csv_path = write_metrics(records, out_dir)
+    tables_path = write_text_atomic(out_dir / "tables.md", tables_markdown(tables, title, intro))
+    html_path = write_html(out_dir / "index.html", title=title, intro=intro, tables=tables, figures=figures)
+    return {"metrics_json": json_path, "metrics_csv": csv_path, "tables": tables_path, "html": html_path}
+
+
+def write_evaluation_report(out_dir: str | os.PathLike, records: Sequence[Mapping], predictions: Mapping,
+                            runs, run_names: Sequence[str]) -> dict[str, Path]:
+    """The report of ``greybox evaluate``: error and regime tables, three figures, the HTML page.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        Report directory (created if missing).
+    records : sequence of dict
+        Records of :func:`greybox.evaluate.experiments.evaluate_models`.
+    predictions : dict
+        ``{model: predicted current [A], runs concatenated}``.
+    runs : list of AxisLog
+        Prepared test runs.
+    run_names : sequence of str
+        Their names.
+
+    Returns
+    -------
+    dict
+        As :func:`write_report`, plus ``figures``.
+    """
+    from .experiments import NOISE_FLOOR
+    from .figures import error_boxplot, residual_vs_position, time_comparison
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(exist_ok=True)
+    tests = "+".join(run_names)
+    models = {name: p for name, p in predictions.items() if name != NOISE_FLOOR}
+    figures = [
+        (f"Absolute error of each model on {tests} (boxes: quartiles, whiskers: 5th-95th percentile)",
+         error_boxplot([(f"test on {tests}", runs, predictions)], out_dir / "error_boxplot.png")),
+        (f"Measured and modelled current on {tests}",
+         time_comparison(runs, models, out_dir / "time_comparison.png", names=run_names)),
+        (f"Measured minus modelled current against position, by direction of motion, on {tests}",
+         residual_vs_position(runs, models, out_dir / "residual_position.png")),
+    ]
+    files = write_report(out_dir, records, [evaluation_table(records), regime_table(records)], figures,
+                         title="greybox: model evaluation", intro=f"Models tested on {tests}.")
+    files["figures"] = [path for _, path in figures]
+    return files

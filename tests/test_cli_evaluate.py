@@ -1,0 +1,116 @@
+"""Tests of ``greybox evaluate`` and ``greybox reproduce`` (through the command's main entry)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import greybox.cli as cli
+from greybox.data.io import write_log
+from greybox.data.prepare import prepare, trim
+from greybox.evaluate.metrics import rmse
+from greybox.evaluate.regimes import REGIME_NAMES
+from greybox.friction import GMSModel, StribeckModel
+from greybox.models.persistence import save_model
+from greybox.twin import make_dataset
+
+
+@pytest.fixture(autouse=True)
+def commands(monkeypatch):
+    """Make sure both sub-commands are registered, whether or not the lead has added them yet."""
+    monkeypatch.setattr(cli, "COMMANDS", tuple(dict.fromkeys(cli.COMMANDS + ("evaluate", "reproduce"))))
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """Two short test logs and two model files trained on a third log."""
+    root = tmp_path_factory.mktemp("evaluate")
+    train = prepare(make_dataset("X", "A", seed=11, duration_s=8.0))[0]
+    paths = {}
+    for name, model in (("stribeck", StribeckModel()), ("gms", GMSModel(n_starts=1, max_iter=60))):
+        paths[name] = save_model(model.fit(train), root / f"{name}.gbm")
+    for d in ("C", "D"):
+        paths[d] = root / f"X_{d}.mcap"
+        write_log(trim(make_dataset("X", d, seed=11, duration_s=6.0), stop_s=6.0), paths[d])
+    return paths
+
+
+def test_evaluate_prints_regimes_and_writes_json_and_report(files, tmp_path, capsys):
+    out, records_file = tmp_path / "report", tmp_path / "metrics.json"
+    status = cli.main(["evaluate", str(files["stribeck"]), str(files["gms"]), "--test", str(files["C"]),
+                       str(files["D"]), "--json", str(records_file), "--out", str(out)])
+    assert status == 0
+    printed = capsys.readouterr().out
+    for regime in REGIME_NAMES:
+        assert regime in printed
+    assert "stribeck" in printed and "gms" in printed and "noise_floor" in printed
+    records = {r["model"]: r for r in json.loads(records_file.read_text())}
+    assert set(records) == {"stribeck", "gms", "noise_floor"}
+    from greybox.models.persistence import load_model
+
+    runs = prepare([trim(make_dataset("X", d, seed=11, duration_s=6.0), stop_s=6.0) for d in "CD"])
+    measured = np.concatenate([run.effort for run in runs])
+    for name in ("stribeck", "gms"):
+        record = records[name]
+        expected = rmse(measured, load_model(files[name]).predict(runs))
+        assert record["rmse"] == pytest.approx(expected, rel=1e-3)  # logs round-trip through MCAP (1 mA)
+        assert record["kind"] == name and record["logs"] == "X_C+X_D" and record["dataset"] == "test"
+        assert record["regimes"]["all"]["rmse"] == pytest.approx(record["rmse"])
+        low, high = record["regimes"]["low_velocity"], record["regimes"]["high_velocity"]
+        assert low["n"] + high["n"] == record["n"]  # the two envelopes split the samples
+        pooled = (low["n"] * low["rmse"] ** 2 + high["n"] * high["rmse"] ** 2) / record["n"]
+        assert np.sqrt(pooled) == pytest.approx(record["rmse"])
+    assert {p.name for p in out.iterdir()} >= {"metrics.json", "metrics.csv", "tables.md", "index.html",
+                                               "error_boxplot.png", "time_comparison.png", "residual_position.png"}
+    assert 'src="data:image/png;base64,' in (out / "index.html").read_text()
+
+
+def test_evaluate_refuses_before_any_work(files, tmp_path, capsys):
+    existing = tmp_path / "m.json"
+    existing.write_text("{}")
+    assert cli.main(["evaluate", str(files["gms"]), "--test", str(files["C"]), "--json", str(existing)]) == 2
+    assert "file exists" in capsys.readouterr().err
+    assert existing.read_text() == "{}"
+    assert cli.main(["evaluate", str(files["gms"]), "--test", str(files["C"]), "--json", str(files["C"]),
+                     "--force"]) == 2
+    assert "is one of the inputs" in capsys.readouterr().err
+    full = tmp_path / "full"
+    full.mkdir()
+    (full / "keep.txt").write_text("x")
+    assert cli.main(["evaluate", str(files["gms"]), "--test", str(files["C"]), "--out", str(full)]) == 2
+    assert "not empty" in capsys.readouterr().err
+    missing = tmp_path / "none.gbm"
+    assert cli.main(["evaluate", str(missing), "--test", str(files["C"])]) == 2
+    err = capsys.readouterr().err
+    assert "none.gbm" in err and "Traceback" not in err
+
+
+def test_reproduce_refuses_a_non_empty_directory_and_missing_logs(files, tmp_path, capsys):
+    full = tmp_path / "full"
+    full.mkdir()
+    (full / "keep.txt").write_text("x")
+    assert cli.main(["reproduce", "--out", str(full), "--data", str(files["C"].parent)]) == 2
+    assert "not empty" in capsys.readouterr().err
+    assert cli.main(["reproduce", "--out", str(tmp_path / "new"), "--data", str(files["C"].parent)]) == 2
+    assert "X_A" in capsys.readouterr().err  # names the missing log before any fitting
+    assert not (tmp_path / "new").exists()
+
+
+def test_reproduce_quick_writes_the_report(tmp_path, capsys):
+    data = tmp_path / "data"
+    data.mkdir()
+    for d in "ABCD":
+        write_log(trim(make_dataset("Y", d, seed=2, duration_s=5.0), stop_s=5.0), data / f"Y_{d}.mcap")
+    out = tmp_path / "out"
+    assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axes", "Y", "--quick",
+                     "--jobs", "1", "--no-models"]) == 0
+    captured = capsys.readouterr()
+    assert "axis Y, experiment 2: gmssvr (GMS on A, SVR on B)" in captured.err  # progress display
+    records = json.loads((out / "metrics.json").read_text())
+    assert {(r["experiment"], r["model"]) for r in records} == {
+        (1, m) for m in ("coulomb", "stribeck", "lugre", "gms", "svr", "gmssvr", "noise_floor")} | {
+        (2, m) for m in ("stribeck", "gms", "svr", "gmssvr", "noise_floor")}
+    assert "Table 3" in (out / "tables.md").read_text() and not (out / "models").exists()
+    assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axes", "Y"]) == 2  # not empty now
