@@ -111,6 +111,6 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
     records = json.loads((out / "metrics.json").read_text())
     assert {(r["experiment"], r["model"]) for r in records} == {
         (1, m) for m in ("coulomb", "stribeck", "lugre", "gms", "svr", "gmssvr", "noise_floor")} | {
-        (2, m) for m in ("stribeck", "gms", "svr", "gmssvr", "noise_floor")}
+        (2, m) for m in ("stribeck", "gms", "svr", "gmssvr", "gmssvr_eq8", "noise_floor")}
     assert "Table 3" in (out / "tables.md").read_text() and not (out / "models").exists()
     assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axes", "Y"]) == 2  # not empty now

@@ -30,7 +30,6 @@ from greybox.evaluate.report import (
     svr_generalisation_table,
     write_metrics,
     write_report,
-    write_text_atomic,
 )
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -95,15 +94,6 @@ def test_metrics_json_and_csv(tmp_path):
 def test_records_json_is_strict():
     text = records_json([{"re": float("inf"), "x": np.float64(2.5), "n": np.int64(3)}])
     assert json.loads(text) == [{"re": None, "x": 2.5, "n": 3}]
-
-
-def test_write_text_atomic_replaces_and_keeps_the_usual_mode(tmp_path):
-    target = tmp_path / "a.md"
-    target.write_text("old")
-    write_text_atomic(target, "new ü")
-    assert target.read_text(encoding="utf-8") == "new ü"
-    assert target.stat().st_mode & 0o044  # readable by others, unlike a bare mkstemp file
-    assert [p.name for p in tmp_path.iterdir()] == ["a.md"]
 
 
 # ---------------------------------------------------------------- tables

@@ -8,7 +8,8 @@ from pathlib import Path
 from ..errors import GreyboxError
 from ..evaluate.experiments import evaluate_models
 from ..evaluate.regimes import REGIME_NAMES
-from ..evaluate.report import RE_NOTE, check_output_dir, records_json, write_evaluation_report, write_text_atomic
+from ..atomic import write_text_atomic
+from ..evaluate.report import RE_NOTE, check_output_dir, records_json, write_evaluation_report
 from ..models.persistence import load_model
 from ._options import add_log_arguments, read_logs
 

@@ -13,7 +13,8 @@ import os
 from pathlib import Path
 from typing import Sequence
 
-from .report import Table, write_text_atomic
+from ..atomic import write_text_atomic
+from .report import Table
 
 __all__ = ["render_html", "write_html", "STYLE"]
 

@@ -35,10 +35,11 @@ import io
 import json
 import math
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
+
+from ..atomic import write_text_atomic
 
 __all__ = [
     "Table",
@@ -47,7 +48,6 @@ __all__ = [
     "PAPER_SOURCE",
     "RE_NOTE",
     "CSV_COLUMNS",
-    "write_text_atomic",
     "check_output_dir",
     "json_ready",
     "records_json",
@@ -137,29 +137,6 @@ class Table:
 
 
 # ---------------------------------------------------------------- writing files
-def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same directory.
-
-    Returns
-    -------
-    pathlib.Path
-        The written file.
-    """
-    path = Path(path)
-    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as stream:
-            stream.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes the file private; give it the usual mode
-        os.replace(temporary, path)
-    finally:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-    return path
-
-
 def check_output_dir(out_dir: str | os.PathLike, *, force: bool = False) -> Path:
     """Refuse a report directory that is a file, or that is not empty unless ``force``.
 
