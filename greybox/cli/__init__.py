@@ -16,7 +16,7 @@ import sys
 from ..errors import GreyboxError
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
-COMMANDS = ("synth", "info", "plot", "train", "predict", "compensate")
+COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate")
 
 
 def build_parser() -> argparse.ArgumentParser:
