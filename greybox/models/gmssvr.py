@@ -42,7 +42,7 @@ from ..errors import LogError, ParameterError
 from ..friction.gms import GMSModel
 from ..identify.progress import make_progress
 from .base import CurrentModel, check_runs
-from .svr import _expansion_of, _store_expansion, fit_svr_expansion, hyperparameters_table
+from .svr import _expansion_of, _fit_expansion, hyperparameters_table
 
 __all__ = ["GMSSVRModel", "TARGETS"]
 
@@ -231,14 +231,8 @@ class GMSSVRModel(CurrentModel):
         y = np.concatenate([run.effort for run in runs])
         if self.target == "residual":
             y = y - X[:, 1]
-        fit = fit_svr_expansion(
-            X, y, coverage, [len(run) for run in runs],
-            fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
-            n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
-            cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=self.bounds,
-            random_state=self.random_state, progress=make_progress(progress),
-            stage="GMS-SVR hyperparameters")
-        _store_expansion(self, fit)
+        _fit_expansion(self, X, y, coverage, [len(run) for run in runs], make_progress(progress),
+                       stage="GMS-SVR hyperparameters")
         return self
 
     def _check_target(self) -> None:

@@ -425,13 +425,7 @@ class SVRCurrentModel(CurrentModel):
         self.J_, self.offset_ = inertia_offset_proxy(runs, self.inertia)
         X = np.concatenate([self._inputs(run) for run in runs])
         target = np.concatenate([run.effort - self.J_ * run.acceleration for run in runs]) - self.offset_
-        fit = fit_svr_expansion(
-            X, target, X, [len(run) for run in runs],
-            fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
-            n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
-            cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=self.bounds,
-            random_state=self.random_state, progress=progress)
-        _store_expansion(self, fit)
+        _fit_expansion(self, X, target, X, [len(run) for run in runs], progress)
 
     def _friction_run(self, run: AxisLog) -> np.ndarray:
         return _expansion_of(self).predict(self._inputs(run))
@@ -454,8 +448,19 @@ class SVRCurrentModel(CurrentModel):
         return hyperparameters_table(self)
 
 
-def _store_expansion(model, fit: SVRExpansion) -> None:
-    """Copy a fitted expansion into a model's learned attributes (arrays and floats only)."""
+def _fit_expansion(model, X, y, coverage, run_lengths: Sequence[int],
+                   progress: Callable[[ProgressEvent], None] | None,
+                   stage: str = "SVR hyperparameters") -> None:
+    """Fit :func:`fit_svr_expansion` with a model's SVR settings (``C``, ``epsilon``,
+    ``gamma``, ``n_subset``, ``optimize``, ``n_calls``, ``cv_folds``, ``cv_blocks``,
+    ``bounds``, ``random_state``) and keep the result as the model's learned
+    attributes (arrays and floats only)."""
+    fit = fit_svr_expansion(
+        X, y, coverage, run_lengths,
+        fixed={"epsilon": model.epsilon, "C": model.C, "gamma": model.gamma},
+        n_subset=model.n_subset, optimize=model.optimize, n_calls=model.n_calls,
+        cv_folds=model.cv_folds, cv_blocks=model.cv_blocks, bounds=model.bounds,
+        random_state=model.random_state, progress=progress, stage=stage)
     model.input_mean_ = fit.input_mean
     model.input_scale_ = fit.input_scale
     model.support_vectors_ = fit.support_vectors
