@@ -23,6 +23,7 @@ from typing import Mapping
 import pandas as pd
 
 from ..errors import LogError
+from .file_metadata import log_metadata, metadata_fields
 from .log import AxisLog
 from .units import log_from_columns
 
@@ -92,16 +93,7 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
     if frame.empty:
         raise LogError(path, "no data rows (the file holds only a header)")
     table = {str(name).strip(): frame[name].to_numpy() for name in frame.columns}
-    return log_from_columns(
-        table,
-        source=path,
-        columns=columns,
-        sample_time=sample_time,
-        effort_unit=metadata.get("effort_unit"),
-        axis=str(metadata.get("axis", "")),
-        dataset=str(metadata.get("dataset", "")),
-        attrs=metadata.get("attrs", {}),
-    )
+    return log_from_columns(table, source=path, columns=columns, sample_time=sample_time, **metadata_fields(metadata))
 
 
 def write_csv(log: AxisLog, path) -> None:
@@ -116,7 +108,6 @@ def write_csv(log: AxisLog, path) -> None:
     path : str or path-like
         Written in place; :func:`greybox.data.io.write_log` makes it atomic.
     """
-    metadata = {"axis": log.axis, "dataset": log.dataset, "effort_unit": log.effort_unit, "attrs": log.attrs}
     with open(path, "w", encoding="utf-8", newline="") as stream:
-        stream.write(_METADATA_TAG + json.dumps(metadata) + "\n")
+        stream.write(_METADATA_TAG + json.dumps(log_metadata(log)) + "\n")
         log.to_frame().to_csv(stream, index=False, lineterminator="\n")

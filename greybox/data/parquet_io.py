@@ -15,6 +15,7 @@ import json
 from typing import Mapping
 
 from ..errors import LogError
+from .file_metadata import log_metadata, metadata_fields
 from .log import AxisLog
 from .units import log_from_columns
 
@@ -63,16 +64,7 @@ def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time:
         column = table.column(name)
         numeric = pa.types.is_integer(column.type) or pa.types.is_floating(column.type) or pa.types.is_boolean(column.type)
         arrays[name] = column.to_numpy() if numeric else column.to_numpy(zero_copy_only=False).astype(object)
-    return log_from_columns(
-        arrays,
-        source=path,
-        columns=columns,
-        sample_time=sample_time,
-        effort_unit=metadata.get("effort_unit"),
-        axis=str(metadata.get("axis", "")),
-        dataset=str(metadata.get("dataset", "")),
-        attrs=metadata.get("attrs", {}),
-    )
+    return log_from_columns(arrays, source=path, columns=columns, sample_time=sample_time, **metadata_fields(metadata))
 
 
 def write_parquet(log: AxisLog, path) -> None:
@@ -88,9 +80,8 @@ def write_parquet(log: AxisLog, path) -> None:
     import pyarrow.parquet as pq
 
     frame = log.to_frame()
-    metadata = {"axis": log.axis, "dataset": log.dataset, "effort_unit": log.effort_unit, "attrs": log.attrs}
     table = pa.table(
         {name: frame[name].to_numpy() for name in frame.columns},
-        metadata={_METADATA_KEY: json.dumps(metadata).encode()},
+        metadata={_METADATA_KEY: json.dumps(log_metadata(log)).encode()},
     )
     pq.write_table(table, path, compression="zstd")
