@@ -73,6 +73,37 @@ def _gms_element_step(z_old, mode, d, v_dt, s_i, alpha_i, c_dt, inv_s):
 
 
 @njit(cache=True, error_model="numpy")
+def _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s):
+    """Quantities of one GMS step shared by all elements.
+
+    Parameters
+    ----------
+    v : float
+        Velocity held over the step [mm/s].
+    sample_time : float
+        Step T [s].
+    s_inf, s_drop : float
+        ``s_inf`` and ``s_0 - s_inf`` of the Stribeck curve [mm].
+    inv_v_s : float
+        ``1 / v_s`` [s/mm].
+
+    Returns
+    -------
+    s : float
+        ``s(v) = s_inf + (s_0 - s_inf) exp(-|v| / v_s)`` [mm].
+    inv_s : float
+        ``1 / s(v)`` [1/mm].
+    d : int
+        ``sgn(v)``.
+    v_dt : float
+        ``v T``: travel over the step [mm].
+    """
+    s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
+    d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
+    return s, 1.0 / s, d, v * sample_time
+
+
+@njit(cache=True, error_model="numpy")
 def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0):
     """Friction of the Generalized Maxwell-Slip model, forward Euler at a constant step.
 
@@ -120,10 +151,7 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
     inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
-        inv_s = 1.0 / s
-        d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
-        v_dt = v * sample_time
+        s, inv_s, d, v_dt = _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
         f = mu * v
         for i in range(alpha.shape[0]):
             z_old = z[i]
@@ -173,10 +201,7 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, 
     inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
-        inv_s = 1.0 / s
-        d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
-        v_dt = v * sample_time
+        s, inv_s, d, v_dt = _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
         w = 0.0
         for i in range(alpha.shape[0]):
             z_old = z[i]
