@@ -10,7 +10,32 @@ import numpy as np
 from ..atomic import atomic_output
 from ..data.log import AxisLog
 
-__all__ = ["plot_log", "save_figure"]
+__all__ = ["plot_log", "save_figure", "import_pyplot", "finish_figure"]
+
+
+def import_pyplot(path: str | os.PathLike | None):
+    """``matplotlib.pyplot``, on the non-interactive Agg backend when the figure goes to a file.
+
+    Parameters
+    ----------
+    path : path-like or None
+        Where the figure will be written; ``None`` leaves the backend alone
+        (the caller shows or returns the figure).
+    """
+    import matplotlib
+
+    if path is not None:
+        matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def finish_figure(figure, path: str | os.PathLike | None):
+    """Return ``figure`` when ``path`` is None, else write it with :func:`save_figure` and return the path."""
+    if path is None:
+        return figure
+    return save_figure(figure, path)
 
 
 def save_figure(figure, path: str | os.PathLike, *, dpi: int = 120) -> Path:
@@ -63,12 +88,7 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
     matplotlib.figure.Figure or pathlib.Path
         The figure, or the written file when ``path`` is given.
     """
-    import matplotlib
-
-    if path is not None:
-        matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
+    plt = import_pyplot(path)
     stride = max(1, int(np.ceil(len(log) / max_points)))
     t = log.time[::stride]
     effort = log.effort[::stride]
@@ -110,6 +130,4 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
     if log.source:
         title += f"  ({Path(log.source).name})"
     figure.suptitle(title)
-    if path is None:
-        return figure
-    return save_figure(figure, path)
+    return finish_figure(figure, path)

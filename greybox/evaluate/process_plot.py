@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .plots import save_figure
+from .plots import finish_figure, import_pyplot
 from .process import ProcessResult
 
 __all__ = ["envelope_indices", "plot_process"]
@@ -68,12 +68,7 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     matplotlib.figure.Figure or pathlib.Path
         The figure, or the written file when ``path`` is given.
     """
-    import matplotlib
-
-    if path is not None:
-        matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
+    plt = import_pyplot(path)
     unit = result.effort_unit
     noun = "current" if unit == "A" else "force"
     starts = envelope_indices(result.time.size, max_points)
@@ -107,6 +102,4 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     if model:
         title += f", {model} model"
     figure.suptitle(title)
-    if path is None:
-        return figure
-    return save_figure(figure, path)
+    return finish_figure(figure, path)
