@@ -15,7 +15,9 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-__all__ = ["atomic_output", "write_text_atomic", "write_bytes_atomic"]
+from .errors import GreyboxError
+
+__all__ = ["atomic_output", "check_output_path", "write_text_atomic", "write_bytes_atomic"]
 
 
 def _default_mode() -> int:
@@ -59,6 +61,43 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
     finally:
         if os.path.exists(temporary):
             os.unlink(temporary)
+
+
+def check_output_path(path: str | os.PathLike, *, overwrite: bool = False, protect=(),
+                      error: type[GreyboxError] = GreyboxError,
+                      inputs_name: str = "an input of this command") -> None:
+    """Raise unless ``path`` may be written: refuse to overwrite without ``overwrite``, never replace an input.
+
+    Parameters
+    ----------
+    path : path-like
+        Output file.
+    overwrite : bool, default False
+        Whether an existing file may be replaced (the commands' ``--force``).
+    protect : iterable of path-like
+        Input files that must never be replaced, whatever ``overwrite``.
+    error : type, default GreyboxError
+        Error class raised (a :class:`GreyboxError` subclass).
+    inputs_name : str, default "an input of this command"
+        What the protected files are, for the message.
+
+    Raises
+    ------
+    GreyboxError
+        (of class ``error``) If ``path`` is a directory, its directory does
+        not exist, it is one of ``protect``, or it exists and ``overwrite`` is false.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise error(f"{path}: is a directory")
+    if not path.parent.is_dir():
+        raise error(f"{path}: directory {path.parent} does not exist")
+    if path.exists():
+        for source in protect:
+            if os.path.exists(source) and os.path.samefile(path, source):
+                raise error(f"{path}: is {inputs_name}; refusing to overwrite it")
+        if not overwrite:
+            raise error(f"{path}: file exists; use --force to overwrite it")
 
 
 def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> Path:

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import time
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import check_output_path
 from ..errors import GreyboxError, ModelFileError
 from ..evaluate.metrics import metrics_table
 from ..models.persistence import load_model, save_model
@@ -117,19 +117,6 @@ def build_model(kind: str, args: argparse.Namespace):
     return model.set_params(**params)
 
 
-def _check_output(out: Path, inputs, force: bool) -> None:
-    """Refuse before any fitting when the model file cannot or must not be written."""
-    for source in inputs:
-        if out.exists() and os.path.exists(source) and os.path.samefile(out, source):
-            raise ModelFileError(f"{out}: is one of the training logs; refusing to overwrite it")
-    if out.exists() and not force:
-        raise ModelFileError(f"{out}: file exists; use --force to overwrite it")
-    if out.is_dir():
-        raise ModelFileError(f"{out}: is a directory")
-    if not out.parent.is_dir():
-        raise ModelFileError(f"{out}: directory {out.parent} does not exist")
-
-
 #: Arrays and lists longer than this are summarised by their shape, not printed.
 _MAX_PRINTED = 12
 
@@ -182,7 +169,8 @@ def _fit(model, args: argparse.Namespace):
 
 def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
-    _check_output(out, list(args.train) + list(args.stage2 or ()), args.force)
+    check_output_path(out, overwrite=args.force, protect=list(args.train) + list(args.stage2 or ()),
+                      error=ModelFileError, inputs_name="one of the training logs")
     model = build_model(args.model, args)
     started = time.perf_counter()
     paths, runs = _fit(model, args)

@@ -24,12 +24,11 @@ back given a column mapping for the effort, e.g.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_output
+from ..atomic import atomic_output, check_output_path
 from ..errors import GreyboxError
 from .process import ProcessResult
 
@@ -165,28 +164,3 @@ def write_process(result: ProcessResult, path, *, overwrite: bool = False, prote
     with atomic_output(path) as temporary:
         _WRITERS[fmt](result, str(temporary))
     return path
-
-
-def check_output_path(path, *, overwrite: bool = False, protect=()) -> None:
-    """Raise :class:`GreyboxError` unless ``path`` may be written.
-
-    Parameters
-    ----------
-    path : path-like
-        Output file.
-    overwrite : bool, default False
-        Whether an existing file may be replaced.
-    protect : iterable of path-like
-        Input files that must never be replaced.
-    """
-    path = Path(path)
-    if path.is_dir():
-        raise GreyboxError(f"{path}: is a directory")
-    if not path.parent.is_dir():
-        raise GreyboxError(f"{path}: directory {path.parent} does not exist")
-    if path.exists():
-        for source in protect:
-            if os.path.exists(source) and os.path.samefile(path, source):
-                raise GreyboxError(f"{path}: is an input of this command; refusing to overwrite it")
-        if not overwrite:
-            raise GreyboxError(f"{path}: file exists; use --force to overwrite it")
