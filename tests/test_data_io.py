@@ -10,44 +10,37 @@ import pytest
 from greybox.data.io import format_of, parse_column_mapping, read_log, write_log
 from greybox.errors import GreyboxError, LogError
 
-
-def _fails(path, *fragments, **options):
-    with pytest.raises(LogError) as error:
-        read_log(path, **options)
-    message = str(error.value)
-    assert message.startswith(str(path) + ": "), message
-    for fragment in fragments:
-        assert fragment in message, message
+from log_errors import assert_read_fails
 
 
 def test_missing_file(tmp_path):
-    _fails(tmp_path / "nothere.csv", "no such file")
+    assert_read_fails(tmp_path / "nothere.csv", "no such file")
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet", ".mcap", ".mat"])
 def test_zero_byte_file(tmp_path, suffix):
     path = tmp_path / f"empty{suffix}"
     path.write_bytes(b"")
-    _fails(path, "empty file (0 bytes)")
+    assert_read_fails(path, "empty file (0 bytes)")
 
 
 def test_unknown_extension(tmp_path):
     path = tmp_path / "log.xlsx"
     path.write_bytes(b"data")
-    _fails(path, "unknown log file extension '.xlsx'")
+    assert_read_fails(path, "unknown log file extension '.xlsx'")
 
 
 def test_directory(tmp_path):
     folder = tmp_path / "dir.csv"
     folder.mkdir()
-    _fails(folder, "is a directory")
+    assert_read_fails(folder, "is a directory")
 
 
 def test_format_override_and_inapplicable_options(tmp_path, make_log):
     path = tmp_path / "log.txt"
     write_log(make_log(n=50), path, fmt="csv")
     assert len(read_log(path, fmt="csv")) == 50
-    _fails(path, "option 'topic' does not apply to csv files", fmt="csv", topic="/axis/X")
+    assert_read_fails(path, "option 'topic' does not apply to csv files", fmt="csv", topic="/axis/X")
     assert format_of("a.PQ") == "parquet" and format_of("b.mat") == "emps"
 
 
@@ -119,4 +112,4 @@ def test_read_log_result_is_validated(tmp_path, make_log):
     log = make_log(n=100)
     bad = log.replace(time=np.where(np.arange(100) < 50, log.time, log.time + 1.0))
     write_log(bad, tmp_path / "gap.parquet")
-    _fails(tmp_path / "gap.parquet", "gap of 1002 ms at t = 0.098 s")
+    assert_read_fails(tmp_path / "gap.parquet", "gap of 1002 ms at t = 0.098 s")

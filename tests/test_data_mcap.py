@@ -12,6 +12,8 @@ from greybox.data.io import read_log, write_log
 from greybox.data.mcap_io import SCHEMA_NAME, join_slices, scan_records
 from greybox.errors import LogError
 
+from log_errors import assert_read_fails
+
 
 def test_round_trip_keeps_values_extras_and_metadata(tmp_path, make_log):
     rng = np.random.default_rng(3)
@@ -172,20 +174,10 @@ def test_messages_out_of_time_order_are_sorted(tmp_path):
     np.testing.assert_allclose(log.position, np.arange(50.0))
 
 
-def _fails(path, *fragments, **options):
-    with pytest.raises(LogError) as error:
-        read_log(path, **options)
-    message = str(error.value)
-    assert message.startswith(str(path) + ": "), message
-    for fragment in fragments:
-        assert fragment in message, message
-    return message
-
-
 def test_random_bytes_are_not_mcap(tmp_path):
     path = tmp_path / "noise.mcap"
     path.write_bytes(np.random.default_rng(0).bytes(5000))
-    _fails(path, "not an MCAP file")
+    assert_read_fails(path, "not an MCAP file")
 
 
 def test_truncated_file(tmp_path, make_log):
@@ -193,7 +185,7 @@ def test_truncated_file(tmp_path, make_log):
     write_log(make_log(), path)
     data = path.read_bytes()
     path.write_bytes(data[: len(data) // 2])
-    _fails(path, "truncated")
+    assert_read_fails(path, "truncated")
 
 
 def test_truncated_file_that_ends_with_the_magic_bytes(tmp_path, make_log):
@@ -201,7 +193,7 @@ def test_truncated_file_that_ends_with_the_magic_bytes(tmp_path, make_log):
     write_log(make_log(), path)
     data = path.read_bytes()
     path.write_bytes(data[: len(data) // 2] + data[:8])
-    _fails(path, "corrupt or truncated", "runs past the end")
+    assert_read_fails(path, "corrupt or truncated", "runs past the end")
 
 
 def test_corrupt_chunk(tmp_path, make_log):
@@ -211,25 +203,25 @@ def test_corrupt_chunk(tmp_path, make_log):
     middle = len(data) // 3
     data[middle:middle + 64] = np.random.default_rng(1).bytes(64)
     path.write_bytes(bytes(data))
-    _fails(path, "corrupt")
+    assert_read_fails(path, "corrupt")
 
 
 def test_messages_that_are_not_json(tmp_path):
     path = tmp_path / "binary.mcap"
     _write_with_mcap_library(path, [(k * 1_000_000, b"\x01\x02 not json") for k in range(10)])
-    _fails(path, "not valid JSON")
+    assert_read_fails(path, "not valid JSON")
 
 
 def test_channel_with_another_encoding(tmp_path):
     path = tmp_path / "proto.mcap"
     _write_with_mcap_library(path, [(k * 1_000_000, b"\x08\x01") for k in range(10)], encoding="protobuf")
-    _fails(path, "message encoding 'protobuf'")
+    assert_read_fails(path, "message encoding 'protobuf'")
 
 
 def test_missing_field(tmp_path):
     path = tmp_path / "nocurrent.mcap"
     _write_with_mcap_library(path, [(k * 1_000_000, json.dumps({"position_mm": 1.0}).encode()) for k in range(10)])
-    _fails(path, "missing required column 'current_A'")
+    assert_read_fails(path, "missing required column 'current_A'")
 
 
 def test_field_missing_in_some_messages_is_reported_as_non_finite(tmp_path):
@@ -237,7 +229,7 @@ def test_field_missing_in_some_messages_is_reported_as_non_finite(tmp_path):
     messages = [(k * 1_000_000, json.dumps({"position_mm": 1.0, "current_A": 2.0}).encode()) for k in range(20)]
     messages[7] = (7_000_000, json.dumps({"position_mm": 1.0}).encode())
     _write_with_mcap_library(path, messages)
-    _fails(path, "channel 'current_A'", "t = 0.007")
+    assert_read_fails(path, "channel 'current_A'", "t = 0.007")
 
 
 def test_repeated_time_stamp(tmp_path):
@@ -245,7 +237,7 @@ def test_repeated_time_stamp(tmp_path):
     messages = _sample_messages(20)
     messages[10] = (messages[9][0], messages[10][1])
     _write_with_mcap_library(path, messages)
-    _fails(path, "time repeats at sample 10")
+    assert_read_fails(path, "time repeats at sample 10")
 
 
 def test_writer_refuses_what_mcap_cannot_hold(tmp_path, make_log):
