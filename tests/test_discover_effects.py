@@ -66,11 +66,20 @@ def test_friction_terms_flip_with_the_direction_and_force_terms_do_not():
                                effect("position_periodic_force").columns(run, context, 5.0))
 
 
-def test_direction_asymmetry_acts_in_positive_motion_only():
+def test_direction_asymmetry_adds_level_and_viscous_friction_in_positive_motion_only():
     run = stroke()
-    column = effect("direction_asymmetry").columns(run, EffectContext(1e-6, (-270.0, -230.0)))[:, 0]
-    assert np.all(column[run.velocity > 1e-3] == pytest.approx(1.0))
-    assert np.all(column[run.velocity < 0] == 0.0)
+    context = EffectContext(1e-6, (-270.0, -230.0))
+    term = effect("direction_asymmetry")
+    current = term.current(run, context, [0.2, 0.01])
+    moving_up, moving_down = run.velocity > 1e-3, run.velocity < 0
+    np.testing.assert_allclose(current[moving_up], 0.2 + 0.01 * run.velocity[moving_up])
+    assert np.all(current[moving_down] == 0.0)
+    assert term.parameters([0.2, 0.01], context, None, "N") == {"level_difference_N": 0.2,
+                                                                "viscous_difference_N_s_per_mm": 0.01}
+    # the twin's (level-only) asymmetry with the same velocity scale is the first column
+    inputs = EffectInputs(run.time, run.position, run.velocity, run.acceleration, (-510.0, 0.0))
+    twin = effect_current("direction_asymmetry", inputs, 0.3, velocity_scale_mm_s=0.5)
+    np.testing.assert_allclose(term.current(run, EffectContext(0.5, (-270.0, -230.0)), [0.3, 0.0]), twin)
 
 
 def test_position_trend_spans_the_twin_trend_up_to_the_direction_term():
@@ -103,7 +112,7 @@ def test_period_scan_is_a_grid_of_integer_frequency_multiples_within_the_range()
     multiples = 1.0 / (periods * step)
     np.testing.assert_allclose(multiples, np.round(multiples), atol=1e-6)
     span = context.position_range_mm[1] - context.position_range_mm[0]
-    assert periods.max() <= span * (1 + 1e-9)
+    assert periods.max() <= span / 2 * (1 + 1e-9)  # two periods at least in the range
     assert step <= 1.0 / (4.0 * span) * (1 + 1e-9)
     median_step = np.median(np.abs(np.diff(run.position)))
     assert periods.min() >= 4.0 * median_step * (1 - 1e-9)
@@ -114,3 +123,13 @@ def test_context_from_runs_takes_the_position_range_and_one_percent_of_the_speed
     context = EffectContext.from_runs([run])
     assert context.position_range_mm == (run.position.min(), run.position.max())
     assert context.velocity_scale_mm_s == pytest.approx(0.01 * np.percentile(np.abs(run.velocity), 99))
+
+
+def test_a_long_travel_scanned_in_fine_steps_keeps_at_most_4000_periods():
+    run = stroke(n=20000, amplitude=500.0, frequency=0.002)  # 240 mm in 40 s: about 0.012 mm per sample
+    context = EffectContext.from_runs([run])
+    span = context.position_range_mm[1] - context.position_range_mm[0]
+    step, periods = period_scan([run], context)
+    assert periods.size == 4000
+    assert periods.min() == pytest.approx(span / 1000.0, rel=0.01)
+    assert step == pytest.approx(1.0 / (4.0 * span), rel=1e-9)

@@ -15,7 +15,7 @@ and acceleration [mm/s^2]:
 ========================== =========================================== ================
 name                       columns                                     shape
 ========================== =========================================== ================
-direction_asymmetry        ``max(d, 0)``                               -
+direction_asymmetry        ``max(d, 0)``, ``v max(d, 0)``              -
 constant_offset            ``1``                                       -
 position_trend             ``u d``, ``(3 u^2 - 1) / 2 * d``            -
 position_periodic_friction ``sin(2 pi x / P) d``, ``cos(2 pi x / P) d`` ``P`` [mm]
@@ -48,9 +48,11 @@ __all__ = ["EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "effect", "peri
 
 #: Periods are scanned at this many points per periodogram resolution ``1 / range``.
 _PERIOD_OVERSAMPLING = 4
+#: Longest period: the position range holds this many periods.
+_MIN_PERIODS_IN_RANGE = 2
 #: Shortest period: this many samples per period at the median moving speed.
 _SAMPLES_PER_PERIOD = 4
-#: Most periods a scan tries (the frequency step grows beyond that).
+#: Most periods a scan tries (the shortest period grows beyond that).
 _MAX_PERIODS = 4000
 #: Points of the logarithmic grids of time constants and Stribeck velocities.
 _LOG_GRID_POINTS = 24
@@ -209,19 +211,21 @@ def period_scan(runs: Sequence[AxisLog], context: EffectContext) -> tuple[float,
 
     The frequencies ``1 / P`` are the integer multiples of the step
     ``1 / (4 R)`` (four points per periodogram resolution ``1 / R``, ``R``
-    the position range of the training data) from ``1 / R`` up to
+    the position range of the training data) from ``2 / R`` (two periods in
+    the range: a slower variation is a trend, not something periodic) up to
     ``1 / P_min``, ``P_min`` giving 4 samples per period at the median moving
-    speed; with more than 4000 periods the step grows. Periods come longest first.
+    speed, but at most 4000 periods (``P_min >= R / 1000``). Periods come
+    longest first.
     """
     low, high = context.position_range_mm
     span = high - low
     steps = np.concatenate([np.abs(np.diff(run.position)) for run in runs])
     moving = steps[steps > 0.0]
     p_min = _SAMPLES_PER_PERIOD * float(np.median(moving)) if moving.size else span / 4.0
-    f_low, f_high = 1.0 / span, 1.0 / min(p_min, span / 4.0)
-    step = max(1.0 / (_PERIOD_OVERSAMPLING * span), f_high / _MAX_PERIODS)
-    multiples = np.arange(int(np.ceil(f_low / step - 1e-9)), int(np.floor(f_high / step + 1e-9)) + 1)
-    return step, 1.0 / (multiples * step)
+    step = 1.0 / (_PERIOD_OVERSAMPLING * span)
+    first = int(round(_MIN_PERIODS_IN_RANGE / (span * step)))
+    last = min(int(np.floor(1.0 / (min(p_min, span / 4.0) * step) + 1e-9)), first + _MAX_PERIODS - 1)
+    return step, 1.0 / (np.arange(first, last + 1) * step)
 
 
 def period_grid(runs: Sequence[AxisLog], context: EffectContext) -> np.ndarray:
@@ -280,6 +284,11 @@ def _trend_parameters(coefficients, context, shape, unit):
             "range_low_mm": low, "range_high_mm": high}
 
 
+def _asymmetry_parameters(coefficients, context, shape, unit):
+    level, viscous = coefficients
+    return {f"level_difference_{unit}": float(level), f"viscous_difference_{unit}_s_per_mm": float(viscous)}
+
+
 def _single(key):
     def describe(coefficients, context, shape, unit):
         return {key.format(E=unit): float(coefficients[0])}
@@ -295,10 +304,11 @@ def _with_shape(key, shape_key):
 _PERIOD = ShapeParameter("period_mm", "frequency", period_grid)
 
 _LIBRARY = (
-    Effect("direction_asymmetry", "friction differs with the direction of motion",
-           ("positive_direction",),
-           lambda run, c, s: np.maximum(c.direction(run), 0.0),
-           _single("level_difference_{E}")),
+    Effect("direction_asymmetry", "friction differs with the direction of motion (level and viscous part)",
+           ("positive_level", "positive_viscous"),
+           lambda run, c, s: np.maximum(c.direction(run), 0.0)[:, None] * np.column_stack((np.ones(len(run)),
+                                                                                         run.velocity)),
+           _asymmetry_parameters),
     Effect("constant_offset", "constant effort: gravity, weight compensation or a current bias",
            ("one",),
            lambda run, c, s: np.ones(len(run)),

@@ -14,13 +14,15 @@ Null calibration
 ----------------
 Data with nothing missing are the fitted model's prediction plus noise like
 the measured residual (:class:`greybox.discover.noise.ResidualNoise`: AR
-process with the residual's autocorrelation and local level, fitted to the
-residual left after all candidates and the structure columns, so that the
-structure being tested does not inflate the noise). Refitting the model to
-such data leaves the simulated noise projected off the nuisance, so every
-null replicate costs one projection, not a model fit; this is exact for
-parameters that enter linearly and the linearisation of the others. The same
-scans run on every replicate.
+process with the residual's autocorrelation and local level, its coefficients
+drawn from their sampling distribution). The noise is fitted to the model's
+residual; if candidates pass, it is fitted once more to the residual left
+after them (and after the structure columns, if those pass), so that
+structure in the residual does not make the noise look louder than it is.
+Refitting the model to simulated data leaves the simulated noise projected
+off the nuisance, so every null replicate costs one projection, not a model
+fit; this is exact for parameters that enter linearly and the linearisation
+of the others. The same scans run on every replicate.
 
 Each candidate's statistic is standardised by its own null distribution,
 ``z = (log f - log q50) / (log q90 - log q50)``, so that flexible

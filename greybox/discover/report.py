@@ -28,7 +28,7 @@ import numpy as np
 from ..evaluate.plots import save_figure
 from .workflow import DiscoveryResult
 
-__all__ = ["jsonable", "write_json", "plot_residuals", "plot_evidence", "write_report"]
+__all__ = ["jsonable", "write_json", "write_text", "plot_residuals", "plot_evidence", "write_report"]
 
 #: Most points drawn of a residual over time.
 _MAX_POINTS = 20_000
@@ -53,13 +53,17 @@ def jsonable(value):
 
 def write_json(document: dict, path: str | os.PathLike) -> Path:
     """Write ``document`` as indented strict JSON, atomically; return the path."""
+    return write_text(json.dumps(jsonable(document), indent=1, allow_nan=False) + "\n", path)
+
+
+def write_text(text: str, path: str | os.PathLike) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically (temporary file, then rename); return the path."""
     path = Path(path)
-    text = json.dumps(jsonable(document), indent=1, allow_nan=False)
     directory = path.parent if str(path.parent) else Path(".")
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            stream.write(text + "\n")
+            stream.write(text)
         os.chmod(temporary, 0o644)
         os.replace(temporary, path)
     except BaseException:
