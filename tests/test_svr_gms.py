@@ -11,6 +11,8 @@ from greybox.errors import ParameterError
 from greybox.friction.gms import GMSModel, simulate_gms
 from greybox.models.gmssvr import GMSSVRModel
 
+from multisine import multisine_motion
+
 TRUTH_GMS = dict(alpha=np.array([0.1, 0.2, 0.3, 0.4]), k=np.full(4, 80.0), C=2.0, sigma=0.01,
                  s_0=0.01, s_inf=0.006, v_s=5.0, mu=0.003)
 RIPPLE_A = 0.3  # amplitude of the position-dependent friction the GMS model cannot represent
@@ -19,14 +21,7 @@ RIPPLE_A = 0.3  # amplitude of the position-dependent friction the GMS model can
 def gms_run(seed, n=20000, ripple=RIPPLE_A, noise=0.02):
     """Multi-sine motion; current = inertia + GMS friction + ripple(position) + noise."""
     rng = np.random.default_rng(seed)
-    t = np.arange(n) * 0.002
-    freq = rng.uniform(0.1, 0.4, 3)
-    phase = rng.uniform(0.0, 2 * np.pi, 3)
-    amp = np.array([120.0, 50.0, 20.0])
-    arg = 2 * np.pi * freq[:, None] * t + phase[:, None]
-    p = 200.0 + (amp[:, None] * np.sin(arg)).sum(0)
-    v = (amp[:, None] * 2 * np.pi * freq[:, None] * np.cos(arg)).sum(0)
-    a = (-amp[:, None] * (2 * np.pi * freq[:, None]) ** 2 * np.sin(arg)).sum(0)
+    t, p, v, a = multisine_motion(rng, n)
     friction, _ = simulate_gms(v, 0.002, **TRUTH_GMS)
     current = 2e-4 * a + friction + ripple * np.sin(2 * np.pi * p / 150.0) + noise * rng.standard_normal(n)
     return AxisLog(time=t, position=p, effort=current, velocity=v, acceleration=a)

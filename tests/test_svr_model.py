@@ -10,6 +10,8 @@ from greybox.data.log import AxisLog
 from greybox.errors import LogError
 from greybox.models.svr import SVRCurrentModel, default_bounds, inertia_offset_proxy
 
+from multisine import multisine_motion
+
 J_TRUE = 2e-4  # A s^2/mm
 OFFSET_TRUE = 0.1  # A
 
@@ -17,14 +19,7 @@ OFFSET_TRUE = 0.1  # A
 def sweep_run(seed, n=6000, dt=0.002, ripple=0.3, noise=0.02):
     """Multi-sine motion over ~0..400 mm; current = inertia + friction + ripple(p) + offset."""
     rng = np.random.default_rng(seed)
-    t = np.arange(n) * dt
-    freq = rng.uniform(0.1, 0.4, 3)
-    phase = rng.uniform(0.0, 2 * np.pi, 3)
-    amp = np.array([120.0, 50.0, 20.0])
-    arg = 2 * np.pi * freq[:, None] * t + phase[:, None]
-    p = 200.0 + (amp[:, None] * np.sin(arg)).sum(0)
-    v = (amp[:, None] * 2 * np.pi * freq[:, None] * np.cos(arg)).sum(0)
-    a = (-amp[:, None] * (2 * np.pi * freq[:, None]) ** 2 * np.sin(arg)).sum(0)
+    t, p, v, a = multisine_motion(rng, n, dt)
     friction = 0.8 * np.tanh(v / 30.0) + 0.003 * v + ripple * np.sin(2 * np.pi * p / 150.0)
     current = J_TRUE * a + friction + OFFSET_TRUE + noise * rng.standard_normal(n)
     return AxisLog(time=t, position=p, effort=current,
