@@ -13,7 +13,7 @@ from sklearn.base import BaseEstimator
 
 from greybox import atomic
 from greybox.errors import ModelFileError
-from greybox.models import persistence, registry
+from greybox.models import registry
 from greybox.models.persistence import FORMAT_VERSION, load_model, save_model
 
 

@@ -23,7 +23,6 @@ message, and so that a damaged file gives a :class:`~greybox.errors.LogError`.
 from __future__ import annotations
 
 import json
-import struct
 import zlib
 from typing import Iterable, Iterator, Mapping, Sequence
 
