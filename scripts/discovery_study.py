@@ -34,7 +34,8 @@ from scipy.signal import decimate
 from greybox.data.io import read_log
 from greybox.data.prepare import prepare
 from greybox.discover.effects import EFFECT_NAMES
-from greybox.discover.report import write_json, write_text
+from greybox.atomic import write_text_atomic
+from greybox.discover.report import write_json
 from greybox.discover.study import ABSORBED, StudyCase, run_case, run_null, summarise
 from greybox.discover.workflow import discover
 from greybox.evaluate.metrics import relerr
@@ -101,7 +102,7 @@ def emps_section(args) -> int:
     write_json(report, args.json)
     print(text)
     if args.markdown:
-        write_text(text, args.markdown)
+        write_text_atomic(args.markdown, text)
     return 0
 
 
@@ -211,7 +212,7 @@ def main(argv=None) -> int:
     text = markdown(args.section, settings, summary, cases, nulls, time.perf_counter() - started)
     print(text)
     if args.markdown:
-        write_text(text, args.markdown)
+        write_text_atomic(args.markdown, text)
     return 0
 
 

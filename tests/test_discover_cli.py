@@ -57,7 +57,7 @@ def test_discover_writes_findings_report_and_model(logs, tmp_path, monkeypatch, 
 
 
 def test_outputs_never_overwrite_inputs_or_models(logs, tmp_path):
-    with pytest.raises(GreyboxError, match="input logs"):
+    with pytest.raises(GreyboxError, match="one of the input logs"):
         run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", logs[1], "--quiet"])
     existing = tmp_path / "model.gbm"
     existing.write_bytes(b"keep")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -11,7 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from ..discover.effects import EFFECT_NAMES
-from ..discover.report import write_json, write_report
+from ..atomic import check_output_path
+from ..discover.report import REPORT_FILES, write_json, write_report
 from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
@@ -39,7 +39,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--json", required=True, metavar="OUT", help="JSON file of the findings to write")
     parser.add_argument("--report", metavar="DIR", help="also write the JSON and residual plots into DIR")
     parser.add_argument("--save-model", metavar="MODEL", help="save the augmented model to this file (.gbm)")
-    parser.add_argument("--force", action="store_true", help="overwrite MODEL if it exists")
+    parser.add_argument("--force", action="store_true", help="overwrite OUT, MODEL and the report's files if they exist")
     workflow = parser.add_argument_group("discovery options")
     workflow.add_argument("--effects", metavar="NAMES",
                           help="comma-separated effects to consider (default: the whole library)")
@@ -63,21 +63,20 @@ def add_parser(subparsers) -> None:
 
 
 def _check_outputs(args) -> None:
-    """Refuse before any fitting when an output would overwrite an input or cannot be written."""
-    inputs = [Path(p) for p in list(args.train) + list(args.test)]
-    outputs = [Path(args.json)] + ([Path(args.save_model)] if args.save_model else [])
-    for out in outputs:
-        for source in inputs:
-            if out.exists() and source.exists() and os.path.samefile(out, source):
-                raise GreyboxError(f"{out}: is one of the input logs; refusing to overwrite it")
-        if out.is_dir():
-            raise GreyboxError(f"{out}: is a directory")
-        if not (out.parent if str(out.parent) else Path(".")).is_dir():
-            raise GreyboxError(f"{out}: directory {out.parent} does not exist")
-    if args.save_model and Path(args.save_model).exists() and not args.force:
-        raise ModelFileError(f"{args.save_model}: file exists; use --force to overwrite it")
-    if args.report and Path(args.report).exists() and not Path(args.report).is_dir():
-        raise GreyboxError(f"{args.report}: exists and is not a directory")
+    """Refuse before any fitting when an output would overwrite an input, or a file without --force."""
+    inputs = list(args.train) + list(args.test)
+    check_output_path(args.json, overwrite=args.force, protect=inputs, inputs_name="one of the input logs")
+    if args.save_model:
+        check_output_path(args.save_model, overwrite=args.force, protect=inputs, error=ModelFileError,
+                          inputs_name="one of the input logs")
+    if args.report:
+        directory = Path(args.report)
+        if directory.exists() and not directory.is_dir():
+            raise GreyboxError(f"{directory}: exists and is not a directory")
+        for name in REPORT_FILES:
+            if (directory / name).exists():
+                check_output_path(directory / name, overwrite=args.force, protect=inputs,
+                                  inputs_name="one of the input logs")
 
 
 def build_base(args: argparse.Namespace):

@@ -20,15 +20,18 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from ..evaluate.plots import save_figure
+from ..atomic import write_text_atomic
+from ..evaluate.plots import import_pyplot, save_figure
 from .workflow import DiscoveryResult
 
-__all__ = ["jsonable", "write_json", "write_text", "plot_residuals", "plot_evidence", "write_report"]
+__all__ = ["REPORT_FILES", "jsonable", "write_json", "plot_residuals", "plot_evidence", "write_report"]
+
+#: Files :func:`write_report` writes into its directory.
+REPORT_FILES = ("discovery.json", "residual_train.png", "residual_test.png", "evidence.png")
 
 #: Most points drawn of a residual over time.
 _MAX_POINTS = 20_000
@@ -53,33 +56,7 @@ def jsonable(value):
 
 def write_json(document: dict, path: str | os.PathLike) -> Path:
     """Write ``document`` as indented strict JSON, atomically; return the path."""
-    return write_text(json.dumps(jsonable(document), indent=1, allow_nan=False) + "\n", path)
-
-
-def write_text(text: str, path: str | os.PathLike) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically (temporary file, then rename); return the path."""
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise
-    return path
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    return plt
+    return write_text_atomic(path, json.dumps(jsonable(document), indent=1, allow_nan=False) + "\n")
 
 
 def _profile(ax, before: dict, after: dict, xlabel: str, title: str, log_x: bool = False) -> None:
@@ -96,7 +73,7 @@ def _profile(ax, before: dict, after: dict, xlabel: str, title: str, log_x: bool
 
 def plot_residuals(result: DiscoveryResult, which: str, path) -> Path:
     """Residual figure of the training (``which="train"``) or test (``"test"``) runs; return the path."""
-    plt = _pyplot()
+    plt = import_pyplot(path)
     data = result.residuals[which]
     gap = result.train if which == "train" else result.test
     unit = result.unit
@@ -148,7 +125,7 @@ def plot_residuals(result: DiscoveryResult, which: str, path) -> Path:
 
 def plot_evidence(result: DiscoveryResult, path) -> Path:
     """Evidence figure: candidates of every step against their thresholds, period scans of step 1."""
-    plt = _pyplot()
+    plt = import_pyplot(path)
     n_steps = len(result.steps)
     figure, axes = plt.subplots(1, n_steps + 1, figsize=(4.5 * (n_steps + 1), 5), layout="constrained",
                                 squeeze=False)
