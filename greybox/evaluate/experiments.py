@@ -22,6 +22,10 @@ When the logs carry the noise-free current (the extra channel
 ``truth_current_A`` of the synthetic axis, :mod:`greybox.twin`), a
 ``noise_floor`` record per experiment gives the error of that truth against
 the measured current: the best any model can do.
+
+:func:`reproduce` runs the experiments for several axes (in parallel worker
+processes if asked) and writes the report of ``greybox reproduce``;
+:func:`evaluate_models` tests saved models on logs for ``greybox evaluate``.
 """
 
 from __future__ import annotations
@@ -257,9 +261,8 @@ def load_axis_logs(
     datasets: Iterable[str],
     *,
     max_duration_s: float | None = None,
-    cutoff_hz: float | None = None,
 ) -> dict[str, AxisLog]:
-    """Read and prepare the logs of one axis, one run per dataset.
+    """Read and prepare the logs of one axis, one run per dataset (default derivative filter).
 
     Parameters
     ----------
@@ -271,8 +274,6 @@ def load_axis_logs(
         Dataset names, e.g. ``"ABCD"``.
     max_duration_s : float, optional
         Keep only the first ``max_duration_s`` seconds of every log (quick runs).
-    cutoff_hz : float, optional
-        Derivative-filter cut-off [Hz] of :func:`greybox.data.prepare.prepare`.
 
     Returns
     -------
@@ -287,7 +288,7 @@ def load_axis_logs(
         log = read_log(find_log(data_dir, axis, dataset))
         if max_duration_s is not None:
             log = trim(log, stop_s=float(log.time[0]) + max_duration_s)
-        logs[dataset] = prepare(log, cutoff_hz=cutoff_hz)[0]
+        logs[dataset] = prepare(log)[0]
     return logs
 
 

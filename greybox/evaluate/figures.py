@@ -35,6 +35,7 @@ MODEL_COLORS = {
     "gms": "#2ca02c",
     "svr": "#d62728",
     "gmssvr": "#1f77b4",
+    "gmssvr_eq8": "#17becf",
     "noise_floor": "#7f7f7f",
 }
 _MEASURED = "#000000"
@@ -208,7 +209,9 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
     velocity = np.concatenate([run.velocity for run in runs])
     measured = np.concatenate([run.effort for run in runs])
     standstill = 0.01 * max(float(np.max(np.abs(velocity))), 1e-12)
-    directions = (("+", velocity > standstill, "#1f77b4"), ("-", velocity < -standstill, "#ff7f0e"))
+    # (label, samples, colour of the points, colour of the mean line)
+    directions = (("+", velocity > standstill, "#6baed6", "#08306b"),
+                  ("-", velocity < -standstill, "#fdae6b", "#7f2704"))
     edges = np.linspace(position.min(), position.max(), n_bins + 1)
     centres = 0.5 * (edges[1:] + edges[:-1])
     n = len(predictions)
@@ -218,10 +221,12 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
                                 sharex=True, sharey=True, layout="constrained")
     for ax, (model, prediction) in zip(axes.ravel(), predictions.items()):
         residual = measured - np.concatenate(split_runs(runs, prediction))
-        for label, mask, color in directions:
+        for label, mask, color, _ in directions:
             index = np.flatnonzero(mask)
             shown = index[:: max(1, index.size // max_points)]
-            ax.plot(position[shown], residual[shown], ".", ms=1, color=color, alpha=0.25)
+            ax.plot(position[shown], residual[shown], ".", ms=1, color=color, alpha=0.3)
+        for label, mask, _, color in directions:
+            index = np.flatnonzero(mask)
             counts = np.histogram(position[index], edges)[0]
             sums = np.histogram(position[index], edges, weights=residual[index])[0]
             with np.errstate(invalid="ignore", divide="ignore"):
