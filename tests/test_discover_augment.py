@@ -109,3 +109,29 @@ def test_saved_model_predicts_identically(stroke, tmp_path, monkeypatch):
     assert type(loaded) is AugmentedModel and type(loaded.base_) is StribeckModel
     np.testing.assert_array_equal(loaded.predict(run), model.predict(run))
     assert loaded.effects_ == model.effects_
+
+
+def test_two_terms_of_one_periodic_effect_stay_apart(stroke):
+    context = AugmentedModel(base=CoulombModel()).fit(stroke.replace(effort=coulomb_current(stroke))).context
+    hidden = effect("position_periodic_friction").current(stroke, context, [0.05, 0.0], 6.0) \
+        + effect("position_periodic_friction").current(stroke, context, [0.0, 0.04], 3.0)
+    rng = np.random.default_rng(5)
+    run = stroke.replace(effort=coulomb_current(stroke) + hidden + rng.normal(0, 0.02, len(stroke)))
+    model = AugmentedModel(base=CoulombModel(), effects=[("position_periodic_friction", 6.0),
+                                                         ("position_periodic_friction", 3.0)]).fit(run)
+    periods = sorted(e["parameters"]["period_mm"] for e in model.effects_)
+    assert periods == [pytest.approx(3.0, rel=0.01), pytest.approx(6.0, rel=0.01)]
+    with pytest.raises(GreyboxError, match="cannot tell them apart"):
+        AugmentedModel(base=CoulombModel(), effects=[("position_periodic_friction", 6.0),
+                                                     ("position_periodic_friction", 6.001)]).fit(run)
+
+
+def test_refinement_never_brings_a_period_next_to_another_of_the_same_effect():
+    from greybox.discover.augment import _apart
+
+    step = 0.01
+    # bracket [4, 6] mm (0.167 ... 0.25 1/mm) around 5 mm; other terms 3 steps above and below in frequency
+    low, high = _apart(5.0, 4.0, 6.0, [1.0 / 0.23, 1.0 / 0.17], step)
+    assert 1.0 / low == pytest.approx(0.23 - 2 * step) and 1.0 / high == pytest.approx(0.17 + 2 * step)
+    # a term far away leaves the bracket as it is
+    assert _apart(5.0, 4.0, 6.0, [1.0], step) == (pytest.approx(4.0), pytest.approx(6.0))

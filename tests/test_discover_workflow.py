@@ -94,3 +94,13 @@ def test_summary_counts():
     assert summary["spurious_rate"] == pytest.approx(0.5)
     low, high = summary["false_positive"]["interval_95"]
     assert low < 0.05 < high
+
+
+def test_several_training_runs_each_drift_from_their_own_start():
+    runs = [case_logs(StudyCase("thermal_drift", 1.5, seed, "coulomb", 12.0))[0] for seed in (4, 5)]
+    test = case_logs(StudyCase("thermal_drift", 1.5, 6, "coulomb", 12.0))[1]
+    result = discover(CoulombModel(), runs, test, seed=4, max_effects=1)
+    assert [entry["name"] for entry in result.effects] == ["thermal_drift"]
+    assert result.settings["train_samples"] == sum(len(run) for run in runs)
+    assert result.residuals["train"]["time"].size == result.settings["train_samples"]
+    assert np.all(np.diff(result.residuals["train"]["time"]) > 0)  # the runs follow one another

@@ -39,7 +39,7 @@ from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
 from ..models.base import CurrentModel, check_runs
 from .baselinear import LinearPart, base_coefficients, base_linear_part, set_base_coefficients
-from .effects import Effect, EffectContext, effect, period_scan
+from .effects import PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
 from .projection import Nuisance, PositionScan, added_squares
 
 __all__ = ["AugmentedModel", "normalise_effects"]
@@ -185,6 +185,7 @@ class AugmentedModel(CurrentModel):
                 part = _joined([base_linear_part(base, run) for run in runs])
                 shapes = [self._start_shape(term, shape, runs, context, part, target)
                           for term, shape in zip([t for t, _ in terms], shapes)]
+                _check_separation(terms, shapes, runs, context)
                 if self.refine_shapes:
                     shapes = self._refine(runs, context, terms, shapes, part, target)
                 coefficients = self._solve(runs, context, terms, shapes, part, target)[0]
@@ -233,6 +234,9 @@ class AugmentedModel(CurrentModel):
             grid = term.shape_grid(runs, context)
             low, high = term.shape_bracket(shapes[i], grid)
             frequency = term.shape.scale == "frequency"
+            if frequency:
+                others = [shapes[j] for j, (other, _) in enumerate(terms) if j != i and other is term]
+                low, high = _apart(shapes[i], low, high, others, period_scan(runs, context)[0])
             to_shape = (lambda s: 1.0 / s) if frequency else np.exp
             bounds = (1.0 / high, 1.0 / low) if frequency else (np.log(low), np.log(high))
 
@@ -335,6 +339,34 @@ class AugmentedModel(CurrentModel):
         """Coefficients of :meth:`linear_part`'s columns."""
         check_is_fitted(self, "effects_")
         return np.concatenate([base_coefficients(self.base_)] + [e["coefficients"] for e in self.effects_])
+
+
+def _apart(period, low, high, others, step) -> tuple[float, float]:
+    """Shrink the period bracket ``[low, high]`` [mm] around ``period`` so that its frequencies stay
+    :data:`PERIOD_SEPARATION_STEPS` steps ``step`` [1/mm] away from the ``others``' frequencies."""
+    f, f_low, f_high = 1.0 / period, 1.0 / high, 1.0 / low
+    gap = PERIOD_SEPARATION_STEPS * step
+    for other in others:
+        g = 1.0 / other
+        if g <= f:
+            f_low = max(f_low, min(g + gap, f))
+        else:
+            f_high = min(f_high, max(g - gap, f))
+    return 1.0 / f_high, 1.0 / f_low
+
+
+def _check_separation(terms, shapes, runs, context) -> None:
+    """Refuse two terms of one periodic effect whose periods are too close to be told apart."""
+    step = None
+    for i, (term, _) in enumerate(terms):
+        for j in range(i):
+            if terms[j][0] is term and term.shape is not None and term.shape.scale == "frequency":
+                step = step or period_scan(runs, context)[0]
+                if abs(1.0 / shapes[i] - 1.0 / shapes[j]) < PERIOD_SEPARATION_STEPS * step - 1e-12:
+                    raise GreyboxError(
+                        f"two {term.name} terms with periods {shapes[j]:.6g} and {shapes[i]:.6g} mm: "
+                        f"closer than {PERIOD_SEPARATION_STEPS} steps of the period scan "
+                        f"({step:.4g} 1/mm), the data cannot tell them apart")
 
 
 def _joined(parts: list[LinearPart]) -> LinearPart:

@@ -43,7 +43,8 @@ import numpy as np
 from ..data.log import AxisLog
 from ..errors import GreyboxError
 
-__all__ = ["EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "effect", "period_grid", "period_scan",
+__all__ = ["EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "PERIOD_SEPARATION_STEPS", "effect", "period_grid",
+           "period_scan",
            "default_velocity_scale"]
 
 #: Periods are scanned at this many points per periodogram resolution ``1 / range``.
@@ -54,6 +55,9 @@ _MIN_PERIODS_IN_RANGE = 2
 _SAMPLES_PER_PERIOD = 4
 #: Most periods a scan tries (the shortest period grows beyond that).
 _MAX_PERIODS = 4000
+#: Two terms of one periodic effect keep their spatial frequencies at least this many scan steps apart
+#: (closer, their columns are nearly the same and their amplitudes are not identifiable).
+PERIOD_SEPARATION_STEPS = 2
 #: Points of the logarithmic grids of time constants and Stribeck velocities.
 _LOG_GRID_POINTS = 24
 

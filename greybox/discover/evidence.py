@@ -53,7 +53,7 @@ from threadpoolctl import threadpool_limits
 
 from ..data.log import AxisLog
 from .baselinear import LinearPart
-from .effects import Effect, EffectContext, effect, period_scan
+from .effects import PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
 from .locate import structure_basis
 from .noise import ResidualNoise
 from .projection import Nuisance, PositionScan, added_squares
@@ -64,8 +64,6 @@ __all__ = ["CandidateScore", "StepEvidence", "score_step", "STRUCTURE"]
 STRUCTURE = "structure"
 #: Null fractions at or below this count as zero: the candidate is absorbed by the model.
 _ABSORBED = 1e-12
-#: Periods within this many scan steps of a period already in the model are not scanned again.
-_EXCLUDED_STEPS = 2
 
 
 @dataclass
@@ -190,7 +188,7 @@ class _Candidate:
             self.frequency_step, self.grid = period_scan(runs, context)
             if len(excluded_periods):
                 distance = np.abs(1.0 / self.grid[:, None] - 1.0 / np.asarray(excluded_periods)[None, :])
-                self.grid = self.grid[np.all(distance > _EXCLUDED_STEPS * self.frequency_step, axis=1)]
+                self.grid = self.grid[np.all(distance > PERIOD_SEPARATION_STEPS * self.frequency_step, axis=1)]
 
     def columns(self, shape) -> np.ndarray:
         return np.concatenate([self.term.columns(run, self.context, shape) for run in self.runs])

@@ -219,10 +219,14 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     model = AugmentedModel(base=base, refit_base=refit_base).fit_terms(train, base=base_model)
     target = np.concatenate([run.effort for run in train])
     rss = _rss(model, train, target)
-    named, steps, rejected, periods = [], [], [], {}
+    named, steps, rejected = [], [], []
     remaining = list(names)
     while True:
         say(f"step {len(steps) + 1}: scoring {len(remaining)} effects against {n_null} null replicates")
+        periods = {}
+        for entry in model.effects_:
+            if effect(entry["name"]).shape is not None and effect(entry["name"]).shape.scale == "frequency":
+                periods.setdefault(entry["name"], []).append(entry["shape"])
         step = score_step(train, model.linear_part(train), model.context, remaining, rng=rng, n_null=n_null,
                           alpha=alpha, excluded_periods=periods)
         steps.append(step)
@@ -251,9 +255,7 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
         entry = model.effects_[-1]
         named.append({"name": entry["name"], "parameters": entry["parameters"],
                       "evidence": _evidence_entry(len(steps) - 1, step, winner.name, gain)})
-        if effect(winner.name).shape is not None and effect(winner.name).shape.scale == "frequency":
-            periods.setdefault(winner.name, []).append(entry["shape"])
-        else:
+        if effect(winner.name).shape is None or effect(winner.name).shape.scale != "frequency":
             remaining.remove(winner.name)
     if named:
         verdict = "named"
