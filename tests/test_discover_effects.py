@@ -133,3 +133,12 @@ def test_a_long_travel_scanned_in_fine_steps_keeps_at_most_4000_periods():
     assert periods.size == 4000
     assert periods.min() == pytest.approx(span / 1000.0, rel=0.01)
     assert step == pytest.approx(1.0 / (4.0 * span), rel=1e-9)
+
+
+def test_position_trend_holds_its_end_values_beyond_the_training_range():
+    run = stroke()
+    context = EffectContext(0.5, (-260.0, -250.0))  # the stroke runs from -270 to -230 mm
+    u = context.unit_position(run)
+    assert u.min() == -1.0 and u.max() == 1.0
+    inside = (run.position >= -260.0) & (run.position <= -250.0)
+    np.testing.assert_allclose(u[inside], (2 * run.position[inside] + 510.0) / 10.0)

@@ -8,7 +8,8 @@ it over :meth:`Effect.shape_grid` and refines it by least squares.
 
 With the direction of motion ``d = tanh(v / v_e)`` (``v_e`` the
 :class:`EffectContext`'s velocity scale), ``u`` the position scaled to
-``[-1, 1]`` over the position range of the training data, ``t`` the time since
+``[-1, 1]`` over the position range of the training data (and held at its end
+values beyond: a trend is not extrapolated), ``t`` the time since
 the start of the run and ``x``, ``v``, ``a`` position [mm], velocity [mm/s]
 and acceleration [mm/s^2]:
 
@@ -107,9 +108,9 @@ class EffectContext:
         return np.tanh(run.velocity / self.velocity_scale_mm_s)
 
     def unit_position(self, run: AxisLog) -> np.ndarray:
-        """Position scaled to ``u`` in [-1, 1] over the context's range."""
+        """Position scaled to ``u`` in [-1, 1] over the context's range, held at -1 / +1 beyond it."""
         low, high = self.position_range_mm
-        return (2.0 * run.position - low - high) / (high - low)
+        return np.clip((2.0 * run.position - low - high) / (high - low), -1.0, 1.0)
 
 
 @dataclass(frozen=True)
