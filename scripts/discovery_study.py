@@ -83,7 +83,8 @@ def emps_section(args) -> int:
     test = prepare([read_log(Path(args.data) / "DATA_EMPS_PULSES.mat")])
     report, lines = {}, ["| base | named (in order) | train relerr % (decimated) | test relerr % (decimated) "
                          "| test RMSE N (1 kHz) | test RMSE constant feed N | s |", "|---|---|---|---|---|---|---|"]
-    for label, base in (("coulomb --offset", CoulombModel(fit_offset=True)), ("gms --offset", GMSModel(fit_offset=True))):
+    bases = (("coulomb --offset", CoulombModel(fit_offset=True)), ("gms --offset", GMSModel(fit_offset=True)))
+    for label, base in bases:
         result = discover(base, train, test, progress=lambda text: print(f"{label}: {text}", flush=True))
         before = {name: result.base_model.predict(runs) for name, runs in (("train", train), ("test", test))}
         after = {name: result.model.predict(runs) for name, runs in (("train", train), ("test", test))}
@@ -94,7 +95,8 @@ def emps_section(args) -> int:
         report[label] = {"document": result.to_dict(), "benchmark": figures}
         named = "; ".join(f"{e['name']} ({', '.join(f'{k} {v:.4g}' for k, v in e['parameters'].items())})"
                           for e in result.effects) or "-"
-        lines.append(f"| {label} | {named} | {figures['train_relerr_before']:.2f} -> {figures['train_relerr_after']:.2f} "
+        lines.append(f"| {label} | {named} "
+                     f"| {figures['train_relerr_before']:.2f} -> {figures['train_relerr_after']:.2f} "
                      f"| {figures['test_relerr_before']:.2f} -> {figures['test_relerr_after']:.2f} "
                      f"| {result.test['rmse_before']:.3f} -> {result.test['rmse_after']:.3f} "
                      f"| {feed['rmse_before']:.3f} -> {feed['rmse_after']:.3f} | {result.seconds:.0f} |")

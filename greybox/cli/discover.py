@@ -39,7 +39,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--json", required=True, metavar="OUT", help="JSON file of the findings to write")
     parser.add_argument("--report", metavar="DIR", help="also write the JSON and residual plots into DIR")
     parser.add_argument("--save-model", metavar="MODEL", help="save the augmented model to this file (.gbm)")
-    parser.add_argument("--force", action="store_true", help="overwrite OUT, MODEL and the report's files if they exist")
+    parser.add_argument("--force", action="store_true",
+                        help="overwrite OUT, MODEL and the report's files if they exist")
     workflow = parser.add_argument_group("discovery options")
     workflow.add_argument("--effects", metavar="NAMES",
                           help="comma-separated effects to consider (default: the whole library)")
@@ -56,7 +57,8 @@ def add_parser(subparsers) -> None:
     model.add_argument("--asymmetric", action="store_true",
                        help="separate Coulomb and viscous levels per direction (coulomb)")
     model.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms)")
-    model.add_argument("--model-seed", type=int, metavar="N", help="seed of the multi-start identification (lugre, gms)")
+    model.add_argument("--model-seed", type=int, metavar="N",
+                       help="seed of the multi-start identification (lugre, gms)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_log_arguments(parser)
     parser.set_defaults(run=run)

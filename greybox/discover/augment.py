@@ -170,27 +170,32 @@ class AugmentedModel(CurrentModel):
         return self
 
     def _fit_terms(self, runs: list[AxisLog], base, progress) -> None:
-        template = self._template()
         context = EffectContext.from_runs(runs, self.velocity_scale_mm_s)
         terms = [(effect(name), shape) for name, shape in normalise_effects(self.effects)]
         target = np.concatenate([run.effort for run in runs])
-        shapes = [shape for _, shape in terms]
-        rounds = 2 if (self.refit_base and terms) else 1
         with threadpool_limits(limits=1, user_api="blas"):
-            for round_ in range(rounds):
-                if round_ == 1:
-                    term_current = self._term_currents(runs, context, terms, shapes, coefficients)
-                    shifted = [run.replace(effort=run.effort - part) for run, part in zip(runs, term_current)]
-                    base = clone(template).fit(shifted, progress=progress)
-                part = _joined([base_linear_part(base, run) for run in runs])
-                shapes = [self._start_shape(term, shape, runs, context, part, target)
-                          for term, shape in zip([t for t, _ in terms], shapes)]
-                _check_separation(terms, shapes, runs, context)
-                if self.refine_shapes:
-                    shapes = self._refine(runs, context, terms, shapes, part, target)
-                coefficients = self._solve(runs, context, terms, shapes, part, target)[0]
-                set_base_coefficients(base, coefficients[:part.columns.shape[1]])
-        self._store(base, context, terms, shapes, coefficients[part.columns.shape[1]:])
+            shapes, coefficients = self._joint_fit(runs, base, context, terms, [s for _, s in terms], target)
+            if self.refit_base and terms:
+                term_current = self._term_currents(runs, context, terms, shapes, coefficients)
+                shifted = [run.replace(effort=run.effort - part) for run, part in zip(runs, term_current)]
+                base = clone(self._template()).fit(shifted, progress=progress)
+                shapes, coefficients = self._joint_fit(runs, base, context, terms, shapes, target)
+        self._store(base, context, terms, shapes, coefficients[base_coefficients(base).size:])
+
+    def _joint_fit(self, runs, base, context, terms, shapes, target) -> tuple[list, np.ndarray]:
+        """Shapes and the joint coefficients (base's linear parameters first) at the base's present shape.
+
+        The base's linear parameters are written into ``base``.
+        """
+        part = _joined([base_linear_part(base, run) for run in runs])
+        shapes = [self._start_shape(term, shape, runs, context, part, target)
+                  for (term, _), shape in zip(terms, shapes)]
+        _check_separation(terms, shapes, runs, context)
+        if self.refine_shapes:
+            shapes = self._refine(runs, context, terms, shapes, part, target)
+        coefficients = self._solve(runs, context, terms, shapes, part, target)[0]
+        set_base_coefficients(base, coefficients[:part.columns.shape[1]])
+        return shapes, coefficients
 
     def _start_shape(self, term: Effect, shape, runs, context, part: LinearPart, target) -> float | None:
         """The given shape, or the best of the effect's grid against the base's residual."""

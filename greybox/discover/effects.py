@@ -244,7 +244,10 @@ def _time_constant_grid(runs, context) -> np.ndarray:
 
 
 def _stribeck_velocity_grid(runs, context) -> np.ndarray:
-    """From three velocity scales ``v_e`` (below, a Stribeck curve mimics the direction factor's smoothing) to the top speed."""
+    """Stribeck velocities [mm/s] from three velocity scales ``v_e`` to the top speed.
+
+    Below ``3 v_e`` a Stribeck term would only mimic the smoothing of the direction factor.
+    """
     speed = np.concatenate([np.abs(run.velocity) for run in runs])
     top = float(np.percentile(speed, 99.9))
     return np.geomspace(min(max(1e-3 * top, 3.0 * context.velocity_scale_mm_s), 0.5 * top), top, _LOG_GRID_POINTS)

@@ -182,8 +182,8 @@ class _Candidate:
         self.term = term
         self.runs = runs
         self.context = context
-        self.grid = term.shape_grid(runs, context)
-        self.periodic = self.grid is not None and term.shape.scale == "frequency"
+        self.periodic = term.shape is not None and term.shape.scale == "frequency"
+        self.grid = None if self.periodic else term.shape_grid(runs, context)
         if self.periodic:
             self.frequency_step, self.grid = period_scan(runs, context)
             if len(excluded_periods):
@@ -213,7 +213,7 @@ def _structure_matrix(families: dict) -> scipy.sparse.csr_matrix:
 
 
 def _saturated_residual(residual_perp, nuisance, blocks) -> np.ndarray:
-    """Residual left after fitting every candidate at its best shape and the structure columns.
+    """Residual left after fitting the column ``blocks`` (dense or sparse) with the nuisance.
 
     Columns (almost) inside the nuisance span are left out.
     """
