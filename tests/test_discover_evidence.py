@@ -76,3 +76,27 @@ def test_the_winner_explains_most_beyond_chance_and_the_report_is_consistent():
         assert score.passes == (score.z >= step.threshold_z)
     summary = step.to_dict()
     assert summary["winner"] == "position_trend" and set(summary["candidates"]) == set(step.candidates)
+
+
+@pytest.mark.parametrize("n", [4, 21, 100])
+def test_leave_one_out_quantiles_match_quantiles_of_the_others(n):
+    from greybox.discover.evidence import _leave_one_out_quantile
+
+    values = np.random.default_rng(n).normal(size=n)
+    values[1] = values[0]  # a tie
+    order = np.argsort(values, kind="stable")
+    rank = np.empty(n, dtype=np.int64)
+    rank[order] = np.arange(n)
+    for level in (0.5, 0.9):
+        expected = [np.quantile(np.delete(values, i), level) for i in range(n)]
+        np.testing.assert_allclose(_leave_one_out_quantile(values[order], rank, level), expected, atol=1e-15)
+
+
+def test_on_pure_noise_the_family_wise_p_values_are_not_too_small():
+    # exchangeable observed and null residuals: P(p <= 0.2) must stay near 0.2 over many noise draws
+    rejections = 0
+    for seed in range(30):
+        run = sine_stroke(n=3000, seed=100 + seed)
+        step = evidence(run, ["constant_offset", "position_trend", "position_periodic_force"], seed=seed)
+        rejections += min(s.p_value for s in step.candidates.values()) <= 0.2
+    assert rejections <= 12  # expected 6 of 30; 12 or more has chance < 1 %

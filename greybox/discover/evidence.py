@@ -29,8 +29,10 @@ Each candidate's statistic is standardised by its own null distribution,
 candidates (a scan over thousands of periods) are not favoured, and the
 family-wise null of the largest ``z`` over all candidates (the structure
 included) gives each candidate's adjusted p-value ``(1 + #{T_b >= z}) / (B + 1)``.
-If nothing is missing, the chance that any candidate passes at level ``alpha``
-is at most ``alpha``.
+The quantiles that standardise a value are those of the other ``B`` values
+(the observed one among them for a replicate), so the observed statistic and
+the replicates are exchangeable when nothing is missing, and the chance that
+any candidate passes at level ``alpha`` is then at most ``alpha``.
 
 Telling effects apart
 ---------------------
@@ -232,19 +234,37 @@ def _saturated_residual(residual_perp, nuisance, blocks) -> np.ndarray:
     return residual_perp.ravel() - nuisance.project(fitted[:, None]).ravel()
 
 
+def _leave_one_out_quantile(ordered: np.ndarray, rank: np.ndarray, level: float) -> np.ndarray:
+    """Quantile (linear interpolation) of ``ordered`` without the element at each sorted position ``rank``."""
+    h = (ordered.size - 2) * level
+    j = int(np.floor(h))
+    below = np.where(j < rank, ordered[j], ordered[min(j + 1, ordered.size - 1)])
+    above = np.where(j + 1 < rank, ordered[min(j + 1, ordered.size - 1)], ordered[min(j + 2, ordered.size - 1)])
+    return below + (h - j) * (above - below)
+
+
 def _standardise(observed: float, null: np.ndarray):
     """``(z_observed, z_null, absorbed, median, q95, to_fraction)`` of one candidate.
 
-    ``to_fraction(z)`` maps a standardised value back to an explained fraction.
+    Each value (the observed one and every replicate) is standardised by the
+    median and 90 % quantile of *the others*, so that the observed statistic
+    and the replicates are treated alike and the family-wise test stays exact.
+    ``to_fraction(z)`` maps a standardised value of the observed residual back
+    to an explained fraction.
     """
     q50, q90, q95 = np.quantile(null, [0.5, 0.9, 0.95])
     if q90 <= _ABSORBED:
         return -np.inf, np.full(null.size, -np.inf), True, float(q50), float(q95), lambda z: np.inf
-    low = np.log(max(q50, _ABSORBED))
-    scale = max(np.log(q90) - low, 1e-6)
-    z = (np.log(np.maximum(observed, 1e-300)) - low) / scale
-    z_null = (np.log(np.maximum(null, 1e-300)) - low) / scale
-    return float(z), z_null, False, float(q50), float(q95), lambda value: float(np.exp(low + value * scale))
+    values = np.log(np.maximum(np.concatenate(([observed], null)), 1e-300))
+    order = np.argsort(values, kind="stable")
+    rank = np.empty(values.size, dtype=np.int64)
+    rank[order] = np.arange(values.size)
+    ordered = values[order]
+    low = np.maximum(_leave_one_out_quantile(ordered, rank, 0.5), np.log(_ABSORBED))
+    scale = np.maximum(_leave_one_out_quantile(ordered, rank, 0.9) - low, 1e-6)
+    z = (values - low) / scale
+    return (float(z[0]), z[1:], False, float(q50), float(q95),
+            lambda value: float(np.exp(low[0] + value * scale[0])))
 
 
 def _p_value(observed, null) -> float:
