@@ -59,6 +59,11 @@ def test_discover_writes_findings_report_and_model(logs, tmp_path, monkeypatch, 
 def test_outputs_never_overwrite_inputs_or_models(logs, tmp_path):
     with pytest.raises(GreyboxError, match="one of the input logs"):
         run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", logs[1], "--quiet"])
+    findings = tmp_path / "findings.json"
+    findings.write_text("keep")
+    with pytest.raises(GreyboxError, match="use --force"):
+        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(findings), "--quiet"])
+    assert findings.read_text() == "keep"
     existing = tmp_path / "model.gbm"
     existing.write_bytes(b"keep")
     with pytest.raises(GreyboxError, match="file exists"):
