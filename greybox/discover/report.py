@@ -12,7 +12,7 @@ figures
 ``evidence.png``
     Every step's candidates: explained fraction of the residual against the
     fraction at which each would pass, and the period scans of the periodic
-    effects of the first step.
+    effects at the first step that named one (else at the first step).
 """
 
 from __future__ import annotations
@@ -124,7 +124,7 @@ def plot_residuals(result: DiscoveryResult, which: str, path) -> Path:
 
 
 def plot_evidence(result: DiscoveryResult, path) -> Path:
-    """Evidence figure: candidates of every step against their thresholds, period scans of step 1."""
+    """Evidence figure: candidates of every step against their thresholds, and period scans."""
     plt = import_pyplot(path)
     n_steps = len(result.steps)
     figure, axes = plt.subplots(1, n_steps + 1, figsize=(4.5 * (n_steps + 1), 5), layout="constrained",
@@ -147,14 +147,16 @@ def plot_evidence(result: DiscoveryResult, path) -> Path:
         ax.legend(fontsize=7, loc="lower right")
         ax.grid(True, axis="x", alpha=0.3)
     ax = axes[0, -1]
-    for score in result.steps[0].candidates.values():
+    shown = next((i for i, step in enumerate(result.steps)
+                  if step.winner and step.candidates[step.winner].shape_name == "period_mm"), 0)
+    for score in result.steps[shown].candidates.values():
         if score.scan is not None and score.shape_name == "period_mm":
             line, = ax.plot(score.scan["shape"], score.scan["explained_fraction"], lw=0.8, label=score.name)
             ax.axhline(score.threshold_fraction, color=line.get_color(), ls="--", lw=0.8)
     ax.set_xscale("log")
     ax.set_xlabel("period [mm]")
     ax.set_ylabel("explained fraction of the residual")
-    ax.set_title("step 1: period scans (dashed: pass level)", fontsize=10)
+    ax.set_title(f"step {shown + 1}: period scans (dashed: pass level)", fontsize=10)
     ax.legend(fontsize=7)
     ax.grid(True, alpha=0.3)
     return save_figure(figure, path)
