@@ -46,7 +46,7 @@ from greybox.friction import CoulombModel, GMSModel
 EMPS_DECIMATION, EMPS_BORDER = 10, 49
 
 SECTIONS = {
-    "coulomb": {"base": CoulombModel, "duration": 30.0, "seeds": 5, "null_seeds": 200,
+    "coulomb": {"base": CoulombModel, "duration": 30.0, "seeds": 5, "null_seeds": 1000,
                 "ratios": (0.25, 0.5, 1.0, 2.0)},
     "twin": {"base": GMSModel, "duration": 60.0, "seeds": 2, "null_seeds": 40, "ratios": (0.5, 1.0, 2.0)},
     "emps": {},
