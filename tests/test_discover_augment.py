@@ -11,7 +11,6 @@ from greybox.discover.baselinear import base_linear_part
 from greybox.discover.effects import effect
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel, StribeckModel
-from greybox.models import registry
 from greybox.models.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
@@ -99,7 +98,6 @@ def test_bad_effects_are_refused(stroke):
 
 
 def test_saved_model_predicts_identically(stroke, tmp_path, monkeypatch):
-    monkeypatch.setitem(registry.MODEL_CLASSES, "augmented", AugmentedModel)
     rng = np.random.default_rng(4)
     run = stroke.replace(effort=coulomb_current(stroke) + rng.normal(0, 0.05, len(stroke)))
     model = AugmentedModel(base=StribeckModel(fit_offset=True),

@@ -280,3 +280,11 @@ def test_registry_names_every_current_model():
     for kind, cls in expected.items():
         assert registry.model_class(kind) is cls
         assert registry.model_kind(cls()) == kind
+
+
+def test_discovered_models_are_files_but_not_trainable_kinds():
+    from greybox.discover.augment import AugmentedModel
+
+    assert registry.model_class("augmented") is AugmentedModel
+    assert registry.model_kind(AugmentedModel()) == "augmented"
+    assert "augmented" not in registry.MODEL_CLASSES  # what `greybox train --model` offers

@@ -7,11 +7,12 @@ a file cannot make greybox run code other than these classes' constructors.
 
 from __future__ import annotations
 
+from ..discover.augment import AugmentedModel
 from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from .gmssvr import GMSSVRModel
 from .svr import SVRCurrentModel
 
-__all__ = ["MODEL_CLASSES", "model_class", "model_kind"]
+__all__ = ["MODEL_CLASSES", "DERIVED_MODEL_CLASSES", "model_class", "model_kind"]
 
 #: Model kind (as written in model files and given to ``greybox train --model``) -> class.
 MODEL_CLASSES: dict[str, type] = {
@@ -23,6 +24,17 @@ MODEL_CLASSES: dict[str, type] = {
     "gmssvr": GMSSVRModel,
 }
 
+#: Kinds that other workflows produce and model files may hold, but ``greybox train`` does not
+#: offer: the base model plus named effects of ``greybox discover``.
+DERIVED_MODEL_CLASSES: dict[str, type] = {
+    "augmented": AugmentedModel,
+}
+
+
+def _file_kinds() -> dict[str, type]:
+    """Every kind a model file may hold (looked up at call time, so registrations count)."""
+    return {**MODEL_CLASSES, **DERIVED_MODEL_CLASSES}
+
 
 def model_class(kind: str) -> type:
     """Return the class registered under ``kind``.
@@ -32,9 +44,10 @@ def model_class(kind: str) -> type:
     KeyError
         If no class is registered under that name.
     """
-    if not isinstance(kind, str) or kind not in MODEL_CLASSES:
-        raise KeyError(f"unknown model kind {kind!r}; known: {', '.join(sorted(MODEL_CLASSES))}")
-    return MODEL_CLASSES[kind]
+    kinds = _file_kinds()
+    if not isinstance(kind, str) or kind not in kinds:
+        raise KeyError(f"unknown model kind {kind!r}; known: {', '.join(sorted(kinds))}")
+    return kinds[kind]
 
 
 def model_kind(model) -> str:
@@ -45,7 +58,7 @@ def model_kind(model) -> str:
     KeyError
         If the model's class is not registered.
     """
-    for kind, cls in MODEL_CLASSES.items():
+    for kind, cls in _file_kinds().items():
         if type(model) is cls:
             return kind
     raise KeyError(f"model class {type(model).__name__} is not registered in greybox.models.registry")
