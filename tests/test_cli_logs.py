@@ -115,3 +115,14 @@ def test_plot_writes_png_of_emps_force_log(tmp_path, capsys):
     assert main(["plot", str(EMPS), "--out", str(out)]) == 0
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert str(out) in capsys.readouterr().out
+
+
+def test_reproduce_finds_the_shipped_data_from_the_working_directory(tmp_path, monkeypatch):
+    from greybox.cli.reproduce import default_data_dir
+
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "X_A.mcap").write_bytes(b"")
+    monkeypatch.chdir(tmp_path)
+    assert default_data_dir() == tmp_path / "data"
+    monkeypatch.chdir(tmp_path / "data")  # no data/ here: fall back to the source tree
+    assert default_data_dir() == REPO / "data"

@@ -14,7 +14,14 @@ from ..evaluate.report import check_output_dir
 
 
 def default_data_dir() -> Path:
-    """The ``data/`` directory of the greybox source tree (the shipped synthetic logs)."""
+    """The shipped synthetic logs: ``./data`` when run in a greybox checkout, else the source tree's ``data/``.
+
+    A plain (non-editable) install puts the package in site-packages, away from the
+    repository's ``data/``; the README runs the command from the repository root.
+    """
+    here = Path.cwd() / "data"
+    if (here / "X_A.mcap").is_file():
+        return here
     return Path(__file__).resolve().parents[2] / "data"
 
 
@@ -29,7 +36,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--out", required=True, metavar="DIR", help="report directory (new or empty)")
     parser.add_argument("--axes", default="X,Y", metavar="LIST", help="comma-separated axes (default X,Y)")
     parser.add_argument("--data", metavar="DIR",
-                        help="directory of the <axis>_<dataset>.mcap logs (default: the repository's data/)")
+                        help="directory of the <axis>_<dataset>.mcap logs (default: ./data, else the source tree's data/)")
     parser.add_argument("--quick", action="store_true",
                         help="smoke run: first 30 s of every log, small optimisation budgets")
     parser.add_argument("--jobs", type=int, default=2, metavar="N",
