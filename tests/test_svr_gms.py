@@ -1,4 +1,4 @@
-"""The grey-box model GMS + SVR (eq. 8) with a frozen GMS stage."""
+"""The grey-box model GMS + SVR (residual target by default; eq. 8 with target="current") with a frozen GMS stage."""
 
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ def rmse(a, b):
 @pytest.fixture(scope="module")
 def fitted():
     train = [gms_run(1), gms_run(2)]
-    return GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit(train), train
+    return GMSSVRModel(gms=quick_gms(), target="current", **SVR_FIXED).fit(train), train
 
 
 def test_beats_gms_alone_on_position_dependent_friction(fitted):
@@ -102,7 +102,8 @@ def test_incomplete_models_are_refused():
 
 def test_residual_target_falls_back_to_the_gms_stage_far_from_the_training_data(fitted):
     model, train = fitted
-    residual = GMSSVRModel(gms=quick_gms(), target="residual", **SVR_FIXED).fit_svr(train, gms=model.gms_)
+    residual = GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit_svr(train, gms=model.gms_)
+    assert residual.target == "residual"  # the default
     test = gms_run(3)
     assert rmse(residual.predict(test), test.current) < 0.5 * rmse(model.gms_predict(test), test.current)
     # 10 m away from the travel the kernel terms vanish: the prediction is I_GMS + intercept,

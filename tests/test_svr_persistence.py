@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from greybox.models import persistence, registry
 from greybox.models.svr import SVRCurrentModel
@@ -21,15 +22,17 @@ def test_saved_and_loaded_model_predicts_identically(tmp_path, monkeypatch):
     assert loaded_table == table
 
 
-def test_grey_box_model_with_nested_gms_stage_round_trips(tmp_path, monkeypatch):
+@pytest.mark.parametrize("target", ["residual", "current"])
+def test_grey_box_model_with_nested_gms_stage_round_trips(tmp_path, monkeypatch, target):
     from greybox.friction.gms import GMSModel
     from greybox.models.gmssvr import GMSSVRModel
     from test_svr_gms import SVR_FIXED, gms_run, quick_gms
 
     monkeypatch.setitem(registry.MODEL_CLASSES, "gms", GMSModel)
     monkeypatch.setitem(registry.MODEL_CLASSES, "gmssvr", GMSSVRModel)
-    model = GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit(gms_run(1, n=6000))
+    model = GMSSVRModel(gms=quick_gms(), target=target, **SVR_FIXED).fit(gms_run(1, n=6000))
     loaded = persistence.load_model(persistence.save_model(model, tmp_path / "gmssvr.gbm"))
+    assert loaded.target == target
     test = gms_run(2, n=2000)
     np.testing.assert_array_equal(loaded.predict(test), model.predict(test))
     np.testing.assert_array_equal(loaded.states(test)[0], model.states(test)[0])
