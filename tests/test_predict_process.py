@@ -51,3 +51,38 @@ def test_thinned_picture_keeps_single_sample_peaks():
     assert process_axes.get_ylabel() == "process current [A]"
     assert [axes.get_ylabel() for axes in process_axes.child_axes] == ["process force [N]"]
     matplotlib.pyplot.close(figure)
+
+
+def test_moving_mean_is_centred_and_exact_at_the_ends():
+    from greybox.evaluate.process_plot import moving_mean
+
+    values = np.array([1.0, 2.0, 3.0, 4.0, 10.0])
+    np.testing.assert_allclose(moving_mean(values, 3), [1.5, 2.0, 3.0, 17 / 3, 7.0])
+    np.testing.assert_array_equal(moving_mean(values, 1), values)
+    # a 100 Hz ripple sampled at 2 ms averages out over whole periods
+    t = np.arange(5000) * 0.002
+    ripple = -0.5 + 0.2 * np.sin(2 * np.pi * 100.0 * t)
+    np.testing.assert_allclose(moving_mean(ripple, 50)[100:-100], -0.5, atol=1e-12)
+
+
+def test_process_panel_draws_the_moving_mean():
+    import matplotlib
+    import matplotlib.pyplot
+
+    matplotlib.use("Agg")
+    from greybox.evaluate.process import ProcessResult
+    from greybox.evaluate.process_plot import plot_process
+
+    n = 2000
+    time = np.arange(n) * 0.002
+    measured = np.where(time > 2.0, -0.4, 0.0) + 0.3 * np.sin(2 * np.pi * 100.0 * time)
+    result = ProcessResult(time=time, position=np.zeros(n), velocity=np.zeros(n), measured=measured,
+                           model=np.zeros(n), force=None)
+    figure = plot_process(result, mean_s=0.1)
+    mean_line = figure.axes[2].lines[1]
+    assert "0.1 s" in mean_line.get_label()
+    inside = mean_line.get_ydata()[(mean_line.get_xdata() > 2.2) & (mean_line.get_xdata() < 3.8)]
+    np.testing.assert_allclose(inside, -0.4, atol=1e-9)
+    matplotlib.pyplot.close(figure)
+    assert len(plot_process(result, mean_s=0.0).axes[2].lines) == 2  # process line and zero line only
+    matplotlib.pyplot.close("all")

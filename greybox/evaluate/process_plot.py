@@ -10,7 +10,7 @@ import numpy as np
 from .plots import finish_figure, import_pyplot
 from .process import ProcessResult
 
-__all__ = ["envelope_indices", "plot_process"]
+__all__ = ["envelope_indices", "moving_mean", "plot_process"]
 
 
 def envelope_indices(n_samples: int, max_points: int) -> np.ndarray:
@@ -38,6 +38,32 @@ def envelope_indices(n_samples: int, max_points: int) -> np.ndarray:
     return np.arange(0, n_samples, size)
 
 
+def moving_mean(values, window: int) -> np.ndarray:
+    """Centred moving mean over ``window`` samples, the window shortened at both ends of the signal.
+
+    Parameters
+    ----------
+    values : array_like
+        Signal.
+    window : int
+        Window length [samples], at least 1 (1 returns the signal).
+
+    Returns
+    -------
+    ndarray
+        Same length as ``values``; sample ``i`` is the mean of the samples of
+        the window centred on ``i`` that lie inside the signal.
+    """
+    values = np.asarray(values, dtype=float)
+    if window < 1:
+        raise ValueError(f"the window must hold at least one sample, got {window}")
+    sums = np.concatenate(([0.0], np.cumsum(values)))
+    index = np.arange(values.size)
+    start = np.clip(index - window // 2, 0, values.size)
+    stop = np.clip(index - window // 2 + window, 0, values.size)
+    return (sums[stop] - sums[start]) / (stop - start)
+
+
 def _min_max(time: np.ndarray, values: np.ndarray, starts: np.ndarray):
     """Per bin the minimum and the maximum, in time order (exact when every bin holds one sample)."""
     if starts.size == values.size:
@@ -48,11 +74,15 @@ def _min_max(time: np.ndarray, values: np.ndarray, starts: np.ndarray):
     return t, np.column_stack((low, high)).ravel()
 
 
-def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *, max_points: int = 100_000):
+def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *, max_points: int = 100_000,
+                 mean_s: float = 0.1):
     """Draw velocity, measured and model current, and the process current over time.
 
     The process panel has a second scale in N when the force is known (the
-    force is proportional to the process current).
+    force is proportional to the process current), and draws the moving mean
+    of the process current over ``mean_s`` on top of the sample values: the
+    level of the cutting force, without the tooth-passing ripple and the
+    current noise.
 
     Parameters
     ----------
@@ -62,6 +92,8 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
         Write the figure there (PNG, SVG or PDF by extension) and close it.
     max_points : int, default 100000
         Longer logs are drawn as the minimum and maximum of bins of samples.
+    mean_s : float, default 0.1
+        Window [s] of the moving mean of the process current; 0 draws none.
 
     Returns
     -------
@@ -85,6 +117,10 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     ax_i.set_ylabel(f"{noun} [{unit}]")
     ax_i.legend(loc="upper right", fontsize="small")
     line(ax_p, result.process, lw=0.6, color="tab:red", label=f"process {noun} = measured - model")
+    if mean_s > 0 and result.time.size > 1:
+        window = max(1, int(round(mean_s / float(np.median(np.diff(result.time))))))
+        line(ax_p, moving_mean(result.process, window), lw=1.2, color="darkred",
+             label=f"moving mean over {mean_s:g} s")
     ax_p.axhline(0.0, color="black", lw=0.5)
     ax_p.set_ylabel(f"process {noun} [{unit}]")
     ax_p.set_xlabel("time [s]")
