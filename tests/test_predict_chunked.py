@@ -60,8 +60,8 @@ def test_chunked_equals_one_shot(models, cut_log, kind):
     np.testing.assert_allclose(chunked, one_shot, rtol=0, atol=1e-10)
 
 
-def test_gmssvr_with_residual_target(models, train_log, cut_log):
-    model = MODEL_CLASSES["gmssvr"](**{**QUICK["gmssvr"], "target": "residual"}).fit(train_log)
+def test_gmssvr_with_current_target(models, train_log, cut_log):
+    model = MODEL_CLASSES["gmssvr"](**{**QUICK["gmssvr"], "target": "current"}).fit(train_log)
     np.testing.assert_allclose(predict_chunked(model, cut_log, chunk_s=CHUNK_S), model.predict(cut_log),
                                rtol=0, atol=1e-10)
 
@@ -147,3 +147,41 @@ def test_unregistered_model_is_refused(cut_log):
 
     with pytest.raises(ParameterError, match="not registered"):
         predict_chunked(Custom(), cut_log)
+
+
+@pytest.fixture(scope="module")
+def augmented(train_log):
+    """A model of 'greybox discover': GMS base plus a drift with the time since the run start and a ripple."""
+    from greybox.discover.augment import AugmentedModel
+
+    return AugmentedModel(base=GMSModel(n_starts=1, max_iter=80),
+                          effects=[("thermal_drift", 3.0), ("position_periodic_force", 10.0),
+                                   "inertia_mismatch"], refine_shapes=False).fit(train_log)
+
+
+def test_augmented_model_of_discover_chunks_like_one_shot(augmented, cut_log):
+    assert [entry["name"] for entry in augmented.effects_][0] == "thermal_drift"
+    late = cut_log.replace(time=cut_log.time + 1000.0)  # the drift counts from the run's own start
+    for log in (cut_log, late):
+        np.testing.assert_allclose(predict_chunked(augmented, log, chunk_s=CHUNK_S), augmented.predict(log),
+                                   rtol=0, atol=1e-10)
+
+
+def test_augmented_chunks_need_the_run_start_and_the_base_state(augmented, cut_log):
+    """Chunks each taken as a run of their own differ: the drift restarts and the GMS base starts at rest."""
+    step = cut_log.sample_time
+    slices = chunk_slices(len(cut_log), samples_per_chunk(step, CHUNK_S))
+    restarted = np.concatenate([predict_chunk(augmented, cut_log.select(s), sample_time=step)[0] for s in slices])
+    assert np.max(np.abs(restarted - augmented.predict(cut_log))) > 1e-3
+    base_state, run_start = initial_state(augmented)
+    assert isinstance(base_state, GMSState) and run_start is None
+
+
+def test_drift_counts_from_the_run_start_given(augmented, cut_log):
+    drift = augmented.effects_[0]
+    assert abs(drift["coefficients"][0]) > 1e-4  # the training run gives the drift a visible size
+    part = slice(2000, 3000)
+    whole = augmented.added_current(cut_log)[part]
+    chunk = cut_log.select(part)
+    np.testing.assert_allclose(augmented.added_current(chunk, run_start_s=cut_log.time[0]), whole, rtol=0, atol=1e-12)
+    assert np.max(np.abs(augmented.added_current(chunk) - whole)) > 1e-5

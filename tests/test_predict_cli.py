@@ -190,3 +190,20 @@ def test_negative_moving_mean_window_is_an_argparse_error(files, tmp_path, capsy
                   "--plot", str(tmp_path / "p.png"), "--plot-mean-s", "-0.1"])
     assert "non-negative number of seconds" in capsys.readouterr().err
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_model_file_of_discover_predicts_in_chunks(files, tmp_path, capsys):
+    """The augmented model files 'greybox discover --save-model' writes work in predict, across chunks."""
+    from greybox.discover.augment import AugmentedModel
+
+    train = prepare([make_dataset("X", "A", seed=11, duration_s=10)])[0]
+    model = AugmentedModel(base=GMSModel(n_starts=1, max_iter=80), effects=[("thermal_drift", 2.0)],
+                           refine_shapes=False).fit(train)
+    model_path = save_model(model, tmp_path / "augmented.gbm")
+    out = tmp_path / "out.csv"
+    status, stdout, stderr = _predict(capsys, model_path, files["log_path"], "--out", out, "--chunk-s", "1.5")
+    assert status == 0, stderr
+    assert "augmented model" in stdout and "6 chunk(s)" in stdout
+    log = prepare([read_log(files["log_path"])])[0]
+    table = pd.read_csv(out, comment="#")
+    np.testing.assert_allclose(table["current_model_A"], model.predict(log), rtol=0, atol=1e-9)

@@ -25,6 +25,7 @@ cogging-like ``position_periodic_force``, which is not friction strictly).
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 from typing import Iterable, Sequence
 
 import numpy as np
@@ -297,12 +298,40 @@ class AugmentedModel(CurrentModel):
         return EffectContext(self.velocity_scale_mm_s_, tuple(self.position_range_mm_))
 
     def _friction_run(self, run: AxisLog) -> np.ndarray:
-        total = self.base_.friction(run)
+        return self.base_.friction(run) + self._effect_friction(run, self.context)
+
+    def _effect_friction(self, run: AxisLog, context: EffectContext) -> np.ndarray:
+        """Friction of the effect terms (all but inertia and offset) over one run [A, or N]."""
+        total = np.zeros(len(run))
         for entry in self.effects_:
             if entry["name"] not in (_INERTIA_TERM, _OFFSET_TERM):
-                total = total + effect(entry["name"]).current(run, self.context, entry["coefficients"],
-                                                              entry["shape"])
+                total += effect(entry["name"]).current(run, context, entry["coefficients"], entry["shape"])
         return total
+
+    def added_current(self, run: AxisLog, *, run_start_s: float | None = None) -> np.ndarray:
+        """What the found effects add to the base model's prediction, over one run or a part of one.
+
+        The prediction is the base model's (its inertia, friction and offset)
+        plus this: the inertia and offset the effects add, and the effect
+        terms' friction. Chunked prediction of long runs uses it.
+
+        Parameters
+        ----------
+        run : AxisLog
+            A prepared run, or consecutive samples of one.
+        run_start_s : float, optional
+            Time [s] at which the run started, for the effects of the time
+            since the start of the run; default the first sample of ``run``.
+
+        Returns
+        -------
+        ndarray, shape (len(run),)
+            [A, or N].
+        """
+        check_is_fitted(self, "effects_")
+        context = replace(self.context, run_start_s=run_start_s)
+        return ((self.J_ - self.base_.J_) * run.acceleration + (self.offset_ - self.base_.offset_)
+                + self._effect_friction(run, context))
 
     def _n_params(self) -> int:
         own = sum(effect(e["name"]).n_columns + (e["shape"] is not None) for e in self.effects_)

@@ -86,10 +86,15 @@ class EffectContext:
         ``v_e`` of the direction factor ``d = tanh(v / v_e)`` [mm/s].
     position_range_mm : tuple of float
         Lower and upper position [mm] mapped to ``u = -1`` and ``u = +1``.
+    run_start_s : float, optional
+        Time [s] at which the run started, for effects of the time since the
+        start of the run; ``None``: the first sample of the log passed. Set it
+        when a log is a part of a run (a chunk of a long run).
     """
 
     velocity_scale_mm_s: float
     position_range_mm: tuple[float, float]
+    run_start_s: float | None = None
 
     @classmethod
     def from_runs(cls, runs: Sequence[AxisLog], velocity_scale_mm_s: float | None = None) -> "EffectContext":
@@ -106,6 +111,11 @@ class EffectContext:
     def direction(self, run: AxisLog) -> np.ndarray:
         """Smoothed direction of motion ``tanh(v / v_e)`` (-1 ... 1)."""
         return np.tanh(run.velocity / self.velocity_scale_mm_s)
+
+    def elapsed(self, run: AxisLog) -> np.ndarray:
+        """Time since the start of the run [s] (see ``run_start_s``)."""
+        start = run.time[0] if self.run_start_s is None else self.run_start_s
+        return run.time - start
 
     def unit_position(self, run: AxisLog) -> np.ndarray:
         """Position scaled to ``u`` in [-1, 1] over the context's range, held at -1 / +1 beyond it."""
@@ -254,10 +264,6 @@ def _stribeck_velocity_grid(runs, context) -> np.ndarray:
 
 
 # ----------------------------------------------------------------- columns and parameters
-def _elapsed(run: AxisLog) -> np.ndarray:
-    return run.time - run.time[0]
-
-
 def _legendre_2(u):
     return 0.5 * (3.0 * u * u - 1.0)
 
@@ -335,7 +341,7 @@ _LIBRARY = (
            _periodic(_force_weight), _amplitude_phase, _PERIOD, _force_weight),
     Effect("thermal_drift", "friction changing with the time since the start of the run",
            ("drift",),
-           lambda run, c, s: (1.0 - np.exp(-_elapsed(run) / s)) * c.direction(run),
+           lambda run, c, s: (1.0 - np.exp(-c.elapsed(run) / s)) * c.direction(run),
            _with_shape("change_{E}", "time_constant_s"),
            ShapeParameter("time_constant_s", "log", _time_constant_grid)),
     Effect("inertia_mismatch", "inertia the model lacks (e.g. a workpiece on the table)",

@@ -24,6 +24,9 @@ svr        none (memoryless: ``f(p, v)``)
 lugre      bristle deflection ``z`` [mm] (float)
 gms        :class:`~greybox.friction.gms.GMSState` (deflections [mm], modes)
 gmssvr     :class:`~greybox.friction.gms.GMSState` of the frozen GMS stage
+augmented  ``(state of the base model, start time of the run [s])``: the model
+           of ``greybox discover``, whose effects may depend on the time since
+           the start of the run
 ========== =====================================================================
 """
 
@@ -111,11 +114,15 @@ def initial_state(model):
 
     Returns
     -------
-    None, float or GMSState
+    None, float, GMSState or tuple
         ``None`` for memoryless models, the bristle deflection ``0.0`` [mm]
-        for LuGre, all elements at rest for GMS and GMS+SVR.
+        for LuGre, all elements at rest for GMS and GMS+SVR; for an augmented
+        model ``(initial state of its base model, None)``, the run's start
+        time being taken from the first chunk.
     """
     kind = _kind(model)
+    if kind == "augmented":
+        return initial_state(model.base_), None
     if kind == "lugre":
         return 0.0
     if kind == "gms":
@@ -157,6 +164,14 @@ def _gmssvr_current(model, run: AxisLog, step: float, state):
     return current, end
 
 
+def _augmented_current(model, run: AxisLog, step: float, state):
+    base_state, run_start_s = state
+    if run_start_s is None:
+        run_start_s = float(run.time[0])
+    base_current, base_end = predict_chunk(model.base_, run, base_state, sample_time=step)
+    return base_current + model.added_current(run, run_start_s=run_start_s), (base_end, run_start_s)
+
+
 def predict_chunk(model, log: AxisLog, state=None, *, sample_time: float | None = None):
     """Predict one chunk of a run from a given state.
 
@@ -164,10 +179,10 @@ def predict_chunk(model, log: AxisLog, state=None, *, sample_time: float | None 
     ----------
     model : CurrentModel
         A fitted model of a registered kind (coulomb, stribeck, lugre, gms,
-        svr, gmssvr).
+        svr, gmssvr, augmented).
     log : AxisLog
         Prepared chunk: consecutive samples of one run, at least two.
-    state : None, float or GMSState, optional
+    state : None, float, GMSState or tuple, optional
         State before the chunk's first sample, as returned for the previous
         chunk; default :func:`initial_state` (the start of a run).
     sample_time : float, optional
@@ -180,7 +195,7 @@ def predict_chunk(model, log: AxisLog, state=None, *, sample_time: float | None 
     current : ndarray, shape (n,)
         Predicted current ``J a + friction + offset`` (or the grey-box
         output) [A, or N for force logs].
-    state : None, float or GMSState
+    state : None, float, GMSState or tuple
         State after the chunk's last sample: the ``state`` of the next chunk.
 
     Raises
@@ -205,6 +220,8 @@ def predict_chunk(model, log: AxisLog, state=None, *, sample_time: float | None 
         return _lugre_current(model, run, step, float(state))
     if kind == "gms":
         return _gms_current(model, run, step, state)
+    if kind == "augmented":
+        return _augmented_current(model, run, step, state)
     return _gmssvr_current(model, run, step, state)
 
 
