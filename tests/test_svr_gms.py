@@ -113,3 +113,45 @@ def test_residual_target_falls_back_to_the_gms_stage_far_from_the_training_data(
     np.testing.assert_allclose(model.predict(far), model.intercept_, atol=1e-9)
     with pytest.raises(ParameterError, match="target"):
         GMSSVRModel(target="force", **SVR_FIXED).fit_svr(train, gms=model.gms_)
+
+
+def _lowest_corner(objective, intervals, n_calls, random_state, progress=None):
+    """Stand-in for the Bayesian optimisation that picks the lower end of every interval."""
+    point = {name: low for name, (low, _) in intervals.items()}
+    return point, [{**point, "objective": objective(point)}]
+
+
+def test_residual_target_searches_local_kernels_only(fitted):
+    """With the residual target gamma stays in RESIDUAL_GAMMA_BOUNDS (the search really runs here)."""
+    from greybox.models.gmssvr import RESIDUAL_GAMMA_BOUNDS
+
+    model, train = fitted
+    residual = GMSSVRModel(C=3.0, epsilon=0.01, n_subset=200, n_calls=5, cv_folds=2, cv_blocks=4)
+    residual.fit_svr(train, gms=model.gms_)
+    tried = [trial["gamma"] for trial in residual.search_history_]
+    low, high = RESIDUAL_GAMMA_BOUNDS
+    assert len(tried) == 5 and all(low <= gamma <= high for gamma in tried) and low <= residual.gamma_ <= high
+
+
+def test_gamma_floor_of_the_residual_target_is_a_prior_not_a_warning(fitted, monkeypatch):
+    import warnings
+
+    from greybox.models import svr
+    from greybox.models.gmssvr import RESIDUAL_GAMMA_BOUNDS
+
+    monkeypatch.setattr(svr, "minimize_log_uniform", _lowest_corner)
+    model, train = fitted
+    search = dict(C=3.0, epsilon=0.01, n_subset=200, n_calls=1, cv_folds=2, cv_blocks=4)
+    residual = GMSSVRModel(**search)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        residual.fit_svr(train, gms=model.gms_)
+    assert residual.gamma_ == RESIDUAL_GAMMA_BOUNDS[0] and residual.at_bounds_ == ["gamma"]
+    # The user's interval replaces the prior, and ending at its end is then worth a warning.
+    widened = GMSSVRModel(**search, bounds={"gamma": (0.01, 100.0)})
+    with pytest.warns(UserWarning, match="gamma = 0.01 ended at the end"):
+        widened.fit_svr(train, gms=model.gms_)
+    # The paper's form searches the default interval, which reaches below the floor.
+    current = GMSSVRModel(**search, target="current")
+    with pytest.warns(UserWarning, match="gamma = 0.01 ended at the end"):
+        current.fit_svr(train, gms=model.gms_)

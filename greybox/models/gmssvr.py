@@ -50,10 +50,18 @@ from ..identify.progress import make_progress
 from .base import CurrentModel, check_runs
 from .svr import _expansion_of, _fit_expansion, hyperparameters_table
 
-__all__ = ["GMSSVRModel", "TARGETS"]
+__all__ = ["GMSSVRModel", "TARGETS", "RESIDUAL_GAMMA_BOUNDS"]
 
 #: What the SVR stage may learn: the GMS stage's residual (default) or the current (paper).
 TARGETS = ("residual", "current")
+
+#: Search interval of the RBF kernel parameter gamma [1/(standardised unit)^2]
+#: when the SVR learns the GMS residual. The floor keeps every kernel at most
+#: one standard deviation of the inputs wide, so the correction stays local
+#: and the model returns to the GMS physics away from its training data; the
+#: cross-validation of the training runs cannot see that, it prefers wider
+#: kernels (see docs/svr.md).
+RESIDUAL_GAMMA_BOUNDS = (1.0, 100.0)
 
 
 class GMSSVRModel(CurrentModel):
@@ -89,7 +97,8 @@ class GMSSVRModel(CurrentModel):
         Contiguous time blocks dealt to the folds (never spanning runs).
     bounds : dict, optional
         Search intervals ``{name: (low, high)}`` replacing
-        :func:`greybox.models.svr.default_bounds`.
+        :func:`greybox.models.svr.default_bounds`; with the residual target,
+        gamma is searched in :data:`RESIDUAL_GAMMA_BOUNDS` unless given here.
     random_state : int, default 0
         Seed of subset choice and optimisation.
 
@@ -237,8 +246,9 @@ class GMSSVRModel(CurrentModel):
         y = np.concatenate([run.effort for run in runs])
         if self.target == "residual":
             y = y - X[:, 1]
+        prior = {"gamma": RESIDUAL_GAMMA_BOUNDS} if self.target == "residual" else None
         _fit_expansion(self, X, y, coverage, [len(run) for run in runs], make_progress(progress),
-                       stage="GMS-SVR hyperparameters")
+                       stage="GMS-SVR hyperparameters", prior_bounds=prior)
         return self
 
     def _check_target(self) -> None:

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Collection, Mapping, Sequence
 
 import numpy as np
 
@@ -166,6 +166,7 @@ def fit_svr_expansion(
     random_state: int,
     progress: Callable[[ProgressEvent], None] | None = None,
     stage: str = "SVR hyperparameters",
+    floors: Collection[str] = (),
 ) -> SVRExpansion:
     """Standardise, choose hyperparameters, train on a covering subset.
 
@@ -201,6 +202,10 @@ def fit_svr_expansion(
         evaluation; its cost is the CV mean squared error over ``var(y)``.
     stage : str
         Stage name in the progress events.
+    floors : collection of str, optional
+        Hyperparameters whose lower search bound is a deliberate floor, a
+        prior of the model rather than a limit of the search: ending there
+        raises no warning (the name is still listed in ``at_bounds``).
 
     Returns
     -------
@@ -273,9 +278,11 @@ def fit_svr_expansion(
         history = [{**{k: v for k, v in t.items() if k != "objective"}, "cv_rmse": t["objective"]} for t in trials]
         cv_rmse = min(t["objective"] for t in trials)
         at_bounds = [name for name in free if _near_bound(hyper[name], search[name])]
-        if at_bounds:
+        surprising = [name for name in at_bounds
+                      if not (name in floors and _near_bound(hyper[name], search[name], end="low"))]
+        if surprising:
             warnings.warn(
-                f"{stage}: {', '.join(f'{n} = {hyper[n]:.3g}' for n in at_bounds)} ended at the end of "
+                f"{stage}: {', '.join(f'{n} = {hyper[n]:.3g}' for n in surprising)} ended at the end of "
                 "its search interval; the optimum may lie outside (widen it with bounds=)",
                 UserWarning, stacklevel=3)
     else:
@@ -291,11 +298,15 @@ def fit_svr_expansion(
     )
 
 
-def _near_bound(value: float, interval: tuple[float, float], fraction: float = 0.01) -> bool:
-    """True if ``value`` lies within ``fraction`` of the log-width of ``interval`` from one of its ends."""
+def _near_bound(value: float, interval: tuple[float, float], fraction: float = 0.01, end: str = "either") -> bool:
+    """True if ``value`` lies within ``fraction`` of the log-width of ``interval`` from an end.
+
+    ``end`` is ``"low"``, ``"high"`` or ``"either"``.
+    """
     low, high = np.log(interval[0]), np.log(interval[1])
     margin = fraction * (high - low)
-    return bool(np.log(value) <= low + margin or np.log(value) >= high - margin)
+    at_low, at_high = bool(np.log(value) <= low + margin), bool(np.log(value) >= high - margin)
+    return {"low": at_low, "high": at_high, "either": at_low or at_high}[end]
 
 
 def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) -> tuple[float, float]:
@@ -450,17 +461,24 @@ class SVRCurrentModel(CurrentModel):
 
 def _fit_expansion(model, X, y, coverage, run_lengths: Sequence[int],
                    progress: Callable[[ProgressEvent], None] | None,
-                   stage: str = "SVR hyperparameters") -> None:
+                   stage: str = "SVR hyperparameters", prior_bounds: Mapping[str, tuple[float, float]] | None = None
+                   ) -> None:
     """Fit :func:`fit_svr_expansion` with a model's SVR settings (``C``, ``epsilon``,
     ``gamma``, ``n_subset``, ``optimize``, ``n_calls``, ``cv_folds``, ``cv_blocks``,
     ``bounds``, ``random_state``) and keep the result as the model's learned
-    attributes (arrays and floats only)."""
+    attributes (arrays and floats only).
+
+    ``prior_bounds`` are search intervals the model class sets by design; the
+    model's own ``bounds`` override them, and their lower ends are floors
+    (see :func:`fit_svr_expansion`) unless overridden."""
+    bounds = {**(prior_bounds or {}), **(model.bounds or {})}
+    floors = [name for name in (prior_bounds or {}) if name not in (model.bounds or {})]
     fit = fit_svr_expansion(
         X, y, coverage, run_lengths,
         fixed={"epsilon": model.epsilon, "C": model.C, "gamma": model.gamma},
         n_subset=model.n_subset, optimize=model.optimize, n_calls=model.n_calls,
-        cv_folds=model.cv_folds, cv_blocks=model.cv_blocks, bounds=model.bounds,
-        random_state=model.random_state, progress=progress, stage=stage)
+        cv_folds=model.cv_folds, cv_blocks=model.cv_blocks, bounds=bounds or None,
+        random_state=model.random_state, progress=progress, stage=stage, floors=floors)
     model.input_mean_ = fit.input_mean
     model.input_scale_ = fit.input_scale
     model.support_vectors_ = fit.support_vectors
