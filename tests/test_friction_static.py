@@ -34,6 +34,20 @@ def test_coulomb_recovers_noise_free_parameters_exactly():
     assert model.n_params == 4
 
 
+def test_coulomb_inertia_is_never_negative():
+    """Data whose best unconstrained fit has J < 0: J is held at 0 and the rest refitted by least squares."""
+    log = log_with(lambda g: -0.001 * g.acceleration + 0.7 * np.sign(g.velocity) + 0.004 * g.velocity)
+    unconstrained = np.linalg.lstsq(np.column_stack((log.acceleration, np.sign(log.velocity), log.velocity)),
+                                    log.effort, rcond=None)[0]
+    assert unconstrained[0] == pytest.approx(-0.001, rel=1e-8)
+    model = CoulombModel().fit(log)
+    assert model.J_ == 0.0
+    friction_only = np.linalg.lstsq(np.column_stack((np.sign(log.velocity), log.velocity)), log.effort,
+                                    rcond=None)[0]
+    assert model.coulomb_pos_ == pytest.approx(friction_only[0], rel=1e-9)
+    assert model.viscous_pos_ == pytest.approx(friction_only[1], rel=1e-9)
+
+
 def test_asymmetric_coulomb_recovers_each_direction():
     truth = {"coulomb_pos": 0.6, "coulomb_neg": 0.8, "viscous_pos": 0.003, "viscous_neg": 0.005}
     log = log_with(lambda g: 0.001 * g.acceleration + coulomb_friction(g.velocity, **truth))

@@ -45,6 +45,14 @@ def test_proxy_recovers_inertia_and_offset_of_a_coulomb_viscous_axis():
     assert J == 3e-4
 
 
+def test_proxy_inertia_is_never_negative():
+    runs = [sweep_run(s, ripple=0.0, noise=0.0) for s in (1, 2)]
+    runs = [r.replace(effort=-J_TRUE * r.acceleration + 0.8 * np.sign(r.velocity) + OFFSET_TRUE) for r in runs]
+    J, offset = inertia_offset_proxy(runs)
+    assert J == 0.0
+    assert np.isfinite(offset)
+
+
 def test_learns_a_position_dependent_friction_a_position_blind_model_cannot():
     # 40 s runs: long enough for the (p, v) curves to cover the plane.
     train = [sweep_run(1, n=20000), sweep_run(2, n=20000)]

@@ -43,7 +43,12 @@ def velocity_range(velocity: np.ndarray) -> tuple[float, float]:
 
 def fit_coulomb(velocity, acceleration, effort, *, asymmetric: bool = False,
                 fit_offset: bool = False) -> dict[str, float]:
-    """Coulomb + viscous friction and inertia by linear least squares.
+    """Coulomb + viscous friction and inertia by linear least squares, the inertia non-negative.
+
+    Where the unconstrained solution has ``J < 0`` (an acceleration too little
+    excited, or correlated with an unmodelled friction), ``J`` is held at 0
+    and the other parameters are refitted, so a positive current always
+    accelerates the axis towards positive positions.
 
     Parameters
     ----------
@@ -84,7 +89,9 @@ def fit_coulomb(velocity, acceleration, effort, *, asymmetric: bool = False,
     if fit_offset:
         columns.append(np.ones_like(v))
     a = np.column_stack(columns)
-    x = np.linalg.lstsq(a, effort, rcond=None)[0]
+    lower = np.full(a.shape[1], -np.inf)
+    lower[0] = 0.0
+    x, _ = bounded_lstsq(a, np.asarray(effort, dtype=float), lower=lower)
     x = [float(value) for value in x]
     if asymmetric:
         return {"J": x[0], "coulomb_pos": x[1], "coulomb_neg": x[2], "viscous_pos": x[3],

@@ -38,6 +38,7 @@ from ..data.log import AxisLog
 from ..errors import ParameterError
 from ..identify.bayes import minimize_log_uniform
 from ..identify.cv import blocked_folds
+from ..identify.linear import bounded_lstsq
 from ..identify.progress import ProgressEvent
 from .base import CurrentModel
 from .rbf import rbf_expansion
@@ -313,7 +314,8 @@ def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) 
     """Inertia and offset from a Coulomb + viscous least-squares proxy.
 
     Fits ``I ~ J a + F_c sgn(v) + mu v + offset`` over the samples with
-    ``|v| > 0.01 max|v|`` of all runs (all samples if fewer than 4 move).
+    ``|v| > 0.01 max|v|`` of all runs (all samples if fewer than 4 move),
+    with ``J >= 0``.
 
     Parameters
     ----------
@@ -342,11 +344,10 @@ def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) 
     design = np.column_stack((np.sign(v), v, np.ones_like(v), a))[moving]
     if inertia is not None:
         design = design[:, :3]
-    # Scale the columns so that mm/s and mm/s^2 do not make the problem ill-conditioned.
-    norms = np.linalg.norm(design, axis=0)
-    norms[norms == 0] = 1.0
-    coef, *_ = np.linalg.lstsq(design / norms, effort[moving], rcond=None)
-    coef = coef / norms
+    lower = np.full(design.shape[1], -np.inf)
+    if inertia is None:
+        lower[3] = 0.0  # an identified inertia is never negative
+    coef, _ = bounded_lstsq(design, effort[moving], lower=lower)
     J = float(inertia) if inertia is not None else float(coef[3])
     return J, float(coef[2])
 
