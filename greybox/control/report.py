@@ -30,7 +30,7 @@ import numpy as np
 
 from ..atomic import write_text_atomic
 from ..errors import GreyboxError
-from ..evaluate.plots import save_figure
+from ..evaluate.plots import finish_figure, import_pyplot
 from .loop import LoopResult
 
 __all__ = ["REPORT_FILES", "report_paths", "comparison_rows", "format_tables", "plot_tracking_errors",
@@ -111,12 +111,7 @@ def plot_tracking_errors(results: list[LoopResult], reference_name: str, path=No
     -------
     matplotlib.figure.Figure or pathlib.Path
     """
-    import matplotlib
-
-    if path is not None:
-        matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
+    plt = import_pyplot(path)
     group = [result for result in results if result.reference.name == reference_name]
     if not group:
         raise GreyboxError(f"no run on reference {reference_name!r}")
@@ -136,9 +131,7 @@ def plot_tracking_errors(results: list[LoopResult], reference_name: str, path=No
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel("time [s]")
     figure.suptitle(f"tracking error on the {reference_name} reference (plant {group[0].plant_name})")
-    if path is None:
-        return figure
-    return save_figure(figure, path)
+    return finish_figure(figure, path)
 
 
 def _csv_text(rows: list[dict]) -> str:

@@ -21,7 +21,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..data.log import AxisLog
-from .plots import save_figure
+from .plots import import_pyplot, save_figure
 from .report import MODEL_LABELS
 
 __all__ = ["MODEL_COLORS", "TIME_MODELS", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs",
@@ -39,15 +39,6 @@ MODEL_COLORS = {
     "noise_floor": "#7f7f7f",
 }
 _MEASURED = "#000000"
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _color(model: str, k: int) -> str:
@@ -93,7 +84,7 @@ def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, ob
         Boxes span the quartiles, whiskers the 5th to 95th percentiles;
         outliers are not drawn.
     """
-    plt = _pyplot()
+    plt = import_pyplot(path)
     n_models = max(len(p[2]) for p in panels)
     figure, axes = plt.subplots(1, len(panels), figsize=(max(5.0, 1.0 + 0.9 * n_models) * len(panels), 4.5),
                                 squeeze=False, layout="constrained")
@@ -152,7 +143,7 @@ def time_comparison(runs: Sequence[AxisLog], predictions: Mapping[str, object], 
     -------
     pathlib.Path
     """
-    plt = _pyplot()
+    plt = import_pyplot(path)
     per_run = {model: split_runs(runs, p) for model, p in predictions.items()}
     if names is None:
         names = [run.dataset or (Path(run.source).stem if run.source else "") or f"run {i + 1}"
@@ -204,7 +195,7 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
     -------
     pathlib.Path
     """
-    plt = _pyplot()
+    plt = import_pyplot(path)
     position = np.concatenate([run.position for run in runs])
     velocity = np.concatenate([run.velocity for run in runs])
     measured = np.concatenate([run.effort for run in runs])
