@@ -404,7 +404,7 @@ class GMSModel(CurrentModel):
     def _n_params(self) -> int:
         return 2 * len(self.alpha_) + 6 + int(self.fit_offset)
 
-    def predict_chunk(self, log, state=None):
+    def predict_chunk(self, log, state=None, *, sample_time=None):
         """Predict one chunk of a run starting from a given state.
 
         Splitting a run into consecutive chunks and passing each returned
@@ -416,6 +416,10 @@ class GMSModel(CurrentModel):
             Prepared chunk (at least two samples, for its step).
         state : GMSState or (z, mode), optional
             State before the chunk's first sample; at rest by default.
+        sample_time : float, optional
+            Integration step [s]; default the chunk's own median step. Pass
+            the step of the whole run so that every chunk of a run with
+            jittered time stamps is integrated alike.
 
         Returns
         -------
@@ -425,7 +429,8 @@ class GMSModel(CurrentModel):
             State after the chunk's last sample.
         """
         (run,) = self._check_predict_runs(log)
-        friction, end = simulate_gms(run.velocity, run.sample_time, **self._parameters(), state=state)
+        step = run.sample_time if sample_time is None else float(sample_time)
+        friction, end = simulate_gms(run.velocity, step, **self._parameters(), state=state)
         return self.J_ * run.acceleration + friction + self.offset_, end
 
     def states(self, logs):

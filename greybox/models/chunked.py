@@ -39,7 +39,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..data.log import AxisLog
 from ..errors import LogError, ParameterError
-from ..friction.gms import GMSState, gms_states, simulate_gms
+from ..friction.gms import GMSState, gms_states
 from ..friction.lugre import simulate_lugre
 from .base import check_runs
 from .rbf import rbf_expansion
@@ -132,16 +132,6 @@ def initial_state(model):
     return None
 
 
-def _gms_parameters(gms) -> dict:
-    return {"alpha": gms.alpha_, "k": gms.k_, "C": gms.C_, "sigma": gms.sigma_, "s_0": gms.s0_,
-            "s_inf": gms.s_inf_, "v_s": gms.v_s_, "mu": gms.mu_}
-
-
-def _gms_current(gms, run: AxisLog, step: float, state):
-    friction, end = simulate_gms(run.velocity, step, **_gms_parameters(gms), state=state)
-    return gms.J_ * run.acceleration + friction + gms.offset_, end
-
-
 def _lugre_current(model, run: AxisLog, step: float, z0: float):
     friction, _, z_end = simulate_lugre(run.velocity, step, sigma0=model.sigma0_, sigma1=model.sigma1_,
                                         sigma2=model.viscous_, coulomb=model.coulomb_, static=model.static_,
@@ -151,7 +141,7 @@ def _lugre_current(model, run: AxisLog, step: float, z0: float):
 
 def _gmssvr_current(model, run: AxisLog, step: float, state):
     gms = model.gms_
-    gms_current, end = _gms_current(gms, run, step, state)
+    gms_current, end = gms.predict_chunk(run, state, sample_time=step)
     z, _, _, _ = gms_states(run.velocity, step, alpha=gms.alpha_, C=gms.C_, s_0=gms.s0_, s_inf=gms.s_inf_,
                             v_s=gms.v_s_, state=state)
     inputs = np.column_stack((run.position, gms_current, z))
@@ -219,7 +209,7 @@ def predict_chunk(model, log: AxisLog, state=None, *, sample_time: float | None 
     if kind == "lugre":
         return _lugre_current(model, run, step, float(state))
     if kind == "gms":
-        return _gms_current(model, run, step, state)
+        return model.predict_chunk(run, state, sample_time=step)
     if kind == "augmented":
         return _augmented_current(model, run, step, state)
     return _gmssvr_current(model, run, step, state)
