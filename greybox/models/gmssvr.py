@@ -22,11 +22,12 @@ learns the current itself, as the paper's eq. 8 is printed,
 
 with the GMS prediction as one input the kernel may correct in any
 direction; such a model collapses to a constant wherever the log leaves the
-(p, I_GMS, z) region of its training data. On the shipped air cuts X_A + X_B
-the time-blocked cross-validation of the hyperparameter search prefers the
-residual (RMSE 0.082 A against 0.087 A), see docs/svr.md. The
-hyperparameters, the training subset and the kernel evaluation are those of
-:mod:`greybox.models.svr`.
+(p, I_GMS, z) region of its training data. On the shipped air cuts X_A + X_B,
+searched over the same intervals, the time-blocked cross-validation of the
+hyperparameter search prefers the residual (RMSE 0.082 A against 0.087 A),
+see docs/svr.md. With the residual target the kernel width is kept local by
+default (:data:`RESIDUAL_GAMMA_BOUNDS`). The hyperparameters, the training
+subset and the kernel evaluation are those of :mod:`greybox.models.svr`.
 
 The stages may be fitted on the same runs (:meth:`GMSSVRModel.fit`) or on
 different ones (:meth:`GMSSVRModel.fit_gms`, then
