@@ -58,7 +58,7 @@ from greybox.evaluate.metrics import rmse
 from greybox.evaluate.plots import finish_figure, import_pyplot
 from greybox.evaluate.process import force_constant_N_per_A, predict_process
 from greybox.models.chunked import predict_chunked
-from greybox.models.registry import MODEL_CLASSES
+from greybox.registry import MODEL_CLASSES
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
 

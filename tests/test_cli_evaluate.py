@@ -13,7 +13,7 @@ from greybox.data.prepare import prepare, trim
 from greybox.evaluate.metrics import rmse
 from greybox.evaluate.regimes import REGIME_NAMES
 from greybox.friction import GMSModel, StribeckModel
-from greybox.models.persistence import save_model
+from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 
@@ -48,7 +48,7 @@ def test_evaluate_prints_regimes_and_writes_json_and_report(files, tmp_path, cap
     assert "stribeck" in printed and "gms" in printed and "noise_floor" in printed
     records = {r["model"]: r for r in json.loads(records_file.read_text())}
     assert set(records) == {"stribeck", "gms", "noise_floor"}
-    from greybox.models.persistence import load_model
+    from greybox.persistence import load_model
 
     runs = prepare([trim(make_dataset("X", d, seed=11, duration_s=6.0), stop_s=6.0) for d in "CD"])
     measured = np.concatenate([run.effort for run in runs])

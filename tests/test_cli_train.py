@@ -10,7 +10,7 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
-from greybox.models.persistence import load_model
+from greybox.persistence import load_model
 
 EMPS = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "EMPS" / "DATA_EMPS.mat"
 
@@ -78,7 +78,7 @@ def test_same_seed_gives_identical_model_files(tmp_path, capsys):
     files = []
     for name in ("a.gbm", "b.gbm"):
         files.append(tmp_path / name)
-        status, _, stderr = _train(capsys, "--model", "lugre", "--seed", "7", "--train", log_path, "--out", files[-1],
+        status, _, stderr = _train(capsys, "--model", "lugre", "--model-seed", "7", "--train", log_path, "--out", files[-1],
                                    "--quiet")
         assert status == 0 and stderr == ""
     assert files[0].read_bytes() == files[1].read_bytes()

@@ -7,11 +7,10 @@ import pytest
 
 from greybox.data.prepare import prepare
 from greybox.discover.augment import AugmentedModel
-from greybox.discover.baselinear import base_linear_part
 from greybox.discover.effects import effect
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel, StribeckModel
-from greybox.models.persistence import load_model, save_model
+from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
 
@@ -31,11 +30,11 @@ def test_joint_fit_is_one_least_squares_solve_over_base_and_terms(stroke):
     model = AugmentedModel(base=CoulombModel(), effects=[("constant_offset", None), ("thermal_drift", 7.0)],
                            refine_shapes=False, refit_base=False).fit(run)
     context = model.context
-    columns = np.column_stack([base_linear_part(model.base_, run).columns,
+    columns = np.column_stack([model.base_.linear_part(run).columns,
                                effect("constant_offset").columns(run, context),
                                effect("thermal_drift").columns(run, context, 7.0)])
     expected, *_ = np.linalg.lstsq(columns, run.effort, rcond=None)
-    np.testing.assert_allclose(model.coefficients(), expected, rtol=1e-8, atol=1e-12)
+    np.testing.assert_allclose(model.linear_coefficients(), expected, rtol=1e-8, atol=1e-12)
     np.testing.assert_allclose(model.predict(run), columns @ expected, atol=1e-10)
     # the constant term is reported in the offset, the rest of the prediction is inertia + friction
     assert model.offset_ == pytest.approx(expected[3])

@@ -13,8 +13,8 @@ from greybox.data.io import write_log
 from greybox.discover.augment import AugmentedModel
 from greybox.discover.study import StudyCase, case_logs
 from greybox.errors import GreyboxError
-from greybox.models import registry
-from greybox.models.persistence import load_model
+from greybox import registry
+from greybox.persistence import load_model
 
 
 def run_cli(argv):
@@ -79,7 +79,7 @@ def test_bad_options_are_refused(logs, tmp_path):
     with pytest.raises(GreyboxError, match="does not apply"):
         run_cli(["--base", "stribeck", "--train", logs[0], "--test", logs[1], "--json", out, "--elements", "3"])
     with pytest.raises(SystemExit):
-        run_cli(["--base", "svr", "--train", logs[0], "--test", logs[1], "--json", out])
+        run_cli(["--base", "augmented", "--train", logs[0], "--test", logs[1], "--json", out])
 
 
 def test_effects_option_restricts_the_library(logs, tmp_path):

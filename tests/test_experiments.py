@@ -21,7 +21,7 @@ from greybox.evaluate.experiments import (
 )
 from greybox.evaluate.metrics import rmse
 from greybox.evaluate.report import svr_generalisation
-from greybox.models.persistence import load_model
+from greybox.persistence import load_model
 from greybox.twin import make_dataset
 
 #: Fast model settings for the tests: few GMS starts, fixed (default) SVR hyperparameters.

@@ -7,7 +7,7 @@ import pytest
 
 from friction_reference import gms_reference, lugre_reference
 from friction_signals import STEP, velocity_profile
-from greybox.friction.gms import GMSState, gms_states, simulate_gms
+from greybox.friction.gms import GMSState, gms_trajectory, simulate_gms
 from greybox.friction.kernels import gms_friction_kernel, gms_trajectory_kernel, lugre_trajectory_kernel
 from greybox.friction.lugre import simulate_lugre
 
@@ -37,9 +37,9 @@ def test_gms_kernel_matches_python_reference(n_elements):
     np.testing.assert_allclose(z_end, ref_z_end, rtol=0, atol=1e-14)
     np.testing.assert_array_equal(mode_end, ref_mode_end)
     # the trajectory kernel reproduces the element states and, through them, the friction
-    z, stick, w, end = gms_states(velocity, STEP, alpha=p["alpha"], C=p["C"], s_0=p["s_0"], s_inf=p["s_inf"],
-                                  v_s=p["v_s"])
+    z, stick, w, trajectory_friction, end = gms_trajectory(velocity, STEP, **p)
     np.testing.assert_allclose(z, ref_z, rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(trajectory_friction, friction)  # one pass gives the same sums in the same order
     np.testing.assert_array_equal(stick, np.asarray(ref_mode) == 0)
     np.testing.assert_allclose(z @ p["k"] + p["sigma"] * w + p["mu"] * velocity, ref, rtol=0, atol=1e-12 * scale)
     np.testing.assert_array_equal(end.z, z_end)
@@ -48,8 +48,8 @@ def test_gms_kernel_matches_python_reference(n_elements):
 def test_gms_kernel_exercises_stick_and_slip():
     velocity = velocity_profile(12.0, seed=4)
     p = gms_parameters(4)
-    _, stick, _, _ = gms_states(velocity, STEP, alpha=p["alpha"], C=p["C"], s_0=p["s_0"], s_inf=p["s_inf"],
-                                v_s=p["v_s"])
+    _, stick, _, _, _ = gms_trajectory(velocity, STEP, alpha=p["alpha"], C=p["C"], s_0=p["s_0"],
+                                       s_inf=p["s_inf"], v_s=p["v_s"])
     # every element both sticks and slips, and there are samples where only some elements stick
     assert stick.any(axis=0).all() and (~stick).any(axis=0).all()
     partial = stick.any(axis=1) & ~stick.all(axis=1)
@@ -82,16 +82,16 @@ def test_kernels_write_into_column_views():
     """The identification passes column views of its regressor matrix as outputs."""
     velocity = velocity_profile(2.0, seed=1)
     p = gms_parameters(4)
-    matrix = np.zeros((velocity.size, 6))
+    matrix = np.zeros((velocity.size, 7))
     modes = np.empty((velocity.size, 4), dtype=np.int8)
     rest = GMSState.at_rest(4)
-    gms_trajectory_kernel(velocity, STEP, p["alpha"], p["s_0"], p["s_inf"], p["v_s"], p["C"], rest.z, rest.mode,
-                          matrix[:, :4], modes, matrix[:, 4])
-    z, stick, w, _ = gms_states(velocity, STEP, alpha=p["alpha"], C=p["C"], s_0=p["s_0"], s_inf=p["s_inf"],
-                                v_s=p["v_s"])
+    gms_trajectory_kernel(velocity, STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["C"],
+                          p["mu"], rest.z, rest.mode, matrix[:, :4], modes, matrix[:, 4], matrix[:, 5])
+    z, stick, w, friction, _ = gms_trajectory(velocity, STEP, **p)
     np.testing.assert_array_equal(matrix[:, :4], z)
     np.testing.assert_array_equal(matrix[:, 4], w)
-    assert np.all(matrix[:, 5] == 0.0)
+    np.testing.assert_array_equal(matrix[:, 5], friction)
+    assert np.all(matrix[:, 6] == 0.0)
     z_col = np.zeros((velocity.size, 2))
     end = lugre_trajectory_kernel(velocity, STEP, 300.0, 0.6, 0.9, 3.0, 0.0, z_col[:, 0], z_col[:, 1])
     _, z_ref, end_ref = simulate_lugre(velocity, STEP, sigma0=300.0, sigma1=0.0, sigma2=0.0, coulomb=0.6,

@@ -13,8 +13,8 @@ from sklearn.base import BaseEstimator
 
 from greybox import atomic
 from greybox.errors import ModelFileError
-from greybox.models import registry
-from greybox.models.persistence import FORMAT_VERSION, load_model, save_model
+from greybox import registry
+from greybox.persistence import FORMAT_VERSION, load_model, save_model
 
 
 class ToyModel(BaseEstimator):

@@ -8,9 +8,8 @@ import pytest
 from greybox.data.prepare import prepare
 from greybox.errors import LogError, ParameterError
 from greybox.friction import GMSModel, GMSState
-from greybox.models.chunked import (chunk_slices, initial_state, iter_chunks, predict_chunk, predict_chunked,
-                                    samples_per_chunk)
-from greybox.models.registry import MODEL_CLASSES
+from greybox.models.chunked import chunk_slices, iter_chunks, predict_chunked, samples_per_chunk
+from greybox.registry import MODEL_CLASSES
 from greybox.twin import make_dataset
 
 #: Quick settings per kind (short searches, no Bayesian optimisation).
@@ -72,26 +71,15 @@ def test_restarting_the_state_at_each_chunk_would_differ(models, cut_log, kind):
     model = models[kind]
     step = cut_log.sample_time
     slices = chunk_slices(len(cut_log), samples_per_chunk(step, CHUNK_S))
-    restarted = np.concatenate([predict_chunk(model, cut_log.select(s), sample_time=step)[0] for s in slices])
+    restarted = np.concatenate([model.predict_chunk(cut_log.select(s), sample_time=step)[0] for s in slices])
     assert np.max(np.abs(restarted - model.predict(cut_log))) > 1e-3
 
 
-def test_gms_state_matches_the_model_own_chunk_method(models, cut_log):
-    """Same end state and current as GMSModel.predict_chunk on a chunk with the run's step."""
-    model = models["gms"]
-    part = cut_log.select(slice(0, 1500))
-    mine, state = predict_chunk(model, part)
-    theirs, their_state = model.predict_chunk(part)
-    np.testing.assert_array_equal(mine, theirs)
-    np.testing.assert_array_equal(state.z, their_state.z)
-    np.testing.assert_array_equal(state.mode, their_state.mode)
-
-
 def test_initial_states(models):
-    assert initial_state(models["coulomb"]) is None
-    assert initial_state(models["svr"]) is None
-    assert initial_state(models["lugre"]) == 0.0
-    state = initial_state(models["gmssvr"])
+    assert models["coulomb"].initial_state() is None
+    assert models["svr"].initial_state() is None
+    assert models["lugre"].initial_state() == 0.0
+    state = models["gmssvr"].initial_state()
     assert isinstance(state, GMSState) and not state.z.any() and not state.mode.any()
 
 
@@ -141,14 +129,6 @@ def test_bad_chunk_lengths_and_units(models, cut_log):
             predict_chunked(models[kind], force_log)
 
 
-def test_unregistered_model_is_refused(cut_log):
-    class Custom(GMSModel):
-        pass
-
-    with pytest.raises(ParameterError, match="not registered"):
-        predict_chunked(Custom(), cut_log)
-
-
 @pytest.fixture(scope="module")
 def augmented(train_log):
     """A model of 'greybox discover': GMS base plus a drift with the time since the run start and a ripple."""
@@ -171,17 +151,7 @@ def test_augmented_chunks_need_the_run_start_and_the_base_state(augmented, cut_l
     """Chunks each taken as a run of their own differ: the drift restarts and the GMS base starts at rest."""
     step = cut_log.sample_time
     slices = chunk_slices(len(cut_log), samples_per_chunk(step, CHUNK_S))
-    restarted = np.concatenate([predict_chunk(augmented, cut_log.select(s), sample_time=step)[0] for s in slices])
+    restarted = np.concatenate([augmented.predict_chunk(cut_log.select(s), sample_time=step)[0] for s in slices])
     assert np.max(np.abs(restarted - augmented.predict(cut_log))) > 1e-3
-    base_state, run_start = initial_state(augmented)
+    base_state, run_start = augmented.initial_state()
     assert isinstance(base_state, GMSState) and run_start is None
-
-
-def test_drift_counts_from_the_run_start_given(augmented, cut_log):
-    drift = augmented.effects_[0]
-    assert abs(drift["coefficients"][0]) > 1e-4  # the training run gives the drift a visible size
-    part = slice(2000, 3000)
-    whole = augmented.added_current(cut_log)[part]
-    chunk = cut_log.select(part)
-    np.testing.assert_allclose(augmented.added_current(chunk, run_start_s=cut_log.time[0]), whole, rtol=0, atol=1e-12)
-    assert np.max(np.abs(augmented.added_current(chunk) - whole)) > 1e-5

@@ -14,7 +14,7 @@ import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.friction import GMSModel
-from greybox.models.persistence import save_model
+from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from greybox.models import persistence, registry
+from greybox import persistence, registry
 from greybox.models.svr import SVRCurrentModel
 from test_svr_model import FIXED, sweep_run
 

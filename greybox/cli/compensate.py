@@ -23,7 +23,7 @@ DEFAULT_REFERENCE_STEP_S = 0.002
 
 def add_parser(subparsers) -> None:
     from ..control.references import STROKES_MM
-    from ..models.registry import MODEL_CLASSES
+    from ..registry import MODEL_CLASSES
 
     parser = subparsers.add_parser(
         "compensate",
@@ -86,7 +86,7 @@ def _say(args, text: str) -> None:
 
 
 def _load(path: str):
-    from ..models.persistence import load_model
+    from ..persistence import load_model
 
     if not os.path.isfile(path):
         raise ModelFileError(f"{path}: no such model file")
@@ -108,7 +108,7 @@ def _plant(args):
 
 
 def _fit_kinds(args) -> list[str]:
-    from ..models.registry import MODEL_CLASSES
+    from ..registry import MODEL_CLASSES
 
     if not args.fit:
         if args.train:
@@ -140,7 +140,8 @@ def _training_runs(args, plant):
 
 
 def _models(args, plant) -> dict:
-    from ..models.registry import MODEL_CLASSES, model_kind
+    from ..registry import model_kind
+    from ._build import build_model
 
     entries = []
     for path in args.models:
@@ -151,7 +152,7 @@ def _models(args, plant) -> dict:
         runs = _training_runs(args, plant)
         for kind in kinds:
             started = time.perf_counter()
-            model = MODEL_CLASSES[kind]().fit(runs)
+            model = build_model(kind, args).fit(runs)
             _say(args, f"fitted {kind} on {len(runs)} run(s) in {time.perf_counter() - started:.1f} s")
             entries.append((kind, "fitted", model))
     if not entries:

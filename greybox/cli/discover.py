@@ -15,12 +15,10 @@ from ..discover.report import REPORT_FILES, write_json, write_report
 from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
-from ..models.persistence import load_model, save_model
-from ..models.registry import model_class
+from ..persistence import load_model, save_model
+from ..registry import MODEL_CLASSES
+from ._build import add_model_arguments, build_model
 from ._options import add_log_arguments, read_logs
-
-#: Base models whose linear parameters the effects are refitted with.
-BASE_KINDS = ("coulomb", "stribeck", "lugre", "gms")
 
 
 def add_parser(subparsers) -> None:
@@ -32,7 +30,9 @@ def add_parser(subparsers) -> None:
         "add the winning effect and refit jointly (at most --max-effects times), and report the error on the "
         "test logs before and after. Effects: " + ", ".join(EFFECT_NAMES) + ".",
     )
-    parser.add_argument("--base", required=True, choices=BASE_KINDS, help="base model kind")
+    parser.add_argument("--base", required=True, choices=sorted(MODEL_CLASSES),
+                        help="base model kind (its linear parameters are refitted with the effects; svr and "
+                        "gmssvr have none and refit slowly)")
     parser.add_argument("--train", required=True, nargs="+", metavar="LOG",
                         help="training logs (CSV, Parquet, MCAP or EMPS .mat), each a separate run")
     parser.add_argument("--test", required=True, nargs="+", metavar="LOG", help="test logs, each a separate run")
@@ -52,13 +52,7 @@ def add_parser(subparsers) -> None:
     workflow.add_argument("--seed", type=int, default=0, help="seed of the null simulations (default 0)")
     workflow.add_argument("--no-refit-base", action="store_true",
                           help="keep the base model's nonlinear shape when effects are added (faster)")
-    model = parser.add_argument_group("base model options")
-    model.add_argument("--offset", action="store_true", help="base model fits a constant effort offset")
-    model.add_argument("--asymmetric", action="store_true",
-                       help="separate Coulomb and viscous levels per direction (coulomb)")
-    model.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms)")
-    model.add_argument("--model-seed", type=int, metavar="N",
-                       help="seed of the multi-start identification (lugre, gms)")
+    add_model_arguments(parser, title="base model options", settings=False)
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
@@ -79,29 +73,6 @@ def _check_outputs(args) -> None:
             if (directory / name).exists():
                 check_output_path(directory / name, overwrite=args.force, protect=inputs,
                                   inputs_name="one of the input logs")
-
-
-def build_base(args: argparse.Namespace):
-    """Unfitted base model of kind ``args.base`` with the base-model options.
-
-    Raises
-    ------
-    GreyboxError
-        If an option does not apply to the model kind.
-    """
-    model = model_class(args.base)()
-    accepted = model.get_params(deep=False)
-    params = {}
-    for option, name, value in (("--offset", "fit_offset", True if args.offset else None),
-                                ("--asymmetric", "asymmetric", True if args.asymmetric else None),
-                                ("--elements", "n_elements", args.elements),
-                                ("--model-seed", "random_state", args.model_seed)):
-        if value is None:
-            continue
-        if name not in accepted:
-            raise GreyboxError(f"option {option} does not apply to the {args.base} model")
-        params[name] = value
-    return model.set_params(**params)
 
 
 def _candidates(text: str | None) -> tuple[str, ...]:
@@ -155,7 +126,7 @@ def _print_summary(result) -> None:
 def run(args: argparse.Namespace) -> int:
     _check_outputs(args)
     names = _candidates(args.effects)
-    base = build_base(args)
+    base = build_model(args.base, args)
     started = time.perf_counter()
 
     def say(text: str) -> None:

@@ -10,7 +10,7 @@ from ..evaluate.experiments import evaluate_models
 from ..evaluate.regimes import REGIME_NAMES
 from ..atomic import write_text_atomic
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json, write_evaluation_report
-from ..models.persistence import load_model
+from ..persistence import load_model
 from ._options import add_log_arguments, read_logs
 
 

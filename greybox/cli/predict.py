@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     from ..evaluate.process import predict_process
     from ..evaluate.process_io import check_output_path, output_format, write_process
     from ..models.chunked import chunk_slices, samples_per_chunk
-    from ..models.persistence import load_model
+    from ..persistence import load_model
 
     inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else [])
     out = Path(args.out)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -12,39 +11,10 @@ import numpy as np
 from ..atomic import check_output_path
 from ..errors import GreyboxError, ModelFileError
 from ..evaluate.metrics import metrics_table
-from ..models.persistence import load_model, save_model
-from ..models.registry import MODEL_CLASSES, model_kind
+from ..persistence import load_model, save_model
+from ..registry import MODEL_CLASSES
+from ._build import add_model_arguments, build_model
 from ._options import add_log_arguments, read_logs
-
-#: Learned attributes that describe the fit rather than the model.
-_FIT_INFO = ("effort_unit_", "sample_time_", "n_samples_fit_", "cost_", "n_evaluations_")
-
-_SVR_UNITS = {"C_": "{E}", "epsilon_": "{E}", "gamma_": "1/(standardised unit)^2", "intercept_": "{E}",
-              "cv_rmse_": "{E}"}
-
-#: Units of the learned parameters per model kind, ``{E}`` standing for the effort unit (A or N).
-_UNITS = {
-    "coulomb": {"coulomb_pos_": "{E}", "coulomb_neg_": "{E}", "viscous_pos_": "{E} s/mm",
-                "viscous_neg_": "{E} s/mm"},
-    "stribeck": {"coulomb_": "{E}", "static_": "{E}", "v_s_": "mm/s", "viscous_": "{E} s/mm"},
-    "lugre": {"sigma0_": "{E}/mm", "sigma1_": "{E} s/mm", "viscous_": "{E} s/mm", "coulomb_": "{E}",
-              "static_": "{E}", "v_s_": "mm/s"},
-    "gms": {"alpha_": "-", "k_": "{E}/mm", "C_": "mm/s", "sigma_": "{E} s/mm", "mu_": "{E} s/mm", "s0_": "mm",
-            "s_inf_": "mm", "v_s_": "mm/s"},
-    "svr": _SVR_UNITS,
-    "gmssvr": _SVR_UNITS,
-}
-#: Units of the parameters every current model has.
-_COMMON_UNITS = {"J_": "{E} s^2/mm", "offset_": "{E}"}
-
-#: Command-line options that set a model hyperparameter: option -> (parameter, value from args).
-_MODEL_OPTIONS = {
-    "--offset": ("fit_offset", lambda args: True if args.offset else None),
-    "--asymmetric": ("asymmetric", lambda args: True if args.asymmetric else None),
-    "--elements": ("n_elements", lambda args: args.elements),
-    "--seed": ("random_state", lambda args: args.seed),
-}
-
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
@@ -65,56 +35,10 @@ def add_parser(subparsers) -> None:
     )
     parser.add_argument("--out", required=True, metavar="MODEL", help="model file to write (.gbm)")
     parser.add_argument("--force", action="store_true", help="overwrite MODEL if it exists")
-    model = parser.add_argument_group("model options")
-    model.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
-    model.add_argument(
-        "--asymmetric", action="store_true", help="separate Coulomb and viscous levels per direction (coulomb)"
-    )
-    model.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms, default 4)")
-    model.add_argument("--seed", type=int, metavar="N", help="seed of the multi-start identification (lugre, gms)")
-    model.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="set any model hyperparameter, e.g. --set n_starts=8 or --set C=2.0 (repeatable; VALUE is read as "
-        "a JSON number, true, false or null, else as text)",
-    )
+    add_model_arguments(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
-
-
-def build_model(kind: str, args: argparse.Namespace):
-    """Return an unfitted model of ``kind`` with the hyperparameters given on the command line.
-
-    Raises
-    ------
-    GreyboxError
-        If an option does not apply to the model kind.
-    """
-    model = MODEL_CLASSES[kind]()
-    accepted = model.get_params(deep=False)
-    params = {}
-    for option, (name, value_of) in _MODEL_OPTIONS.items():
-        value = value_of(args)
-        if value is None:
-            continue
-        if name not in accepted:
-            raise GreyboxError(f"option {option} does not apply to the {kind} model")
-        params[name] = value
-    for setting in args.set:
-        name, sep, text = setting.partition("=")
-        name = name.strip()
-        if not sep or not name:
-            raise GreyboxError(f"--set expects NAME=VALUE, got {setting!r}")
-        if name not in accepted:
-            raise GreyboxError(f"the {kind} model has no hyperparameter {name!r}; it has: {', '.join(sorted(accepted))}")
-        try:
-            params[name] = json.loads(text)
-        except json.JSONDecodeError:
-            params[name] = text
-    return model.set_params(**params)
 
 
 #: Arrays and lists longer than this are summarised by their shape, not printed.
@@ -133,24 +57,10 @@ def _format_value(value) -> str:
     return str(value)
 
 
-def describe_parameters(model, prefix: str = "") -> list[str]:
-    """Lines ``name = value unit`` of the identified parameters of a fitted model.
-
-    A fitted model nested in another (the GMS stage of a GMS+SVR model) is
-    listed below it, its names prefixed with the attribute name.
-    """
-    unit = getattr(model, "effort_unit_", "A")
-    units = {**_COMMON_UNITS, **_UNITS.get(model_kind(model), {})}
-    lines = []
-    for name, value in vars(model).items():
-        if not name.endswith("_") or name.startswith("_") or name in _FIT_INFO:
-            continue
-        if hasattr(value, "get_params"):
-            lines += describe_parameters(value, prefix=f"{prefix}{name[:-1]}.")
-            continue
-        suffix = units.get(name, "").format(E=unit)
-        lines.append(f"  {prefix + name[:-1]:<14} = {_format_value(value)} {suffix}".rstrip())
-    return lines
+def describe_parameters(model) -> list[str]:
+    """Lines ``name = value unit`` of the model's parameter table (see ``parameter_table``)."""
+    return [f"  {row.name:<14} = {_format_value(row.value)} {row.unit if row.unit != '-' else ''}".rstrip()
+            for row in model.parameter_table()]
 
 
 def _fit(model, args: argparse.Namespace):

@@ -456,7 +456,7 @@ class ModelPlant:
     def __init__(self, model, *, name: str | None = None, max_step_s: float = 0.25e-3):
         from sklearn.utils.validation import check_is_fitted
 
-        from ..models.registry import model_kind
+        from ..registry import model_kind
 
         kind = model_kind(model)
         if kind not in ("gms", "lugre"):

@@ -6,7 +6,7 @@
 1. the base model is identified by its own ``fit`` (its nonlinear shape:
    Stribeck velocity, GMS element fractions, ...);
 2. with that shape held, the base's linear parameters
-   (:mod:`greybox.discover.baselinear`: inertia, friction levels or
+   (:meth:`~greybox.base.ModelProtocol.linear_part`: inertia, friction levels or
    stiffnesses, viscous coefficient, offset) and the coefficients of all terms
    are solved by one bounded least-squares fit, and the terms' own shape
    parameters (period, time constant, Stribeck velocity) are refined by a
@@ -18,7 +18,7 @@
 The prediction is ``J a + base friction + sum of terms + offset``. A
 ``constant_offset`` term is reported in ``offset_`` and an
 ``inertia_mismatch`` term in ``J_``; every other term belongs to what
-:meth:`~greybox.models.base.CurrentModel.friction` returns (so does a
+:meth:`~greybox.estimator.CurrentModel.friction` returns (so does a
 cogging-like ``position_periodic_force``, which is not friction strictly).
 """
 
@@ -34,12 +34,13 @@ from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 from threadpoolctl import threadpool_limits
 
+from ..base import LinearPart, Parameter
 from ..data.log import AxisLog
 from ..errors import GreyboxError, ParameterError
+from ..estimator import CurrentModel, check_runs
+from ..friction.gms import GMSModel
 from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
-from ..models.base import CurrentModel, check_runs
-from .baselinear import LinearPart, base_coefficients, base_linear_part, set_base_coefficients
 from .effects import PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
 from .projection import Nuisance, PositionScan, added_squares
 
@@ -122,7 +123,7 @@ class AugmentedModel(CurrentModel):
         "A" or "N".
     """
 
-    def __init__(self, base=None, effects=(), refine_shapes: bool = True, refit_base: bool = True,
+    def __init__(self, *, base=None, effects=(), refine_shapes: bool = True, refit_base: bool = True,
                  velocity_scale_mm_s: float | None = None):
         self.base = base
         self.effects = effects
@@ -131,15 +132,17 @@ class AugmentedModel(CurrentModel):
         self.velocity_scale_mm_s = velocity_scale_mm_s
 
     # ---------------------------------------------------------------- fitting
-    def _template(self):
-        if self.base is None:
-            from ..friction import GMSModel
-
-            return GMSModel()
-        if not isinstance(self.base, CurrentModel) or isinstance(self.base, AugmentedModel):
+    def _check_params(self) -> None:
+        if self.base is not None and (not isinstance(self.base, CurrentModel) or isinstance(self.base, AugmentedModel)):
             raise ParameterError(f"base must be a current model other than AugmentedModel, "
                                  f"got {type(self.base).__name__}")
-        return self.base
+        normalise_effects(self.effects)
+        scale = self.velocity_scale_mm_s
+        if scale is not None and not (isinstance(scale, (int, float, np.number)) and np.isfinite(scale) and scale > 0):
+            raise ParameterError(f"velocity_scale_mm_s must be a positive speed, got {scale!r} mm/s")
+
+    def _template(self):
+        return GMSModel() if self.base is None else self.base
 
     def _fit_runs(self, runs, progress) -> None:
         base = clone(self._template()).fit(runs, progress=progress)
@@ -162,11 +165,10 @@ class AugmentedModel(CurrentModel):
         -------
         self
         """
+        self._check_params()
         check_is_fitted(base)
         runs = check_runs(logs)
-        self.effort_unit_ = runs[0].effort_unit
-        self.sample_time_ = float(np.median([run.sample_time for run in runs]))
-        self.n_samples_fit_ = int(sum(len(run) for run in runs))
+        self._set_fit_info(runs)
         self._fit_terms(runs, copy.deepcopy(base), make_progress(progress))
         return self
 
@@ -181,21 +183,21 @@ class AugmentedModel(CurrentModel):
                 shifted = [run.replace(effort=run.effort - part) for run, part in zip(runs, term_current)]
                 base = clone(self._template()).fit(shifted, progress=progress)
                 shapes, coefficients = self._joint_fit(runs, base, context, terms, shapes, target)
-        self._store(base, context, terms, shapes, coefficients[base_coefficients(base).size:])
+        self._store(base, context, terms, shapes, coefficients[base.linear_coefficients().size:])
 
     def _joint_fit(self, runs, base, context, terms, shapes, target) -> tuple[list, np.ndarray]:
         """Shapes and the joint coefficients (base's linear parameters first) at the base's present shape.
 
         The base's linear parameters are written into ``base``.
         """
-        part = _joined([base_linear_part(base, run) for run in runs])
+        part = _joined([base.linear_part(run) for run in runs])
         shapes = [self._start_shape(term, shape, runs, context, part, target)
                   for (term, _), shape in zip(terms, shapes)]
         _check_separation(terms, shapes, runs, context)
         if self.refine_shapes:
             shapes = self._refine(runs, context, terms, shapes, part, target)
         coefficients = self._solve(runs, context, terms, shapes, part, target)[0]
-        set_base_coefficients(base, coefficients[:part.columns.shape[1]])
+        base.set_linear_coefficients(coefficients[:part.columns.shape[1]])
         return shapes, coefficients
 
     def _start_shape(self, term: Effect, shape, runs, context, part: LinearPart, target) -> float | None:
@@ -297,8 +299,24 @@ class AugmentedModel(CurrentModel):
         check_is_fitted(self, "effects_")
         return EffectContext(self.velocity_scale_mm_s_, tuple(self.position_range_mm_))
 
-    def _friction_run(self, run: AxisLog) -> np.ndarray:
-        return self.base_.friction(run) + self._effect_friction(run, self.context)
+    def initial_state(self):
+        """``(initial state of the base model, None)``: the run's start time is taken from its first chunk."""
+        return self.base_.initial_state(), None
+
+    def _simulate(self, run: AxisLog, state, sample_time):
+        base_state, run_start_s = state
+        if run_start_s is None:
+            run_start_s = float(run.time[0])
+        base_friction, base_end = self.base_.friction_chunk(run, base_state, sample_time=sample_time)
+        context = replace(self.context, run_start_s=run_start_s)
+        return base_friction + self._effect_friction(run, context), (base_end, run_start_s)
+
+    def _own_parameters(self) -> list[Parameter]:
+        base = [Parameter(f"base.{p.name}", p.value, p.unit, f"base model: {p.description}")
+                for p in self.base_.parameter_table()]
+        terms = [Parameter(f"{i + 1}:{e['name']}.{name}", value, "(in the name)", f"added effect {e['name']}")
+                 for i, e in enumerate(self.effects_) for name, value in e["parameters"].items()]
+        return base + terms
 
     def _effect_friction(self, run: AxisLog, context: EffectContext) -> np.ndarray:
         """Friction of the effect terms (all but inertia and offset) over one run [A, or N]."""
@@ -307,31 +325,6 @@ class AugmentedModel(CurrentModel):
             if entry["name"] not in (_INERTIA_TERM, _OFFSET_TERM):
                 total += effect(entry["name"]).current(run, context, entry["coefficients"], entry["shape"])
         return total
-
-    def added_current(self, run: AxisLog, *, run_start_s: float | None = None) -> np.ndarray:
-        """What the found effects add to the base model's prediction, over one run or a part of one.
-
-        The prediction is the base model's (its inertia, friction and offset)
-        plus this: the inertia and offset the effects add, and the effect
-        terms' friction. Chunked prediction of long runs uses it.
-
-        Parameters
-        ----------
-        run : AxisLog
-            A prepared run, or consecutive samples of one.
-        run_start_s : float, optional
-            Time [s] at which the run started, for the effects of the time
-            since the start of the run; default the first sample of ``run``.
-
-        Returns
-        -------
-        ndarray, shape (len(run),)
-            [A, or N].
-        """
-        check_is_fitted(self, "effects_")
-        context = replace(self.context, run_start_s=run_start_s)
-        return ((self.J_ - self.base_.J_) * run.acceleration + (self.offset_ - self.base_.offset_)
-                + self._effect_friction(run, context))
 
     def _n_params(self) -> int:
         own = sum(effect(e["name"]).n_columns + (e["shape"] is not None) for e in self.effects_)
@@ -358,7 +351,7 @@ class AugmentedModel(CurrentModel):
         (named ``"<effect>.<column>"``).
         """
         runs = self._check_predict_runs(logs)
-        part = _joined([base_linear_part(self.base_, run) for run in runs])
+        part = _joined([self.base_.linear_part(run) for run in runs])
         names, blocks = list(part.names), [part.columns]
         for entry in self.effects_:
             term = effect(entry["name"])
@@ -369,10 +362,28 @@ class AugmentedModel(CurrentModel):
                           np.concatenate((part.lower, np.full(n_extra, -np.inf))),
                           np.concatenate((part.upper, np.full(n_extra, np.inf))))
 
-    def coefficients(self) -> np.ndarray:
-        """Coefficients of :meth:`linear_part`'s columns."""
+    def linear_coefficients(self) -> np.ndarray:
+        """Coefficients of :meth:`linear_part`'s columns: the base's, then every term's."""
         check_is_fitted(self, "effects_")
-        return np.concatenate([base_coefficients(self.base_)] + [e["coefficients"] for e in self.effects_])
+        return np.concatenate([self.base_.linear_coefficients()] + [e["coefficients"] for e in self.effects_])
+
+    def set_linear_coefficients(self, values) -> None:
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the base model and the terms."""
+        check_is_fitted(self, "effects_")
+        x = np.asarray(values, dtype=float)
+        n_base = self.base_.linear_coefficients().size
+        self.base_.set_linear_coefficients(x[:n_base])
+        start = n_base
+        for entry in self.effects_:
+            n = effect(entry["name"]).n_columns
+            entry["coefficients"] = [float(value) for value in x[start:start + n]]
+            entry["parameters"] = effect(entry["name"]).parameters(entry["coefficients"], self.context,
+                                                                  entry["shape"], self.effort_unit_)
+            start += n
+        self.J_ = float(self.base_.J_) + sum(e["coefficients"][0] for e in self.effects_
+                                             if e["name"] == _INERTIA_TERM)
+        self.offset_ = float(self.base_.offset_) + sum(e["coefficients"][0] for e in self.effects_
+                                                       if e["name"] == _OFFSET_TERM)
 
 
 def _apart(period, low, high, others, step) -> tuple[float, float]:

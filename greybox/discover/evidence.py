@@ -54,7 +54,7 @@ import scipy.sparse
 from threadpoolctl import threadpool_limits
 
 from ..data.log import AxisLog
-from .baselinear import LinearPart
+from ..base import LinearPart
 from .effects import PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
 from .locate import structure_basis
 from .noise import ResidualNoise

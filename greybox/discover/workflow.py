@@ -30,7 +30,7 @@ from ..data.log import AxisLog
 from ..errors import GreyboxError
 from ..evaluate.metrics import metrics_table
 from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
-from ..models.base import check_runs
+from ..estimator import check_runs
 from .augment import AugmentedModel
 from .effects import EFFECT_NAMES, effect
 from .evidence import StepEvidence, score_step

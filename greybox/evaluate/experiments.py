@@ -81,7 +81,7 @@ class ModelSpec:
     Parameters
     ----------
     kind : str
-        Model kind of :data:`greybox.models.registry.MODEL_CLASSES`.
+        Model kind of :data:`greybox.registry.MODEL_CLASSES`.
     train : tuple of str
         Datasets the model is fitted on (for ``gmssvr`` with ``stage2``: the
         datasets of the GMS stage only).
@@ -418,7 +418,7 @@ class _FitCache:
 
     def fit(self, spec: ModelSpec, settings, logs, model_progress) -> tuple[object, float, list[str]]:
         """The fitted model, the fit's wall time [s] (0 when shared) and the warnings it issued."""
-        from ..models.registry import model_class
+        from ..registry import model_class
 
         model = model_class(spec.kind)(**_settings_for(spec, settings))
         key = _key(model, spec.train, spec.stage2)
@@ -472,7 +472,7 @@ def run_experiments(
     progress : callable, optional
         Receives one line of text per step (model fitted, with its time).
     model_progress : None, bool or callable, optional
-        Passed to every model's ``fit`` (see :meth:`greybox.models.base.CurrentModel.fit`).
+        Passed to every model's ``fit`` (see :meth:`greybox.estimator.CurrentModel.fit`).
 
     Returns
     -------
@@ -599,7 +599,7 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
     predictions : dict
         ``{name: predicted current [A], runs concatenated}``.
     """
-    from ..models.registry import model_kind
+    from ..registry import model_kind
     from .regimes import metrics_by_regime
 
     axis = "/".join(dict.fromkeys(run.axis for run in runs if run.axis))
@@ -739,7 +739,7 @@ def reproduce(
     progress : callable, optional
         Receives one line of text per step.
     model_progress : None, bool or callable, optional
-        Progress of every model fit (see :meth:`greybox.models.base.CurrentModel.fit`).
+        Progress of every model fit (see :meth:`greybox.estimator.CurrentModel.fit`).
     intro : str
         Text placed under the report's title (e.g. the command that made it).
 
@@ -747,7 +747,7 @@ def reproduce(
     -------
     Reproduction
     """
-    from ..models.persistence import save_model
+    from ..persistence import save_model
     from .figures import experiment_figures
     from .report import report_tables, write_report
 

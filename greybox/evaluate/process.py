@@ -46,7 +46,7 @@ from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog, as_log_list
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S, predict_chunked
-from ..models.registry import model_kind
+from ..registry import model_kind
 
 __all__ = ["force_constant_N_per_A", "process_force", "ProcessResult", "predict_process"]
 

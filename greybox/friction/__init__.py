@@ -1,7 +1,7 @@
 """Physical friction models: Coulomb, Stribeck, LuGre and GMS.
 
 Each model is a current model (inertia + friction, see
-:class:`greybox.models.base.CurrentModel`) with scikit-learn estimator
+:class:`greybox.estimator.CurrentModel`) with scikit-learn estimator
 conventions; the dynamic ones (LuGre, GMS) run compiled kernels from
 :mod:`greybox.friction.kernels`.
 """

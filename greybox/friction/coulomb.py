@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..base import EFFORT, LinearPart, Parameter
+from ..errors import ParameterError
+from ..estimator import CurrentModel
 from ..identify.initial import check_motion, samples_at_speed
 from ..identify.static import fit_coulomb
-from ..models.base import CurrentModel
 
 __all__ = ["CoulombModel", "coulomb_friction"]
 
@@ -63,10 +65,17 @@ class CoulombModel(CurrentModel):
         Unit of the effort the model was fitted on, "A" or "N".
     """
 
-    def __init__(self, asymmetric: bool = False, fit_offset: bool = False, min_speed: float = 0.0):
+    def __init__(self, *, asymmetric: bool = False, fit_offset: bool = False, min_speed: float = 0.0):
         self.asymmetric = asymmetric
         self.fit_offset = fit_offset
         self.min_speed = min_speed
+
+    def _check_params(self) -> None:
+        if self.asymmetric and self.fit_offset:
+            raise ParameterError("an offset and direction-dependent Coulomb levels are not separately "
+                                 "identifiable: choose asymmetric or fit_offset, not both")
+        if not (np.isfinite(self.min_speed) and self.min_speed >= 0.0):
+            raise ParameterError(f"min_speed must be a non-negative speed, got {self.min_speed} mm/s")
 
     def _fit_runs(self, runs, progress) -> None:
         check_motion(runs)
@@ -79,9 +88,47 @@ class CoulombModel(CurrentModel):
         self.viscous_neg_ = params["viscous_neg"]
         self.offset_ = params["offset"]
 
-    def _friction_run(self, run) -> np.ndarray:
+    def _simulate(self, run, state, sample_time):
         return coulomb_friction(run.velocity, self.coulomb_pos_, self.coulomb_neg_,
-                                self.viscous_pos_, self.viscous_neg_)
+                                self.viscous_pos_, self.viscous_neg_), None
 
     def _n_params(self) -> int:
         return (5 if self.asymmetric else 3) + int(self.fit_offset)
+
+    def _own_parameters(self) -> list[Parameter]:
+        return [
+            Parameter("coulomb_pos", self.coulomb_pos_, EFFORT, "Coulomb level, positive motion"),
+            Parameter("coulomb_neg", self.coulomb_neg_, EFFORT, "Coulomb level magnitude, negative motion"),
+            Parameter("viscous_pos", self.viscous_pos_, f"{EFFORT} s/mm", "viscous coefficient, positive motion"),
+            Parameter("viscous_neg", self.viscous_neg_, f"{EFFORT} s/mm", "viscous coefficient, negative motion"),
+        ]
+
+    # ---------------------------------------------------------------- linear part
+    def linear_part(self, run) -> LinearPart:
+        """Columns ``a, sgn v, v (, 1)``, or ``a, [v>0], -[v<0], v [v>0], v [v<0]`` if asymmetric."""
+        v, a = run.velocity, run.acceleration
+        if self.asymmetric:
+            positive, negative = (v > 0.0).astype(float), (v < 0.0).astype(float)
+            return LinearPart.from_columns([a, positive, -negative, v * positive, v * negative],
+                                           ["J", "coulomb_pos", "coulomb_neg", "viscous_pos", "viscous_neg"])
+        columns, names = [a, np.sign(v), v], ["J", "coulomb", "viscous"]
+        if self.fit_offset:
+            columns.append(np.ones(len(run)))
+            names.append("offset")
+        return LinearPart.from_columns(columns, names)
+
+    def linear_coefficients(self) -> np.ndarray:
+        """``J, coulomb, viscous (, offset)``, or the five levels of the asymmetric model."""
+        if self.asymmetric:
+            return np.array([self.J_, self.coulomb_pos_, self.coulomb_neg_, self.viscous_pos_, self.viscous_neg_])
+        return np.array([self.J_, self.coulomb_pos_, self.viscous_pos_] + ([self.offset_] if self.fit_offset else []))
+
+    def set_linear_coefficients(self, values) -> None:
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model."""
+        x = [float(value) for value in np.asarray(values, dtype=float)]
+        if self.asymmetric:
+            self.J_, self.coulomb_pos_, self.coulomb_neg_, self.viscous_pos_, self.viscous_neg_ = x
+            return
+        self.J_, self.coulomb_pos_, self.viscous_pos_ = x[:3]
+        self.coulomb_neg_, self.viscous_neg_ = self.coulomb_pos_, self.viscous_pos_
+        self.offset_ = x[3] if self.fit_offset else 0.0

@@ -23,15 +23,16 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..base import EFFORT, LinearPart, Parameter
 from ..errors import ParameterError
+from ..estimator import CurrentModel
 from ..identify.initial import DEFAULT_DEFLECTION_MM, check_motion, presliding_deflection, static_initial_guess
 from ..identify.linear import bounded_lstsq
-from ..identify.optimize import METHODS, local_search, multistart
+from ..identify.optimize import check_search_settings, local_search, multistart
 from ..identify.static import velocity_range
-from ..models.base import CurrentModel
 from .kernels import gms_friction_kernel, gms_trajectory_kernel
 
-__all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_states"]
+__all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_trajectory"]
 
 #: Largest ``T C / min(s_0, s_inf)`` the identification allows: the slip step
 #: then relaxes monotonically (no overshoot), well inside the stability limit 2.
@@ -157,8 +158,8 @@ def simulate_gms(velocity, sample_time, *, alpha, k, C, sigma, s_0, s_inf, v_s, 
     return friction, GMSState(z, mode)
 
 
-def gms_states(velocity, sample_time, *, alpha, C, s_0, s_inf, v_s, state=None):
-    """Element deflections and stick flags of the GMS model over one run.
+def gms_trajectory(velocity, sample_time, *, alpha, C, s_0, s_inf, v_s, k=None, sigma=0.0, mu=0.0, state=None):
+    """Element deflections, stick flags and friction of the GMS model over one run, in one pass.
 
     Parameters
     ----------
@@ -167,8 +168,11 @@ def gms_states(velocity, sample_time, *, alpha, C, s_0, s_inf, v_s, state=None):
     sample_time : float
         Step T [s].
     alpha, C, s_0, s_inf, v_s
-        Parameters, see :func:`check_gms_parameters` (the element states do
-        not depend on ``k``, ``sigma`` or ``mu``).
+        Shape parameters, see :func:`check_gms_parameters` (the element states
+        depend on these only).
+    k, sigma, mu : optional
+        Stiffnesses [A/mm], micro-damping and viscous coefficient [A s/mm] of
+        the friction; zero by default (then the friction returned is zero).
     state : GMSState or (z, mode), optional
         State before the first sample; all elements at rest by default.
 
@@ -180,19 +184,23 @@ def gms_states(velocity, sample_time, *, alpha, C, s_0, s_inf, v_s, state=None):
         True where the element sticks.
     w : ndarray, shape (n,)
         ``sum_i alpha_i dz_i/dt`` [mm/s] (the damping term is ``sigma * w``).
+    friction : ndarray, shape (n,)
+        Friction [A], equal to :func:`simulate_gms`'s.
     state : GMSState
         State after the last sample.
     """
     alpha = np.ascontiguousarray(alpha, dtype=float)
-    check_gms_parameters(alpha, np.zeros_like(alpha), C, 0.0, s_0, s_inf, v_s, 0.0, sample_time)
+    k = np.zeros_like(alpha) if k is None else np.ascontiguousarray(k, dtype=float)
+    check_gms_parameters(alpha, k, C, sigma, s_0, s_inf, v_s, mu, sample_time)
     start = _as_state(state, alpha.size)
     velocity = np.ascontiguousarray(velocity, dtype=float)
     z = np.empty((velocity.size, alpha.size))
     mode = np.empty((velocity.size, alpha.size), dtype=np.int8)
-    w = np.empty(velocity.size)
-    z_end, mode_end = gms_trajectory_kernel(velocity, float(sample_time), alpha, float(s_0), float(s_inf),
-                                            float(v_s), float(C), start.z, start.mode, z, mode, w)
-    return z, mode == 0, w, GMSState(z_end, mode_end)
+    w, friction = np.empty(velocity.size), np.empty(velocity.size)
+    z_end, mode_end = gms_trajectory_kernel(velocity, float(sample_time), alpha, k, float(sigma), float(s_0),
+                                            float(s_inf), float(v_s), float(C), float(mu), start.z, start.mode,
+                                            z, mode, w, friction)
+    return z, mode == 0, w, friction, GMSState(z_end, mode_end)
 
 
 class _Regression:
@@ -213,6 +221,8 @@ class _Regression:
         self.matrix[:, n_elements + 1] = np.concatenate([run.velocity for run in runs])
         self.matrix[:, n_elements + 2] = np.concatenate([run.acceleration for run in runs])
         self.modes = np.empty((self.rows[-1], n_elements), dtype=np.int8)
+        self.no_friction = np.empty(self.rows[-1])
+        self.zeros = np.zeros(n_elements)
         self.target = np.concatenate([run.effort for run in runs])
         self.norm = np.sqrt(self.target.size * max(np.var(self.target), np.finfo(float).tiny))
         self.lower = np.zeros(n_cols)
@@ -225,8 +235,9 @@ class _Regression:
         rest = GMSState.at_rest(self.n_elements)
         n = self.n_elements
         for step, velocity, r0, r1 in zip(self.steps, self.velocities, self.rows[:-1], self.rows[1:]):
-            gms_trajectory_kernel(velocity, step, alpha, s_0, s_inf, v_s, c, rest.z, rest.mode,
-                                  self.matrix[r0:r1, :n], self.modes[r0:r1], self.matrix[r0:r1, n])
+            gms_trajectory_kernel(velocity, step, alpha, self.zeros, 0.0, s_0, s_inf, v_s, c, 0.0, rest.z, rest.mode,
+                                  self.matrix[r0:r1, :n], self.modes[r0:r1], self.matrix[r0:r1, n],
+                                  self.no_friction[r0:r1])
         x, residual = bounded_lstsq(self.matrix, self.target, self.lower, self.upper)
         return x, residual / self.norm
 
@@ -305,7 +316,7 @@ class GMSModel(CurrentModel):
         Unit of the effort the model was fitted on, "A" or "N".
     """
 
-    def __init__(self, n_elements: int = 4, fit_offset: bool = False, method: str = "nelder-mead",
+    def __init__(self, *, n_elements: int = 4, fit_offset: bool = False, method: str = "nelder-mead",
                  n_starts: int = 4, random_state=0, max_iter: int = 400, staged: bool = True):
         self.n_elements = n_elements
         self.fit_offset = fit_offset
@@ -343,12 +354,14 @@ class GMSModel(CurrentModel):
                                 [np.log(v_hi), np.log(MAX_SLIP_STEP_RATIO)]))
         return theta, lower, upper
 
+    def _check_params(self) -> None:
+        n = self.n_elements
+        if not (isinstance(n, (int, np.integer)) and not isinstance(n, bool) and n >= 1):
+            raise ParameterError(f"n_elements must be a positive integer, got {n!r}")
+        check_search_settings(self)
+
     def _fit_runs(self, runs, progress) -> None:
         n = self.n_elements
-        if not (isinstance(n, (int, np.integer)) and n >= 1):
-            raise ParameterError(f"n_elements must be a positive integer, got {n!r}")
-        if self.method not in METHODS:
-            raise ParameterError(f"unknown method {self.method!r}; expected one of {METHODS}")
         check_motion(runs)
         regression = _Regression(runs, n, self.fit_offset)
         max_step = max(regression.steps)
@@ -398,40 +411,55 @@ class GMSModel(CurrentModel):
         return {"alpha": self.alpha_, "k": self.k_, "C": self.C_, "sigma": self.sigma_, "s_0": self.s0_,
                 "s_inf": self.s_inf_, "v_s": self.v_s_, "mu": self.mu_}
 
-    def _friction_run(self, run) -> np.ndarray:
-        return simulate_gms(run.velocity, run.sample_time, **self._parameters())[0]
+    def initial_state(self) -> GMSState:
+        """All elements relaxed and sticking."""
+        return GMSState.at_rest(len(self.alpha_))
+
+    def _simulate(self, run, state, sample_time):
+        return simulate_gms(run.velocity, sample_time, **self._parameters(), state=state)
 
     def _n_params(self) -> int:
         return 2 * len(self.alpha_) + 6 + int(self.fit_offset)
 
-    def predict_chunk(self, log, state=None, *, sample_time=None):
-        """Predict one chunk of a run starting from a given state.
+    def _own_parameters(self) -> list[Parameter]:
+        return [
+            Parameter("alpha", self.alpha_, "-", "element fractions (sum 1)"),
+            Parameter("k", self.k_, f"{EFFORT}/mm", "element stiffnesses"),
+            Parameter("C", self.C_, "mm/s", "slip rate constant"),
+            Parameter("sigma", self.sigma_, f"{EFFORT} s/mm", "micro-damping"),
+            Parameter("mu", self.mu_, f"{EFFORT} s/mm", "viscous coefficient"),
+            Parameter("s0", self.s0_, "mm", "break-away deflection at rest"),
+            Parameter("s_inf", self.s_inf_, "mm", "break-away deflection at high speed"),
+            Parameter("v_s", self.v_s_, "mm/s", "Stribeck velocity"),
+        ]
 
-        Splitting a run into consecutive chunks and passing each returned
-        state to the next chunk gives the same prediction as the whole run.
+    def trajectory(self, log, state=None, *, sample_time=None):
+        """Current and element states of one run or chunk, from one simulation.
 
         Parameters
         ----------
         log : AxisLog
-            Prepared chunk (at least two samples, for its step).
+            One prepared run or chunk.
         state : GMSState or (z, mode), optional
-            State before the chunk's first sample; at rest by default.
+            State before the first sample; at rest by default.
         sample_time : float, optional
-            Integration step [s]; default the chunk's own median step. Pass
-            the step of the whole run so that every chunk of a run with
-            jittered time stamps is integrated alike.
+            Integration step [s]; default the log's own median step.
 
         Returns
         -------
         current : ndarray, shape (n,)
-            ``J a + friction + offset`` [A].
+            ``J a + friction + offset`` [A], equal to :meth:`predict_chunk`'s.
+        z : ndarray, shape (n, N)
+            Deflection of each element at each sample [mm].
+        stick : ndarray of bool, shape (n, N)
+            True where the element sticks.
         state : GMSState
-            State after the chunk's last sample.
+            State after the last sample.
         """
         (run,) = self._check_predict_runs(log)
         step = run.sample_time if sample_time is None else float(sample_time)
-        friction, end = simulate_gms(run.velocity, step, **self._parameters(), state=state)
-        return self.J_ * run.acceleration + friction + self.offset_, end
+        z, stick, _, friction, end = gms_trajectory(run.velocity, step, state=state, **self._parameters())
+        return self.J_ * run.acceleration + friction + self.offset_, z, stick, end
 
     def states(self, logs):
         """Element deflections and stick flags over one or several runs (each from rest).
@@ -448,7 +476,30 @@ class GMSModel(CurrentModel):
         stick : ndarray of bool, shape (n_samples, N)
             True where the element sticks.
         """
-        runs = self._check_predict_runs(logs)
-        parts = [gms_states(run.velocity, run.sample_time, alpha=self.alpha_, C=self.C_, s_0=self.s0_,
-                            s_inf=self.s_inf_, v_s=self.v_s_) for run in runs]
-        return np.vstack([p[0] for p in parts]), np.vstack([p[1] for p in parts])
+        parts = [self.trajectory(run) for run in self._check_predict_runs(logs)]
+        return np.vstack([p[1] for p in parts]), np.vstack([p[2] for p in parts])
+
+    # ---------------------------------------------------------------- linear part
+    def linear_part(self, run) -> LinearPart:
+        """Columns ``z_1..z_N, w, v, a (, 1)`` at the fitted element shape (``w = sum_i alpha_i dz_i/dt``)."""
+        z, _, w, _, _ = gms_trajectory(run.velocity, run.sample_time, alpha=self.alpha_, C=self.C_, s_0=self.s0_,
+                                       s_inf=self.s_inf_, v_s=self.v_s_)
+        n = z.shape[1]
+        columns = list(z.T) + [w, run.velocity, run.acceleration]
+        names = [f"k{i + 1}" for i in range(n)] + ["sigma", "mu", "J"]
+        if self.fit_offset:
+            columns.append(np.ones(len(run)))
+            names.append("offset")
+        return LinearPart.from_columns(columns, names, non_negative=n + 3)
+
+    def linear_coefficients(self) -> np.ndarray:
+        """``k_1..k_N, sigma, mu, J (, offset)``."""
+        return np.concatenate((self.k_, [self.sigma_, self.mu_, self.J_], [self.offset_] if self.fit_offset else []))
+
+    def set_linear_coefficients(self, values) -> None:
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model."""
+        x = [float(value) for value in np.asarray(values, dtype=float)]
+        n = len(self.alpha_)
+        self.k_ = np.array(x[:n])
+        self.sigma_, self.mu_, self.J_ = x[n:n + 3]
+        self.offset_ = x[n + 3] if self.fit_offset else 0.0

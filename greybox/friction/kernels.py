@@ -164,20 +164,23 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
 
 
 @njit(cache=True, error_model="numpy")
-def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, mode0, z_out, mode_out, w_out):
-    """Element states of the GMS model over a run (forward Euler, constant step).
+def gms_trajectory_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0,
+                          z_out, mode_out, w_out, friction_out):
+    """Element states and friction of the GMS model over a run (forward Euler, constant step).
 
     The element deflections do not depend on the stiffnesses ``k_i``, the
     damping ``sigma`` or the viscous coefficient, so the friction is linear in
-    those given this trajectory: ``F = z_out @ k + sigma * w_out + mu * v``.
+    those given this trajectory: ``F = z_out @ k + sigma * w_out + mu * v``
+    (the identification passes zeros for them and reads the states only).
     The outputs are written into arrays given by the caller (they may be
-    column views of a regressor matrix).
+    column views of a regressor matrix). ``friction_out`` equals the output of
+    :func:`gms_friction_kernel` bit for bit (the same sums in the same order).
 
     Parameters
     ----------
     velocity : ndarray, shape (n,)
         Velocity [mm/s].
-    sample_time, alpha, s_0, s_inf, v_s, c, z0, mode0
+    sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0
         As in :func:`gms_friction_kernel`.
     z_out : ndarray, shape (n, N)
         Receives the deflection of each element at each sample, before its update [mm].
@@ -185,6 +188,8 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, 
         Receives the mode of each element at each sample, before its update.
     w_out : ndarray, shape (n,)
         Receives ``sum_i alpha_i dz_i/dt`` over each step [mm/s].
+    friction_out : ndarray, shape (n,)
+        Receives the friction at each sample [A].
 
     Returns
     -------
@@ -196,6 +201,7 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, 
     n = velocity.shape[0]
     z = z0.copy()
     mode = mode0.copy()
+    damping = sigma * alpha
     c_dt = c * sample_time
     s_drop = s_0 - s_inf
     inv_v_s = 1.0 / v_s
@@ -203,15 +209,19 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, s_0, s_inf, v_s, c, z0, 
         v = velocity[j]
         s, inv_s, d, v_dt = _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
         w = 0.0
+        f = mu * v
         for i in range(alpha.shape[0]):
             z_old = z[i]
             z_out[j, i] = z_old
             mode_out[j, i] = mode[i]
             z_new, m = _gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
-            w += alpha[i] * ((z_new - z_old) / sample_time)
+            rate = (z_new - z_old) / sample_time
+            w += alpha[i] * rate
+            f += k[i] * z_old + damping[i] * rate
             z[i] = z_new
             mode[i] = m
         w_out[j] = w
+        friction_out[j] = f
     return z, mode
 
 

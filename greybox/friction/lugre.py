@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..base import EFFORT, LinearPart, Parameter
 from ..errors import ParameterError
+from ..estimator import CurrentModel
 from ..identify.initial import DEFAULT_DEFLECTION_MM, check_motion, presliding_deflection, static_initial_guess
 from ..identify.linear import bounded_lstsq
-from ..identify.optimize import METHODS, multistart
+from ..identify.optimize import check_search_settings, multistart
 from ..identify.static import velocity_range
-from ..models.base import CurrentModel
 from .kernels import lugre_trajectory_kernel
 
 __all__ = ["LuGreModel", "check_lugre_parameters", "simulate_lugre"]
@@ -163,7 +164,7 @@ class LuGreModel(CurrentModel):
         Unit of the effort the model was fitted on, "A" or "N".
     """
 
-    def __init__(self, fit_offset: bool = False, method: str = "nelder-mead", n_starts: int = 3,
+    def __init__(self, *, fit_offset: bool = False, method: str = "nelder-mead", n_starts: int = 3,
                  random_state=0, max_iter: int = 300):
         self.fit_offset = fit_offset
         self.method = method
@@ -171,9 +172,10 @@ class LuGreModel(CurrentModel):
         self.random_state = random_state
         self.max_iter = max_iter
 
+    def _check_params(self) -> None:
+        check_search_settings(self)
+
     def _fit_runs(self, runs, progress) -> None:
-        if self.method not in METHODS:
-            raise ParameterError(f"unknown method {self.method!r}; expected one of {METHODS}")
         check_motion(runs)
         static = static_initial_guess(runs, fit_offset=self.fit_offset)
         delta = presliding_deflection(runs, static, fraction=_RECOVERY) or DEFAULT_DEFLECTION_MM
@@ -197,10 +199,59 @@ class LuGreModel(CurrentModel):
         self.offset_ = float(x[3]) if self.fit_offset else 0.0
         self.cost_ = float(residual @ residual)
 
-    def _friction_run(self, run) -> np.ndarray:
-        return simulate_lugre(run.velocity, run.sample_time, sigma0=self.sigma0_, sigma1=self.sigma1_,
-                              sigma2=self.viscous_, coulomb=self.coulomb_, static=self.static_,
-                              v_s=self.v_s_)[0]
+    def initial_state(self) -> float:
+        """Bristle deflection at the start of a run: ``0.0`` [mm]."""
+        return 0.0
+
+    def _simulate(self, run, state, sample_time):
+        friction, _, z_end = simulate_lugre(run.velocity, sample_time, sigma0=self.sigma0_, sigma1=self.sigma1_,
+                                            sigma2=self.viscous_, coulomb=self.coulomb_, static=self.static_,
+                                            v_s=self.v_s_, z0=_as_deflection(state))
+        return friction, float(z_end)
 
     def _n_params(self) -> int:
         return 7 + int(self.fit_offset)
+
+    def _own_parameters(self) -> list[Parameter]:
+        return [
+            Parameter("sigma0", self.sigma0_, f"{EFFORT}/mm", "bristle stiffness"),
+            Parameter("sigma1", self.sigma1_, f"{EFFORT} s/mm", "bristle damping"),
+            Parameter("viscous", self.viscous_, f"{EFFORT} s/mm", "viscous coefficient sigma2"),
+            Parameter("coulomb", self.coulomb_, EFFORT, "Coulomb level F_c"),
+            Parameter("static", self.static_, EFFORT, "static level F_s"),
+            Parameter("v_s", self.v_s_, "mm/s", "Stribeck velocity"),
+        ]
+
+    # ---------------------------------------------------------------- linear part
+    def linear_part(self, run) -> LinearPart:
+        """Columns ``dz/dt, v, a (, 1)`` at the fitted bristle law; ``sigma0 z`` is the fixed part."""
+        v = np.ascontiguousarray(run.velocity, dtype=float)
+        z, z_dot = np.empty(v.size), np.empty(v.size)
+        lugre_trajectory_kernel(v, float(run.sample_time), self.sigma0_, self.coulomb_, self.static_,
+                                self.v_s_, 0.0, z, z_dot)
+        columns, names = [z_dot, v, run.acceleration], ["sigma1", "viscous", "J"]
+        if self.fit_offset:
+            columns.append(np.ones(len(run)))
+            names.append("offset")
+        return LinearPart.from_columns(columns, names, non_negative=3, fixed=self.sigma0_ * z)
+
+    def linear_coefficients(self) -> np.ndarray:
+        """``sigma1, viscous, J (, offset)``."""
+        return np.array([self.sigma1_, self.viscous_, self.J_] + ([self.offset_] if self.fit_offset else []))
+
+    def set_linear_coefficients(self, values) -> None:
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model."""
+        x = [float(value) for value in np.asarray(values, dtype=float)]
+        self.sigma1_, self.viscous_, self.J_ = x[:3]
+        self.offset_ = x[3] if self.fit_offset else 0.0
+
+
+def _as_deflection(state) -> float:
+    """The LuGre state (a bristle deflection [mm]) as a float, or raise :class:`ParameterError`."""
+    try:
+        z = float(state)
+    except (TypeError, ValueError):
+        raise ParameterError(f"LuGre state must be a bristle deflection in mm, got {state!r}") from None
+    if not np.isfinite(z):
+        raise ParameterError(f"LuGre state must be a finite bristle deflection, got {z} mm")
+    return z

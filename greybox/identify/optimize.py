@@ -27,6 +27,7 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 from threadpoolctl import threadpool_limits
 
+from ..errors import ParameterError
 from .progress import ProgressEvent
 
 __all__ = ["METHODS", "SearchResult", "local_search", "multistart"]
@@ -99,6 +100,30 @@ class _TrackedResiduals:
         if self.progress is not None:
             self.progress(ProgressEvent(self.stage, self.start, self.n_starts, self.n_evaluations,
                                         self.last_cost, self.stage_best, done=True))
+
+
+def check_search_settings(model) -> None:
+    """Raise :class:`ParameterError` unless a model's search settings are valid.
+
+    Checks ``method`` (one of :data:`METHODS`), ``n_starts`` and ``max_iter``
+    (positive integers) and ``random_state`` (None or a non-negative integer
+    seed) of an estimator that fits by :func:`multistart`.
+    """
+    if model.method not in METHODS:
+        raise ParameterError(f"unknown method {model.method!r}; expected one of {METHODS}")
+    for name in ("n_starts", "max_iter"):
+        value = getattr(model, name)
+        if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= 1):
+            raise ParameterError(f"{name} must be a positive integer, got {value!r}")
+    check_seed(model.random_state, allow_none=True)
+
+
+def check_seed(seed, *, name: str = "random_state", allow_none: bool = False) -> None:
+    """Raise :class:`ParameterError` unless ``seed`` is a non-negative integer (or None if allowed)."""
+    if seed is None and allow_none:
+        return
+    if not (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0):
+        raise ParameterError(f"{name} must be a non-negative integer seed, got {seed!r}")
 
 
 def _check_bounds(x0, lower, upper):

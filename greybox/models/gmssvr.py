@@ -44,12 +44,13 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 
+from ..base import Parameter
 from ..data.log import AxisLog
 from ..errors import LogError, ParameterError
+from ..estimator import check_runs
 from ..friction.gms import GMSModel
 from ..identify.progress import make_progress
-from .base import CurrentModel, check_runs
-from .svr import _expansion_of, _fit_expansion, hyperparameters_table
+from .svr import KernelRegressionModel
 
 __all__ = ["GMSSVRModel", "TARGETS", "RESIDUAL_GAMMA_BOUNDS"]
 
@@ -65,7 +66,7 @@ TARGETS = ("residual", "current")
 RESIDUAL_GAMMA_BOUNDS = (1.0, 100.0)
 
 
-class GMSSVRModel(CurrentModel):
+class GMSSVRModel(KernelRegressionModel):
     """Grey-box current model ``I = I_GMS + SVR(p, I_GMS, z_1..z_N)`` with a frozen GMS stage.
 
     With ``target="current"`` (the paper's eq. 8): ``I = SVR(p, I_GMS, z_1..z_N)``.
@@ -132,7 +133,7 @@ class GMSSVRModel(CurrentModel):
         Size of the SVR training subset.
     """
 
-    def __init__(self, gms=None, C=None, epsilon=None, gamma=None, target="residual", n_subset=2000,
+    def __init__(self, *, gms=None, C=None, epsilon=None, gamma=None, target="residual", n_subset=2000,
                  optimize=True, n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
         self.gms = gms
         self.C = C
@@ -166,7 +167,7 @@ class GMSSVRModel(CurrentModel):
         logs : AxisLog or list of AxisLog
             Prepared runs (velocity [mm/s] and acceleration [mm/s^2] present).
         progress : None, bool or callable, optional
-            See :meth:`greybox.models.base.CurrentModel.fit`.
+            See :meth:`greybox.estimator.CurrentModel.fit`.
 
         Returns
         -------
@@ -183,16 +184,14 @@ class GMSSVRModel(CurrentModel):
         logs : AxisLog or list of AxisLog
             Prepared runs.
         progress : None, bool or callable, optional
-            See :meth:`greybox.models.base.CurrentModel.fit`.
+            See :meth:`greybox.estimator.CurrentModel.fit`.
 
         Returns
         -------
         self
         """
-        self._check_target()
+        self._check_params()
         template = GMSModel() if self.gms is None else self.gms
-        if not isinstance(template, GMSModel):
-            raise ParameterError(f"gms must be a GMSModel or None, got {type(template).__name__}")
         for name in [n for n in vars(self) if n.endswith("_") and not n.startswith("_")]:
             delattr(self, name)
         self.gms_ = clone(template).fit(logs, progress=progress)
@@ -207,7 +206,7 @@ class GMSSVRModel(CurrentModel):
         logs : AxisLog or list of AxisLog
             Prepared runs; may differ from the runs the GMS stage was fitted on.
         progress : None, bool or callable, optional
-            See :meth:`greybox.models.base.CurrentModel.fit`.
+            See :meth:`greybox.estimator.CurrentModel.fit`.
         gms : GMSModel, optional
             A fitted GMS model to freeze (a copy is kept as ``gms_``); by
             default the one from :meth:`fit_gms`.
@@ -223,7 +222,7 @@ class GMSSVRModel(CurrentModel):
         LogError
             If the runs' effort unit differs from the GMS stage's.
         """
-        self._check_target()
+        self._check_params()
         if gms is not None:
             if not isinstance(gms, GMSModel):
                 raise ParameterError(f"gms must be a fitted GMSModel, got {type(gms).__name__}")
@@ -236,41 +235,54 @@ class GMSSVRModel(CurrentModel):
             if run.effort_unit != self.gms_.effort_unit_:
                 raise LogError(run.source or None, f"log carries effort in {run.effort_unit}, "
                                                    f"the GMS stage was fitted on {self.gms_.effort_unit_}")
-        self.effort_unit_ = runs[0].effort_unit
-        self.sample_time_ = float(np.median([run.sample_time for run in runs]))
-        self.n_samples_fit_ = int(sum(len(run) for run in runs))
+        self._set_fit_info(runs)
         self.J_ = float(self.gms_.J_)
         self.offset_ = float(self.gms_.offset_)
 
-        X = np.concatenate([self._inputs(run) for run in runs])
+        X = np.concatenate([self._inputs(run, self.gms_.initial_state(), run.sample_time)[0] for run in runs])
         coverage = np.concatenate([np.column_stack((run.position, run.velocity)) for run in runs])
         y = np.concatenate([run.effort for run in runs])
         if self.target == "residual":
             y = y - X[:, 1]
         prior = {"gamma": RESIDUAL_GAMMA_BOUNDS} if self.target == "residual" else None
-        _fit_expansion(self, X, y, coverage, [len(run) for run in runs], make_progress(progress),
-                       stage="GMS-SVR hyperparameters", prior_bounds=prior)
+        self._fit_kernel(X, y, coverage, [len(run) for run in runs], make_progress(progress),
+                         stage="GMS-SVR hyperparameters", prior_bounds=prior)
         return self
 
-    def _check_target(self) -> None:
+    def _check_params(self) -> None:
+        super()._check_params()
         if self.target not in TARGETS:
             raise ParameterError(f"target must be one of {TARGETS}, got {self.target!r}")
+        if self.gms is not None and not isinstance(self.gms, GMSModel):
+            raise ParameterError(f"gms must be a GMSModel or None, got {type(self.gms).__name__}")
 
     # ---------------------------------------------------------------- prediction
-    def _inputs(self, run: AxisLog) -> np.ndarray:
-        """SVR inputs of one run: position [mm], GMS current [A], deflections [mm]."""
-        z, _ = self.gms_.states(run)
-        return np.column_stack((run.position, self.gms_.predict(run), z))
+    def _inputs(self, run: AxisLog, state, sample_time: float):
+        """SVR inputs of one run or chunk: position [mm], GMS current [A], deflections [mm]; and the end state.
 
-    def _friction_run(self, run: AxisLog) -> np.ndarray:
-        inputs = self._inputs(run)
-        current = _expansion_of(self).predict(inputs)
+        One simulation of the GMS stage gives both its current and its element states.
+        """
+        gms_current, z, _, end = self.gms_.trajectory(run, state, sample_time=sample_time)
+        return np.column_stack((run.position, gms_current, z)), end
+
+    def initial_state(self):
+        """State of the frozen GMS stage at the start of a run (all elements at rest)."""
+        return self.gms_.initial_state()
+
+    def _simulate(self, run: AxisLog, state, sample_time):
+        inputs, end = self._inputs(run, state, sample_time)
+        current = self._kernel_predict(inputs)
         if self.target == "residual":
             current = current + inputs[:, 1]
-        return current - self.J_ * run.acceleration - self.offset_
+        return current - self.J_ * run.acceleration - self.offset_, end
 
     def _n_params(self) -> int:
         return int(self.dual_coef_.size) + 1 + self.gms_.n_params
+
+    def _own_parameters(self) -> list[Parameter]:
+        stage = [Parameter(f"gms.{p.name}", p.value, p.unit, f"GMS stage: {p.description}")
+                 for p in self.gms_.parameter_table() if p.name not in ("J", "offset")]
+        return stage + self._kernel_parameters()
 
     def gms_predict(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
         """Current of the frozen GMS stage alone [A], the runs concatenated."""
@@ -289,8 +301,3 @@ class GMSSVRModel(CurrentModel):
         """
         check_is_fitted(self, "gms_")
         return self.gms_.states(logs)
-
-    def hyperparameters_table(self) -> dict[str, object]:
-        """The SVR settings as in the paper's Table 2 (see
-        :meth:`greybox.models.svr.SVRCurrentModel.hyperparameters_table`)."""
-        return hyperparameters_table(self)

@@ -34,23 +34,27 @@ from typing import Callable, Collection, Mapping, Sequence
 
 import numpy as np
 
+from sklearn.utils.validation import check_is_fitted
+
+from ..base import EFFORT, Parameter
 from ..data.log import AxisLog
 from ..errors import ParameterError
+from ..estimator import CurrentModel
 from ..identify.bayes import minimize_log_uniform
 from ..identify.cv import blocked_folds
 from ..identify.linear import bounded_lstsq
+from ..identify.optimize import check_seed
 from ..identify.progress import ProgressEvent
-from .base import CurrentModel
 from .rbf import rbf_expansion
 from .subset import coverage_subset
 
 __all__ = [
+    "KernelRegressionModel",
     "SVRCurrentModel",
     "SVRExpansion",
     "fit_svr_expansion",
     "inertia_offset_proxy",
     "default_bounds",
-    "hyperparameters_table",
     "HYPERPARAMETERS",
 ]
 
@@ -352,7 +356,106 @@ def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) 
     return J, float(coef[2])
 
 
-class SVRCurrentModel(CurrentModel):
+class KernelRegressionModel(CurrentModel):
+    """Shared parts of the current models with an RBF support vector regression stage.
+
+    The subclass stores the SVR settings ``C``, ``epsilon``, ``gamma``,
+    ``n_subset``, ``optimize``, ``n_calls``, ``cv_folds``, ``cv_blocks``,
+    ``bounds`` and ``random_state`` (see :class:`SVRCurrentModel`); this class
+    checks them, fits the expansion (:func:`fit_svr_expansion`) into the
+    learned attributes ``input_mean_``, ``input_scale_``, ``support_vectors_``,
+    ``dual_coef_``, ``intercept_``, ``epsilon_``, ``C_``, ``gamma_``,
+    ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_`` and
+    ``n_train_``, and evaluates it.
+    """
+
+    def _check_params(self) -> None:
+        for name in HYPERPARAMETERS:
+            value = getattr(self, name)
+            smallest_allowed = 0.0 if name == "epsilon" else np.nextafter(0.0, 1.0)
+            if value is not None and not (isinstance(value, (int, float, np.number)) and np.isfinite(value)
+                                          and value >= smallest_allowed):
+                kind = "non-negative" if name == "epsilon" else "positive"
+                raise ParameterError(f"SVR hyperparameter {name} must be {kind} and finite, got {value!r}")
+        for name, least in (("n_subset", 2), ("n_calls", 1), ("cv_folds", 2), ("cv_blocks", 2)):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= least):
+                raise ParameterError(f"{name} must be an integer of at least {least}, got {value!r}")
+        check_seed(self.random_state)
+
+    def _fit_kernel(self, X, y, coverage, run_lengths: Sequence[int],
+                    progress: Callable[[ProgressEvent], None] | None, *, stage: str = "SVR hyperparameters",
+                    prior_bounds: Mapping[str, tuple[float, float]] | None = None) -> None:
+        """Fit :func:`fit_svr_expansion` with this model's SVR settings and keep it as learned attributes.
+
+        ``prior_bounds`` are search intervals the model class sets by design;
+        the model's own ``bounds`` override them, and their lower ends are
+        floors (see :func:`fit_svr_expansion`) unless overridden.
+        """
+        bounds = {**(prior_bounds or {}), **(self.bounds or {})}
+        floors = [name for name in (prior_bounds or {}) if name not in (self.bounds or {})]
+        fit = fit_svr_expansion(
+            X, y, coverage, run_lengths,
+            fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
+            n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
+            cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=bounds or None,
+            random_state=self.random_state, progress=progress, stage=stage, floors=floors)
+        self.input_mean_ = fit.input_mean
+        self.input_scale_ = fit.input_scale
+        self.support_vectors_ = fit.support_vectors
+        self.dual_coef_ = fit.dual_coef
+        self.intercept_ = fit.intercept
+        self.epsilon_ = fit.hyperparameters["epsilon"]
+        self.C_ = fit.hyperparameters["C"]
+        self.gamma_ = fit.hyperparameters["gamma"]
+        self.optimised_ = list(fit.optimised)
+        self.cv_rmse_ = fit.cv_rmse
+        self.search_history_ = list(fit.history)
+        self.at_bounds_ = list(fit.at_bounds)
+        self.n_train_ = fit.n_train
+
+    def _kernel_predict(self, X) -> np.ndarray:
+        """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
+        scaled = (np.asarray(X, dtype=np.float64) - self.input_mean_) / self.input_scale_
+        return rbf_expansion(scaled, self.support_vectors_, self.dual_coef_, self.intercept_, self.gamma_)
+
+    def _kernel_parameters(self) -> list[Parameter]:
+        """Rows of the SVR stage for the parameter table."""
+        return [
+            Parameter("C", self.C_, EFFORT, "SVR regularisation"),
+            Parameter("epsilon", self.epsilon_, EFFORT, "SVR insensitive tube half-width"),
+            Parameter("gamma", self.gamma_, "1/(standardised unit)^2", "RBF kernel parameter"),
+            Parameter("n_support", int(self.dual_coef_.size), "-", "support vectors"),
+            Parameter("intercept", self.intercept_, EFFORT, "SVR intercept"),
+        ]
+
+    def hyperparameters_table(self) -> dict[str, object]:
+        """The SVR settings as in the paper's Table 2.
+
+        Returns
+        -------
+        dict
+            ``kernel`` ("rbf"), ``epsilon`` [A], ``C`` [A], ``gamma``
+            [1/(standardised unit)^2], ``n_support``, ``n_train``,
+            ``optimised`` (names chosen by Bayesian optimisation),
+            ``at_bounds`` (those that ended at an end of their search
+            interval) and ``cv_rmse`` [A].
+        """
+        check_is_fitted(self)
+        return {
+            "kernel": "rbf",
+            "epsilon": self.epsilon_,
+            "C": self.C_,
+            "gamma": self.gamma_,
+            "n_support": int(self.dual_coef_.size),
+            "n_train": self.n_train_,
+            "optimised": list(self.optimised_),
+            "at_bounds": list(self.at_bounds_),
+            "cv_rmse": self.cv_rmse_,
+        }
+
+
+class SVRCurrentModel(KernelRegressionModel):
     """Pure SVR current model (benchmark): ``I = J a + offset + f(p, v)``.
 
     Parameters
@@ -416,7 +519,7 @@ class SVRCurrentModel(CurrentModel):
     #: Names of the model inputs, in the order of the columns of the support vectors.
     input_names = ("position_mm", "velocity_mm_s")
 
-    def __init__(self, inertia=None, C=None, epsilon=None, gamma=None, n_subset=2000, optimize=True,
+    def __init__(self, *, inertia=None, C=None, epsilon=None, gamma=None, n_subset=2000, optimize=True,
                  n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
         self.inertia = inertia
         self.C = C
@@ -430,6 +533,12 @@ class SVRCurrentModel(CurrentModel):
         self.bounds = bounds
         self.random_state = random_state
 
+    def _check_params(self) -> None:
+        super()._check_params()
+        if self.inertia is not None and not (isinstance(self.inertia, (int, float, np.number))
+                                             and np.isfinite(self.inertia)):
+            raise ParameterError(f"inertia must be a finite number in A s^2/mm, got {self.inertia!r}")
+
     def _inputs(self, run: AxisLog) -> np.ndarray:
         return np.column_stack((run.position, run.velocity))
 
@@ -437,86 +546,13 @@ class SVRCurrentModel(CurrentModel):
         self.J_, self.offset_ = inertia_offset_proxy(runs, self.inertia)
         X = np.concatenate([self._inputs(run) for run in runs])
         target = np.concatenate([run.effort - self.J_ * run.acceleration for run in runs]) - self.offset_
-        _fit_expansion(self, X, target, X, [len(run) for run in runs], progress)
+        self._fit_kernel(X, target, X, [len(run) for run in runs], progress)
 
-    def _friction_run(self, run: AxisLog) -> np.ndarray:
-        return _expansion_of(self).predict(self._inputs(run))
+    def _simulate(self, run, state, sample_time):
+        return self._kernel_predict(self._inputs(run)), None
 
     def _n_params(self) -> int:
         return int(self.dual_coef_.size) + 3  # dual coefficients, intercept, J, offset
 
-    def hyperparameters_table(self) -> dict[str, object]:
-        """The SVR settings as in the paper's Table 2.
-
-        Returns
-        -------
-        dict
-            ``kernel`` ("rbf"), ``epsilon`` [A], ``C`` [A], ``gamma``
-            [1/(standardised unit)^2], ``n_support``, ``n_train``,
-            ``optimised`` (names chosen by Bayesian optimisation),
-            ``at_bounds`` (those that ended at an end of their search
-            interval) and ``cv_rmse`` [A].
-        """
-        return hyperparameters_table(self)
-
-
-def _fit_expansion(model, X, y, coverage, run_lengths: Sequence[int],
-                   progress: Callable[[ProgressEvent], None] | None,
-                   stage: str = "SVR hyperparameters", prior_bounds: Mapping[str, tuple[float, float]] | None = None
-                   ) -> None:
-    """Fit :func:`fit_svr_expansion` with a model's SVR settings (``C``, ``epsilon``,
-    ``gamma``, ``n_subset``, ``optimize``, ``n_calls``, ``cv_folds``, ``cv_blocks``,
-    ``bounds``, ``random_state``) and keep the result as the model's learned
-    attributes (arrays and floats only).
-
-    ``prior_bounds`` are search intervals the model class sets by design; the
-    model's own ``bounds`` override them, and their lower ends are floors
-    (see :func:`fit_svr_expansion`) unless overridden."""
-    bounds = {**(prior_bounds or {}), **(model.bounds or {})}
-    floors = [name for name in (prior_bounds or {}) if name not in (model.bounds or {})]
-    fit = fit_svr_expansion(
-        X, y, coverage, run_lengths,
-        fixed={"epsilon": model.epsilon, "C": model.C, "gamma": model.gamma},
-        n_subset=model.n_subset, optimize=model.optimize, n_calls=model.n_calls,
-        cv_folds=model.cv_folds, cv_blocks=model.cv_blocks, bounds=bounds or None,
-        random_state=model.random_state, progress=progress, stage=stage, floors=floors)
-    model.input_mean_ = fit.input_mean
-    model.input_scale_ = fit.input_scale
-    model.support_vectors_ = fit.support_vectors
-    model.dual_coef_ = fit.dual_coef
-    model.intercept_ = fit.intercept
-    model.epsilon_ = fit.hyperparameters["epsilon"]
-    model.C_ = fit.hyperparameters["C"]
-    model.gamma_ = fit.hyperparameters["gamma"]
-    model.optimised_ = list(fit.optimised)
-    model.cv_rmse_ = fit.cv_rmse
-    model.search_history_ = list(fit.history)
-    model.at_bounds_ = list(fit.at_bounds)
-    model.n_train_ = fit.n_train
-
-
-def _expansion_of(model) -> SVRExpansion:
-    """Rebuild the expansion from a model's learned attributes."""
-    return SVRExpansion(
-        input_mean=model.input_mean_, input_scale=model.input_scale_,
-        support_vectors=model.support_vectors_, dual_coef=model.dual_coef_, intercept=model.intercept_,
-        hyperparameters={"epsilon": model.epsilon_, "C": model.C_, "gamma": model.gamma_},
-    )
-
-
-def hyperparameters_table(model) -> dict[str, object]:
-    """Table-2 style summary of a fitted SVR-based model (see :meth:`SVRCurrentModel.hyperparameters_table`)."""
-    from sklearn.utils.validation import check_is_fitted
-
-    check_is_fitted(model)
-    return {
-        "kernel": "rbf",
-        "epsilon": model.epsilon_,
-        "C": model.C_,
-        "gamma": model.gamma_,
-        "n_support": int(model.dual_coef_.size),
-        "n_train": model.n_train_,
-        "optimised": list(model.optimised_),
-        "at_bounds": list(model.at_bounds_),
-        "cv_rmse": model.cv_rmse_,
-    }
+    def _own_parameters(self) -> list[Parameter]:
+        return self._kernel_parameters()

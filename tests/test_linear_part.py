@@ -1,4 +1,4 @@
-"""The base models' linear parameters as regressor columns."""
+"""Each model's linear parameters as regressor columns (the linear part of the model protocol)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from greybox.data.prepare import prepare
-from greybox.discover.baselinear import base_coefficients, base_linear_part, set_base_coefficients
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.twin import make_dataset
 
@@ -23,25 +22,25 @@ def run():
 @pytest.mark.parametrize("template", MODELS, ids=lambda m: repr(m))
 def test_columns_times_coefficients_plus_fixed_is_the_prediction(template, run):
     model = template.fit(run)
-    part = base_linear_part(model, run)
-    assert part.columns.shape == (len(run), base_coefficients(model).size)
-    np.testing.assert_allclose(part.columns @ base_coefficients(model) + part.fixed, model.predict(run),
+    part = model.linear_part(run)
+    assert part.columns.shape == (len(run), model.linear_coefficients().size)
+    np.testing.assert_allclose(part.columns @ model.linear_coefficients() + part.fixed, model.predict(run),
                                rtol=0, atol=1e-12)
-    assert np.all(base_coefficients(model) >= part.lower) and np.all(base_coefficients(model) <= part.upper)
+    assert np.all(model.linear_coefficients() >= part.lower) and np.all(model.linear_coefficients() <= part.upper)
 
 
 @pytest.mark.parametrize("template", MODELS, ids=lambda m: repr(m))
 def test_written_coefficients_change_the_prediction_as_the_columns_say(template, run):
     model = template.fit(run)
-    part = base_linear_part(model, run)
-    new = base_coefficients(model) * 1.1 + 0.01
-    set_base_coefficients(model, new)
-    np.testing.assert_array_equal(base_coefficients(model), new)
+    part = model.linear_part(run)
+    new = model.linear_coefficients() * 1.1 + 0.01
+    model.set_linear_coefficients(new)
+    np.testing.assert_array_equal(model.linear_coefficients(), new)
     np.testing.assert_allclose(model.predict(run), part.columns @ new + part.fixed, rtol=0, atol=1e-12)
 
 
 def test_symmetric_coulomb_keeps_its_levels_tied(run):
     model = CoulombModel().fit(run)
-    set_base_coefficients(model, [3e-4, 0.8, 0.01])
+    model.set_linear_coefficients([3e-4, 0.8, 0.01])
     assert model.coulomb_pos_ == model.coulomb_neg_ == 0.8
     assert model.viscous_pos_ == model.viscous_neg_ == 0.01

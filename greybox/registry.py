@@ -7,10 +7,10 @@ a file cannot make greybox run code other than these classes' constructors.
 
 from __future__ import annotations
 
-from ..discover.augment import AugmentedModel
-from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from .gmssvr import GMSSVRModel
-from .svr import SVRCurrentModel
+from .discover.augment import AugmentedModel
+from .friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from .models.gmssvr import GMSSVRModel
+from .models.svr import SVRCurrentModel
 
 __all__ = ["MODEL_CLASSES", "DERIVED_MODEL_CLASSES", "model_class", "model_kind"]
 
@@ -61,4 +61,4 @@ def model_kind(model) -> str:
     for kind, cls in _file_kinds().items():
         if type(model) is cls:
             return kind
-    raise KeyError(f"model class {type(model).__name__} is not registered in greybox.models.registry")
+    raise KeyError(f"model class {type(model).__name__} is not registered in greybox.registry")

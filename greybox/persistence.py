@@ -28,7 +28,7 @@ stage, say). Floats are written with Python's shortest round-trip repr, and
 arrays byte for byte, so a loaded model predicts bit-identically.
 
 The class of a model is looked up by its ``kind`` in the explicit registry
-:data:`greybox.models.registry.MODEL_CLASSES`; nothing named in the file is ever
+:data:`greybox.registry.MODEL_CLASSES`; nothing named in the file is ever
 imported. A file of a newer format version, of an unknown kind, or with
 parameters the class does not take is refused with a
 :class:`~greybox.errors.ModelFileError` naming the file. Files are written
@@ -49,8 +49,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_output
-from ..errors import ModelFileError
+from .atomic import atomic_output
+from .errors import ModelFileError
 from . import registry
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "save_model", "load_model"]
@@ -142,7 +142,7 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
     Parameters
     ----------
     model : estimator
-        An instance of a class in :data:`greybox.models.registry.MODEL_CLASSES`.
+        An instance of a class in :data:`greybox.registry.MODEL_CLASSES`.
         Its ``get_params(deep=False)`` and every attribute whose name ends in
         ``_`` (the learned attributes) are saved; they may be numbers, strings,
         booleans, None, lists, tuples, dicts with string keys, NumPy arrays
@@ -163,7 +163,7 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
         If the file exists and ``overwrite`` is false, the model is not
         registered, or a value cannot be saved without pickle.
     """
-    from .. import __version__
+    from . import __version__
 
     path = Path(path)
     if path.exists() and not overwrite:

@@ -1,0 +1,81 @@
+"""The one builder of unfitted models from command-line options (train, discover, compensate)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..errors import GreyboxError
+from ..registry import model_class
+
+__all__ = ["add_model_arguments", "build_model"]
+
+#: Options that set a model hyperparameter: (option, attribute of the parsed arguments, hyperparameter).
+_MODEL_OPTIONS = (
+    ("--offset", "offset", "fit_offset"),
+    ("--asymmetric", "asymmetric", "asymmetric"),
+    ("--elements", "elements", "n_elements"),
+    ("--model-seed", "model_seed", "random_state"),
+)
+
+
+def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model options",
+                        settings: bool = True) -> None:
+    """Add the options that set the hyperparameters of the model a command builds.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        Parser of the sub-command.
+    title : str
+        Heading of the option group in ``--help``.
+    settings : bool, default True
+        Also offer ``--set NAME=VALUE`` for any hyperparameter.
+    """
+    group = parser.add_argument_group(title)
+    group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
+    group.add_argument("--asymmetric", action="store_true",
+                       help="separate Coulomb and viscous levels per direction (coulomb)")
+    group.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms; default 4)")
+    group.add_argument("--model-seed", type=int, metavar="N",
+                       help="seed of the identification: multi-start searches (lugre, gms) and SVR "
+                       "subsets and hyperparameter search (svr, gmssvr); default 0")
+    if settings:
+        group.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                           help="set any model hyperparameter, e.g. --set n_starts=8 or --set C=2.0 (repeatable; "
+                           "VALUE is read as a JSON number, true, false or null, else as text)")
+
+
+def build_model(kind: str, args: argparse.Namespace):
+    """Return an unfitted model of ``kind`` with the hyperparameters given on the command line.
+
+    Options a command does not offer count as not given.
+
+    Raises
+    ------
+    GreyboxError
+        If an option does not apply to the model kind, or a ``--set`` is malformed or unknown.
+    """
+    model = model_class(kind)()
+    accepted = model.get_params(deep=False)
+    params = {}
+    for option, attribute, name in _MODEL_OPTIONS:
+        value = getattr(args, attribute, None)
+        if value is None or value is False:
+            continue
+        if name not in accepted:
+            raise GreyboxError(f"option {option} does not apply to the {kind} model")
+        params[name] = value
+    for setting in getattr(args, "set", None) or []:
+        name, sep, text = setting.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise GreyboxError(f"--set expects NAME=VALUE, got {setting!r}")
+        if name not in accepted:
+            raise GreyboxError(f"the {kind} model has no hyperparameter {name!r} (--set); it has: "
+                               f"{', '.join(sorted(accepted))}")
+        try:
+            params[name] = json.loads(text)
+        except json.JSONDecodeError:
+            params[name] = text
+    return model.set_params(**params)

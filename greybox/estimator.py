@@ -1,0 +1,262 @@
+"""The shared implementation of the current models: fitting template, run checks, prediction.
+
+A current model predicts the drive effort of a feed axis from its prepared
+motion,
+
+    I = J * a + I_friction(v, history) + offset,
+
+in A (or in N when the logs carry force; the models are unit-agnostic and
+remember the unit they were fitted on). A fit may use several runs: each run is
+simulated from its own initial state, and predictions of a list of runs are
+concatenated in order, never carrying a state across the seam between runs.
+The methods callers rely on are those of :class:`greybox.base.ModelProtocol`.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+import numpy as np
+from sklearn.utils.validation import check_is_fitted
+
+from .base import EFFORT, ModelProtocol, Parameter
+from .data.log import AxisLog, as_log_list
+from .errors import LogError
+from .identify.progress import make_progress
+
+__all__ = ["CurrentModel", "check_runs"]
+
+
+def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
+    """Return ``logs`` as a list of prepared runs, or raise :class:`LogError`.
+
+    Parameters
+    ----------
+    logs : AxisLog or iterable of AxisLog
+        One run or several runs.
+
+    Raises
+    ------
+    LogError
+        If a run has no velocity or acceleration (not prepared), too few
+        samples (fewer than 2), non-finite motion or effort values, or the runs mix effort
+        units. The message names the run's source file.
+    """
+    runs = as_log_list(logs)
+    unit = runs[0].effort_unit
+    for run in runs:
+        source = run.source or None
+        if not run.is_prepared:
+            missing = [name for name in ("velocity", "acceleration") if getattr(run, name) is None]
+            raise LogError(source, f"log is not prepared: no {' and no '.join(missing)} channel "
+                                   "(derive them with greybox.data.prepare first)")
+        if len(run) < 2:
+            raise LogError(source, f"log has {len(run)} sample(s), a model needs at least 2 (one time step)")
+        for name in ("velocity", "acceleration", "effort"):
+            values = getattr(run, name)
+            if not np.all(np.isfinite(values)):
+                bad = int(np.flatnonzero(~np.isfinite(values))[0])
+                raise LogError(source, f"channel '{name}' is not finite at sample {bad} "
+                                       f"(t = {run.time[bad]:.6g} s)")
+        if not np.isfinite(run.sample_time) or run.sample_time <= 0.0:
+            raise LogError(source, "time is not increasing: no positive sample time")
+        if run.effort_unit != unit:
+            raise LogError(source, f"runs mix effort units: {unit} and {run.effort_unit}")
+    return runs
+
+
+class CurrentModel(ModelProtocol):
+    """Base class of the current models (scikit-learn estimator conventions).
+
+    Subclasses store their keyword-only hyperparameters in ``__init__`` and implement
+
+    - ``_check_params()``: raise :class:`~greybox.errors.ParameterError` for an
+      invalid hyperparameter (called first by :meth:`fit`; default: nothing to check);
+    - ``_fit_runs(runs, progress)``: identify the parameters from prepared
+      runs and set the learned attributes (ending in ``_``), among them
+      ``J_`` [A s^2/mm] and ``offset_`` [A];
+    - ``_simulate(run, state, sample_time)``: the friction current of one run
+      or chunk [A] from ``state``, and the state after its last sample;
+    - ``_n_params()``: the number of identified parameters;
+    - ``_own_parameters()``: the rows of the parameter table besides ``J`` and ``offset``;
+
+    and the methods of :class:`~greybox.base.ModelProtocol` that apply to them.
+
+    Learned attributes set here: ``effort_unit_`` ("A" or "N"),
+    ``sample_time_`` (median step of the fitted runs [s]) and
+    ``n_samples_fit_``.
+    """
+
+    def fit(self, logs: AxisLog | Iterable[AxisLog], progress=None) -> "CurrentModel":
+        """Identify the model from one or several prepared runs.
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs (velocity [mm/s] and acceleration [mm/s^2] present).
+        progress : None, bool or callable, optional
+            ``None``/``False``: silent. ``True``: print progress to stderr.
+            A callable receives :class:`greybox.identify.progress.ProgressEvent`.
+
+        Returns
+        -------
+        self
+        """
+        self._check_params()
+        runs = check_runs(logs)
+        self._set_fit_info(runs)
+        self._fit_runs(runs, make_progress(progress))
+        return self
+
+    def predict(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
+        """Predicted effort ``J a + friction + offset`` [A, or N].
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs; the state of a dynamic model restarts at each run.
+
+        Returns
+        -------
+        ndarray, shape (n_samples,)
+            The prediction of each run, concatenated in order.
+        """
+        runs = self._check_predict_runs(logs)
+        return np.concatenate([self._effort(run, self.initial_state(), run.sample_time)[0] for run in runs])
+
+    def predict_chunk(self, log: AxisLog, state=None, *, sample_time: float | None = None):
+        """Predict one chunk of a run from a given state.
+
+        Splitting a run into consecutive chunks and passing each returned state
+        to the next chunk gives the prediction of the whole run.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared chunk: consecutive samples of one run, at least two.
+        state : object, optional
+            State before the chunk's first sample, as returned for the previous
+            chunk; default :meth:`initial_state` (the start of a run).
+        sample_time : float, optional
+            Integration step [s] of a dynamic model; default the chunk's own
+            median step. Pass the step of the whole run so that every chunk of
+            a run with jittered time stamps is integrated alike.
+
+        Returns
+        -------
+        current : ndarray, shape (n,)
+            Predicted effort ``J a + friction + offset`` [A, or N].
+        state : object
+            State after the chunk's last sample: the ``state`` of the next chunk.
+        """
+        (run,) = self._check_predict_runs(log)
+        step = run.sample_time if sample_time is None else float(sample_time)
+        return self._effort(run, self.initial_state() if state is None else state, step)
+
+    def friction_chunk(self, log: AxisLog, state=None, *, sample_time: float | None = None):
+        """Friction of one chunk of a run from a given state (no inertia, no offset) [A, or N].
+
+        Parameters
+        ----------
+        log, state, sample_time
+            As in :meth:`predict_chunk`.
+
+        Returns
+        -------
+        friction : ndarray, shape (n,)
+        state : object
+            State after the chunk's last sample.
+        """
+        (run,) = self._check_predict_runs(log)
+        step = run.sample_time if sample_time is None else float(sample_time)
+        return self._simulate(run, self.initial_state() if state is None else state, step)
+
+    def friction(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
+        """Friction part of the prediction (no inertia, no offset) [A, or N].
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs; the state of a dynamic model restarts at each run.
+
+        Returns
+        -------
+        ndarray, shape (n_samples,)
+        """
+        runs = self._check_predict_runs(logs)
+        return np.concatenate([self._simulate(run, self.initial_state(), run.sample_time)[0] for run in runs])
+
+    def score(self, logs: AxisLog | Iterable[AxisLog], y=None) -> float:
+        """Negative RMSE of the prediction [A, or N] (greater is better, as scikit-learn expects).
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs with their measured effort.
+        y : ignored
+            The measured effort is each run's ``effort``.
+
+        Returns
+        -------
+        float
+        """
+        runs = self._check_predict_runs(logs)
+        error = self.predict(runs) - np.concatenate([run.effort for run in runs])
+        return -float(np.sqrt(np.mean(error ** 2)))
+
+    @property
+    def n_params(self) -> int:
+        """Number of identified parameters of the fitted model."""
+        check_is_fitted(self)
+        return self._n_params()
+
+    def parameter_table(self) -> list[Parameter]:
+        """The identified parameters with units and descriptions: the model's own, then ``J`` and ``offset``.
+
+        Returns
+        -------
+        list of Parameter
+            Units carry the effort unit the model was fitted on (A or N).
+        """
+        check_is_fitted(self)
+        rows = self._own_parameters() + [
+            Parameter("J", self.J_, f"{EFFORT} s^2/mm", "inertia (x 1000 = kg for force logs)"),
+            Parameter("offset", self.offset_, EFFORT, "constant effort"),
+        ]
+        unit = self.effort_unit_
+        return [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit), p.description) for p in rows]
+
+    # ---------------------------------------------------------------- shared parts
+    def _effort(self, run: AxisLog, state, sample_time: float):
+        friction, end = self._simulate(run, state, sample_time)
+        return self.J_ * run.acceleration + friction + self.offset_, end
+
+    def _set_fit_info(self, runs: list[AxisLog]) -> None:
+        self.effort_unit_ = runs[0].effort_unit
+        self.sample_time_ = float(np.median([run.sample_time for run in runs]))
+        self.n_samples_fit_ = int(sum(len(run) for run in runs))
+
+    def _check_predict_runs(self, logs) -> list[AxisLog]:
+        check_is_fitted(self)
+        runs = check_runs(logs)
+        for run in runs:
+            if run.effort_unit != self.effort_unit_:
+                raise LogError(run.source or None,
+                               f"log carries effort in {run.effort_unit}, the model was fitted on {self.effort_unit_}")
+        return runs
+
+    # ---------------------------------------------------------------- hooks
+    def _check_params(self) -> None:
+        return None
+
+    def _fit_runs(self, runs: list[AxisLog], progress) -> None:
+        raise NotImplementedError
+
+    def _simulate(self, run: AxisLog, state, sample_time: float):
+        raise NotImplementedError
+
+    def _n_params(self) -> int:
+        raise NotImplementedError
+
+    def _own_parameters(self) -> list[Parameter]:
+        raise NotImplementedError
