@@ -21,7 +21,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from .base import EFFORT, ModelProtocol, Parameter
 from .data.log import AxisLog, as_log_list
-from .errors import LogError
+from .errors import LogError, ParameterError
 from .identify.progress import make_progress
 
 __all__ = ["CurrentModel", "check_runs"]
@@ -226,6 +226,45 @@ class CurrentModel(ModelProtocol):
         unit = self.effort_unit_
         return [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit), p.description) for p in rows]
 
+    def validate_fitted(self) -> None:
+        """Check that the learned state is complete and usable, as a model read from a file must be.
+
+        Checks the hyperparameters, that the parameter table is finite, and
+        predicts a short probe run (a reversal at the fitted sample time) in
+        chunks and at once.
+
+        Raises
+        ------
+        ParameterError
+            Naming the missing or malformed learned attribute or the invalid
+            hyperparameter, or the error the probe prediction gave.
+        """
+        self._check_params()
+        try:
+            check_is_fitted(self)
+            for row in self.parameter_table():
+                if not np.all(np.isfinite(np.asarray(row.value, dtype=float))):
+                    raise ParameterError(f"parameter {row.name} is not finite: {row.value!r}")
+            if self.effort_unit_ not in ("A", "N"):
+                raise ParameterError(f"effort_unit_ must be 'A' or 'N', got {self.effort_unit_!r}")
+            step = float(self.sample_time_)
+            if not (np.isfinite(step) and step > 0.0):
+                raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")
+            probe = _probe_run(step, self.effort_unit_)
+            whole = self.predict(probe)
+            first, state = self.predict_chunk(probe.select(slice(0, 50)), sample_time=step)
+            second, _ = self.predict_chunk(probe.select(slice(50, None)), state, sample_time=step)
+            if whole.shape != (len(probe),) or not np.all(np.isfinite(whole)):
+                raise ParameterError("the prediction of a probe run is not finite")
+            if not np.allclose(np.concatenate((first, second)), whole, rtol=0, atol=1e-9 * (1 + np.abs(whole).max())):
+                raise ParameterError("chunked and one-shot prediction of a probe run differ")
+        except AttributeError as error:
+            raise ParameterError(f"a learned attribute is missing: {error}") from None
+        except (TypeError, ValueError, IndexError, KeyError) as error:
+            if isinstance(error, ParameterError):
+                raise
+            raise ParameterError(f"a learned attribute is malformed: {error}") from None
+
     # ---------------------------------------------------------------- shared parts
     def _effort(self, run: AxisLog, state, sample_time: float):
         friction, end = self._simulate(run, state, sample_time)
@@ -260,3 +299,16 @@ class CurrentModel(ModelProtocol):
 
     def _own_parameters(self) -> list[Parameter]:
         raise NotImplementedError
+
+
+def _probe_run(sample_time: float, effort_unit: str) -> AxisLog:
+    """A short prepared run with a reversal and a dwell: 200 samples at ``sample_time`` [s]."""
+    n = 200
+    time = np.arange(n) * sample_time
+    phase = np.linspace(0.0, 2.0 * np.pi, n)
+    velocity = 10.0 * np.sin(phase)
+    velocity[150:] = 0.0
+    position = np.concatenate(([0.0], np.cumsum(velocity[:-1] * sample_time)))
+    acceleration = np.gradient(velocity, sample_time)
+    return AxisLog(time=time, position=position, effort=np.zeros(n), velocity=velocity,
+                   acceleration=acceleration, effort_unit=effort_unit)

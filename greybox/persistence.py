@@ -50,7 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import atomic_output
-from .errors import ModelFileError
+from .errors import GreyboxError, ModelFileError
 from . import registry
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "save_model", "load_model"]
@@ -298,8 +298,18 @@ def load_model(path: str | PathLike):
                     f"({document.get('greybox_version', 'unknown version')}); this greybox reads versions "
                     f"up to {FORMAT_VERSION}: upgrade greybox"
                 )
-            return _Decoder(path, archive).estimator(document.get("model"), "model")
-    except zipfile.BadZipFile:
+            model = _Decoder(path, archive).estimator(document.get("model"), "model")
+    except (zipfile.BadZipFile, zlib.error, EOFError) as error:
+        if zipfile.is_zipfile(path):
+            raise ModelFileError(f"{path}: damaged model file (a ZIP archive whose content does not check out: "
+                                 f"{error})") from None
         raise ModelFileError(f"{path}: not a greybox model file (not a ZIP archive)") from None
-    except (zipfile.LargeZipFile, zlib.error, OSError, EOFError) as error:
+    except (zipfile.LargeZipFile, OSError) as error:
         raise ModelFileError(f"{path}: cannot read model file: {error}") from None
+    if not any(name.endswith("_") and not name.startswith("_") for name in vars(model)):
+        return model  # an unfitted model: its parameters were checked by the decoder
+    try:
+        model.validate_fitted()
+    except GreyboxError as error:
+        raise ModelFileError(f"{path}: invalid {type(model).__name__} in the model file: {error}") from None
+    return model

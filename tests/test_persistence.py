@@ -12,7 +12,7 @@ import pytest
 from sklearn.base import BaseEstimator
 
 from greybox import atomic
-from greybox.errors import ModelFileError
+from greybox.errors import ModelFileError, ParameterError
 from greybox import registry
 from greybox.persistence import FORMAT_VERSION, load_model, save_model
 
@@ -38,6 +38,11 @@ class ToyModel(BaseEstimator):
         self.missing_ = float("nan")
         self.limit_ = float("-inf")
         return self
+
+    def validate_fitted(self):
+        """Part of the model protocol: refuse an incomplete learned state (here: coef_ must hold 3 numbers)."""
+        if np.shape(getattr(self, "coef_", None)) != (3,):
+            raise ParameterError("coef_ must hold 3 coefficients")
 
     def predict(self, x):
         x = np.asarray(x, dtype=float)
@@ -288,3 +293,47 @@ def test_discovered_models_are_files_but_not_trainable_kinds():
     assert registry.model_class("augmented") is AugmentedModel
     assert registry.model_kind(AugmentedModel()) == "augmented"
     assert "augmented" not in registry.MODEL_CLASSES  # what `greybox train --model` offers
+
+
+@pytest.fixture(scope="module")
+def gms_file(tmp_path_factory):
+    from greybox.friction import GMSModel
+
+    path = tmp_path_factory.mktemp("gms") / "gms.gbm"
+    save_model(GMSModel(n_elements=3, n_starts=1, max_iter=40).fit([_axis_run(0)]), path)
+    return path
+
+
+@pytest.mark.parametrize("attribute", ["k_", "alpha_", "J_", "effort_unit_"])
+def test_missing_learned_attribute_is_one_clear_error(tmp_path, gms_file, attribute):
+    path = tmp_path / "cut.gbm"
+    path.write_bytes(gms_file.read_bytes())
+    _rewrite_json(path, lambda document: document["model"]["attributes"].pop(attribute))
+    with pytest.raises(ModelFileError, match=rf"cut\.gbm: invalid GMSModel.*{attribute[:-1]}"):
+        load_model(path)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d["model"]["attributes"].update(C_=-1.0), "C must be positive"),
+    (lambda d: d["model"]["attributes"].update(k_=[1.0, 2.0]), "malformed|same length"),
+    (lambda d: d["model"]["attributes"].update(J_="heavy"), "malformed|not finite|could not convert"),
+    (lambda d: d["model"]["params"].update(n_elements=-2), "n_elements must be a positive integer"),
+])
+def test_inconsistent_learned_state_is_refused(tmp_path, gms_file, change, message):
+    path = tmp_path / "odd.gbm"
+    path.write_bytes(gms_file.read_bytes())
+    _rewrite_json(path, change)
+    with pytest.raises(ModelFileError, match=rf"odd\.gbm: invalid GMSModel.*({message})"):
+        load_model(path)
+
+
+def test_flipped_byte_is_called_damaged_not_a_foreign_file(tmp_path, gms_file):
+    data = bytearray(gms_file.read_bytes())
+    with zipfile.ZipFile(gms_file) as archive:
+        info = archive.getinfo("model.json")
+    start = info.header_offset + 30 + len(info.filename) + len(info.extra)  # first byte of the member's data
+    data[start + 10] ^= 0x01
+    path = tmp_path / "flipped.gbm"
+    path.write_bytes(bytes(data))
+    with pytest.raises(ModelFileError, match=r"flipped\.gbm: damaged model file"):
+        load_model(path)
