@@ -17,9 +17,6 @@ TWIN_PLANTS = {"twin-x": "X", "twin-y": "Y"}
 #: Generated references.
 STROKE_REFERENCES = ("low", "high")
 
-#: Step [s] of generated references when no feed-forward model says otherwise.
-DEFAULT_REFERENCE_STEP_S = 0.002
-
 
 def add_parser(subparsers) -> None:
     from ..control.references import STROKES_MM
@@ -124,19 +121,16 @@ def _fit_kinds(args) -> list[str]:
 
 def _training_runs(args, plant):
     from ..control.plants import TwinPlant
-    from ..data.prepare import prepare
-    from ..twin import make_dataset
+    from ..control.workflow import twin_training_runs
+    from ._options import read_logs
 
     if args.train:
-        from ._options import read_logs
-
         return read_logs(args, args.train)
     if not isinstance(plant, TwinPlant) or plant.axis is None:
         raise GreyboxError("--fit with a model plant needs training logs: give --train LOG ...")
-    axis = plant.axis
-    _say(args, f"synthesising training data: axis {axis}, datasets A and P, {args.train_duration:g} s each, "
+    _say(args, f"synthesising training data: axis {plant.axis}, datasets A and P, {args.train_duration:g} s each, "
                f"seed {args.seed}")
-    return prepare([make_dataset(axis, dataset, args.seed, duration_s=args.train_duration) for dataset in "AP"])
+    return twin_training_runs(plant, seed=args.seed, duration_s=args.train_duration)
 
 
 def _models(args, plant) -> dict:
@@ -169,56 +163,28 @@ def _models(args, plant) -> dict:
     return models
 
 
-def _feedforwards(args, plant, models: dict) -> list:
-    from ..control.feedforward import InertiaFeedForward, ModelFeedForward
-
+def _inertia(args):
     choice = args.inertia.strip().lower()
-    if choice == "plant":
-        inertia = plant.inertia_A_s2_mm
-    elif choice == "model":
-        inertia = None
-    else:
-        try:
-            inertia = float(choice)
-        except ValueError:
-            raise GreyboxError(f"--inertia must be 'plant', 'model' or a number [A s^2/mm], got {args.inertia!r}"
-                               ) from None
-    baseline = InertiaFeedForward(plant.inertia_A_s2_mm if inertia is None else inertia)
-    return [baseline] + [ModelFeedForward(model, inertia, name) for name, model in models.items()]
+    if choice in ("plant", "model"):
+        return choice
+    try:
+        return float(choice)
+    except ValueError:
+        raise GreyboxError(f"--inertia must be 'plant', 'model' or a number [A s^2/mm], got {args.inertia!r}"
+                           ) from None
 
 
-def _reference_step(args, models: dict) -> float:
-    if args.reference_step is not None:
-        return args.reference_step
-    steps = {round(float(model.sample_time_), 12) for model in models.values()}
-    return steps.pop() if len(steps) == 1 else DEFAULT_REFERENCE_STEP_S
+def _references(args) -> list:
+    from ._options import read_logs
 
-
-def _references(args, plant, step: float) -> list:
-    from ..control.plants import TwinPlant
-    from ..control.references import reference_from_log, stroke_reference
-    from ..twin import axis_geometry
-
-    if args.start is not None:
-        start = args.start
-    elif isinstance(plant, TwinPlant) and plant.axis is not None:
-        start = axis_geometry(plant.axis).window_centre_mm
-    else:
-        start = 0.0
     references = []
     for value in args.reference:
         if value in STROKE_REFERENCES:
-            references.append(stroke_reference(value, args.duration, args.seed, sample_time_s=step, start_mm=start))
-        else:
-            from ._options import read_logs
-
-            if not os.path.isfile(value):
-                raise GreyboxError(f"{value}: no such log; --reference takes low, high or log files")
-            (log,) = read_logs(args, [value])
-            references.append(reference_from_log(log))
-    names = [reference.name for reference in references]
-    if len(set(names)) != len(names):
-        raise GreyboxError(f"references with the same name: {', '.join(names)}")
+            references.append(value)
+            continue
+        if not os.path.isfile(value):
+            raise GreyboxError(f"{value}: no such log; --reference takes low, high or log files")
+        references += read_logs(args, [value])
     return references
 
 
@@ -245,46 +211,30 @@ def _check_output(args) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..control.loop import compare_feedforwards, controller_periods
     from ..control.report import comparison_rows, write_report
-    from ..control.tuning import default_bandwidth_hz, pole_placement_gains
-    from ..twin import CurrentNoise
+    from ..control.workflow import compensation_study
 
     _check_output(args)
-    plant = _plant(args)
-    models = _models(args, plant)
-    feedforwards = _feedforwards(args, plant, models)
-    references = _references(args, plant, _reference_step(args, models))
-    step = references[0].sample_time
-    period = step / controller_periods(step, args.controller_period)
-    bandwidth = args.bandwidth if args.bandwidth is not None else default_bandwidth_hz(period)
-    gains = pole_placement_gains(plant.inertia_A_s2_mm, bandwidth)
-    _say(args, f"plant {plant.name}, controller period {period * 1e3:g} ms, bandwidth {bandwidth:.3g} Hz: "
-               f"kp = {gains.kp:.4g} A/mm, ki = {gains.ki:.4g} A/(mm s), kd = {gains.kd:.4g} A s/mm")
     if args.disturbance_std < 0:
         raise GreyboxError(f"--disturbance-std must be non-negative, got {args.disturbance_std} A")
-    disturbance = CurrentNoise(args.disturbance_std) if args.disturbance_std > 0 else None
+    plant = _plant(args)
+    models = _models(args, plant)
     started = time.perf_counter()
-    results = compare_feedforwards(plant, references, feedforwards, gains, controller_period_s=args.controller_period,
-                                   current_limit_A=args.current_limit, resolution_mm=args.resolution,
-                                   disturbance=disturbance, seed=args.seed)
-    _say(args, f"simulated {len(results)} closed-loop runs in {time.perf_counter() - started:.1f} s")
+    study = compensation_study(plant, models, references=_references(args), duration_s=args.duration,
+                               seed=args.seed, start_mm=args.start, reference_step_s=args.reference_step,
+                               inertia=_inertia(args), bandwidth_hz=args.bandwidth,
+                               controller_period_s=args.controller_period, current_limit_A=args.current_limit,
+                               resolution_mm=args.resolution, disturbance_std_A=args.disturbance_std,
+                               progress=lambda text: _say(args, text))
+    _say(args, f"simulated {len(study.results)} closed-loop runs in {time.perf_counter() - started:.1f} s")
     print(f"  {'reference':<16} {'feed-forward':<16} {'RMS um':>10} {'max um':>10} {'vs none %':>10}")
-    for row in comparison_rows(results):
+    for row in comparison_rows(study.results):
         relative = f"{100.0 * row['rms_vs_none']:.1f}" if row["rms_vs_none"] == row["rms_vs_none"] else ""
         print(f"  {row['reference'][:16]:<16} {row['feedforward'][:16]:<16} {1e3 * row['rms_error_mm']:>10.4g} "
               f"{1e3 * row['peak_error_mm']:>10.4g} {relative:>10}")
-    settings = {
-        "plant": plant.describe(),
-        "feedforwards": [ff.describe() for ff in feedforwards],
-        "references": [{"name": r.name, "duration_s": r.duration, "step_s": r.sample_time, **r.attrs}
-                       for r in references],
-        "bandwidth_hz": bandwidth,
-        "model_files": list(args.models),
-        "fitted": args.fit,
-        "training_logs": list(args.train or ()),
-    }
-    written = write_report(results, args.out, settings=settings, force=args.force)
+    settings = {**study.settings, "model_files": list(args.models), "fitted": args.fit,
+                "training_logs": list(args.train or ())}
+    written = write_report(study.results, args.out, settings=settings, force=args.force)
     for path in written:
         _say(args, f"wrote {path}")
     return 0
