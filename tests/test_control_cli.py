@@ -51,6 +51,7 @@ def test_twin_plant_with_fitted_models(tmp_path, capsys):
     assert [float(r["rms_vs_none"]) for r in rows if r["feedforward"] == "none"] == [1.0, 1.0]
     document = json.loads((out / "compensation.json").read_text())  # strict JSON
     assert document["settings"]["plant"]["axis"] == "X" and len(document["rows"]) == 6
+    assert document["provenance"]["cpu_count"] >= 1 and "numpy" in document["provenance"]["libraries"]
     table = (out / "compensation.md").read_text()
     assert "| friction feed-forward | RMS error [um] | max error [um] |" in table
 

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..atomic import write_text_atomic
 from ..errors import GreyboxError
+from ..provenance import provenance, provenance_line
 from ..evaluate.plots import finish_figure, import_pyplot
 from .loop import LoopResult
 
@@ -174,18 +175,19 @@ def write_report(results: list[LoopResult], out_dir, *, settings: dict | None = 
                            "nothing was written. Choose another directory or pass --force to overwrite")
     out.mkdir(parents=True, exist_ok=True)
     settings = dict(settings or {})
+    machine = provenance()
     rows = comparison_rows(results)
     first = results[0].settings
     markdown = ["# Closed-loop tracking error with friction feed-forward", "", format_tables(results),
                 "Errors are those of the true position against the reference at the reference samples; "
                 "'none' feeds forward the inertia only. One set of PID gains for every row.", "",
-                "## Settings", "", f"- controller: {json.dumps(first)}"]
+                "## Settings", "", f"- controller: {json.dumps(first)}", f"- measured with: {provenance_line(machine)}"]
     markdown += [f"- {key}: {json.dumps(value)}" for key, value in settings.items()]
     write_text_atomic(targets[0], "\n".join(markdown) + "\n")
     write_text_atomic(targets[1], _csv_text(rows))
     strict_rows = [{key: (None if isinstance(value, float) and np.isnan(value) else value)
                     for key, value in row.items()} for row in rows]
-    document = {"settings": {**settings, "controller": first}, "rows": strict_rows}
+    document = {"settings": {**settings, "controller": first}, "provenance": machine, "rows": strict_rows}
     write_text_atomic(targets[2], json.dumps(document, indent=2, allow_nan=False) + "\n")
     for name, path in zip(names, targets[len(REPORT_FILES):]):
         plot_tracking_errors(results, name, path)

@@ -31,6 +31,7 @@ from ..errors import GreyboxError
 from ..evaluate.metrics import metrics_table
 from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
 from ..estimator import check_runs
+from ..provenance import provenance
 from .augment import AugmentedModel
 from .effects import EFFECT_NAMES, effect
 from .evidence import StepEvidence, score_step
@@ -114,6 +115,7 @@ class DiscoveryResult:
             "model": {"base": type(self.base_model).__name__, "effects": self.model.effects_},
             "settings": self.settings,
             "seconds": self.seconds,
+            "provenance": provenance(),
             "notes": {"re": "RE = RMSE / mean |effort| in %",
                       "before": "base model alone, fitted on the training logs",
                       "after": "base model plus the named effects, refitted jointly on the training logs"},
