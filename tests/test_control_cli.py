@@ -103,3 +103,11 @@ def test_static_model_and_model_plant_without_training_logs_are_refused(tmp_path
         run_cli("--plant", model_files["coulomb"], "--fit", "coulomb", "--out", tmp_path / "a")
     with pytest.raises(GreyboxError, match="needs training logs"):
         run_cli("--plant", model_files["gms"], "--fit", "coulomb", "--out", tmp_path / "b")
+
+
+def test_a_damaged_plant_file_is_named_once(tmp_path):
+    plant = tmp_path / "bad.gbm"
+    plant.write_bytes(b"not a model")
+    with pytest.raises(GreyboxError) as caught:
+        run_cli("--plant", plant, "--fit", "coulomb", "--out", tmp_path / "a")
+    assert str(caught.value).count("bad.gbm") == 1

@@ -98,8 +98,9 @@ def _plant(args):
         return TwinPlant.for_axis(TWIN_PLANTS[key])
     if not os.path.isfile(args.plant):
         raise GreyboxError(f"{args.plant}: not a model file; the plant is twin-X, twin-Y or a gms/lugre model file")
+    model = _load(args.plant)  # its errors name the file already
     try:
-        return ModelPlant(_load(args.plant), name=Path(args.plant).stem)
+        return ModelPlant(model, name=Path(args.plant).stem)
     except GreyboxError as error:
         raise GreyboxError(f"{args.plant}: {error}") from None
 
