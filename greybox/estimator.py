@@ -149,9 +149,7 @@ class CurrentModel(ModelProtocol):
         state : object
             State after the chunk's last sample: the ``state`` of the next chunk.
         """
-        (run,) = self._check_predict_runs(log)
-        step = run.sample_time if sample_time is None else float(sample_time)
-        return self._effort(run, self.initial_state() if state is None else state, step)
+        return self._effort(*self._chunk_arguments(log, state, sample_time))
 
     def friction_chunk(self, log: AxisLog, state=None, *, sample_time: float | None = None):
         """Friction of one chunk of a run from a given state (no inertia, no offset) [A, or N].
@@ -167,9 +165,7 @@ class CurrentModel(ModelProtocol):
         state : object
             State after the chunk's last sample.
         """
-        (run,) = self._check_predict_runs(log)
-        step = run.sample_time if sample_time is None else float(sample_time)
-        return self._simulate(run, self.initial_state() if state is None else state, step)
+        return self._simulate(*self._chunk_arguments(log, state, sample_time))
 
     def friction(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
         """Friction part of the prediction (no inertia, no offset) [A, or N].
@@ -269,6 +265,12 @@ class CurrentModel(ModelProtocol):
     def _effort(self, run: AxisLog, state, sample_time: float):
         friction, end = self._simulate(run, state, sample_time)
         return self.J_ * run.acceleration + friction + self.offset_, end
+
+    def _chunk_arguments(self, log: AxisLog, state, sample_time: float | None):
+        """The checked chunk, its start state (default: the start of a run) and its integration step [s]."""
+        (run,) = self._check_predict_runs(log)
+        step = run.sample_time if sample_time is None else float(sample_time)
+        return run, self.initial_state() if state is None else state, step
 
     def _set_fit_info(self, runs: list[AxisLog]) -> None:
         self.effort_unit_ = runs[0].effort_unit
