@@ -119,20 +119,27 @@ class LinearPart:
 class PlantLaw:
     """A friction law as the plant of a position loop.
 
+    The loop (:mod:`greybox.control.plants`) integrates ``J dv/dt = I - F - offset``
+    by semi-implicit Euler: the velocity from ``friction`` of the present
+    state, then the position, then ``advance`` at the new velocity. The two
+    functions are compiled with numba for float64 C-contiguous ``parameters``
+    and ``state`` (the loop takes them as first-class functions).
+
     Attributes
     ----------
     friction : callable
-        Compiled ``friction(parameters, state, velocity) -> float``: the friction
-        [A] of the present state at velocity [mm/s].
+        Compiled ``friction(parameters, state, position_mm, velocity_mm_s) -> float``:
+        the friction [A] of the present state at the position [mm] and velocity [mm/s].
     advance : callable
-        Compiled ``advance(parameters, state, velocity, step_s) -> None``: moves
-        ``state`` (in place) over one internal step at the given velocity.
-    parameters : ndarray
+        Compiled ``advance(parameters, state, velocity_mm_s, step_s) -> None``: moves
+        ``state`` (in place) over one internal step [s] at the given velocity [mm/s]
+        (the displacement of the step is ``step_s * velocity_mm_s``).
+    parameters : ndarray of float64
         Parameters of the law, in the layout ``friction`` and ``advance`` read.
-    state : ndarray
+    state : ndarray of float64
         State of the law at rest (copied by the loop before use).
     stable_step_s : float
-        Largest internal step [s] at which the law stays stable on its inertia.
+        Largest internal step [s] to run the law at (stable on its inertia, accurate).
     inertia : float
         ``J`` [A s^2/mm].
     offset : float

@@ -70,3 +70,17 @@ def lugre_reference(velocity, sample_time, sigma0, sigma1, sigma2, f_c, f_s, v_s
         else:
             z = z + v * sample_time
     return friction, z_history, z
+
+
+def stribeck_reference(velocity, low, high, v_s):
+    """The models' Stribeck curve ``low + (high - low) exp(-|v| / v_s)`` (``s(v)`` of GMS, ``g(v)`` of LuGre)."""
+    return low + (high - low) * math.exp(-abs(velocity) / v_s)
+
+
+def lugre_step_reference(z, v, sigma0, f_c, f_s, v_s, step):
+    """Bristle deflection after one exact step of ``dz/dt = v - sigma0 |v| z / g(v)`` with ``v`` held."""
+    lam = sigma0 * abs(v) / stribeck_reference(v, f_c, f_s, v_s)
+    if lam == 0.0:
+        return z + v * step
+    decay = math.exp(-lam * step)
+    return z * decay + v * (1.0 - decay) / lam

@@ -13,6 +13,12 @@ applied over the step ``[t_j, t_j + T]``.
 
 GMS element modes (``int8``): ``0`` sticking, ``+1`` slipping in the positive
 direction, ``-1`` slipping in the negative direction.
+
+Each formula is written once, as a compiled step that the run kernels here
+and the plant laws of the position loop (:mod:`greybox.friction.plant_laws`)
+call: the Stribeck curve :func:`stribeck_at`, the GMS element step
+:func:`gms_element_step` (with :func:`gms_sample`), the LuGre exact step
+:func:`lugre_exact_step` (with :func:`lugre_decay_rate`).
 """
 
 from __future__ import annotations
@@ -22,11 +28,49 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["gms_friction_kernel", "gms_trajectory_kernel", "lugre_trajectory_kernel"]
+__all__ = [
+    "stribeck_at",
+    "gms_sample",
+    "gms_element_step",
+    "lugre_decay_rate",
+    "lugre_exact_step",
+    "gms_friction_kernel",
+    "gms_trajectory_kernel",
+    "lugre_trajectory_kernel",
+]
+
+
+# ------------------------------------------------------------------ shared steps (one copy each)
+@njit(cache=True, error_model="numpy")
+def stribeck_at(speed, low, drop, inv_v_s):
+    """The models' Stribeck curve ``low + drop exp(-speed / v_s)`` at a speed ``|v|`` [mm/s].
+
+    It is the break-away deflection ``s(v) = s_inf + (s_0 - s_inf) exp(-|v|/v_s)``
+    [mm] of the GMS elements and the level ``g(v) = F_c + (F_s - F_c)
+    exp(-|v|/v_s)`` [A] of the LuGre bristles. The callers pass ``1 / v_s``
+    so that a kernel divides once per run.
+
+    Parameters
+    ----------
+    speed : float
+        ``|v|`` [mm/s], non-negative.
+    low : float
+        Level at high speed (``s_inf`` [mm] or ``F_c`` [A]).
+    drop : float
+        Excess at rest over ``low`` (``s_0 - s_inf`` [mm] or ``F_s - F_c`` [A]).
+    inv_v_s : float
+        ``1 / v_s`` [s/mm].
+
+    Returns
+    -------
+    float
+        The curve at ``speed``, in the unit of ``low``.
+    """
+    return low + drop * math.exp(-speed * inv_v_s)
 
 
 @njit(cache=True, error_model="numpy")
-def _gms_element_step(z_old, mode, d, v_dt, s_i, alpha_i, c_dt, inv_s):
+def gms_element_step(z_old, mode, d, v_dt, s_i, alpha_i, c_dt, inv_s):
     """One forward-Euler step of one GMS element.
 
     Parameters
@@ -73,7 +117,7 @@ def _gms_element_step(z_old, mode, d, v_dt, s_i, alpha_i, c_dt, inv_s):
 
 
 @njit(cache=True, error_model="numpy")
-def _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s):
+def gms_sample(v, sample_time, s_inf, s_drop, inv_v_s):
     """Quantities of one GMS step shared by all elements.
 
     Parameters
@@ -98,11 +142,58 @@ def _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s):
     v_dt : float
         ``v T``: travel over the step [mm].
     """
-    s = s_inf + s_drop * math.exp(-abs(v) * inv_v_s)
+    s = stribeck_at(abs(v), s_inf, s_drop, inv_v_s)
     d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
     return s, 1.0 / s, d, v * sample_time
 
 
+@njit(cache=True, error_model="numpy")
+def lugre_decay_rate(speed, sigma0, f_c, f_drop, inv_v_s):
+    """Relaxation rate ``lambda = sigma0 |v| / g(v)`` [1/s] of the LuGre bristle equation.
+
+    ``dz/dt = v - lambda z`` with ``g(v) = F_c + (F_s - F_c) exp(-|v|/v_s)``
+    (:func:`stribeck_at`).
+
+    Parameters
+    ----------
+    speed : float
+        ``|v|`` [mm/s].
+    sigma0 : float
+        Bristle stiffness [A/mm].
+    f_c, f_drop : float
+        ``F_c`` and ``F_s - F_c`` [A].
+    inv_v_s : float
+        ``1 / v_s`` [s/mm].
+    """
+    return sigma0 * speed / stribeck_at(speed, f_c, f_drop, inv_v_s)
+
+
+@njit(cache=True, error_model="numpy")
+def lugre_exact_step(z, v, rate, step_s):
+    """Bristle deflection [mm] after a step of ``dz/dt = v - lambda z`` with ``v`` and ``lambda`` held.
+
+    The exact solution ``z e^{-lambda h} + v (1 - e^{-lambda h}) / lambda``,
+    stable and accurate for any bristle stiffness (forward Euler diverges once
+    ``lambda h > 2``); ``z + v h`` at rest (``lambda = 0``).
+
+    Parameters
+    ----------
+    z : float
+        Deflection before the step [mm].
+    v : float
+        Velocity held over the step [mm/s].
+    rate : float
+        ``lambda`` [1/s] (:func:`lugre_decay_rate`).
+    step_s : float
+        Step ``h`` [s].
+    """
+    x = rate * step_s
+    if x > 0.0:
+        return z * math.exp(-x) - v * math.expm1(-x) / rate
+    return z + v * step_s
+
+
+# ------------------------------------------------------------------ run kernels
 @njit(cache=True, error_model="numpy")
 def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0):
     """Friction of the Generalized Maxwell-Slip model, forward Euler at a constant step.
@@ -151,11 +242,11 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
     inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        s, inv_s, d, v_dt = _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
+        s, inv_s, d, v_dt = gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
         f = mu * v
         for i in range(alpha.shape[0]):
             z_old = z[i]
-            z_new, m = _gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
+            z_new, m = gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
             f += k[i] * z_old + damping[i] * ((z_new - z_old) / sample_time)
             z[i] = z_new
             mode[i] = m
@@ -207,14 +298,14 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_
     inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        s, inv_s, d, v_dt = _gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
+        s, inv_s, d, v_dt = gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
         w = 0.0
         f = mu * v
         for i in range(alpha.shape[0]):
             z_old = z[i]
             z_out[j, i] = z_old
             mode_out[j, i] = mode[i]
-            z_new, m = _gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
+            z_new, m = gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
             rate = (z_new - z_old) / sample_time
             w += alpha[i] * rate
             f += k[i] * z_old + damping[i] * rate
@@ -262,17 +353,12 @@ def lugre_trajectory_kernel(velocity, sample_time, sigma0, f_c, f_s, v_s, z0, z_
     """
     n = velocity.shape[0]
     z = z0
+    f_drop = f_s - f_c
     inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        speed = abs(v)
-        g = f_c + (f_s - f_c) * math.exp(-speed * inv_v_s)
-        lam = sigma0 * speed / g
+        lam = lugre_decay_rate(abs(v), sigma0, f_c, f_drop, inv_v_s)
         z_out[j] = z
         z_dot_out[j] = v - lam * z
-        x = lam * sample_time
-        if x > 0.0:
-            z = z * math.exp(-x) - v * math.expm1(-x) / lam
-        else:
-            z = z + v * sample_time
+        z = lugre_exact_step(z, v, lam, sample_time)
     return z

@@ -30,7 +30,11 @@ component periodic with the screw lead. The motor current without noise is
 
 The elements are integrated at a fine internal step (0.25 ms by default,
 eight steps per 2 ms log sample) by a numba kernel; the clamp makes the update
-unconditionally stable.
+unconditionally stable. The Stribeck ratio, its lag and the element update
+are compiled once (:func:`stribeck_ratio`, :func:`lagged_stribeck_ratio`,
+:func:`maxwell_slip_update`) and shared by the prescribed-motion kernel
+:func:`maxwell_slip_kernel` and the plant law of a position loop
+(:func:`twin_plant_law`).
 """
 
 from __future__ import annotations
@@ -41,13 +45,21 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 from numba import njit
 
+from ..base import PlantLaw
 from ..errors import GreyboxError
 from .axes import axis_geometry
 
 __all__ = [
     "PlantParameters",
     "default_plant_parameters",
+    "stribeck_ratio",
+    "lag_decay",
+    "lagged_stribeck_ratio",
+    "maxwell_slip_update",
     "maxwell_slip_kernel",
+    "twin_plant_law",
+    "twin_plant_friction",
+    "twin_plant_advance",
     "PlantResponse",
     "fine_steps_per_sample",
     "simulate_plant",
@@ -131,10 +143,12 @@ class PlantParameters:
         return float(np.sum(self.breakaway_A))
 
     def stribeck_ratio(self, velocity_mm_s) -> np.ndarray:
-        """Steady Stribeck ratio ``rho(v)`` of the breakaway levels (1 at rest)."""
-        speed = np.abs(np.asarray(velocity_mm_s, dtype=float))
-        r = self.coulomb_ratio
-        return r + (1.0 - r) * np.exp(-((speed / self.stribeck_velocity_mm_s) ** self.stribeck_shape))
+        """Steady Stribeck ratio ``rho(v)`` of the breakaway levels (1 at rest), at velocities [mm/s]."""
+        velocity = np.asarray(velocity_mm_s, dtype=float)
+        flat = np.ascontiguousarray(velocity.ravel())
+        ratio = _stribeck_ratios(flat, float(self.coulomb_ratio), float(self.stribeck_velocity_mm_s),
+                                 float(self.stribeck_shape))
+        return ratio.reshape(velocity.shape)[()]
 
     def position_factor(self, position_mm) -> np.ndarray:
         """Position factor ``g(x)`` of the Maxwell-slip friction (dimensionless)."""
@@ -205,6 +219,102 @@ def default_plant_parameters(axis: str = "X", travel_mm=None) -> PlantParameters
     )
 
 
+# ------------------------------------------------------------------ compiled laws (one copy each)
+@njit(cache=True)
+def stribeck_ratio(velocity_mm_s, coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape):
+    """Steady Stribeck ratio ``rho(v) = r_c + (1 - r_c) exp(-(|v|/v_s)^delta)`` of the twin (1 at rest).
+
+    Parameters
+    ----------
+    velocity_mm_s : float
+        Velocity [mm/s].
+    coulomb_ratio : float
+        ``r_c``, the sliding level relative to the level at rest.
+    stribeck_velocity_mm_s : float
+        ``v_s`` [mm/s].
+    stribeck_shape : float
+        ``delta``.
+    """
+    return coulomb_ratio + (1.0 - coulomb_ratio) * math.exp(
+        -((abs(velocity_mm_s) / stribeck_velocity_mm_s) ** stribeck_shape))
+
+
+@njit(cache=True)
+def _stribeck_ratios(velocity_mm_s, coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape):
+    out = np.empty(velocity_mm_s.shape[0])
+    for i in range(velocity_mm_s.shape[0]):
+        out[i] = stribeck_ratio(velocity_mm_s[i], coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape)
+    return out
+
+
+@njit(cache=True)
+def lag_decay(step_s, lag_time_s):
+    """``exp(-h / tau)``: what remains of a deviation of the lagged ratio after a step ``h`` [s] (0 without lag).
+
+    Parameters
+    ----------
+    step_s : float
+        Step ``h`` [s].
+    lag_time_s : float
+        Time constant ``tau`` [s]; 0 for no lag.
+    """
+    return math.exp(-step_s / lag_time_s) if lag_time_s > 0.0 else 0.0
+
+
+@njit(cache=True)
+def lagged_stribeck_ratio(level, velocity_mm_s, coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape, decay):
+    """One step of the lagged Stribeck ratio ``tau dr/dt = rho(v) - r``, exact for ``rho`` held.
+
+    Parameters
+    ----------
+    level : float
+        Ratio ``r`` before the step.
+    velocity_mm_s : float
+        Velocity [mm/s] over the step.
+    coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape : float
+        ``rho`` as in :func:`stribeck_ratio`.
+    decay : float
+        :func:`lag_decay` of the step.
+
+    Returns
+    -------
+    float
+        ``rho + (r - rho) decay``.
+    """
+    target = stribeck_ratio(velocity_mm_s, coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape)
+    return target + (level - target) * decay
+
+
+@njit(cache=True)
+def maxwell_slip_update(deflection, step_mm, level, stiffness, breakaway_deflection):
+    """Move every elasto-plastic element by ``step_mm`` and clamp it; return ``sum_i k_i d_i`` [A].
+
+    ``d_i <- clip(d_i + dx, -D_i r, +D_i r)``, summed in element order.
+
+    Parameters
+    ----------
+    deflection : ndarray, shape (m,)
+        Element deflections ``d_i`` [mm], updated in place.
+    step_mm : float
+        Axis displacement over the step [mm].
+    level : float
+        Stribeck ratio ``r`` scaling the breakaway deflections.
+    stiffness, breakaway_deflection : ndarray, shape (m,)
+        ``k_i`` [A/mm] and ``D_i`` [mm].
+    """
+    force = 0.0
+    for j in range(deflection.shape[0]):
+        limit = breakaway_deflection[j] * level
+        d = deflection[j] + step_mm
+        if d > limit:
+            d = limit
+        elif d < -limit:
+            d = -limit
+        deflection[j] = d
+        force += stiffness[j] * d
+    return force
+
+
 @njit(cache=True)
 def maxwell_slip_kernel(position_mm, velocity_mm_s, step_s, stride, stiffness_A_mm, deflection_mm,
                         coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape, lag_time_s):
@@ -231,29 +341,17 @@ def maxwell_slip_kernel(position_mm, velocity_mm_s, step_s, stride, stiffness_A_
         Maxwell-slip current [A] at fine steps 0, stride, 2 stride, ...
     """
     n = position_mm.shape[0]
-    m = stiffness_A_mm.shape[0]
     out = np.empty((n - 1) // stride + 1)
-    state = np.zeros(m)
-    decay = math.exp(-step_s / lag_time_s) if lag_time_s > 0.0 else 0.0
-    level = coulomb_ratio + (1.0 - coulomb_ratio) * math.exp(
-        -((abs(velocity_mm_s[0]) / stribeck_velocity_mm_s) ** stribeck_shape))
+    state = np.zeros(stiffness_A_mm.shape[0])
+    decay = lag_decay(step_s, lag_time_s)
+    level = stribeck_ratio(velocity_mm_s[0], coulomb_ratio, stribeck_velocity_mm_s, stribeck_shape)
     for i in range(n):
         step = 0.0
         if i > 0:
-            target = coulomb_ratio + (1.0 - coulomb_ratio) * math.exp(
-                -((abs(velocity_mm_s[i]) / stribeck_velocity_mm_s) ** stribeck_shape))
-            level = target + (level - target) * decay
+            level = lagged_stribeck_ratio(level, velocity_mm_s[i], coulomb_ratio, stribeck_velocity_mm_s,
+                                          stribeck_shape, decay)
             step = position_mm[i] - position_mm[i - 1]
-        force = 0.0
-        for j in range(m):
-            limit = deflection_mm[j] * level
-            d = state[j] + step
-            if d > limit:
-                d = limit
-            elif d < -limit:
-                d = -limit
-            state[j] = d
-            force += stiffness_A_mm[j] * d
+        force = maxwell_slip_update(state, step, level, stiffness_A_mm, deflection_mm)
         if i % stride == 0:
             out[i // stride] = force
     return out
@@ -317,3 +415,66 @@ def simulate_plant(params: PlantParameters, motion, n_samples: int, sample_time_
     x_log, v_log, a_log = x[::stride], v[::stride], a[::stride]
     friction = params.position_factor(x_log) * maxwell + params.viscous_A_s_mm * v_log
     return PlantResponse(x_log, v_log, a_log, friction, params.inertia_A_s2_mm * a_log)
+
+
+# ------------------------------------------------------------------ the plant of a position loop
+_TWIN_HEAD = 11  # r_c, v_s, delta, tau, sigma_v, x_lo, x_hi, c_pre, lead, c_lead, phi
+
+
+@njit(cache=True)
+def twin_plant_friction(parameters, state, position_mm, velocity_mm_s):
+    """Friction [A] ``g(x) sum_i k_i d_i + sigma_v v`` of the present state (layout in :func:`twin_plant_law`)."""
+    low, high = parameters[5], parameters[6]
+    u = (2.0 * position_mm - low - high) / (high - low)
+    factor = 1.0 + parameters[7] * u ** 4 + parameters[9] * math.sin(
+        2.0 * math.pi * position_mm / parameters[8] + parameters[10])
+    return factor * state[1] + parameters[4] * velocity_mm_s
+
+
+@njit(cache=True)
+def twin_plant_advance(parameters, state, velocity_mm_s, step_s):
+    """Move the lagged Stribeck ratio and the elements over one step ``step_s`` [s] at ``velocity_mm_s`` (in place).
+
+    The element displacement over the step is ``step_s * velocity_mm_s``;
+    ``state[1]`` receives ``sum_i k_i d_i`` [A] after the step.
+    """
+    m = (parameters.shape[0] - _TWIN_HEAD) // 2
+    decay = lag_decay(step_s, parameters[3])
+    level = lagged_stribeck_ratio(state[0], velocity_mm_s, parameters[0], parameters[1], parameters[2], decay)
+    state[0] = level
+    state[1] = maxwell_slip_update(state[2:], step_s * velocity_mm_s, level, parameters[_TWIN_HEAD:_TWIN_HEAD + m],
+                                   parameters[_TWIN_HEAD + m:])
+
+
+def twin_plant_law(params: PlantParameters, *, friction: bool = True) -> PlantLaw:
+    """The truth plant as the plant of a position loop, at rest (relaxed elements, ratio 1).
+
+    ``parameters = (r_c, v_s, delta, tau, sigma_v, x_lo, x_hi, c_pre, lead, c_lead, phi,
+    k_1..m, D_1..m)``, ``state = (r, sum_i k_i d_i, d_1..m)``; the friction
+    is ``g(x) sum_i k_i d_i + sigma_v v`` (see the module doc).
+
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant.
+    friction : bool, default True
+        With ``False`` the stiffnesses and the viscous coefficient are zero:
+        the plant is its inertia alone.
+
+    Returns
+    -------
+    PlantLaw
+        Its internal step is the plant's ``internal_step_s`` (the clamp is
+        stable at any step); no constant load.
+    """
+    scale = 1.0 if friction else 0.0
+    head = [float(params.coulomb_ratio), float(params.stribeck_velocity_mm_s), float(params.stribeck_shape),
+            float(params.lag_time_s), float(params.viscous_A_s_mm) * scale, float(params.travel_mm[0]),
+            float(params.travel_mm[1]), float(params.preload_gain), float(params.lead_mm), float(params.lead_gain),
+            float(params.lead_phase_rad)]
+    parameters = np.concatenate((head, np.asarray(params.stiffness_A_mm, float) * scale,
+                                 np.asarray(params.breakaway_deflection_mm, float)))
+    state = np.zeros(2 + len(params.breakaway_A))
+    state[0] = 1.0
+    return PlantLaw(twin_plant_friction, twin_plant_advance, np.ascontiguousarray(parameters), state,
+                    float(params.internal_step_s), float(params.inertia_A_s2_mm), 0.0)

@@ -1,0 +1,201 @@
+"""The dynamic friction models as plants of a position loop (:class:`greybox.base.PlantLaw`).
+
+A position loop (:mod:`greybox.control.plants`) integrates ``J dv/dt = I - F
+- I_0`` at a fine internal step ``h`` and asks the friction law two things,
+through compiled functions it receives as arguments:
+
+``friction(parameters, state, position_mm, velocity_mm_s) -> float``
+    The friction [A] of the present state at the present velocity.
+``advance(parameters, state, velocity_mm_s, step_s) -> None``
+    The state (in place) after one internal step at the new velocity.
+
+``parameters`` and ``state`` are float64 arrays in the layout of each law
+(below). The element and bristle steps are the ones the models' run kernels
+use (:mod:`greybox.friction.kernels`), so a plant follows its model's law,
+now at the fine step ``h`` instead of the log's sample time. The friction
+is explicit: it reads the deflections and the rate of the previous step.
+
+GMS (``N`` elements)
+    ``parameters = (mu, sigma, s_inf, s_0 - s_inf, 1 / v_s, C, alpha_1..N, k_1..N)``,
+    ``state = (sum_i alpha_i dz_i/dt, z_1..N, mode_1..N)``;
+    ``F = mu v + sigma sum_i alpha_i dz_i/dt + sum_i k_i z_i``.
+LuGre
+    ``parameters = (sigma0, sigma1, sigma2, F_c, F_s - F_c, 1 / v_s)``,
+    ``state = (z, dz/dt)``; ``F = sigma0 z + sigma1 dz/dt + sigma2 v``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..base import PlantLaw
+from .kernels import gms_element_step, gms_sample, lugre_decay_rate, lugre_exact_step
+
+__all__ = [
+    "MAX_STEP_RATIO",
+    "stable_step",
+    "gms_plant_law",
+    "gms_plant_friction",
+    "gms_plant_advance",
+    "lugre_plant_law",
+    "lugre_plant_friction",
+    "lugre_plant_advance",
+]
+
+#: Largest ``omega h`` (natural frequency of the stiffest friction spring with
+#: the inertia, times the internal step) and ``c h / J`` (friction damping)
+#: the internal step is chosen for; semi-implicit Euler is stable below 2.
+MAX_STEP_RATIO = 0.25
+
+_GMS_HEAD = 6  # mu, sigma, s_inf, s_drop, inv_v_s, C
+
+
+def stable_step(inertia: float, stiffness: float, damping: float) -> float:
+    """Largest internal step [s] for a friction stiffness and damping on an inertia.
+
+    Parameters
+    ----------
+    inertia : float
+        ``J`` [A s^2/mm], positive.
+    stiffness : float
+        Total stiffness of the friction springs [A/mm].
+    damping : float
+        Total damping of the friction [A s/mm].
+
+    Returns
+    -------
+    float
+        ``MAX_STEP_RATIO`` times the smaller of ``sqrt(J / stiffness)`` and
+        ``J / damping`` [s]; infinite without stiffness and damping.
+    """
+    limits = [np.inf]
+    if stiffness > 0.0:
+        limits.append(MAX_STEP_RATIO * math.sqrt(inertia / stiffness))
+    if damping > 0.0:
+        limits.append(MAX_STEP_RATIO * inertia / damping)
+    return float(min(limits))
+
+
+# ------------------------------------------------------------------ GMS
+@njit(cache=True, error_model="numpy")
+def gms_plant_friction(parameters, state, position_mm, velocity_mm_s):
+    """GMS friction [A] ``mu v + sigma w + sum_i k_i z_i`` of the present state (layout in the module doc)."""
+    n = (parameters.shape[0] - _GMS_HEAD) // 2
+    force = parameters[0] * velocity_mm_s + parameters[1] * state[0]
+    for i in range(n):
+        force += parameters[_GMS_HEAD + n + i] * state[1 + i]
+    return force
+
+
+@njit(cache=True, error_model="numpy")
+def gms_plant_advance(parameters, state, velocity_mm_s, step_s):
+    """Move the GMS elements over one internal step ``step_s`` [s] at ``velocity_mm_s`` [mm/s] (in place).
+
+    Every element takes :func:`greybox.friction.kernels.gms_element_step`;
+    ``state[0]`` receives ``sum_i alpha_i dz_i/dt`` over the step [mm/s].
+    """
+    n = (parameters.shape[0] - _GMS_HEAD) // 2
+    s, inv_s, d, v_dt = gms_sample(velocity_mm_s, step_s, parameters[2], parameters[3], parameters[4])
+    c_dt = parameters[5] * step_s
+    rate = 0.0
+    for i in range(n):
+        alpha_i = parameters[_GMS_HEAD + i]
+        z_old = state[1 + i]
+        z_new, mode = gms_element_step(z_old, int(state[1 + n + i]), d, v_dt, alpha_i * s, alpha_i, c_dt, inv_s)
+        rate += alpha_i * (z_new - z_old) / step_s
+        state[1 + i] = z_new
+        state[1 + n + i] = mode
+    state[0] = rate
+
+
+def gms_plant_law(*, alpha, k, sigma, s_0, s_inf, v_s, c, mu, inertia, offset) -> PlantLaw:
+    """The GMS law as a plant: elements relaxed and sticking at rest.
+
+    Parameters
+    ----------
+    alpha, k : array_like, shape (N,)
+        Element fractions and stiffnesses [A/mm].
+    sigma, mu : float
+        Micro-damping and viscous coefficient [A s/mm].
+    s_0, s_inf : float
+        Break-away deflection at rest and at high speed [mm].
+    v_s : float
+        Stribeck velocity [mm/s].
+    c : float
+        Slip rate constant [mm/s].
+    inertia : float
+        ``J`` [A s^2/mm].
+    offset : float
+        Constant load [A].
+
+    Returns
+    -------
+    PlantLaw
+        Its internal step is stable for ``sum k`` and ``sigma + mu`` on the
+        inertia and below ``min(s_0, s_inf) / C``, where the forward-Euler
+        slip step relaxes without overshoot.
+    """
+    alpha = np.asarray(alpha, dtype=float)
+    k = np.asarray(k, dtype=float)
+    s_0, s_inf, v_s, c = float(s_0), float(s_inf), float(v_s), float(c)
+    head = [float(mu), float(sigma), s_inf, s_0 - s_inf, 1.0 / v_s, c]
+    parameters = np.ascontiguousarray(np.concatenate((head, alpha, k)))
+    state = np.zeros(1 + 2 * alpha.size)
+    slip_step = min(s_0, s_inf) / c
+    step = min(stable_step(inertia, float(np.sum(k)), float(sigma + mu)), slip_step)
+    return PlantLaw(gms_plant_friction, gms_plant_advance, parameters, state, step, float(inertia), float(offset))
+
+
+# ------------------------------------------------------------------ LuGre
+@njit(cache=True, error_model="numpy")
+def lugre_plant_friction(parameters, state, position_mm, velocity_mm_s):
+    """LuGre friction [A] ``sigma0 z + sigma1 dz/dt + sigma2 v`` of the present state."""
+    return parameters[0] * state[0] + parameters[1] * state[1] + parameters[2] * velocity_mm_s
+
+
+@njit(cache=True, error_model="numpy")
+def lugre_plant_advance(parameters, state, velocity_mm_s, step_s):
+    """Move the bristles over one internal step ``step_s`` [s] at ``velocity_mm_s`` [mm/s] (in place).
+
+    The exact step :func:`greybox.friction.kernels.lugre_exact_step`;
+    ``state[1]`` receives ``dz/dt`` over the step [mm/s].
+    """
+    z = state[0]
+    rate = lugre_decay_rate(abs(velocity_mm_s), parameters[0], parameters[3], parameters[4], parameters[5])
+    z_new = lugre_exact_step(z, velocity_mm_s, rate, step_s)
+    state[1] = (z_new - z) / step_s
+    state[0] = z_new
+
+
+def lugre_plant_law(*, sigma0, sigma1, sigma2, coulomb, static, v_s, inertia, offset) -> PlantLaw:
+    """The LuGre law as a plant: bristles relaxed at rest.
+
+    Parameters
+    ----------
+    sigma0 : float
+        Bristle stiffness [A/mm].
+    sigma1, sigma2 : float
+        Bristle damping and viscous coefficient [A s/mm].
+    coulomb, static : float
+        ``F_c`` and ``F_s`` [A].
+    v_s : float
+        Stribeck velocity [mm/s].
+    inertia : float
+        ``J`` [A s^2/mm].
+    offset : float
+        Constant load [A].
+
+    Returns
+    -------
+    PlantLaw
+        Its internal step is stable for ``sigma0`` and ``sigma1 + sigma2`` on the inertia.
+    """
+    coulomb = float(coulomb)
+    parameters = np.array([float(sigma0), float(sigma1), float(sigma2), coulomb, float(static) - coulomb,
+                           1.0 / float(v_s)])
+    step = stable_step(inertia, float(sigma0), float(sigma1 + sigma2))
+    return PlantLaw(lugre_plant_friction, lugre_plant_advance, parameters, np.zeros(2), step, float(inertia),
+                    float(offset))
