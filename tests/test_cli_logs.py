@@ -14,7 +14,6 @@ from greybox.cli import main
 from greybox.data.io import write_log
 
 REPO = Path(__file__).resolve().parents[1]
-EMPS = REPO.parent / "shared" / "data" / "real" / "EMPS" / "DATA_EMPS.mat"
 
 GOOD_CSV = "time_s,position_mm,current_A\n" + "".join(f"{0.002 * k:.3f},{0.01 * k},{0.1}\n" for k in range(400))
 
@@ -110,9 +109,9 @@ def test_info_column_mapping_on_a_cnc_export(tmp_path, capsys):
     assert summary["effort_rms"] == pytest.approx(1.5)
 
 
-def test_plot_writes_png_of_emps_force_log(tmp_path, capsys):
+def test_plot_writes_png_of_emps_force_log(tmp_path, capsys, real_data):
     out = tmp_path / "emps.png"
-    assert main(["plot", str(EMPS), "--out", str(out)]) == 0
+    assert main(["plot", str(real_data("EMPS") / "DATA_EMPS.mat"), "--out", str(out)]) == 0
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert str(out) in capsys.readouterr().out
 

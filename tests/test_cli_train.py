@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -11,8 +9,6 @@ import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.persistence import load_model
-
-EMPS = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "EMPS" / "DATA_EMPS.mat"
 
 # Coulomb + viscous + offset truth: J [A s^2/mm], Fc [A], Fv [A s/mm], offset [A]
 TRUTH = {"J_": 2e-3, "coulomb_pos_": 1.2, "viscous_pos_": 0.015, "offset_": -0.3}
@@ -84,10 +80,10 @@ def test_same_seed_gives_identical_model_files(tmp_path, capsys):
     assert files[0].read_bytes() == files[1].read_bytes()
 
 
-def test_emps_file_gives_the_benchmark_mass(tmp_path, capsys):
+def test_emps_file_gives_the_benchmark_mass(tmp_path, capsys, real_data):
     out = tmp_path / "emps.gbm"
     status, stdout, _ = _train(capsys, "--model", "coulomb", "--offset", "--cutoff-hz", "100",
-                               "--train", EMPS, "--out", out, "--quiet")
+                               "--train", real_data("EMPS") / "DATA_EMPS.mat", "--out", out, "--quiet")
     assert status == 0
     model = load_model(out)
     assert model.effort_unit_ == "N"

@@ -2,15 +2,11 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from greybox.data.io import read_log, write_log
 from greybox.errors import LogError
-
-UMICH = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "UMich_CNC_mill_tool_wear"
 
 
 def test_round_trip_is_exact_and_keeps_metadata(tmp_path, make_log):
@@ -99,8 +95,8 @@ def test_time_column_and_sample_time_conflict(tmp_path):
         read_log(path, sample_time=0.1)
 
 
-def test_umich_cnc_mill_file_with_column_mapping():
-    path = UMICH / "experiment_01.csv"
+def test_umich_cnc_mill_file_with_column_mapping(real_data):
+    path = real_data("UMich_CNC_mill_tool_wear") / "experiment_01.csv"
     log = read_log(
         path,
         columns={"position_mm": "X1_ActualPosition", "velocity_mm_s": "X1_ActualVelocity", "current_A": "X1_CurrentFeedback"},

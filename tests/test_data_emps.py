@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from scipy.io import loadmat, savemat
@@ -11,12 +9,16 @@ from scipy.io import loadmat, savemat
 from greybox.data.io import read_log
 from greybox.errors import LogError
 
-EMPS = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "EMPS"
+
+@pytest.fixture
+def emps(real_data):
+    """The folder of the EMPS benchmark files (skips without it)."""
+    return real_data("EMPS")
 
 
 @pytest.mark.parametrize("name", ["DATA_EMPS", "DATA_EMPS_PULSES"])
-def test_emps_units(name):
-    path = EMPS / f"{name}.mat"
+def test_emps_units(emps, name):
+    path = emps / f"{name}.mat"
     log = read_log(path)
     raw = loadmat(path)
     assert log.effort_unit == "N" and log.dataset == name
@@ -31,8 +33,8 @@ def test_emps_units(name):
     assert ("pulses_N" in log.extras) == (name == "DATA_EMPS_PULSES")
 
 
-def test_pulses_are_a_zero_five_square_wave():
-    pulses = read_log(EMPS / "DATA_EMPS_PULSES.mat").extras["pulses_N"]
+def test_pulses_are_a_zero_five_square_wave(emps):
+    pulses = read_log(emps / "DATA_EMPS_PULSES.mat").extras["pulses_N"]
     assert set(np.unique(pulses)) == {0.0, 5.0}
     assert np.count_nonzero(pulses == 5.0) == 12497  # README
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -11,8 +9,6 @@ from greybox.data.io import read_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import default_cutoff, derive, prepare, resample, trim
 from greybox.errors import LogError
-
-EMPS = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "EMPS"
 
 
 def _sine(frequency_hz, n=5000, sample_time=0.002, amplitude_mm=50.0, **fields):
@@ -83,9 +79,9 @@ def test_derive_errors():
         derive(jittery.replace(time=time))
 
 
-def test_default_cutoff_matches_the_emps_benchmark_filter():
+def test_default_cutoff_matches_the_emps_benchmark_filter(real_data):
     """IDIM-LS fit of gtau*vir = M a + Fv v + Fc sign(v) + offset: default (50 Hz) vs the benchmark's 100 Hz."""
-    log = read_log(EMPS / "DATA_EMPS.mat")
+    log = read_log(real_data("EMPS") / "DATA_EMPS.mat")
 
     def fit(prepared):
         v, a = prepared.velocity / 1e3, prepared.acceleration / 1e3  # m/s, m/s^2

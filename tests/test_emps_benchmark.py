@@ -21,7 +21,6 @@ import pytest
 from greybox.friction import CoulombModel
 
 REPO = Path(__file__).resolve().parents[1]
-DATA = REPO.parent / "shared" / "data" / "real" / "EMPS"
 SCRIPT = REPO / "scripts" / "emps_benchmark.py"
 
 SYMMETRIC = {"M_kg": 95.1089, "Fv_N_s_per_m": 203.5034, "Fc_N": 20.3935, "offset_N": -3.1648}
@@ -42,8 +41,14 @@ bench = _load_script()
 
 
 @pytest.fixture(scope="module")
-def logs():
-    return {role: bench.benchmark_log(DATA / name) for role, name in
+def emps(real_data):
+    """The folder of the EMPS benchmark files (skips without it)."""
+    return real_data("EMPS")
+
+
+@pytest.fixture(scope="module")
+def logs(emps):
+    return {role: bench.benchmark_log(emps / name) for role, name in
             (("train", "DATA_EMPS.mat"), ("test", "DATA_EMPS_PULSES.mat"))}
 
 
@@ -81,20 +86,20 @@ def test_greybox_coulomb_model_matches_the_published_estimates(logs):
     assert bench.benchmark_relerr(logs["test"], model.predict(logs["test"])) == pytest.approx(TEST_RELERR, abs=0.2)
 
 
-def test_benchmark_samples_and_the_2ms_grid(logs):
+def test_benchmark_samples_and_the_2ms_grid(logs, emps):
     full = logs["train"]
     assert len(full) == 24841 - 49
     assert bench.decimate_benchmark(full.effort).size == 2480
-    coarse = bench.benchmark_log(DATA / "DATA_EMPS.mat", step_ms=2)
+    coarse = bench.benchmark_log(emps / "DATA_EMPS.mat", step_ms=2)
     assert coarse.sample_time == pytest.approx(0.002, rel=1e-4)
     assert coarse.time[0] == full.time[0]
     assert np.isin(coarse.time, full.time).all()
 
 
-def test_script_writes_json_markdown_and_plot(tmp_path):
+def test_script_writes_json_markdown_and_plot(tmp_path, emps):
     out, md, png = tmp_path / "emps.json", tmp_path / "emps.md", tmp_path / "emps.png"
     result = subprocess.run(
-        [sys.executable, str(SCRIPT), "--json", str(out), "--markdown", str(md), "--plot", str(png),
+        [sys.executable, str(SCRIPT), "--data", str(emps), "--json", str(out), "--markdown", str(md), "--plot", str(png),
          "--models", "coulomb_idim_ls", "coulomb", "stribeck", "--quiet"],
         capture_output=True, text=True, cwd=tmp_path, timeout=300,
     )

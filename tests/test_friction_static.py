@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import scipy.io
@@ -14,8 +12,6 @@ from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
 from greybox.friction import CoulombModel, StribeckModel, stribeck_curve
 from greybox.friction.coulomb import coulomb_friction
-
-EMPS = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "EMPS" / "DATA_EMPS.mat"
 
 
 def log_with(current_of):
@@ -93,9 +89,9 @@ def test_stribeck_curve_decays_from_static_to_coulomb():
     np.testing.assert_allclose(s, [0.6, 0.6 + 0.3 / np.e, 0.9, 0.6 + 0.3 / np.e, 0.6])
 
 
-def emps_log():
+def emps_log(path):
     """The EMPS estimation run at 1 kHz, prepared as the benchmark's IDIM-LS script does (positions in mm)."""
-    data = scipy.io.loadmat(EMPS)
+    data = scipy.io.loadmat(path)
     time = data["t"].ravel()
     position = 1e3 * data["qm"].ravel()
     force = float(data["gtau"].ravel()[0]) * data["vir"].ravel()
@@ -104,15 +100,15 @@ def emps_log():
     smooth = scipy.signal.filtfilt(b, a, position)
     velocity = np.gradient(smooth, step)
     log = AxisLog(time=time, position=position, effort=force, velocity=velocity,
-                  acceleration=np.gradient(velocity, step), effort_unit="N", source=str(EMPS))
+                  acceleration=np.gradient(velocity, step), effort_unit="N", source=str(path))
     return log.select(slice(49, None))
 
 
-def test_coulomb_model_is_the_emps_idim_ls_estimator():
+def test_coulomb_model_is_the_emps_idim_ls_estimator(real_data):
     """Published IDIM-LS estimates (Janot et al. 2019): M 95.1089 kg, Fv 203.5034 N s/m, Fc 20.3935 N,
     offset -3.1648 N; asymmetric: M 95.1540, Fv+ 166.7061, Fc+ 20.1440, Fv- 240.4236, Fc- 20.6277.
     The benchmark decimates by 10 before the fit; at 1 kHz the estimates agree within 2 %."""
-    log = emps_log()
+    log = emps_log(real_data("EMPS") / "DATA_EMPS.mat")
     model = CoulombModel(fit_offset=True).fit(log)
     assert model.effort_unit_ == "N"
     assert 1e3 * model.J_ == pytest.approx(95.1089, rel=0.01)
