@@ -31,6 +31,7 @@ from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_search_settings, local_search, multistart
 from ..identify.static import velocity_range
 from .kernels import gms_friction_kernel, gms_trajectory_kernel
+from .plant_laws import gms_plant_law
 
 __all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_trajectory"]
 
@@ -478,6 +479,17 @@ class GMSModel(CurrentModel):
         """
         parts = [self.trajectory(run) for run in self._check_predict_runs(logs)]
         return np.vstack([p[1] for p in parts]), np.vstack([p[2] for p in parts])
+
+    def plant_law(self):
+        """The fitted GMS law as the plant of a position loop (:func:`greybox.friction.plant_laws.gms_plant_law`).
+
+        Returns
+        -------
+        PlantLaw
+            The element law with ``J_`` [A s^2/mm] and ``offset_`` [A] as constant load.
+        """
+        return gms_plant_law(alpha=self.alpha_, k=self.k_, sigma=self.sigma_, s_0=self.s0_, s_inf=self.s_inf_,
+                             v_s=self.v_s_, c=self.C_, mu=self.mu_, inertia=self.J_, offset=self.offset_)
 
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:

@@ -12,6 +12,7 @@ from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_search_settings, multistart
 from ..identify.static import velocity_range
 from .kernels import lugre_trajectory_kernel
+from .plant_laws import lugre_plant_law
 
 __all__ = ["LuGreModel", "check_lugre_parameters", "simulate_lugre"]
 
@@ -221,6 +222,17 @@ class LuGreModel(CurrentModel):
             Parameter("static", self.static_, EFFORT, "static level F_s"),
             Parameter("v_s", self.v_s_, "mm/s", "Stribeck velocity"),
         ]
+
+    def plant_law(self):
+        """The fitted LuGre law as the plant of a position loop (:func:`greybox.friction.plant_laws.lugre_plant_law`).
+
+        Returns
+        -------
+        PlantLaw
+            The bristle law with ``J_`` [A s^2/mm] and ``offset_`` [A] as constant load.
+        """
+        return lugre_plant_law(sigma0=self.sigma0_, sigma1=self.sigma1_, sigma2=self.viscous_, coulomb=self.coulomb_,
+                               static=self.static_, v_s=self.v_s_, inertia=self.J_, offset=self.offset_)
 
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:
