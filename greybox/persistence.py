@@ -1,13 +1,13 @@
 """Saving and loading fitted models, without pickle.
 
-File format (format name ``greybox-model``, version 1)
+File format (format name ``greybox-model``, version 2)
 ------------------------------------------------------
 A model file is a ZIP archive (any file name; ``.gbm`` by convention) with
 
 ``model.json``
     A JSON object::
 
-        {"format": "greybox-model", "format_version": 1,
+        {"format": "greybox-model", "format_version": 2,
          "greybox_version": "0.1.0",
          "model": {"kind": "gms",
                    "params": {...},       # get_params(deep=False)
@@ -57,8 +57,9 @@ __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "save_model", "load_model"]
 
 #: Value of the ``format`` field of every model file.
 FORMAT_NAME = "greybox-model"
-#: Newest format version this greybox writes and reads.
-FORMAT_VERSION = 1
+#: Newest format version this greybox writes and reads. Version 2 renamed learned attributes
+#: (a class's ``renamed_attributes``); version-1 files are read with the old names mapped.
+FORMAT_VERSION = 2
 
 _JSON_MEMBER = "model.json"
 _ARRAY_DIR = "arrays/"
@@ -193,9 +194,10 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
 class _Decoder:
     """Rebuild values (and nested models) from the JSON and the ``.npy`` members."""
 
-    def __init__(self, path: Path, archive: zipfile.ZipFile):
+    def __init__(self, path: Path, archive: zipfile.ZipFile, version: int):
         self.path = path
         self.archive = archive
+        self.version = version
 
     def fail(self, problem: str):
         raise ModelFileError(f"{self.path}: {problem}")
@@ -218,6 +220,9 @@ class _Decoder:
         if unknown:
             self.fail(f"{kind} model in {where} has parameters this greybox does not know: {', '.join(unknown)}")
         model = cls(**{name: self.value(value, f"{where}.{name}") for name, value in params.items()})
+        if self.version < 2:
+            renamed = getattr(cls, "renamed_attributes", {})
+            attributes = {renamed.get(name, name): value for name, value in attributes.items()}
         for name, value in attributes.items():
             if not isinstance(name, str) or not _ATTRIBUTE_NAME.match(name):
                 self.fail(f"{where} has an invalid learned-attribute name {name!r}")
@@ -298,7 +303,7 @@ def load_model(path: str | PathLike):
                     f"({document.get('greybox_version', 'unknown version')}); this greybox reads versions "
                     f"up to {FORMAT_VERSION}: upgrade greybox"
                 )
-            model = _Decoder(path, archive).estimator(document.get("model"), "model")
+            model = _Decoder(path, archive, version).estimator(document.get("model"), "model")
     except (zipfile.BadZipFile, zlib.error, EOFError) as error:
         if zipfile.is_zipfile(path):
             raise ModelFileError(f"{path}: damaged model file (a ZIP archive whose content does not check out: "

@@ -30,7 +30,7 @@ class GMSPlant:
     @classmethod
     def of(cls, m):
         """The plant of a fitted GMSModel."""
-        return cls(m.alpha_, m.k_, m.sigma_, m.s0_, m.s_inf_, m.v_s_, m.C_, m.mu_)
+        return cls(m.alpha_, m.k_, m.sigma_, m.s_0_, m.s_inf_, m.v_s_, m.slip_rate_, m.viscous_)
 
     def friction(self, x, v):
         return self.mu * v + self.sigma * self.rate + sum(k * z for k, z in zip(self.k, self.z))

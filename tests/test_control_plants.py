@@ -41,7 +41,7 @@ def _fixed_model(which, offset=0.0, inertia=2.8e-4):
     if which == "gms":
         model = GMSModel()
         model.alpha_, model.k_ = np.array([0.1, 0.2, 0.3, 0.4]), np.array([30.0, 60.0, 20.0, 10.0])
-        model.C_, model.sigma_, model.s0_, model.s_inf_, model.v_s_, model.mu_ = 0.8, 0.02, 0.012, 0.008, 3.0, 0.006
+        model.slip_rate_, model.sigma_, model.s_0_, model.s_inf_, model.v_s_, model.viscous_ = 0.8, 0.02, 0.012, 0.008, 3.0, 0.006
         model.n_evaluations_ = 0
     else:
         model = LuGreModel()
@@ -160,8 +160,8 @@ def test_model_plants_slide_with_their_steady_friction(fitted_dynamic_models, wh
     result = simulate_loop(ModelPlant(model), _ramp(speed), resolution_mm=0.0)
     late = result.reference.time > 0.6
     if which == "gms":
-        s = model.s_inf_ + (model.s0_ - model.s_inf_) * np.exp(-abs(speed) / model.v_s_)
-        expected = -np.sum(model.k_ * model.alpha_) * s + model.mu_ * speed
+        s = model.s_inf_ + (model.s_0_ - model.s_inf_) * np.exp(-abs(speed) / model.v_s_)
+        expected = -np.sum(model.k_ * model.alpha_) * s + model.viscous_ * speed
     else:
         g = model.coulomb_ + (model.static_ - model.coulomb_) * np.exp(-abs(speed) / model.v_s_)
         expected = -g + model.viscous_ * speed

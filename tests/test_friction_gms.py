@@ -19,8 +19,8 @@ INERTIA = 0.001  # A s^2/mm
 def fitted(params=TRUTH, inertia=INERTIA):
     """A GMSModel carrying the given parameters, as if fitted on current logs."""
     model = GMSModel(n_elements=len(params["alpha"]))
-    model.alpha_, model.k_, model.C_, model.sigma_ = params["alpha"], params["k"], params["C"], params["sigma"]
-    model.s0_, model.s_inf_, model.v_s_, model.mu_ = params["s_0"], params["s_inf"], params["v_s"], params["mu"]
+    model.alpha_, model.k_, model.slip_rate_, model.sigma_ = params["alpha"], params["k"], params["C"], params["sigma"]
+    model.s_0_, model.s_inf_, model.v_s_, model.viscous_ = params["s_0"], params["s_inf"], params["v_s"], params["mu"]
     model.J_, model.offset_, model.effort_unit_ = inertia, 0.0, "A"
     return model
 
@@ -168,19 +168,19 @@ def test_identification_recovers_the_parameters_from_noise_free_data():
     truth = fitted()
     stiffness = np.sum(model.k_ * model.alpha_)
     true_stiffness = np.sum(TRUTH["k"] * TRUTH["alpha"])
-    assert stiffness * model.s0_ == pytest.approx(true_stiffness * TRUTH["s_0"], rel=1e-3)  # static level
+    assert stiffness * model.s_0_ == pytest.approx(true_stiffness * TRUTH["s_0"], rel=1e-3)  # static level
     assert stiffness * model.s_inf_ == pytest.approx(true_stiffness * TRUTH["s_inf"], rel=1e-3)  # Coulomb level
     assert model.v_s_ == pytest.approx(TRUTH["v_s"], rel=1e-2)
-    assert model.mu_ == pytest.approx(TRUTH["mu"], rel=1e-3)
+    assert model.viscous_ == pytest.approx(TRUTH["mu"], rel=1e-3)
     assert model.J_ == pytest.approx(INERTIA, rel=1e-3)
     # total pre-sliding stiffness and break-away deflection of the stiffest part of the curve
     assert np.sum(model.k_) == pytest.approx(np.sum(TRUTH["k"]), rel=0.02)
-    assert model.s0_ == pytest.approx(TRUTH["s_0"], rel=0.02)
+    assert model.s_0_ == pytest.approx(TRUTH["s_0"], rel=0.02)
     residual = model.predict(log) - log.effort
     assert np.sqrt(np.mean(residual ** 2)) < 1e-3 * np.std(log.effort)
     assert model.cost_ < 1e-6
-    check_gms_parameters(model.alpha_, model.k_, model.C_, model.sigma_, model.s0_, model.s_inf_, model.v_s_,
-                         model.mu_, sample_time=STEP)
+    check_gms_parameters(model.alpha_, model.k_, model.slip_rate_, model.sigma_, model.s_0_, model.s_inf_, model.v_s_,
+                         model.viscous_, sample_time=STEP)
     assert model.n_params == 14
     np.testing.assert_allclose(truth.predict(log), log.effort, atol=1e-12)
 
@@ -190,7 +190,7 @@ def test_identification_is_reproducible_for_a_seed_and_reports_progress():
     events = []
     first = GMSModel(n_starts=2, max_iter=60, random_state=7).fit(log, progress=events.append)
     second = GMSModel(n_starts=2, max_iter=60, random_state=7).fit(log)
-    for name in ("alpha_", "k_", "C_", "sigma_", "s0_", "s_inf_", "v_s_", "mu_", "J_", "cost_"):
+    for name in ("alpha_", "k_", "slip_rate_", "sigma_", "s_0_", "s_inf_", "v_s_", "viscous_", "J_", "cost_"):
         np.testing.assert_array_equal(getattr(first, name), getattr(second, name))
     assert {event.stage for event in events} == {"GMS pre-sliding", "GMS joint"}
     assert sum(event.done for event in events) == 3  # two pre-sliding starts, one joint search
@@ -214,5 +214,5 @@ def test_single_element_without_stages():
     model = GMSModel(n_elements=1, staged=False, n_starts=2, max_iter=200).fit(log)
     np.testing.assert_array_equal(model.alpha_, [1.0])
     assert model.k_[0] * model.s_inf_ == pytest.approx(45.0 * TRUTH["s_inf"], rel=1e-3)
-    assert model.s0_ == pytest.approx(TRUTH["s_0"], rel=0.02)
+    assert model.s_0_ == pytest.approx(TRUTH["s_0"], rel=0.02)
     assert model.n_params == 8

@@ -314,7 +314,7 @@ def test_missing_learned_attribute_is_one_clear_error(tmp_path, gms_file, attrib
 
 
 @pytest.mark.parametrize("change, message", [
-    (lambda d: d["model"]["attributes"].update(C_=-1.0), "C must be positive"),
+    (lambda d: d["model"]["attributes"].update(slip_rate_=-1.0), "C must be positive"),
     (lambda d: d["model"]["attributes"].update(k_=[1.0, 2.0]), "malformed|same length"),
     (lambda d: d["model"]["attributes"].update(J_="heavy"), "malformed|not finite|could not convert"),
     (lambda d: d["model"]["params"].update(n_elements=-2), "n_elements must be a positive integer"),
@@ -337,3 +337,22 @@ def test_flipped_byte_is_called_damaged_not_a_foreign_file(tmp_path, gms_file):
     path.write_bytes(bytes(data))
     with pytest.raises(ModelFileError, match=r"flipped\.gbm: damaged model file"):
         load_model(path)
+
+
+def test_format_1_files_are_read_with_the_old_attribute_names(tmp_path, gms_file):
+    """Version 1 named the GMS slip rate C_ (as the SVR's regularisation), its viscous coefficient mu_ and s0_."""
+    reference = load_model(gms_file)
+    path = tmp_path / "v1.gbm"
+    path.write_bytes(gms_file.read_bytes())
+
+    def to_version_1(document):
+        document["format_version"] = 1
+        attributes = document["model"]["attributes"]
+        for old, new in (("C_", "slip_rate_"), ("mu_", "viscous_"), ("s0_", "s_0_")):
+            attributes[old] = attributes.pop(new)
+
+    _rewrite_json(path, to_version_1)
+    old = load_model(path)
+    assert (old.slip_rate_, old.viscous_, old.s_0_) == (reference.slip_rate_, reference.viscous_, reference.s_0_)
+    run = _axis_run(3)
+    np.testing.assert_array_equal(old.predict(run), reference.predict(run))

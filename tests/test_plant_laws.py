@@ -177,7 +177,7 @@ def test_stable_step_of_stiffness_and_damping_on_the_inertia():
 def test_models_offer_their_law_and_static_models_none():
     gms = GMSModel()
     gms.alpha_, gms.k_ = GMS["alpha"], GMS["k"]
-    gms.C_, gms.sigma_, gms.s0_, gms.s_inf_, gms.v_s_, gms.mu_ = (GMS[key] for key in
+    gms.slip_rate_, gms.sigma_, gms.s_0_, gms.s_inf_, gms.v_s_, gms.viscous_ = (GMS[key] for key in
                                                                     ("c", "sigma", "s_0", "s_inf", "v_s", "mu"))
     gms.J_, gms.offset_ = 3e-4, 0.07
     law = gms.plant_law()

@@ -295,16 +295,16 @@ class GMSModel(CurrentModel):
         Element fractions (sum 1).
     k_ : ndarray, shape (N,)
         Element stiffnesses [A/mm].
-    C_ : float
-        Slip rate constant [mm/s].
+    slip_rate_ : float
+        Slip rate constant ``C`` [mm/s].
     sigma_ : float
         Micro-damping [A s/mm].
-    s0_, s_inf_ : float
+    s_0_, s_inf_ : float
         Stribeck curve of the break-away deflection at rest and at high speed [mm].
     v_s_ : float
         Stribeck velocity [mm/s].
-    mu_ : float
-        Viscous coefficient [A s/mm].
+    viscous_ : float
+        Viscous coefficient ``mu`` [A s/mm].
     J_ : float
         Inertia [A s^2/mm].
     offset_ : float
@@ -316,6 +316,9 @@ class GMSModel(CurrentModel):
     effort_unit_ : str
         Unit of the effort the model was fitted on, "A" or "N".
     """
+
+    #: Names of format-1 model files: the slip rate and the viscous coefficient had names other models use.
+    renamed_attributes = {"C_": "slip_rate_", "mu_": "viscous_", "s0_": "s_0_"}
 
     def __init__(self, *, n_elements: int = 4, fit_offset: bool = False, method: str = "nelder-mead",
                  n_starts: int = 4, random_state=0, max_iter: int = 400, staged: bool = True):
@@ -401,16 +404,16 @@ class GMSModel(CurrentModel):
         alpha, s_0, s_inf, v_s, c = shape
         self.alpha_ = alpha
         self.k_ = x[:n].copy()
-        self.sigma_, self.mu_, self.J_ = (float(value) for value in x[n:n + 3])
+        self.sigma_, self.viscous_, self.J_ = (float(value) for value in x[n:n + 3])
         self.offset_ = float(x[n + 3]) if self.fit_offset else 0.0
-        self.C_, self.s0_, self.s_inf_, self.v_s_ = float(c), float(s_0), float(s_inf), float(v_s)
+        self.slip_rate_, self.s_0_, self.s_inf_, self.v_s_ = float(c), float(s_0), float(s_inf), float(v_s)
         self.cost_ = float(residual @ residual)
         self.n_evaluations_ = int(n_evaluations)
 
     # ---------------------------------------------------------------- prediction
     def _parameters(self) -> dict:
-        return {"alpha": self.alpha_, "k": self.k_, "C": self.C_, "sigma": self.sigma_, "s_0": self.s0_,
-                "s_inf": self.s_inf_, "v_s": self.v_s_, "mu": self.mu_}
+        return {"alpha": self.alpha_, "k": self.k_, "C": self.slip_rate_, "sigma": self.sigma_, "s_0": self.s_0_,
+                "s_inf": self.s_inf_, "v_s": self.v_s_, "mu": self.viscous_}
 
     def initial_state(self) -> GMSState:
         """All elements relaxed and sticking."""
@@ -426,10 +429,10 @@ class GMSModel(CurrentModel):
         return [
             Parameter("alpha", self.alpha_, "-", "element fractions (sum 1)"),
             Parameter("k", self.k_, f"{EFFORT}/mm", "element stiffnesses"),
-            Parameter("C", self.C_, "mm/s", "slip rate constant"),
+            Parameter("slip_rate", self.slip_rate_, "mm/s", "slip rate constant C"),
             Parameter("sigma", self.sigma_, f"{EFFORT} s/mm", "micro-damping"),
-            Parameter("mu", self.mu_, f"{EFFORT} s/mm", "viscous coefficient"),
-            Parameter("s0", self.s0_, "mm", "break-away deflection at rest"),
+            Parameter("viscous", self.viscous_, f"{EFFORT} s/mm", "viscous coefficient mu"),
+            Parameter("s_0", self.s_0_, "mm", "break-away deflection at rest"),
             Parameter("s_inf", self.s_inf_, "mm", "break-away deflection at high speed"),
             Parameter("v_s", self.v_s_, "mm/s", "Stribeck velocity"),
         ]
@@ -488,17 +491,17 @@ class GMSModel(CurrentModel):
         PlantLaw
             The element law with ``J_`` [A s^2/mm] and ``offset_`` [A] as constant load.
         """
-        return gms_plant_law(alpha=self.alpha_, k=self.k_, sigma=self.sigma_, s_0=self.s0_, s_inf=self.s_inf_,
-                             v_s=self.v_s_, c=self.C_, mu=self.mu_, inertia=self.J_, offset=self.offset_)
+        return gms_plant_law(alpha=self.alpha_, k=self.k_, sigma=self.sigma_, s_0=self.s_0_, s_inf=self.s_inf_,
+                             v_s=self.v_s_, c=self.slip_rate_, mu=self.viscous_, inertia=self.J_, offset=self.offset_)
 
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:
         """Columns ``z_1..z_N, w, v, a (, 1)`` at the fitted element shape (``w = sum_i alpha_i dz_i/dt``)."""
-        z, _, w, _, _ = gms_trajectory(run.velocity, run.sample_time, alpha=self.alpha_, C=self.C_, s_0=self.s0_,
+        z, _, w, _, _ = gms_trajectory(run.velocity, run.sample_time, alpha=self.alpha_, C=self.slip_rate_, s_0=self.s_0_,
                                        s_inf=self.s_inf_, v_s=self.v_s_)
         n = z.shape[1]
         columns = list(z.T) + [w, run.velocity, run.acceleration]
-        names = [f"k{i + 1}" for i in range(n)] + ["sigma", "mu", "J"]
+        names = [f"k{i + 1}" for i in range(n)] + ["sigma", "viscous", "J"]
         if self.fit_offset:
             columns.append(np.ones(len(run)))
             names.append("offset")
@@ -506,12 +509,12 @@ class GMSModel(CurrentModel):
 
     def linear_coefficients(self) -> np.ndarray:
         """``k_1..k_N, sigma, mu, J (, offset)``."""
-        return np.concatenate((self.k_, [self.sigma_, self.mu_, self.J_], [self.offset_] if self.fit_offset else []))
+        return np.concatenate((self.k_, [self.sigma_, self.viscous_, self.J_], [self.offset_] if self.fit_offset else []))
 
     def set_linear_coefficients(self, values) -> None:
         """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model."""
         x = [float(value) for value in np.asarray(values, dtype=float)]
         n = len(self.alpha_)
         self.k_ = np.array(x[:n])
-        self.sigma_, self.mu_, self.J_ = x[n:n + 3]
+        self.sigma_, self.viscous_, self.J_ = x[n:n + 3]
         self.offset_ = x[n + 3] if self.fit_offset else 0.0
