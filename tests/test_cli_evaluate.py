@@ -98,6 +98,7 @@ def test_reproduce_refuses_a_non_empty_directory_and_missing_logs(files, tmp_pat
     assert not (tmp_path / "new").exists()
 
 
+@pytest.mark.slow  # end to end: synthetic logs, greybox reproduce --quick, report: 3.5-14 s on 2 cores
 def test_reproduce_quick_writes_the_report(tmp_path, capsys):
     data = tmp_path / "data"
     data.mkdir()

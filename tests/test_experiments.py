@@ -174,6 +174,7 @@ def test_reproduce_writes_the_report_and_model_files(tmp_path):
         np.testing.assert_array_equal(load_model(path).predict(test), fitted.predict(test))
 
 
+@pytest.mark.slow  # end to end, real fits with Bayesian optimisation: 5-10 s on 2 cores
 def test_gmssvr_beats_gms_and_stribeck_on_c_and_d():
     """Experiment 2 on shortened logs (A, C: 20 s; D: its first 25 s; B whole), with real fits:
     Bayesian optimisation of the SVR stage included. The synthetic axis has a position-dependent
