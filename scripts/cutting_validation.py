@@ -54,7 +54,7 @@ from greybox.data.axis_config import read_axis_config
 from greybox.data.io import read_log
 from greybox.data.prepare import prepare
 from greybox.evaluate.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
-from greybox.evaluate.metrics import rmse
+from greybox.metrics import rmse
 from greybox.evaluate.plots import finish_figure, import_pyplot
 from greybox.evaluate.process import force_constant_N_per_A, predict_process
 from greybox.models.chunked import predict_chunked

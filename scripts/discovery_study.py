@@ -38,7 +38,7 @@ from greybox.atomic import write_text_atomic
 from greybox.discover.report import write_json
 from greybox.discover.study import ABSORBED, StudyCase, run_case, run_null, summarise
 from greybox.discover.workflow import discover
-from greybox.evaluate.metrics import relerr
+from greybox.metrics import relerr
 from greybox.friction import CoulombModel, GMSModel
 
 #: The EMPS benchmark's figure of merit: relerr on the force decimated by 10 (zero-phase IIR), after

@@ -50,7 +50,7 @@ from greybox.data.io import read_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import derive, trim
 from greybox.errors import GreyboxError
-from greybox.evaluate.metrics import relerr
+from greybox.metrics import relerr
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 
 #: Default data folder: ``../shared/data/real/EMPS`` relative to the repository.

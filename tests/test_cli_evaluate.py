@@ -10,9 +10,9 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare, trim
-from greybox.evaluate.metrics import rmse
 from greybox.evaluate.regimes import REGIME_NAMES
 from greybox.friction import GMSModel, StribeckModel
+from greybox.metrics import rmse
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 

@@ -19,8 +19,8 @@ from greybox.evaluate.experiments import (
     reproduce,
     run_experiments,
 )
-from greybox.evaluate.metrics import rmse
 from greybox.evaluate.report import svr_generalisation
+from greybox.metrics import rmse
 from greybox.persistence import load_model
 from greybox.twin import make_dataset
 

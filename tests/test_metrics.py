@@ -9,8 +9,8 @@ import pytest
 
 from greybox.data.log import AxisLog
 from greybox.errors import LogError
-from greybox.evaluate.metrics import max_error, metrics_table, nmse, relative_error, relerr, rmse
 from greybox.evaluate.regimes import REGIME_NAMES, RegimeThresholds, metrics_by_regime, regime_masks
+from greybox.metrics import max_error, metrics_table, nmse, relative_error, relerr, rmse
 
 # ----------------------------------------------------------------- metrics
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..atomic import check_output_path
 from ..errors import GreyboxError, ModelFileError
-from ..evaluate.metrics import metrics_table
+from ..metrics import metrics_table
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model

@@ -41,7 +41,7 @@ from sklearn.base import clone
 
 from ..data.log import AxisLog
 from ..data.prepare import prepare
-from ..evaluate.metrics import rmse
+from ..metrics import rmse
 from ..twin import EFFECTS as TWIN_EFFECTS
 from ..twin import CurrentNoise, EffectInputs, axis_geometry, default_plant_parameters, make_dataset
 from ..twin import effect_current as twin_effect_current

@@ -28,9 +28,9 @@ from sklearn.base import clone
 
 from ..data.log import AxisLog
 from ..errors import GreyboxError
-from ..evaluate.metrics import metrics_table
-from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
 from ..estimator import check_runs
+from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
+from ..metrics import metrics_table
 from ..provenance import provenance
 from .augment import AugmentedModel
 from .effects import EFFECT_NAMES, effect

@@ -41,7 +41,7 @@ import numpy as np
 
 from ..data.log import AxisLog
 from ..errors import GreyboxError
-from .metrics import metrics_table
+from ..metrics import metrics_table
 
 __all__ = [
     "ModelSpec",

@@ -5,7 +5,7 @@ friction matters most: near zero velocity and at reversals. Tjahjowidodo et al.
 (IFAC 2005) therefore judge models separately on a low-velocity and a
 high-velocity envelope. This module splits a prepared :class:`~greybox.data.log.AxisLog`
 into such regimes (boolean masks over its samples) and computes
-:func:`~greybox.evaluate.metrics.metrics_table` on each.
+:func:`~greybox.metrics.metrics_table` on each.
 
 Regimes (a sample may belong to several):
 
@@ -46,7 +46,7 @@ import numpy as np
 
 from ..data.log import AxisLog, as_log_list
 from ..errors import LogError
-from .metrics import metrics_table
+from ..metrics import metrics_table
 
 __all__ = ["REGIME_NAMES", "RegimeThresholds", "regime_masks", "metrics_by_regime"]
 

@@ -17,6 +17,8 @@ from typing import Sequence
 
 import numpy as np
 
+from ..metrics import metrics_table
+
 __all__ = ["coverage_subset", "grid_cells", "accuracy_vs_subset_size"]
 
 
@@ -139,13 +141,12 @@ def accuracy_vs_subset_size(model, train_logs, test_logs, sizes: Sequence[int]) 
     -------
     list of dict
         Per size: ``n_subset``, ``fit_seconds`` [s], ``predict_seconds`` [s],
-        and the metrics of :func:`greybox.evaluate.metrics.metrics_table` on
+        and the metrics of :func:`greybox.metrics.metrics_table` on
         the test logs (``rmse`` [A], ``re`` [%], ...).
     """
     from sklearn.base import clone
 
     from ..data.log import as_log_list
-    from ..evaluate.metrics import metrics_table
 
     test_runs = as_log_list(test_logs)
     measured = np.concatenate([run.current for run in test_runs])
