@@ -1,38 +1,8 @@
 """Validation of ``greybox predict`` on the synthetic axis: recovery of a known cutting-force current.
 
-Protocol:
-
-1. every model kind is fitted with its default settings (as ``greybox train
-   --model KIND`` does) on the shipped air cuts ``data/X_A.mcap`` and
-   ``data/X_B.mcap``;
-2. cutting logs come from :func:`greybox.twin.make_dataset` with a
-   :class:`greybox.twin.cutting.CuttingSpec` (100 Hz tooth ripple, cutting on
-   negative feed over the central 60 % of the travelled range) on trajectories
-   not used in training: dataset C (random steps and sines, a new draw in the
-   measurement window) and D (1200 mm/min over the whole travel, a speed not
-   in training), with a seed other than the shipped data's. The cut strength
-   (mean process current at 1000 mm/min, full engagement) is swept over
-   ``--strengths``; ``--strength`` is the one of the detailed table;
-3. :func:`greybox.evaluate.process.predict_process` gives the process current
-   and force (axis metadata ``examples/axis_x.toml``); it is compared with
-   the log's ``truth_process_A`` (and the force this truth implies);
-4. the air-cut test RMSE is the model's RMSE on the shipped air cut of the
-   same dataset (``data/X_C.mcap``, ``data/X_D.mcap``: seed 2024), the figure
-   an ordinary evaluation of the model gives;
-5. the correlation ceiling is the correlation of the true process current
-   with itself plus the log's current noise (``truth_noise_A``): what a
-   perfect model would reach;
-6. the cut strength (and mean cut force) from which each model reaches the
-   correlation target ``--target`` follows from the recovery error, which
-   does not depend on the strength (:mod:`greybox.evaluate.cut_recovery`);
-   the swept logs check this.
-
-In the twin the cut changes neither the motion nor the noise, so the error of
-the recovered process current equals the model's residual on the same
-trajectory without the cut up to the 1 mA current resolution; the script
-checks this (``air_identity_A``, the largest difference over all strengths).
-On a machine the cut also changes the following error and the load on the
-screw, so expect the process error to exceed the air-cut error there.
+Runs the protocol of :mod:`greybox.studies.cutting` (models fitted on the
+shipped air cuts, cutting logs of the twin at several cut strengths, the
+process current recovered and compared with the truth) and prints its tables.
 
 Usage::
 
@@ -42,170 +12,14 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-import time
 from pathlib import Path
 
-import numpy as np
-
-from greybox.atomic import write_text_atomic
-from greybox.data.axis_config import read_axis_config
-from greybox.data.io import read_log
-from greybox.data.prepare import prepare
-from greybox.evaluate.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
-from greybox.metrics import rmse
-from greybox.evaluate.plots import finish_figure, import_pyplot
-from greybox.evaluate.process import force_constant_N_per_A, predict_process
-from greybox.models.chunked import predict_chunked
-from greybox.registry import MODEL_CLASSES
-from greybox.twin import make_dataset
+from greybox.errors import GreyboxError
+from greybox.studies.cutting import DEFAULT_STRENGTHS, KINDS, cutting_validation
 from greybox.twin.cutting import CuttingSpec
 
 ROOT = Path(__file__).resolve().parents[1]
-TRAIN_FILES = ("X_A.mcap", "X_B.mcap")
-TEST_DATASETS = ("C", "D")
-KINDS = ("coulomb", "stribeck", "lugre", "gms", "svr", "gmssvr")
-LABELS = {"coulomb": "Coulomb", "stribeck": "Stribeck", "lugre": "LuGre", "gms": "GMS", "svr": "SVR",
-          "gmssvr": "GMS+SVR"}
-
-
-class CuttingCase:
-    """The cutting logs of one trajectory at every swept strength, and its air cut.
-
-    Parameters
-    ----------
-    dataset : str
-        Dataset id (C or D).
-    seed : int
-        Seed of the synthetic logs.
-    strengths : sequence of float
-        Cut strengths [A at the reference feed].
-    data : Path
-        Folder of the shipped air cuts.
-    """
-
-    def __init__(self, dataset: str, seed: int, strengths, data: Path):
-        self.dataset = dataset
-        self.name = f"X_{dataset} seed {seed}"
-        self.strengths = tuple(strengths)
-        logs = [make_dataset("X", dataset, seed=seed, cutting=CuttingSpec(strength_A=s)) for s in self.strengths]
-        *self.cuts, self.air = prepare(logs + [make_dataset("X", dataset, seed=seed)])
-        self.shipped = prepare([read_log(data / f"X_{dataset}.mcap")])[0]
-        first = self.cuts[0]
-        self.unit_truth = first.extras["truth_process_A"] / self.strengths[0]
-        self.noise = first.extras["truth_noise_A"]
-        self.cutting = self.unit_truth != 0.0
-
-    def mean_cut_force_N(self, strength: float, factor: float) -> float:
-        """Mean force [N] of the cut at ``strength`` (magnitude), over the samples in the cut."""
-        return float(abs(strength * factor * np.mean(self.unit_truth[self.cutting])))
-
-
-def evaluate_model(kind: str, model, case: CuttingCase, config, detail_strength: float, target: float,
-                   chunk_s: float) -> tuple[dict, object]:
-    """All figures of one fitted model on one cutting case, and its result at the detailed strength."""
-    factor = force_constant_N_per_A(config)
-    air_residual = case.air.current - predict_chunked(model, case.air, chunk_s=chunk_s)
-    air_test = rmse(case.shipped.current, predict_chunked(model, case.shipped, chunk_s=chunk_s))
-    identity = 0.0
-    by_strength = {}
-    detail = None
-    for strength, cut in zip(case.strengths, case.cuts):
-        truth = cut.extras["truth_process_A"]
-        result = predict_process(model, cut, axis_config=config, chunk_s=chunk_s)
-        identity = max(identity, float(np.max(np.abs(result.process - truth - air_residual))))
-        metrics = recovery_metrics(truth, result.process, cut.extras["truth_noise_A"], factor)
-        by_strength[f"{strength:g}"] = {"strength_A": strength, **metrics}
-        if np.isclose(strength, detail_strength):
-            detail = (metrics, result)
-    error = -air_residual
-    needed = strength_for_correlation(case.unit_truth, error, target)
-    row = {
-        "model": kind,
-        "test": case.name,
-        "air_test_rmse_A": air_test,
-        "air_same_trajectory_rmse_A": float(np.sqrt(np.mean(air_residual**2))),
-        "air_identity_A": identity,
-        **detail[0],
-        "by_strength": by_strength,
-        "target": target,
-        "strength_for_target_A": needed,
-        "mean_cut_force_for_target_N": case.mean_cut_force_N(needed, factor) if np.isfinite(needed) else None,
-    }
-    return row, detail[1]
-
-
-def detail_table(rows: list[dict]) -> str:
-    """The detailed figures at one strength as a Markdown table."""
-    lines = [
-        "| model | cutting log | air-cut test RMSE [A] | process RMSE [A] | correlation (ceiling) "
-        "| process RMSE in cut [A] | force RMSE [N] | mean cut force true / estimated [N] |",
-        "|---|---|---:|---:|---:|---:|---:|---:|",
-    ]
-    for row in rows:
-        lines.append(
-            f"| {LABELS[row['model']]} | {row['test']} | {row['air_test_rmse_A']:.4f} | {row['process_rmse_A']:.4f} "
-            f"| {row['correlation']:.3f} ({row['correlation_ceiling']:.3f}) | {row['process_rmse_in_cut_A']:.4f} "
-            f"| {row['force_rmse_N']:.1f} "
-            f"| {row['mean_cut_force_true_N']:.1f} / {row['mean_cut_force_estimated_N']:.1f} |"
-        )
-    return "\n".join(lines) + "\n"
-
-
-def sweep_table(rows: list[dict], cases: dict, factor: float, target: float) -> str:
-    """Correlation per cut strength and the mean cut force needed for the target, as a Markdown table."""
-    strengths = next(iter(cases.values())).strengths
-    header = " | ".join(f"r at {s:g} A" for s in strengths)
-    lines = [f"| model | cutting log | {header} | r >= {target:g} from a cut of [A] / mean force [N] |",
-             "|---|---|" + "---:|" * len(strengths) + "---:|"]
-    for name, case in cases.items():
-        forces = ", ".join(f"{s:g} A: {case.mean_cut_force_N(s, factor):.0f} N" for s in strengths)
-        ceiling = [correlation_at_strength(case.unit_truth, case.noise, s) for s in strengths]
-        needed = strength_for_correlation(case.unit_truth, case.noise, target)
-        lines.append(f"| perfect model (noise only) | {name} ({forces}) | "
-                     + " | ".join(f"{r:.3f}" for r in ceiling)
-                     + f" | {_needed(needed, case.mean_cut_force_N(needed, factor))} |")
-        for row in rows:
-            if row["test"] != name:
-                continue
-            cells = " | ".join(f"{row['by_strength'][f'{s:g}']['correlation']:.3f}" for s in strengths)
-            lines.append(f"| {LABELS[row['model']]} | {name} | {cells} "
-                         f"| {_needed(row['strength_for_target_A'], row['mean_cut_force_for_target_N'])} |")
-    return "\n".join(lines) + "\n"
-
-
-def _needed(strength: float, force: float | None) -> str:
-    if not np.isfinite(strength):
-        return "not reached"
-    return f"{strength:.2f} / {force:.0f}"
-
-
-def plot_correlation_vs_force(rows: list[dict], cases: dict, factor: float, target: float, path: Path):
-    """Correlation of recovered and true process current against the mean cut force, one panel per log."""
-    plt = import_pyplot(path)
-    figure, axes = plt.subplots(1, len(cases), figsize=(5.5 * len(cases), 4.5), layout="constrained",
-                                sharey=True, squeeze=False)
-    for ax, (name, case) in zip(axes[0], cases.items()):
-        strengths = np.geomspace(0.05, 5.0, 60)
-        force = [case.mean_cut_force_N(s, factor) for s in strengths]
-        ceiling = [correlation_at_strength(case.unit_truth, case.noise, s) for s in strengths]
-        ax.plot(force, ceiling, color="black", lw=1.5, ls="--", label="perfect model (noise only)")
-        for row in rows:
-            if row["test"] != name:
-                continue
-            swept = sorted(row["by_strength"].values(), key=lambda item: item["strength_A"])
-            ax.plot([case.mean_cut_force_N(item["strength_A"], factor) for item in swept],
-                    [item["correlation"] for item in swept], marker="o", lw=1.2, label=LABELS[row["model"]])
-        ax.axhline(target, color="tab:red", lw=0.8, label=f"target r = {target:g}")
-        ax.set_xscale("log")
-        ax.set_xlabel("mean cut force [N]")
-        ax.set_title(name)
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].set_ylabel("correlation of recovered and true process current")
-    axes[0][0].set_ylim(0.0, 1.0)
-    axes[0][-1].legend(loc="lower right", fontsize="small")
-    return finish_figure(figure, path)
 
 
 def _floats(text: str) -> tuple[float, ...]:
@@ -221,7 +35,7 @@ def main(argv=None) -> int:
     parser.add_argument("--axis-config", type=Path, default=ROOT / "examples" / "axis_x.toml")
     parser.add_argument("--seed", type=int, default=7, help="seed of the cutting logs (the shipped data use 2024)")
     parser.add_argument("--models", default=",".join(KINDS), help="comma-separated model kinds")
-    parser.add_argument("--strengths", type=_floats, default=(0.25, 0.5, 1.0, 2.0),
+    parser.add_argument("--strengths", type=_floats, default=DEFAULT_STRENGTHS,
                         help="cut strengths swept [A at 1000 mm/min, full engagement], comma-separated")
     parser.add_argument("--strength", type=float, default=CuttingSpec().strength_A,
                         help="cut strength of the detailed table [A] (one of --strengths)")
@@ -234,55 +48,19 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     kinds = [k.strip() for k in args.models.split(",") if k.strip()]
-    unknown = sorted(set(kinds) - set(MODEL_CLASSES))
-    if unknown:
-        parser.error(f"unknown model kind(s) {unknown}; known: {sorted(MODEL_CLASSES)}")
-    if not any(np.isclose(args.strength, s) for s in args.strengths):
-        parser.error(f"--strength {args.strength:g} is not one of --strengths {args.strengths}")
-    config = read_axis_config(args.axis_config)
-    factor = force_constant_N_per_A(config)
-    train = prepare([read_log(args.data / name) for name in TRAIN_FILES])
-    cases = {case.name: case for case in (CuttingCase(d, args.seed, args.strengths, args.data) for d in TEST_DATASETS)}
-    print(f"training on {', '.join(TRAIN_FILES)} ({sum(len(r) for r in train)} samples); "
-          f"force constant {factor:.1f} N/A from {args.axis_config.name}; cut strengths "
-          f"{', '.join(f'{s:g}' for s in args.strengths)} A", flush=True)
-    if args.plot_dir:
-        args.plot_dir.mkdir(parents=True, exist_ok=True)
-
-    rows = []
-    for kind in kinds:
-        started = time.perf_counter()
-        model = MODEL_CLASSES[kind]().fit(train)
-        fit_s = time.perf_counter() - started
-        for name, case in cases.items():
-            row, result = evaluate_model(kind, model, case, config, args.strength, args.target, args.chunk_s)
-            rows.append({**row, "fit_s": fit_s})
-            swept = "  ".join(f"{s:g} A: {row['by_strength'][f'{s:g}']['correlation']:.3f}" for s in args.strengths)
-            print(f"{kind:<9} {name:<14} fit {fit_s:6.1f} s  air-cut test RMSE {row['air_test_rmse_A']:.4f} A  "
-                  f"process RMSE {row['process_rmse_A']:.4f} A  r {swept}  "
-                  f"|process error - air residual| <= {row['air_identity_A'] * 1e3:.2f} mA", flush=True)
-            if args.plot_dir:
-                from greybox.evaluate.process_plot import plot_process
-
-                plot_process(result, args.plot_dir / f"predict_{kind}_X_{case.dataset}.png")
-
-    tables = (f"Cut strength {args.strength:g} A at 1000 mm/min:\n\n" + detail_table(rows)
-              + "\nCorrelation by cut strength:\n\n" + sweep_table(rows, cases, factor, args.target))
+    try:
+        result = cutting_validation(args.data, args.axis_config, seed=args.seed, kinds=kinds,
+                                    strengths=args.strengths, strength=args.strength, target=args.target,
+                                    chunk_s=args.chunk_s, markdown_path=args.markdown, json_path=args.json,
+                                    plot_dir=args.plot_dir, progress=lambda line: print(line, flush=True))
+    except GreyboxError as error:
+        parser.error(str(error))
     print()
-    print(tables, end="")
-    noise = ", ".join(f"{name} {np.sqrt(np.mean(case.noise ** 2)):.4f} A" for name, case in cases.items())
+    print(result.tables, end="")
+    noise = ", ".join(f"{name} {rms:.4f} A" for name, rms in result.noise_rms_A.items())
     print(f"noise floor rms(truth_noise_A): {noise}")
-    if args.markdown:
-        write_text_atomic(args.markdown, tables)
-    if args.json:
-        write_text_atomic(args.json, json.dumps({
-            "seed": args.seed, "train": list(TRAIN_FILES), "axis_config": str(args.axis_config),
-            "force_constant_N_per_A": factor, "strengths_A": list(args.strengths), "detail_strength_A": args.strength,
-            "rows": rows}, indent=2) + "\n")
-    if args.plot_dir:
-        written = plot_correlation_vs_force(rows, cases, factor, args.target,
-                                            args.plot_dir / "correlation_vs_cut_force.png")
-        print(f"wrote {written}")
+    if result.figure is not None:
+        print(f"wrote {result.figure}")
     return 0
 
 

@@ -1,38 +1,36 @@
-"""The cutting validation script, run small: its tables, figures and the strength sweep hold together."""
+"""The cutting validation, run small: its tables, figures and the strength sweep hold together."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from greybox.errors import GreyboxError
+from greybox.studies.cutting import cutting_validation
+
 REPO = Path(__file__).resolve().parents[1]
 SCRIPT = REPO / "scripts" / "cutting_validation.py"
-
-
-def _load_script():
-    spec = importlib.util.spec_from_file_location("cutting_validation", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+DATA = REPO / "data"
+AXIS_CONFIG = REPO / "examples" / "axis_x.toml"
 
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     out = tmp_path_factory.mktemp("validation")
-    script = _load_script()
-    status = script.main(["--models", "coulomb,stribeck", "--strengths", "0.5,2", "--strength", "0.5",
-                          "--json", str(out / "v.json"), "--markdown", str(out / "v.md"),
-                          "--plot-dir", str(out / "figures")])
-    return status, out, json.loads((out / "v.json").read_text())
+    validation = cutting_validation(DATA, AXIS_CONFIG, kinds=("coulomb", "stribeck"), strengths=(0.5, 2.0),
+                                    strength=0.5, json_path=out / "v.json", markdown_path=out / "v.md",
+                                    plot_dir=out / "figures")
+    return validation, out, json.loads((out / "v.json").read_text())
 
 
-def test_script_writes_every_output(run):
-    status, out, result = run
-    assert status == 0
+def test_every_output_is_written(run):
+    validation, out, result = run
+    assert validation.figure == out / "figures" / "correlation_vs_cut_force.png"
     assert (out / "figures" / "correlation_vs_cut_force.png").read_bytes()[:4] == b"\x89PNG"
     assert (out / "figures" / "predict_coulomb_X_D.png").exists()
     table = (out / "v.md").read_text()
@@ -65,7 +63,21 @@ def test_correlation_rises_with_strength_and_the_threshold_sits_between(run):
                 abs(weak["mean_cut_force_true_N"]) * needed / 0.5, rel=1e-9)
 
 
-def test_strength_of_the_table_must_be_swept():
-    script = _load_script()
-    with pytest.raises(SystemExit):
-        script.main(["--models", "coulomb", "--strengths", "0.5,2", "--strength", "1"])
+def test_strength_of_the_table_must_be_swept_and_kinds_registered():
+    with pytest.raises(GreyboxError, match="not one of the swept strengths"):
+        cutting_validation(DATA, AXIS_CONFIG, kinds=("coulomb",), strengths=(0.5, 2.0), strength=1.0)
+    with pytest.raises(GreyboxError, match="unknown model kind"):
+        cutting_validation(DATA, AXIS_CONFIG, kinds=("coulombb",), strengths=(0.5,), strength=0.5)
+
+
+def test_the_script_runs_as_a_user_runs_it(tmp_path):
+    result = subprocess.run([sys.executable, str(SCRIPT), "--models", "coulomb", "--strengths", "0.5,2",
+                             "--strength", "0.5", "--json", str(tmp_path / "v.json")],
+                            capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert "Correlation by cut strength" in result.stdout and "noise floor rms(truth_noise_A)" in result.stdout
+    assert [row["model"] for row in json.loads((tmp_path / "v.json").read_text())["rows"]] == ["coulomb"] * 2
+    refused = subprocess.run([sys.executable, str(SCRIPT), "--models", "coulomb", "--strengths", "0.5,2",
+                              "--strength", "1"], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert refused.returncode == 2 and "not one of the swept strengths" in refused.stderr
+    assert "Traceback" not in refused.stderr

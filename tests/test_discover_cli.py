@@ -8,13 +8,13 @@ import json
 import numpy as np
 import pytest
 
+from greybox import registry
 from greybox.cli import discover as discover_cli
 from greybox.data.io import write_log
 from greybox.discover.augment import AugmentedModel
-from greybox.discover.study import StudyCase, case_logs
 from greybox.errors import GreyboxError
-from greybox import registry
 from greybox.persistence import load_model
+from greybox.studies.discovery import StudyCase, case_logs
 
 
 def run_cli(argv):

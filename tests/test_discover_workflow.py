@@ -1,4 +1,4 @@
-"""The discovery workflow: a seeded small version of the validation study (scripts/discovery_study.py).
+"""The discovery workflow: a seeded small version of the validation study (:mod:`greybox.studies.discovery`).
 
 Coulomb plant (the base model class is exactly right), 20 s logs: null data
 must give "nothing_missing", each hidden library effect must be named and
@@ -15,10 +15,10 @@ import pytest
 
 from greybox.discover.effects import EFFECT_NAMES
 from greybox.discover.report import write_json
-from greybox.discover.study import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
 from greybox.discover.workflow import VERDICTS, discover
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel
+from greybox.studies.discovery import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
 
 DURATION_S = 20.0
 

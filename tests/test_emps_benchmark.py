@@ -1,7 +1,7 @@
-"""The EMPS benchmark script reproduces the published IDIM-LS results on the real data.
+"""The EMPS benchmark protocol reproduces the published IDIM-LS results on the real data.
 
 Reference figures are the published ones (Janot, Gautier & Brunot 2019, "Data
-Set and Reference Models of EMPS"), typed in here independently of the script.
+Set and Reference Models of EMPS"), typed in here independently of the protocol.
 Our preprocessing uses scipy's filters, whose edge handling differs slightly
 from MATLAB's, hence the tolerances: 2 % on parameters, 0.2 percentage points
 on relerr.
@@ -9,7 +9,6 @@ on relerr.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import subprocess
 import sys
@@ -18,7 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel
+from greybox.studies import emps as bench
 
 REPO = Path(__file__).resolve().parents[1]
 SCRIPT = REPO / "scripts" / "emps_benchmark.py"
@@ -28,16 +29,6 @@ ASYMMETRIC = {"M_kg": 95.1540, "Fv_pos_N_s_per_m": 166.7061, "Fc_pos_N": 20.1440
               "Fv_neg_N_s_per_m": 240.4236, "Fc_neg_N": 20.6277}
 TRAIN_RELERR, TEST_RELERR, ASYM_TRAIN_RELERR = 4.0834, 5.9824, 3.1117
 CONDITION_NUMBER = 25.9883
-
-
-def _load_script():
-    spec = importlib.util.spec_from_file_location("emps_benchmark", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-bench = _load_script()
 
 
 @pytest.fixture(scope="module")
@@ -110,14 +101,19 @@ def test_script_writes_json_markdown_and_plot(tmp_path, emps):
         assert 0 < entry["train_relerr"] < 10 and 0 < entry["test_relerr"] < 10
         assert entry["params"]
     assert models["coulomb_idim_ls"]["params"]["M_kg"] == pytest.approx(SYMMETRIC["M_kg"], rel=0.02)
+    # the greybox models' parameters are their parameter tables: every value with its unit
+    assert set(models["stribeck"]["units"]) == set(models["stribeck"]["params"])
+    assert models["stribeck"]["units"]["v_s"] == "mm/s" and models["coulomb"]["units"]["offset"] == "N"
     assert "| `stribeck` |" in md.read_text()
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
 
 
-def test_missing_data_folder_is_reported(tmp_path, capsys):
-    status = bench.main(["--json", str(tmp_path / "x.json"), "--data", str(tmp_path / "nowhere")])
-    stderr = capsys.readouterr().err
-    assert status == 2
-    assert "nowhere" in stderr and "Traceback" not in stderr
+def test_missing_data_folder_is_reported(tmp_path):
+    with pytest.raises(GreyboxError, match="nowhere"):
+        bench.emps_benchmark(tmp_path / "nowhere", tmp_path / "x.json")
+    result = subprocess.run([sys.executable, str(SCRIPT), "--json", str(tmp_path / "x.json"),
+                             "--data", str(tmp_path / "nowhere")], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 2
+    assert "nowhere" in result.stderr and "Traceback" not in result.stderr
     assert not (tmp_path / "x.json").exists()

@@ -8,10 +8,13 @@ import pytest
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare, trim
 from greybox.errors import GreyboxError
-from greybox.evaluate.experiments import (
+from greybox.evaluate.records import NOISE_FLOOR
+from greybox.evaluate.report import svr_generalisation
+from greybox.metrics import rmse
+from greybox.persistence import load_model
+from greybox.studies.experiments import (
     EXPERIMENTS,
     MODEL_SETTINGS,
-    NOISE_FLOOR,
     Experiment,
     ModelSpec,
     find_log,
@@ -19,9 +22,6 @@ from greybox.evaluate.experiments import (
     reproduce,
     run_experiments,
 )
-from greybox.evaluate.report import svr_generalisation
-from greybox.metrics import rmse
-from greybox.persistence import load_model
 from greybox.twin import make_dataset
 
 #: Fast model settings for the tests: few GMS starts, fixed (default) SVR hyperparameters.

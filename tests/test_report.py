@@ -12,14 +12,13 @@ import pytest
 
 from greybox.data.log import AxisLog
 from greybox.errors import GreyboxError
-from greybox.evaluate.experiments import metric_record
 from greybox.evaluate.figures import error_boxplot, residual_vs_position, split_runs, time_comparison
 from greybox.evaluate.html import render_html, write_html
+from greybox.evaluate.records import metric_record
 from greybox.evaluate.report import (
     CSV_COLUMNS,
     PAPER_RE,
     RE_NOTE,
-    Table,
     check_output_dir,
     experiment_table,
     hyperparameter_table,
@@ -31,6 +30,7 @@ from greybox.evaluate.report import (
     write_metrics,
     write_report,
 )
+from greybox.evaluate.table import Table
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

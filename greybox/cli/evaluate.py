@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import GreyboxError
-from ..evaluate.experiments import evaluate_models
-from ..evaluate.regimes import REGIME_NAMES
 from ..atomic import write_text_atomic
-from ..evaluate.report import RE_NOTE, check_output_dir, records_json, write_evaluation_report
+from ..errors import GreyboxError
+from ..evaluate.records import evaluate_models, write_evaluation_report
+from ..evaluate.regimes import REGIME_NAMES
+from ..evaluate.report import RE_NOTE, check_output_dir, records_json
 from ..persistence import load_model
 from ._options import add_log_arguments, read_logs
 

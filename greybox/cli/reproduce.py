@@ -9,8 +9,8 @@ import time
 from pathlib import Path
 
 from ..errors import GreyboxError
-from ..evaluate.experiments import EXPERIMENTS, find_log, reproduce
 from ..evaluate.report import check_output_dir
+from ..studies.experiments import EXPERIMENTS, find_log, reproduce
 
 
 def default_data_dir() -> Path:

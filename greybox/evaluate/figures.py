@@ -24,8 +24,7 @@ from ..data.log import AxisLog
 from .plots import import_pyplot, save_figure
 from .report import MODEL_LABELS
 
-__all__ = ["MODEL_COLORS", "TIME_MODELS", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs",
-           "experiment_figures"]
+__all__ = ["MODEL_COLORS", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs"]
 
 #: Line colours of the models, the same in every figure.
 MODEL_COLORS = {
@@ -234,57 +233,3 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
     axes[0, 0].legend(loc="upper right", fontsize="small")
     figure.suptitle(title)
     return save_figure(figure, path)
-
-
-#: Models drawn in the time-domain comparisons (the paper's Figs. 4 and 6), when present.
-TIME_MODELS = ("stribeck", "svr", "gms", "gmssvr")
-
-
-def experiment_figures(results, experiment, out_dir: str | os.PathLike) -> list[tuple[str, Path]]:
-    """The figures of one experiment over all axes: box plot, time comparisons, residual maps.
-
-    Parameters
-    ----------
-    results : sequence of greybox.evaluate.experiments.AxisResults
-        One per axis.
-    experiment : greybox.evaluate.experiments.Experiment
-    out_dir : path-like
-        Directory of the PNG files (``exp<n>_*.png``).
-
-    Returns
-    -------
-    list of (caption, path)
-    """
-    from .experiments import TRUTH_CHANNEL
-
-    out_dir = Path(out_dir)
-    n = experiment.number
-    test = "+".join(experiment.test)
-    figures = []
-    panels = []
-    for axis_results in results:
-        runs = [axis_results.logs[d] for d in experiment.test]
-        predictions = {m.name: [m.test_prediction[d] for d in experiment.test]
-                       for m in axis_results.experiments[n]}
-        if all(TRUTH_CHANNEL in run.extras for run in runs):
-            predictions["noise_floor"] = [run.extras[TRUTH_CHANNEL] for run in runs]
-        panels.append((f"axis {axis_results.axis}, test on {test}", runs, predictions))
-    figure_number = {1: "Fig. 3", 2: "Fig. 5"}.get(n, "")
-    path = error_boxplot(panels, out_dir / f"exp{n}_error_boxplot.png",
-                         title=f"Experiment {n}: absolute error on {test}")
-    figures.append((f"Experiment {n}: absolute error of each model on {test} "
-                    f"(boxes: quartiles, whiskers: 5th-95th percentile; like the paper's {figure_number})", path))
-    figure_number = {1: "Fig. 4", 2: "Fig. 6"}.get(n, "")
-    for axis_results, (_, runs, predictions) in zip(results, panels):
-        axis = axis_results.axis
-        shown = {m: predictions[m] for m in TIME_MODELS if m in predictions}
-        path = time_comparison(runs, shown, out_dir / f"exp{n}_time_{axis}.png",
-                               title=f"Experiment {n}, axis {axis}: measured and modelled current")
-        figures.append((f"Experiment {n}, axis {axis}: measured and modelled current on {test} "
-                        f"(like the paper's {figure_number})", path))
-        models = {m: p for m, p in predictions.items() if m != "noise_floor"}
-        path = residual_vs_position(runs, models, out_dir / f"exp{n}_residual_position_{axis}.png",
-                                    title=f"Experiment {n}, axis {axis}: residual against position on {test}")
-        figures.append((f"Experiment {n}, axis {axis}: measured minus modelled current against position, "
-                        f"by direction of motion, on {test}", path))
-    return figures

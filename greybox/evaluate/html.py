@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Sequence
 
 from ..atomic import write_text_atomic
-from .report import Table
+from .table import Table
 
 __all__ = ["render_html", "write_html", "STYLE"]
 

@@ -2,7 +2,7 @@
 
 A report is built from *metric records*, one per model, axis, experiment and
 side (``train`` or ``test``), as made by
-:func:`greybox.evaluate.experiments.metric_record`::
+:func:`greybox.evaluate.records.metric_record`::
 
     {"experiment": 1, "axis": "X", "model": "gms", "dataset": "test",
      "rmse": 0.071, "re": 7.2, "logs": "C", "n": 60552, "nmse": ..., "max_error": ...,
@@ -19,7 +19,7 @@ Files written by :func:`write_report`:
 ``metrics.csv``
     The same records without ``per_log``, one row each.
 ``tables.md``
-    Markdown tables (:class:`Table`): one per experiment in the layout of
+    Markdown tables (:class:`~greybox.evaluate.table.Table`): one per experiment in the layout of
     the paper's Tables 3 and 4 with the published figures beside ours, the
     SVR hyperparameters like the paper's Table 2, the noise-floor ratio of the
     grey-box model, the sole SVR's change from training to each test log, and
@@ -35,14 +35,14 @@ import io
 import json
 import math
 import os
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
 from ..atomic import write_text_atomic
+from .html import write_html
+from .table import Table
 
 __all__ = [
-    "Table",
     "MODEL_LABELS",
     "PAPER_RE",
     "PAPER_SOURCE",
@@ -52,7 +52,6 @@ __all__ = [
     "json_ready",
     "records_json",
     "write_metrics",
-    "write_evaluation_report",
     "experiment_table",
     "hyperparameter_table",
     "noise_floor_ratios",
@@ -105,35 +104,6 @@ RE_NOTE = (
 
 #: Columns of ``metrics.csv``, in order.
 CSV_COLUMNS = ("experiment", "axis", "model", "dataset", "logs", "n", "rmse", "re", "nmse", "max_error")
-
-
-@dataclass
-class Table:
-    """A titled table of text cells, rendered to Markdown here and to HTML in :mod:`greybox.evaluate.html`.
-
-    Attributes
-    ----------
-    title : str
-    header : list of str
-    rows : list of list of str
-    notes : list of str
-        Sentences printed under the table.
-    """
-
-    title: str
-    header: list[str]
-    rows: list[list[str]]
-    notes: list[str] = field(default_factory=list)
-
-    def to_markdown(self) -> str:
-        """The table as a Markdown section (``###`` title, pipe table, notes)."""
-        lines = [f"### {self.title}", "", "| " + " | ".join(self.header) + " |",
-                 "|" + "|".join("---" for _ in self.header) + "|"]
-        lines += ["| " + " | ".join(row) + " |" for row in self.rows]
-        if self.notes:
-            lines.append("")
-            lines += [f"{note}  " if i < len(self.notes) - 1 else note for i, note in enumerate(self.notes)]
-        return "\n".join(lines) + "\n"
 
 
 # ---------------------------------------------------------------- writing files
@@ -512,53 +482,8 @@ def write_report(out_dir: str | os.PathLike, records: Sequence[Mapping], tables:
     dict
         ``{"metrics_json", "metrics_csv", "tables", "html"}`` -> written file.
     """
-    from .html import write_html
-
     out_dir = Path(out_dir)
     json_path, csv_path = write_metrics(records, out_dir)
     tables_path = write_text_atomic(out_dir / "tables.md", tables_markdown(tables, title, intro))
     html_path = write_html(out_dir / "index.html", title=title, intro=intro, tables=tables, figures=figures)
     return {"metrics_json": json_path, "metrics_csv": csv_path, "tables": tables_path, "html": html_path}
-
-
-def write_evaluation_report(out_dir: str | os.PathLike, records: Sequence[Mapping], predictions: Mapping,
-                            runs, run_names: Sequence[str]) -> dict[str, Path]:
-    """The report of ``greybox evaluate``: error and regime tables, three figures, the HTML page.
-
-    Parameters
-    ----------
-    out_dir : path-like
-        Report directory (created if missing).
-    records : sequence of dict
-        Records of :func:`greybox.evaluate.experiments.evaluate_models`.
-    predictions : dict
-        ``{model: predicted current [A], runs concatenated}``.
-    runs : list of AxisLog
-        Prepared test runs.
-    run_names : sequence of str
-        Their names.
-
-    Returns
-    -------
-    dict
-        As :func:`write_report`, plus ``figures``.
-    """
-    from .experiments import NOISE_FLOOR
-    from .figures import error_boxplot, residual_vs_position, time_comparison
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(exist_ok=True)
-    tests = "+".join(run_names)
-    models = {name: p for name, p in predictions.items() if name != NOISE_FLOOR}
-    figures = [
-        (f"Absolute error of each model on {tests} (boxes: quartiles, whiskers: 5th-95th percentile)",
-         error_boxplot([(f"test on {tests}", runs, predictions)], out_dir / "error_boxplot.png")),
-        (f"Measured and modelled current on {tests}",
-         time_comparison(runs, models, out_dir / "time_comparison.png", names=run_names)),
-        (f"Measured minus modelled current against position, by direction of motion, on {tests}",
-         residual_vs_position(runs, models, out_dir / "residual_position.png")),
-    ]
-    files = write_report(out_dir, records, [evaluation_table(records), regime_table(records)], figures,
-                         title="greybox: model evaluation", intro=f"Models tested on {tests}.")
-    files["figures"] = [path for _, path in figures]
-    return files

@@ -29,29 +29,42 @@ hidden effect, simulated on that log's motion, plus noise like its residual
 (:class:`~greybox.discover.noise.ResidualNoise`): nothing is missing from
 the model by construction, so any verdict but ``nothing_missing`` is a false
 positive.
+
+:func:`run_section` runs a whole section of the study (many cases, nulls and
+the summary, or the workflow on the real EMPS benchmark) and writes its
+files; ``scripts/discovery_study.py`` is its command (docs/discover.md).
 """
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from sklearn.base import clone
 
+from ..atomic import write_text_atomic
+from ..data.io import read_log
 from ..data.log import AxisLog
 from ..data.prepare import prepare
-from ..metrics import rmse
+from ..discover.augment import AugmentedModel
+from ..discover.effects import EFFECT_NAMES, EffectContext, effect
+from ..discover.noise import ResidualNoise
+from ..discover.report import write_json
+from ..discover.workflow import discover
+from ..friction import CoulombModel, GMSModel
+from ..metrics import relerr, rmse
 from ..twin import EFFECTS as TWIN_EFFECTS
 from ..twin import CurrentNoise, EffectInputs, axis_geometry, default_plant_parameters, make_dataset
 from ..twin import effect_current as twin_effect_current
-from .augment import AugmentedModel
-from .effects import EffectContext, effect
-from .noise import ResidualNoise
-from .workflow import discover
+from .emps import BORDER as EMPS_BORDER
+from .emps import decimate_benchmark
 
-__all__ = ["PLANTS", "TRUE_SHAPES", "HIDDEN_LIBRARY_TERMS", "ABSORBED", "StudyCase", "case_logs", "null_logs",
-           "run_case", "run_null", "summarise"]
+__all__ = ["PLANTS", "TRUE_SHAPES", "HIDDEN_LIBRARY_TERMS", "ABSORBED", "SECTIONS", "StudyCase", "case_logs",
+           "null_logs", "run_case", "run_null", "summarise", "benchmark_relerr", "emps_section", "markdown",
+           "run_section"]
 
 #: Plants a case may use.
 PLANTS = ("coulomb", "twin")
@@ -290,3 +303,212 @@ def summarise(cases: list[dict], nulls: list[dict], *, min_ratio: float = 0.5) -
                                    for ratio, rows in cells.items()}
                             for name, cells in by_effect.items()},
     }
+
+
+# ---------------------------------------------------------------- the study's sections
+#: Sections of the study and their default settings: the base model, log length [s], seeds per effect and
+#: ratio, null data sets and effect RMS / noise RMS ratios. ``emps`` runs on the real EMPS benchmark.
+SECTIONS = {
+    "coulomb": {"base": CoulombModel, "duration": 30.0, "seeds": 5, "null_seeds": 1000,
+                "ratios": (0.25, 0.5, 1.0, 2.0)},
+    "twin": {"base": GMSModel, "duration": 60.0, "seeds": 2, "null_seeds": 40, "ratios": (0.5, 1.0, 2.0)},
+    "emps": {},
+}
+
+
+def benchmark_relerr(runs, prediction) -> float:
+    """relerr [%] on the EMPS benchmark's decimated samples of one run (:mod:`greybox.studies.emps`)."""
+    (run,) = runs
+    measured = decimate_benchmark(run.effort[EMPS_BORDER:])
+    modelled = decimate_benchmark(prediction[EMPS_BORDER:])
+    return relerr(measured, modelled)
+
+
+def emps_section(data: str | os.PathLike, json_path: str | os.PathLike, *, markdown_path=None,
+                 progress=None) -> str:
+    """Discovery on EMPS with a Coulomb and a GMS base; findings and errors before and after.
+
+    Parameters
+    ----------
+    data : path-like
+        Directory of ``DATA_EMPS.mat`` (training) and ``DATA_EMPS_PULSES.mat`` (test).
+    json_path : path-like
+        Every base's discovery document and benchmark errors.
+    markdown_path : path-like, optional
+        The table.
+    progress : callable, optional
+        Receives the workflow's progress lines, prefixed with the base.
+
+    Returns
+    -------
+    str
+        The table (Markdown).
+    """
+    say = progress or (lambda line: None)
+    train = prepare([read_log(Path(data) / "DATA_EMPS.mat")])
+    test = prepare([read_log(Path(data) / "DATA_EMPS_PULSES.mat")])
+    report, lines = {}, ["| base | named (in order) | train relerr % (decimated) | test relerr % (decimated) "
+                         "| test RMSE N (1 kHz) | test RMSE constant feed N | s |", "|---|---|---|---|---|---|---|"]
+    bases = (("coulomb --offset", CoulombModel(fit_offset=True)), ("gms --offset", GMSModel(fit_offset=True)))
+    for label, base in bases:
+        result = discover(base, train, test, progress=lambda text, label=label: say(f"{label}: {text}"))
+        before = {name: result.base_model.predict(runs) for name, runs in (("train", train), ("test", test))}
+        after = {name: result.model.predict(runs) for name, runs in (("train", train), ("test", test))}
+        figures = {f"{name}_relerr_{when}": benchmark_relerr(runs, values[name])
+                   for name, runs in (("train", train), ("test", test))
+                   for when, values in (("before", before), ("after", after))}
+        feed = result.test["regimes"]["constant_feed"]
+        report[label] = {"document": result.to_dict(), "benchmark": figures}
+        named = "; ".join(f"{e['name']} ({', '.join(f'{k} {v:.4g}' for k, v in e['parameters'].items())})"
+                          for e in result.effects) or "-"
+        lines.append(f"| {label} | {named} "
+                     f"| {figures['train_relerr_before']:.2f} -> {figures['train_relerr_after']:.2f} "
+                     f"| {figures['test_relerr_before']:.2f} -> {figures['test_relerr_after']:.2f} "
+                     f"| {result.test['rmse_before']:.3f} -> {result.test['rmse_after']:.3f} "
+                     f"| {feed['rmse_before']:.3f} -> {feed['rmse_after']:.3f} | {result.seconds:.0f} |")
+    text = "\n".join(lines) + "\n"
+    write_json(report, json_path)
+    if markdown_path:
+        write_text_atomic(markdown_path, text)
+    return text
+
+
+def _fmt(value, spec=".2f") -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def markdown(section: str, settings: dict, summary: dict, cases: list, nulls: list, seconds: float) -> str:
+    """The tables of a synthetic section: the study's figures against their targets, and per effect and ratio."""
+    fp, acc, closure = summary["false_positive"], summary["accuracy"], summary["closure"]
+    lines = [
+        f"### Section `{section}`: {settings['description']}",
+        "",
+        f"Base model {settings['base']}, logs of {settings['duration']:g} s (train: dataset A, test: dataset C), "
+        f"{settings['seeds']} seed(s) per cell, {settings['null_seeds']} null data sets; "
+        f"{len(cases) + len(nulls)} workflow runs in {seconds / 60:.1f} min.",
+        "",
+        "| figure | measured | target |",
+        "|---|---|---|",
+        f"| false positives on null data (verdict other than nothing_missing) | {fp['count']}/{fp['n']} = "
+        f"{100 * fp['rate']:.1f} % (95 % CI {100 * fp['interval_95'][0]:.1f}-{100 * fp['interval_95'][1]:.1f} %) "
+        f"| <= 5 % |",
+        f"| naming accuracy, effect RMS >= {acc['min_ratio']:g} x noise RMS (absorbed effects excluded) | "
+        f"{acc['count']}/{acc['n']} = {100 * acc['rate']:.1f} % (95 % CI {100 * acc['interval_95'][0]:.1f}-"
+        f"{100 * acc['interval_95'][1]:.1f} %) | >= 90 % |",
+        f"| gap closure vs the true term, median over named cases | {_fmt(closure['median'], '.3f')} "
+        f"({closure['n']} cases; {_fmt(100 * closure['share_at_least_0.8'] if closure['n'] else None, '.0f')} % "
+        f"of them >= 0.8) | >= 0.8 |",
+        f"| cases naming an effect neither hidden nor background | {_fmt(100 * summary['spurious_rate'], '.1f')} % "
+        f"| - |",
+        "",
+        "Named (hidden effect found, period within 5 %) / cases, and the median gap closure, per effect and "
+        "effect RMS / noise RMS:",
+        "",
+        "| effect | " + " | ".join(f"{r:g}" for r in settings["ratios"]) + " |",
+        "|---|" + "---|" * len(settings["ratios"]),
+    ]
+    for name, cells in summary["by_effect_ratio"].items():
+        row = []
+        for ratio in settings["ratios"]:
+            cell = cells.get(f"{ratio:g}")
+            if cell is None:
+                row.append("-")
+                continue
+            text = f"{cell['named']}/{cell['n']}"
+            if cell["median_closure"] is not None:
+                text += f", closure {cell['median_closure']:.2f}"
+            elif name in ABSORBED:
+                text += f" ({cell['nothing_missing']} nothing_missing)"
+            row.append(text)
+        lines.append(f"| {name}{' (absorbed)' if name in ABSORBED else ''} | " + " | ".join(row) + " |")
+    if settings.get("background"):
+        lines += ["", "Background (named on the plain logs, the plant's own structure): "
+                  + "; ".join(f"seed {seed}: {', '.join(names) or 'none'}"
+                              for seed, names in settings["background"].items())]
+    return "\n".join(lines) + "\n"
+
+
+def run_section(section: str, json_path: str | os.PathLike, *, markdown_path=None, seeds: int | None = None,
+                null_seeds: int | None = None, ratios=None, duration_s: float | None = None, effects=None,
+                data: str | os.PathLike | None = None, progress=None) -> str:
+    """Run one section of the study and write its files; the JSON is rewritten after every case.
+
+    Parameters
+    ----------
+    section : {"coulomb", "twin", "emps"}
+        See :data:`SECTIONS`; ``emps`` is :func:`emps_section`.
+    json_path : path-like
+        Settings, summary, cases and nulls (rewritten as the run goes, so that
+        a long run can be followed and an interrupted one still holds its cases).
+    markdown_path : path-like, optional
+        The tables (:func:`markdown`).
+    seeds, null_seeds : int, optional
+        Seeds per effect and ratio, and null data sets; the section's defaults if None.
+    ratios : sequence of float, optional
+        Effect RMS over noise RMS.
+    duration_s : float, optional
+        Length of the training and test logs [s].
+    effects : sequence of str, optional
+        Hidden effects (default: the whole library).
+    data : path-like, optional
+        ``emps`` only: directory of the benchmark files.
+    progress : callable, optional
+        Receives one line of text per workflow run.
+
+    Returns
+    -------
+    str
+        The tables (Markdown).
+    """
+    say = progress or (lambda line: None)
+    if section == "emps":
+        return emps_section(data, json_path, markdown_path=markdown_path, progress=progress)
+    defaults = SECTIONS[section]
+    seeds = seeds if seeds is not None else defaults["seeds"]
+    null_seeds = null_seeds if null_seeds is not None else defaults["null_seeds"]
+    ratios = tuple(ratios) if ratios else defaults["ratios"]
+    duration = duration_s or defaults["duration"]
+    effects = tuple(effects) if effects else EFFECT_NAMES
+    base = defaults["base"]()
+    settings = {"section": section, "base": type(base).__name__, "duration": duration, "seeds": seeds,
+                "null_seeds": null_seeds, "ratios": list(ratios), "effects": list(effects),
+                "description": ("Coulomb plant, Coulomb base model: the base class is exactly right"
+                                if section == "coulomb" else
+                                "the twin's truth plant (Maxwell-slip, lagged Stribeck, preload profile, lead "
+                                "ripple), GMS base model")}
+    started = time.perf_counter()
+    cases, nulls, background = [], [], {}
+
+    def save():
+        summary = summarise(cases, nulls)
+        write_json({"settings": settings, "summary": summary, "cases": cases, "nulls": nulls,
+                    "seconds": time.perf_counter() - started}, json_path)
+        return summary
+
+    if section == "twin":
+        for seed in range(seeds):
+            row = run_case(base, StudyCase(None, 0.0, seed, "twin", duration))
+            background[str(seed)] = row["named"]
+            say(f"background seed {seed}: {row['verdict']} {row['named']} ({row['seconds']:.0f} s)")
+        settings["background"] = background
+    for seed in range(null_seeds):
+        row = run_null(base, seed, plant=section, duration_s=duration)
+        nulls.append(row)
+        say(f"null {seed}: {row['verdict']} {row['named']} ({row['seconds']:.1f} s)")
+        if seed % 10 == 9:
+            save()
+    for name in effects:
+        for ratio in ratios:
+            for seed in range(seeds):
+                case = StudyCase(name, ratio, seed, section, duration)
+                row = run_case(base, case, background=frozenset(background.get(str(seed), ())))
+                cases.append(row)
+                closure = "-" if row["closure"] is None else f"{row['closure']:.3f}"
+                say(f"{name} x{ratio:g} seed {seed}: {row['verdict']} {row['named']} correct={row['correct']} "
+                    f"closure={closure} ({row['seconds']:.1f} s)")
+                save()
+    summary = save()
+    text = markdown(section, settings, summary, cases, nulls, time.perf_counter() - started)
+    if markdown_path:
+        write_text_atomic(markdown_path, text)
+    return text

@@ -15,7 +15,7 @@ An experiment is a tuple of :class:`ModelSpec` (what to fit on which
 datasets) and the test datasets. :func:`run_axis` reads the logs of one axis
 (``<axis>_<dataset>.<ext>`` in a directory), fits every model of the
 experiments, and returns an :class:`AxisResults` holding the fitted models,
-their predictions and the metric records of :mod:`greybox.evaluate.report`.
+their predictions and the metric records of :mod:`greybox.evaluate.records`.
 A fit that two experiments share (the GMS stage on A) is done once.
 
 When the logs carry the noise-free current (the extra channel
@@ -23,14 +23,17 @@ When the logs carry the noise-free current (the extra channel
 ``noise_floor`` record per experiment gives the error of that truth against
 the measured current: the best any model can do.
 
-:func:`reproduce` runs the experiments for several axes (in parallel worker
-processes if asked) and writes the report of ``greybox reproduce``;
-:func:`evaluate_models` tests saved models on logs for ``greybox evaluate``.
+:func:`experiment_figures` draws an experiment's figures (the paper's Figs. 3
+to 6); :func:`reproduce` runs the experiments for several axes (in parallel
+worker processes if asked) and writes the report of ``greybox reproduce``.
+Saved models are tested on logs for ``greybox evaluate`` by
+:func:`greybox.evaluate.records.evaluate_models`.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -41,7 +44,8 @@ import numpy as np
 
 from ..data.log import AxisLog
 from ..errors import GreyboxError
-from ..metrics import metrics_table
+from ..evaluate.figures import error_boxplot, residual_vs_position, time_comparison
+from ..evaluate.records import NOISE_FLOOR, TRUTH_CHANNEL, metric_record
 
 __all__ = [
     "ModelSpec",
@@ -49,27 +53,21 @@ __all__ = [
     "EXPERIMENTS",
     "MODEL_SETTINGS",
     "QUICK_SETTINGS",
-    "NOISE_FLOOR",
     "GMSSVR_NOTE",
     "GMSSVR_EQ8_NOTE",
-    "TRUTH_CHANNEL",
     "ModelResult",
     "AxisResults",
     "find_log",
     "load_axis_logs",
     "run_experiments",
     "run_axis",
-    "metric_record",
+    "TIME_MODELS",
+    "experiment_figures",
     "QUICK_DURATION_S",
     "Reproduction",
     "reproduce",
-    "evaluate_models",
 ]
 
-#: Model name of the records that compare the noise-free current with the measured one.
-NOISE_FLOOR = "noise_floor"
-#: Extra channel of a log holding the noise-free current [A] (synthetic axis).
-TRUTH_CHANNEL = "truth_current_A"
 #: Log file extensions :func:`find_log` tries, in this order.
 LOG_EXTENSIONS = (".mcap", ".parquet", ".csv")
 
@@ -293,45 +291,6 @@ def load_axis_logs(
 
 
 # ---------------------------------------------------------------- results
-def metric_record(experiment: int | None, axis: str, model: str, dataset: str, measured, modelled,
-                  logs: Sequence[str], per_log: Mapping[str, tuple] | None = None) -> dict:
-    """One record of ``metrics.json``.
-
-    Parameters
-    ----------
-    experiment : int or None
-        Experiment number (None outside the paper's experiments).
-    axis, model : str
-        Axis and model name.
-    dataset : {"train", "test"}
-        Which side of the experiment the record describes.
-    measured, modelled : array_like
-        Measured and modelled current [A], the runs concatenated.
-    logs : sequence of str
-        Names of the runs (datasets) concatenated.
-    per_log : dict, optional
-        ``{name: (measured, modelled)}`` of every run, for the per-run errors.
-
-    Returns
-    -------
-    dict
-        ``experiment``, ``axis``, ``model``, ``dataset``, ``rmse`` [A],
-        ``re`` [%] (RMSE over mean absolute current), plus ``logs`` (e.g.
-        ``"C+D"``), ``n``, ``nmse`` [%], ``max_error`` [A] and ``per_log``
-        (``{name: {"n", "rmse", "re"}}``).
-    """
-    table = metrics_table(measured, modelled)
-    record = {"experiment": experiment, "axis": axis, "model": model, "dataset": dataset,
-              "rmse": table["rmse"], "re": table["re"], "logs": "+".join(logs), "n": table["n"],
-              "nmse": table["nmse"], "max_error": table["max_error"]}
-    if per_log:
-        record["per_log"] = {}
-        for name, (y, y_hat) in per_log.items():
-            part = metrics_table(y, y_hat)
-            record["per_log"][name] = {"n": part["n"], "rmse": part["rmse"], "re": part["re"]}
-    return record
-
-
 @dataclass
 class ModelResult:
     """A fitted model of an experiment and its predictions.
@@ -576,46 +535,57 @@ def run_axis(
     return results
 
 
-# ---------------------------------------------------------------- evaluating saved models
-def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
-    """Metric records (with per-regime metrics) of every model on the runs, and the predictions.
+# ---------------------------------------------------------------- figures
+#: Models drawn in the time-domain comparisons (the paper's Figs. 4 and 6), when present.
+TIME_MODELS = ("stribeck", "svr", "gms", "gmssvr")
+
+
+def experiment_figures(results, experiment, out_dir: str | os.PathLike) -> list[tuple[str, Path]]:
+    """The figures of one experiment over all axes: box plot, time comparisons, residual maps.
 
     Parameters
     ----------
-    models : dict
-        ``{name: fitted model}``.
-    runs : list of AxisLog
-        Prepared test runs.
-    run_names : list of str
-        Their names in the records.
+    results : sequence of AxisResults
+        One per axis.
+    experiment : Experiment
+    out_dir : path-like
+        Directory of the PNG files (``exp<n>_*.png``).
 
     Returns
     -------
-    records : list of dict
-        One ``test`` record per model (see
-        :func:`greybox.evaluate.experiments.metric_record`) with ``kind`` and
-        ``regimes`` added, plus a ``noise_floor`` record when every run
-        carries the noise-free current.
-    predictions : dict
-        ``{name: predicted current [A], runs concatenated}``.
+    list of (caption, path)
     """
-    from ..registry import model_kind
-    from .regimes import metrics_by_regime
-
-    axis = "/".join(dict.fromkeys(run.axis for run in runs if run.axis))
-    measured = np.concatenate([run.effort for run in runs])
-    predictions = {name: model.predict(runs) for name, model in models.items()}
-    if all(TRUTH_CHANNEL in run.extras for run in runs):
-        predictions[NOISE_FLOOR] = np.concatenate([run.extras[TRUTH_CHANNEL] for run in runs])
-    records = []
-    for name, prediction in predictions.items():
-        parts = np.split(prediction, np.cumsum([len(run) for run in runs])[:-1])
-        per_log = {n: (run.effort, p) for n, run, p in zip(run_names, runs, parts)}
-        record = metric_record(None, axis, name, "test", measured, prediction, run_names, per_log)
-        record["kind"] = model_kind(models[name]) if name in models else NOISE_FLOOR
-        record["regimes"] = metrics_by_regime(runs, prediction)
-        records.append(record)
-    return records, predictions
+    out_dir = Path(out_dir)
+    n = experiment.number
+    test = "+".join(experiment.test)
+    figures = []
+    panels = []
+    for axis_results in results:
+        runs = [axis_results.logs[d] for d in experiment.test]
+        predictions = {m.name: [m.test_prediction[d] for d in experiment.test]
+                       for m in axis_results.experiments[n]}
+        if all(TRUTH_CHANNEL in run.extras for run in runs):
+            predictions["noise_floor"] = [run.extras[TRUTH_CHANNEL] for run in runs]
+        panels.append((f"axis {axis_results.axis}, test on {test}", runs, predictions))
+    figure_number = {1: "Fig. 3", 2: "Fig. 5"}.get(n, "")
+    path = error_boxplot(panels, out_dir / f"exp{n}_error_boxplot.png",
+                         title=f"Experiment {n}: absolute error on {test}")
+    figures.append((f"Experiment {n}: absolute error of each model on {test} "
+                    f"(boxes: quartiles, whiskers: 5th-95th percentile; like the paper's {figure_number})", path))
+    figure_number = {1: "Fig. 4", 2: "Fig. 6"}.get(n, "")
+    for axis_results, (_, runs, predictions) in zip(results, panels):
+        axis = axis_results.axis
+        shown = {m: predictions[m] for m in TIME_MODELS if m in predictions}
+        path = time_comparison(runs, shown, out_dir / f"exp{n}_time_{axis}.png",
+                               title=f"Experiment {n}, axis {axis}: measured and modelled current")
+        figures.append((f"Experiment {n}, axis {axis}: measured and modelled current on {test} "
+                        f"(like the paper's {figure_number})", path))
+        models = {m: p for m, p in predictions.items() if m != "noise_floor"}
+        path = residual_vs_position(runs, models, out_dir / f"exp{n}_residual_position_{axis}.png",
+                                    title=f"Experiment {n}, axis {axis}: residual against position on {test}")
+        figures.append((f"Experiment {n}, axis {axis}: measured minus modelled current against position, "
+                        f"by direction of motion, on {test}", path))
+    return figures
 
 
 # ---------------------------------------------------------------- the whole reproduction
@@ -747,9 +717,8 @@ def reproduce(
     -------
     Reproduction
     """
+    from ..evaluate.report import report_tables, write_report
     from ..persistence import save_model
-    from .figures import experiment_figures
-    from .report import report_tables, write_report
 
     started = time.perf_counter()
     out_dir = Path(out_dir)

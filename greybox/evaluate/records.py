@@ -1,0 +1,152 @@
+"""Metric records of fitted models tested on logs, and the report of ``greybox evaluate``.
+
+A *metric record* (:func:`metric_record`) holds the errors of one model on
+one side (``train`` or ``test``) of an experiment or evaluation: RMSE [A], RE
+[%], NMSE [%], largest error [A], and the errors per run. The tables and files
+of :mod:`greybox.evaluate.report` are built from such records, those of the
+paper's experiments (:mod:`greybox.studies.experiments`) as those of
+:func:`evaluate_models`.
+
+When the logs carry the noise-free current (the extra channel
+:data:`TRUTH_CHANNEL` of the synthetic axis), a :data:`NOISE_FLOOR` record
+gives the error of that truth against the measured current: the best any
+model can do.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from ..metrics import metrics_table
+from ..registry import model_kind
+from .figures import error_boxplot, residual_vs_position, time_comparison
+from .regimes import metrics_by_regime
+from .report import evaluation_table, regime_table, write_report
+
+__all__ = ["NOISE_FLOOR", "TRUTH_CHANNEL", "metric_record", "evaluate_models", "write_evaluation_report"]
+
+#: Model name of the records that compare the noise-free current with the measured one.
+NOISE_FLOOR = "noise_floor"
+#: Extra channel of a log holding the noise-free current [A] (synthetic axis).
+TRUTH_CHANNEL = "truth_current_A"
+
+
+def metric_record(experiment: int | None, axis: str, model: str, dataset: str, measured, modelled,
+                  logs: Sequence[str], per_log: Mapping[str, tuple] | None = None) -> dict:
+    """One record of ``metrics.json``.
+
+    Parameters
+    ----------
+    experiment : int or None
+        Experiment number (None outside the paper's experiments).
+    axis, model : str
+        Axis and model name.
+    dataset : {"train", "test"}
+        Which side of the experiment the record describes.
+    measured, modelled : array_like
+        Measured and modelled current [A], the runs concatenated.
+    logs : sequence of str
+        Names of the runs (datasets) concatenated.
+    per_log : dict, optional
+        ``{name: (measured, modelled)}`` of every run, for the per-run errors.
+
+    Returns
+    -------
+    dict
+        ``experiment``, ``axis``, ``model``, ``dataset``, ``rmse`` [A],
+        ``re`` [%] (RMSE over mean absolute current), plus ``logs`` (e.g.
+        ``"C+D"``), ``n``, ``nmse`` [%], ``max_error`` [A] and ``per_log``
+        (``{name: {"n", "rmse", "re"}}``).
+    """
+    table = metrics_table(measured, modelled)
+    record = {"experiment": experiment, "axis": axis, "model": model, "dataset": dataset,
+              "rmse": table["rmse"], "re": table["re"], "logs": "+".join(logs), "n": table["n"],
+              "nmse": table["nmse"], "max_error": table["max_error"]}
+    if per_log:
+        record["per_log"] = {}
+        for name, (y, y_hat) in per_log.items():
+            part = metrics_table(y, y_hat)
+            record["per_log"][name] = {"n": part["n"], "rmse": part["rmse"], "re": part["re"]}
+    return record
+
+
+def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
+    """Metric records (with per-regime metrics) of every model on the runs, and the predictions.
+
+    Parameters
+    ----------
+    models : dict
+        ``{name: fitted model}``.
+    runs : list of AxisLog
+        Prepared test runs.
+    run_names : list of str
+        Their names in the records.
+
+    Returns
+    -------
+    records : list of dict
+        One ``test`` record per model (see
+        :func:`metric_record`) with ``kind`` and
+        ``regimes`` added, plus a ``noise_floor`` record when every run
+        carries the noise-free current.
+    predictions : dict
+        ``{name: predicted current [A], runs concatenated}``.
+    """
+    axis = "/".join(dict.fromkeys(run.axis for run in runs if run.axis))
+    measured = np.concatenate([run.effort for run in runs])
+    predictions = {name: model.predict(runs) for name, model in models.items()}
+    if all(TRUTH_CHANNEL in run.extras for run in runs):
+        predictions[NOISE_FLOOR] = np.concatenate([run.extras[TRUTH_CHANNEL] for run in runs])
+    records = []
+    for name, prediction in predictions.items():
+        parts = np.split(prediction, np.cumsum([len(run) for run in runs])[:-1])
+        per_log = {n: (run.effort, p) for n, run, p in zip(run_names, runs, parts)}
+        record = metric_record(None, axis, name, "test", measured, prediction, run_names, per_log)
+        record["kind"] = model_kind(models[name]) if name in models else NOISE_FLOOR
+        record["regimes"] = metrics_by_regime(runs, prediction)
+        records.append(record)
+    return records, predictions
+
+
+def write_evaluation_report(out_dir: str | os.PathLike, records: Sequence[Mapping], predictions: Mapping,
+                            runs, run_names: Sequence[str]) -> dict[str, Path]:
+    """The report of ``greybox evaluate``: error and regime tables, three figures, the HTML page.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        Report directory (created if missing).
+    records : sequence of dict
+        Records of :func:`evaluate_models`.
+    predictions : dict
+        ``{model: predicted current [A], runs concatenated}``.
+    runs : list of AxisLog
+        Prepared test runs.
+    run_names : sequence of str
+        Their names.
+
+    Returns
+    -------
+    dict
+        As :func:`greybox.evaluate.report.write_report`, plus ``figures``.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(exist_ok=True)
+    tests = "+".join(run_names)
+    models = {name: p for name, p in predictions.items() if name != NOISE_FLOOR}
+    figures = [
+        (f"Absolute error of each model on {tests} (boxes: quartiles, whiskers: 5th-95th percentile)",
+         error_boxplot([(f"test on {tests}", runs, predictions)], out_dir / "error_boxplot.png")),
+        (f"Measured and modelled current on {tests}",
+         time_comparison(runs, models, out_dir / "time_comparison.png", names=run_names)),
+        (f"Measured minus modelled current against position, by direction of motion, on {tests}",
+         residual_vs_position(runs, models, out_dir / "residual_position.png")),
+    ]
+    files = write_report(out_dir, records, [evaluation_table(records), regime_table(records)], figures,
+                         title="greybox: model evaluation", intro=f"Models tested on {tests}.")
+    files["figures"] = [path for _, path in figures]
+    return files

@@ -1,0 +1,41 @@
+"""A titled table of text cells, the unit of every report: Markdown here, HTML in :mod:`greybox.evaluate.html`.
+
+It sits below both :mod:`greybox.evaluate.report` (which builds tables and
+writes the report files) and :mod:`greybox.evaluate.html` (which renders
+them), so that neither imports the other in both directions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+__all__ = ["Table"]
+
+
+@dataclass
+class Table:
+    """A titled table of text cells, rendered to Markdown here and to HTML in :mod:`greybox.evaluate.html`.
+
+    Attributes
+    ----------
+    title : str
+    header : list of str
+    rows : list of list of str
+    notes : list of str
+        Sentences printed under the table.
+    """
+
+    title: str
+    header: list[str]
+    rows: list[list[str]]
+    notes: list[str] = field(default_factory=list)
+
+    def to_markdown(self) -> str:
+        """The table as a Markdown section (``###`` title, pipe table, notes)."""
+        lines = [f"### {self.title}", "", "| " + " | ".join(self.header) + " |",
+                 "|" + "|".join("---" for _ in self.header) + "|"]
+        lines += ["| " + " | ".join(row) + " |" for row in self.rows]
+        if self.notes:
+            lines.append("")
+            lines += [f"{note}  " if i < len(self.notes) - 1 else note for i, note in enumerate(self.notes)]
+        return "\n".join(lines) + "\n"

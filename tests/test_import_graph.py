@@ -1,0 +1,260 @@
+"""The direction of dependencies inside greybox, read from the source with ``ast``.
+
+Every ``import`` statement of every module counts, also those inside
+functions and under ``if TYPE_CHECKING:``: an import that only runs later is
+still a dependency, and hiding a cycle in a function does not remove it. The
+rules (DESIGN.md, "Layout"):
+
+- no import cycle between modules;
+- only ``greybox.twin`` itself, ``greybox.control``, ``greybox.studies`` and
+  ``greybox.cli`` import the synthetic twin;
+- ``greybox.base`` (the model protocol) imports nothing of greybox;
+- the physical and current models (``greybox.friction``, ``greybox.models``)
+  import nothing of the layers above them: ``evaluate``, ``discover``,
+  ``studies``, ``control``, ``cli``.
+
+An import names a module (``import greybox.twin.plant``, ``from ..twin import
+plant``) or a package's ``__init__`` (``from ..twin import make_dataset``).
+Importing a submodule also runs its parent packages' ``__init__``; that
+implicit step is not an edge here, or every module of a package whose
+``__init__`` imports it would be in a cycle with it.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections import deque
+from pathlib import Path
+
+import pytest
+
+PACKAGE_DIR = Path(__file__).resolve().parents[1] / "greybox"
+
+#: Packages that may import the synthetic twin (besides the twin itself).
+TWIN_USERS = ("greybox.control", "greybox.studies", "greybox.cli")
+#: Layers the models must not depend on.
+ABOVE_MODELS = ("greybox.evaluate", "greybox.discover", "greybox.studies", "greybox.control", "greybox.cli")
+
+
+def _within(module: str, package: str) -> bool:
+    """Whether ``module`` is ``package`` or inside it."""
+    return module == package or module.startswith(package + ".")
+
+
+def module_files(package_dir: Path) -> dict[str, Path]:
+    """Every module of the package under ``package_dir``: ``{dotted name: file}``."""
+    modules = {}
+    for path in sorted(package_dir.rglob("*.py")):
+        parts = path.relative_to(package_dir.parent).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        modules[".".join(parts)] = path
+    return modules
+
+
+def _known(name: str, modules) -> str | None:
+    """The longest prefix of the dotted ``name`` that is a module of the package, if any."""
+    parts = name.split(".")
+    for end in range(len(parts), 0, -1):
+        candidate = ".".join(parts[:end])
+        if candidate in modules:
+            return candidate
+    return None
+
+
+def imports_of(module: str, path: Path, modules) -> list[tuple[str, int]]:
+    """The package's modules that ``module`` imports anywhere in its source, with the line of each import.
+
+    Parameters
+    ----------
+    module : str
+        Dotted name of the importing module.
+    path : Path
+        Its source file.
+    modules : collection of str
+        Dotted names of every module of the package.
+
+    Returns
+    -------
+    list of (str, int)
+        Imported module and line number, in the order of the source.
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    own_package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            targets = [_known(alias.name, modules) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = own_package[: len(own_package) - (node.level - 1)]
+                stem = ".".join(base + (node.module.split(".") if node.module else []))
+            else:
+                stem = node.module or ""
+            # ``from package import name`` imports the submodule ``name`` if there is one, else the package
+            targets = [_known(f"{stem}.{alias.name}", modules) or _known(stem, modules) for alias in node.names]
+        else:
+            continue
+        found += [(target, node.lineno) for target in targets if target is not None and target != module]
+    return sorted(set(found), key=lambda item: (item[1], item[0]))
+
+
+def import_graph(package_dir: Path = PACKAGE_DIR) -> dict[str, dict[str, int]]:
+    """``{module: {imported module: first line importing it}}`` over the whole package."""
+    modules = module_files(package_dir)
+    graph = {}
+    for module, path in modules.items():
+        edges = {}
+        for target, line in imports_of(module, path, modules):
+            edges.setdefault(target, line)
+        graph[module] = edges
+    return graph
+
+
+def strongly_connected(graph) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan's algorithm, iterative)."""
+    index, low, on_stack, stack, components = {}, {}, set(), [], []
+    counter = 0
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in index:
+                    index[child] = low[child] = counter
+                    counter += 1
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(graph.get(child, ())))))
+                elif child in on_stack:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                parent = work[-1][0]
+                low[parent] = min(low[parent], low[node])
+            if low[node] == index[node]:
+                component = []
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    component.append(member)
+                    if member == node:
+                        break
+                if len(component) > 1:
+                    components.append(sorted(component))
+    return sorted(components)
+
+
+def shortest_cycle(graph, component) -> list[str]:
+    """A shortest cycle through the first module of ``component``, as a closed list of modules."""
+    start, members = component[0], set(component)
+    previous = {start: None}
+    queue = deque([start])
+    while queue:
+        node = queue.popleft()
+        for child in sorted(graph[node]):
+            if child == start:
+                path = [node]
+                while previous[path[-1]] is not None:
+                    path.append(previous[path[-1]])
+                return [start, *reversed(path[:-1]), start] if len(path) > 1 else [start, node, start]
+            if child in members and child not in previous:
+                previous[child] = node
+                queue.append(child)
+    raise AssertionError(f"no cycle through {start} in its component")  # cannot happen in a component
+
+
+def cycles(graph) -> list[str]:
+    """One line per import cycle: ``a (line) -> b (line) -> ... -> a``, with the line of each import."""
+    lines = []
+    for component in strongly_connected(graph):
+        cycle = shortest_cycle(graph, component)
+        steps = [f"{a} (line {graph[a][b]})" for a, b in zip(cycle, cycle[1:])]
+        lines.append(" -> ".join(steps + [cycle[-1]]) + f"  (knot of {len(component)}: {', '.join(component)})")
+    return lines
+
+
+def forbidden(graph, importers, imported) -> list[str]:
+    """Imports from a module matching ``importers`` of a module matching ``imported`` (predicates)."""
+    return [f"{module} (line {line}) imports {target}"
+            for module, edges in sorted(graph.items()) if importers(module)
+            for target, line in sorted(edges.items()) if imported(target)]
+
+
+@pytest.fixture(scope="module")
+def graph():
+    return import_graph()
+
+
+def test_no_import_cycle(graph):
+    found = cycles(graph)
+    assert not found, "import cycles (imports inside functions count):\n" + "\n".join(found)
+
+
+def test_only_the_twin_the_control_loop_the_studies_and_the_cli_import_the_twin(graph):
+    found = forbidden(graph,
+                      lambda m: not any(_within(m, p) for p in ("greybox.twin", *TWIN_USERS)),
+                      lambda t: _within(t, "greybox.twin"))
+    assert not found, "the synthetic twin imported outside twin/, control/, studies/, cli/:\n" + "\n".join(found)
+
+
+def test_the_model_protocol_imports_nothing_of_greybox(graph):
+    assert "greybox.base" in graph
+    found = forbidden(graph, lambda m: m == "greybox.base", lambda t: True)
+    assert not found, "greybox/base.py must import nothing of greybox:\n" + "\n".join(found)
+
+
+def test_the_models_import_nothing_of_the_layers_above_them(graph):
+    found = forbidden(graph,
+                      lambda m: _within(m, "greybox.friction") or _within(m, "greybox.models"),
+                      lambda t: any(_within(t, p) for p in ABOVE_MODELS))
+    assert not found, "friction/ and models/ depend on a layer above them:\n" + "\n".join(found)
+
+
+# ---------------------------------------------------------------- the checker itself
+def _package(root: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        path = root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return root / "pkg"
+
+
+def test_the_walker_sees_imports_inside_functions_and_relative_ones(tmp_path):
+    package = _package(tmp_path, {
+        "pkg/__init__.py": "",
+        "pkg/a.py": "from .b import f\n",
+        "pkg/b.py": "def f():\n    from . import c\n",
+        "pkg/c.py": "def g():\n    import pkg.a\n",
+        "pkg/sub/__init__.py": "from .d import x\n",
+        "pkg/sub/d.py": "from ..a import f\nx = 1\n",
+        "pkg/e.py": "from pkg import sub\nfrom pkg.sub import x\n",
+    })
+    found = import_graph(package)
+    assert found["pkg.a"] == {"pkg.b": 1}
+    assert found["pkg.b"] == {"pkg.c": 2}
+    assert found["pkg.c"] == {"pkg.a": 2}
+    assert found["pkg.sub"] == {"pkg.sub.d": 1}
+    assert found["pkg.sub.d"] == {"pkg.a": 1}
+    assert found["pkg.e"] == {"pkg.sub": 1}
+    (line,) = cycles(found)
+    assert line.startswith("pkg.a (line 1) -> pkg.b (line 2) -> pkg.c (line 2) -> pkg.a")
+    assert forbidden(found, lambda m: m == "pkg.sub.d", lambda t: _within(t, "pkg")) == [
+        "pkg.sub.d (line 1) imports pkg.a"]
+
+
+def test_a_package_importing_its_own_modules_is_no_cycle(tmp_path):
+    package = _package(tmp_path, {
+        "pkg/__init__.py": "from .a import f\nfrom .b import g\n",
+        "pkg/a.py": "def f():\n    return 1\n",
+        "pkg/b.py": "from .a import f\n\ndef g():\n    return f()\n",
+    })
+    assert cycles(import_graph(package)) == []
