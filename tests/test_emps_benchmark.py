@@ -90,8 +90,8 @@ def test_benchmark_samples_and_the_2ms_grid(logs, emps):
 def test_script_writes_json_markdown_and_plot(tmp_path, emps):
     out, md, png = tmp_path / "emps.json", tmp_path / "emps.md", tmp_path / "emps.png"
     result = subprocess.run(
-        [sys.executable, str(SCRIPT), "--data", str(emps), "--json", str(out), "--markdown", str(md), "--plot", str(png),
-         "--models", "coulomb_idim_ls", "coulomb", "stribeck", "--quiet"],
+        [sys.executable, str(SCRIPT), "--data", str(emps), "--json", str(out), "--markdown", str(md),
+         "--plot", str(png), "--models", "coulomb_idim_ls", "coulomb", "stribeck", "--quiet"],
         capture_output=True, text=True, cwd=tmp_path, timeout=300,
     )
     assert result.returncode == 0, result.stderr
