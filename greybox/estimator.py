@@ -23,6 +23,7 @@ from .base import EFFORT, ModelProtocol, Parameter
 from .data.log import AxisLog, as_log_list
 from .errors import LogError, ParameterError
 from .identify.progress import make_progress
+from .metrics import rmse
 
 __all__ = ["CurrentModel", "check_runs"]
 
@@ -197,8 +198,7 @@ class CurrentModel(ModelProtocol):
         float
         """
         runs = self._check_predict_runs(logs)
-        error = self.predict(runs) - np.concatenate([run.effort for run in runs])
-        return -float(np.sqrt(np.mean(error ** 2)))
+        return -rmse(np.concatenate([run.effort for run in runs]), self.predict(runs))
 
     @property
     def n_params(self) -> int:
