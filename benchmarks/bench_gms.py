@@ -32,14 +32,13 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
 
-from friction_reference import gms_reference  # noqa: E402
-from friction_signals import STEP, motion_log, velocity_profile  # noqa: E402
+from greybox.friction.reference import gms_reference
+from greybox.friction.signals import STEP, motion_log, velocity_profile
 
-from greybox.friction import GMSModel  # noqa: E402
-from greybox.friction.gms import GMSState, simulate_gms  # noqa: E402
-from greybox.friction.kernels import gms_friction_kernel  # noqa: E402
+from greybox.friction import GMSModel
+from greybox.friction.gms import GMSState, simulate_gms
+from greybox.friction.kernels import gms_friction_kernel
 
 
 def parameters(n_elements: int) -> dict:

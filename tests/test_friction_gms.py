@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from friction_reference import gms_reference
-from friction_signals import STEP, motion_log, velocity_profile
+from greybox.friction.reference import gms_reference
+from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.errors import ParameterError
 from greybox.friction import GMSModel, stribeck_curve
 from greybox.friction.gms import check_gms_parameters, simulate_gms

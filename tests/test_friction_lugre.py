@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from friction_signals import STEP, motion_log, velocity_profile
+from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.errors import ParameterError
 from greybox.friction import LuGreModel, stribeck_curve
 from greybox.friction.lugre import check_lugre_parameters, simulate_lugre

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
-from friction_signals import STEP, motion_log, velocity_profile
+from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.errors import LogError, ParameterError
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.friction.gms import simulate_gms

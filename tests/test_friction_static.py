@@ -7,7 +7,7 @@ import pytest
 import scipy.io
 import scipy.signal
 
-from friction_signals import motion_log, velocity_profile
+from greybox.friction.signals import motion_log, velocity_profile
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
 from greybox.friction import CoulombModel, StribeckModel, stribeck_curve

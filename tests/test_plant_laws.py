@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import plant_reference as ref
-from friction_reference import lugre_step_reference, stribeck_reference
-from friction_signals import STEP, velocity_profile
+from greybox.friction.reference import lugre_step_reference, stribeck_reference
+from greybox.friction.signals import STEP, velocity_profile
 from greybox.base import PlantLaw
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
 from greybox.friction.kernels import (gms_trajectory_kernel, lugre_decay_rate, lugre_exact_step,

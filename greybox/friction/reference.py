@@ -1,9 +1,10 @@
 """Plain-Python reference implementations of the compiled friction kernels.
 
-Written directly from the equations in docs/friction-models.md (and
-../shared/DESIGN.md), one sample and one element at a time, without numba, so
-that the tests can check the kernels against them. benchmarks/bench_gms.py
-times :func:`gms_reference` as the plain-Python baseline.
+Written directly from the equations in docs/friction-models.md, one sample
+and one element at a time, without numba, so that the tests can check the
+kernels against them (scikit-learn's and stumpy's rule for compiled code);
+benchmarks/bench_gms.py times :func:`gms_reference` as the plain-Python
+baseline. Slow by design: not for use on real logs.
 """
 
 from __future__ import annotations

@@ -1,10 +1,11 @@
-"""Synthetic motion and axis logs for the friction-model tests (numpy only, seeded)."""
+"""Seeded synthetic motion that exercises every branch of the friction models (stick, slip, reversals, rest),
+for their tests and benchmarks (numpy only)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from greybox.data.log import AxisLog
+from ..data.log import AxisLog
 
 #: Sample time of the synthetic logs [s] (500 Hz, as SINUMERIK traces).
 STEP = 0.002
