@@ -109,6 +109,37 @@ class CurrentModel(ModelProtocol):
         self._fit_runs(runs, make_progress(progress))
         return self
 
+    def first_stage(self):
+        """Unfitted model of the first stage of a two-stage model; ``None`` for a one-stage model (default)."""
+        return None
+
+    def fit_staged(self, logs, stage2_logs=None, *, progress=None, first_stage=None) -> "CurrentModel":
+        """Fit a model whose stages may learn from different runs.
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs of the first stage (of the whole model for a one-stage model).
+        stage2_logs : AxisLog or list of AxisLog, optional
+            Prepared runs of the second stage; default ``logs``.
+        progress : None, bool or callable, optional
+            See :meth:`fit`.
+        first_stage : CurrentModel, optional
+            An already fitted first stage (a fit of :meth:`first_stage`) to freeze instead of fitting one.
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ParameterError
+            For a one-stage model given ``stage2_logs`` or ``first_stage``.
+        """
+        if stage2_logs is not None or first_stage is not None:
+            raise ParameterError(f"a {type(self).__name__} has one stage: it fits on one set of runs")
+        return self.fit(logs, progress=progress)
+
     def predict(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
         """Predicted effort ``J a + friction + offset`` [A, or N].
 

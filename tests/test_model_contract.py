@@ -23,6 +23,7 @@ from greybox.base import EFFORT, Parameter
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.discover.augment import AugmentedModel
+from greybox.errors import GreyboxError
 from greybox.estimator import CurrentModel
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
 from greybox.models.chunked import predict_chunked
@@ -201,3 +202,15 @@ def test_a_new_kind_is_one_class_and_one_registry_line(monkeypatch, train_runs, 
     assert main(["train", "--model", "viscous", "--offset", "--quiet", "--train", *map(str, logs),
                  "--out", str(out)]) == 0
     assert isinstance(load_model(out), ViscousModel)
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_staged_fit_on_the_same_runs_is_the_fit(case, fitted, train_runs, unseen_log):
+    model = CASES[case]()
+    stage = model.first_stage()
+    assert stage is None or (isinstance(stage, CurrentModel) and not any(n.endswith("_") for n in vars(stage)))
+    staged = model.fit_staged(train_runs)
+    np.testing.assert_array_equal(staged.predict(unseen_log), fitted[case].predict(unseen_log))
+    if stage is None:
+        with pytest.raises(GreyboxError, match="one stage"):
+            CASES[case]().fit_staged(train_runs[:1], train_runs[1:])

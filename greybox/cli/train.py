@@ -66,14 +66,14 @@ def describe_parameters(model) -> list[str]:
 def _fit(model, args: argparse.Namespace):
     """Fit ``model`` as the options say; return the paths and runs it was fitted on."""
     progress = None if args.quiet else True
-    if args.stage2 and not hasattr(model, "fit_svr"):
-        raise GreyboxError(f"option --stage2 does not apply to the {args.model} model")
+    if args.stage2 and model.first_stage() is None:
+        raise GreyboxError(f"option --stage2 does not apply to the {args.model} model: it has one stage")
     runs = read_logs(args, args.train)
     if not args.stage2:
         model.fit(runs, progress=progress)
         return list(args.train), runs
     second = read_logs(args, args.stage2)
-    model.fit_gms(runs, progress=progress).fit_svr(second, progress=progress)
+    model.fit_staged(runs, second, progress=progress)
     return list(args.train) + list(args.stage2), runs + second
 
 

@@ -176,6 +176,33 @@ class GMSSVRModel(KernelRegressionModel):
         self.fit_gms(logs, progress=progress)
         return self.fit_svr(logs, progress=progress)
 
+    def first_stage(self) -> GMSModel:
+        """Unfitted GMS stage: a clone of ``gms`` (``GMSModel()`` by default)."""
+        return clone(GMSModel() if self.gms is None else self.gms)
+
+    def fit_staged(self, logs, stage2_logs=None, *, progress=None, first_stage=None) -> "GMSSVRModel":
+        """Fit the GMS stage on ``logs`` (or freeze ``first_stage``), then the SVR stage on ``stage2_logs``.
+
+        Parameters
+        ----------
+        logs : AxisLog or list of AxisLog
+            Prepared runs of the GMS stage (unused when ``first_stage`` is given).
+        stage2_logs : AxisLog or list of AxisLog, optional
+            Prepared runs of the SVR stage; default ``logs``.
+        progress : None, bool or callable, optional
+            See :meth:`greybox.estimator.CurrentModel.fit`.
+        first_stage : GMSModel, optional
+            A fitted GMS model to freeze instead of fitting one.
+
+        Returns
+        -------
+        self
+        """
+        second = logs if stage2_logs is None else stage2_logs
+        if first_stage is None:
+            self.fit_gms(logs, progress=progress)
+        return self.fit_svr(second, progress=progress, gms=first_stage)
+
     def fit_gms(self, logs: AxisLog | Iterable[AxisLog], progress=None) -> "GMSSVRModel":
         """Identify the GMS stage (a clone of ``gms``) and forget any fitted SVR stage.
 

@@ -351,14 +351,18 @@ class AxisResults:
 
 
 def _settings_for(spec: ModelSpec, settings: Mapping[str, Mapping]) -> dict:
-    """Constructor arguments of a model: its kind's settings and its own, a GMS stage built for gmssvr."""
-    kind = spec.kind
-    params = {**settings.get(kind, {}), **spec.params}
-    if kind == "gmssvr":
-        from ..friction.gms import GMSModel
+    """Constructor arguments of a model: its kind's settings and its own.
 
-        gms = params.get("gms", settings.get("gms", {}))
-        params["gms"] = gms if isinstance(gms, GMSModel) else GMSModel(**dict(gms))
+    A hyperparameter named after a registered kind is a stage of that kind (the ``gms`` of ``gmssvr``):
+    it is built from that kind's settings unless given as a model.
+    """
+    from ..registry import MODEL_CLASSES, model_class
+
+    params = {**settings.get(spec.kind, {}), **spec.params}
+    for name in model_class(spec.kind)().get_params(deep=False):
+        if name in MODEL_CLASSES:
+            stage = params.get(name, settings.get(name, {}))
+            params[name] = stage if hasattr(stage, "get_params") else model_class(name)(**dict(stage))
     return params
 
 
@@ -386,23 +390,19 @@ class _FitCache:
         started = time.perf_counter()
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            if spec.kind == "gmssvr":
-                gms = self._gms_stage(model.gms, spec.train, logs, model_progress)
-                model.fit_svr([logs[d] for d in spec.stage2 or spec.train], progress=model_progress, gms=gms)
-            else:
-                model.fit([logs[d] for d in spec.train], progress=model_progress)
+            template = model.first_stage()
+            first = None if template is None else self._stage(template, spec.train, logs, model_progress)
+            model.fit_staged([logs[d] for d in spec.train], [logs[d] for d in spec.stage2] if spec.stage2 else None,
+                             progress=model_progress, first_stage=first)
         self.models[key] = model
         notes = list(dict.fromkeys(str(w.message) for w in caught))
         return model, time.perf_counter() - started, notes
 
-    def _gms_stage(self, template, train, logs, model_progress):
-        """The GMS model of ``template``'s settings fitted on ``train`` (shared with a ``gms`` fit)."""
-        from sklearn.base import clone
-
-        gms = clone(template)
-        key = _key(gms, tuple(train))
+    def _stage(self, template, train, logs, model_progress):
+        """The first stage ``template`` fitted on ``train`` (shared with a fit of that stage's kind alone)."""
+        key = _key(template, tuple(train))
         if key not in self.models:
-            self.models[key] = gms.fit([logs[d] for d in train], progress=model_progress)
+            self.models[key] = template.fit([logs[d] for d in train], progress=model_progress)
         return self.models[key]
 
 
