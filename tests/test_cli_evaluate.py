@@ -65,6 +65,9 @@ def test_evaluate_prints_regimes_and_writes_json_and_report(files, tmp_path, cap
     assert {p.name for p in out.iterdir()} >= {"metrics.json", "metrics.csv", "tables.md", "index.html",
                                                "error_boxplot.png", "time_comparison.png", "residual_position.png"}
     assert 'src="data:image/png;base64,' in (out / "index.html").read_text()
+    machine = json.loads((out / "provenance.json").read_text())
+    assert machine["cpu_count"] >= 1 and machine["libraries"]["numpy"] == np.__version__
+    assert f"numpy {np.__version__}" in (out / "tables.md").read_text()
 
 
 def test_evaluate_refuses_before_any_work(files, tmp_path, capsys):

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
 from ..atomic import write_text_atomic
+from ..provenance import provenance, provenance_line
 from .html import write_html
 from .table import Table
 
@@ -463,7 +464,11 @@ def tables_markdown(tables: Sequence[Table], title: str = "greybox report", intr
 def write_report(out_dir: str | os.PathLike, records: Sequence[Mapping], tables: Sequence[Table],
                  figures: Sequence[tuple[str, str | os.PathLike]] = (), *, title: str = "greybox report",
                  intro: str = "") -> dict[str, Path]:
-    """Write ``metrics.json``, ``metrics.csv``, ``tables.md`` and ``index.html`` into ``out_dir``.
+    """Write ``metrics.json``, ``metrics.csv``, ``tables.md``, ``index.html`` and ``provenance.json`` into ``out_dir``.
+
+    ``tables.md`` and ``index.html`` end their introduction with the versions
+    and the machine the figures were measured with (:mod:`greybox.provenance`),
+    which ``provenance.json`` holds in full.
 
     Parameters
     ----------
@@ -480,10 +485,14 @@ def write_report(out_dir: str | os.PathLike, records: Sequence[Mapping], tables:
     Returns
     -------
     dict
-        ``{"metrics_json", "metrics_csv", "tables", "html"}`` -> written file.
+        ``{"metrics_json", "metrics_csv", "tables", "html", "provenance"}`` -> written file.
     """
     out_dir = Path(out_dir)
+    machine = provenance()
+    intro = "\n\n".join(part for part in (intro.rstrip(), f"Measured with {provenance_line(machine)}.") if part)
     json_path, csv_path = write_metrics(records, out_dir)
     tables_path = write_text_atomic(out_dir / "tables.md", tables_markdown(tables, title, intro))
     html_path = write_html(out_dir / "index.html", title=title, intro=intro, tables=tables, figures=figures)
-    return {"metrics_json": json_path, "metrics_csv": csv_path, "tables": tables_path, "html": html_path}
+    provenance_path = write_text_atomic(out_dir / "provenance.json", json.dumps(machine, indent=1) + "\n")
+    return {"metrics_json": json_path, "metrics_csv": csv_path, "tables": tables_path, "html": html_path,
+            "provenance": provenance_path}
