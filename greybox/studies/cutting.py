@@ -51,6 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text_atomic
+from ..provenance import provenance, provenance_line
 from ..data.axis_config import read_axis_config
 from ..data.io import read_log
 from ..data.prepare import prepare
@@ -326,13 +327,14 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
     tables = (f"Cut strength {strength:g} A at 1000 mm/min:\n\n" + detail_table(rows)
               + "\nCorrelation by cut strength:\n\n" + sweep_table(rows, cases, factor, target))
     noise = {name: float(np.sqrt(np.mean(case.noise ** 2))) for name, case in cases.items()}
+    machine = provenance()
     if markdown_path:
-        write_text_atomic(markdown_path, tables)
+        write_text_atomic(markdown_path, f"{tables}\nMeasured with {provenance_line(machine)}.\n")
     if json_path:
         write_text_atomic(json_path, json.dumps({
             "seed": seed, "train": list(TRAIN_FILES), "axis_config": str(axis_config),
             "force_constant_N_per_A": factor, "strengths_A": list(strengths), "detail_strength_A": strength,
-            "rows": rows}, indent=2) + "\n")
+            "provenance": machine, "rows": rows}, indent=2) + "\n")
     figure = None
     if plot_dir:
         figure = plot_correlation_vs_force(rows, cases, factor, target, plot_dir / "correlation_vs_cut_force.png")

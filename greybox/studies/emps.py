@@ -47,6 +47,7 @@ import numpy as np
 from scipy.signal import decimate
 
 from ..atomic import write_text_atomic
+from ..provenance import provenance, provenance_line
 from ..data.io import read_log
 from ..data.log import AxisLog
 from ..data.prepare import derive, trim
@@ -395,10 +396,11 @@ def emps_benchmark(data: str | os.PathLike, json_path: str | os.PathLike, *, mar
         if out is not None and not Path(out).resolve().parent.is_dir():
             raise GreyboxError(f"{out}: directory {Path(out).resolve().parent} does not exist")
     results, curves = run_benchmark(Path(data), names, seed, progress=progress)
-    write_text_atomic(json_path, json.dumps(results, indent=2) + "\n")
+    machine = provenance()
+    write_text_atomic(json_path, json.dumps({**results, "provenance": machine}, indent=2) + "\n")
     table = markdown_table(results)
     if markdown_path is not None:
-        write_text_atomic(markdown_path, table)
+        write_text_atomic(markdown_path, f"{table}\nMeasured with {provenance_line(machine)}.\n")
     if plot_path is not None:
         plot_curves(curves, names, plot_path)
     return table
