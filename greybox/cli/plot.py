@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from ..atomic import check_output_path
+from ..errors import GreyboxError
 from ..evaluate.plots import plot_log
 from ._options import add_log_arguments, read_logs
 
@@ -15,7 +18,9 @@ def add_parser(subparsers) -> None:
         description="Draw position, velocity and current over time, and current over velocity.",
     )
     parser.add_argument("log", help="log file (CSV, Parquet, MCAP or EMPS .mat)")
-    parser.add_argument("--out", required=True, help="PNG file to write")
+    parser.add_argument("--out", required=True, metavar="PNG",
+                        help="picture to write (.png, .svg or .pdf); an existing file is kept unless --force")
+    parser.add_argument("--force", action="store_true", help="overwrite PNG if it exists")
     parser.add_argument(
         "--raw",
         action="store_true",
@@ -25,7 +30,20 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(run=run)
 
 
+#: Picture formats by file extension.
+_PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def _check_out(args: argparse.Namespace) -> None:
+    """Refuse before reading the log: unknown extension, existing file without --force, the log itself."""
+    out = Path(args.out)
+    if out.suffix.lower() not in _PLOT_SUFFIXES:
+        raise GreyboxError(f"{out}: unknown picture extension '{out.suffix}'; use {', '.join(_PLOT_SUFFIXES)}")
+    check_output_path(out, overwrite=args.force, protect=[args.log], inputs_name="the log to draw")
+
+
 def run(args: argparse.Namespace) -> int:
+    _check_out(args)
     (log,) = read_logs(args, [args.log], prepare=not args.raw)
     path = plot_log(log, args.out)
     print(f"wrote {path}")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from ..errors import GreyboxError
 from ..twin.cutting import CuttingSpec
@@ -24,7 +25,8 @@ def add_parser(subparsers) -> None:
         ),
     )
     parser.add_argument("--axis", required=True, metavar="AXES", help="axis or comma-separated axes: X, Y or X,Y")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
+    parser.add_argument("--out", required=True, metavar="DIR",
+                        help="output directory (created if missing; a non-empty one only with --force)")
     parser.add_argument("--seed", required=True, type=int, metavar="N", help="master seed (non-negative integer)")
     parser.add_argument("--datasets", default=",".join(DEFAULT_DATASETS), metavar="IDS",
                         help=f"comma-separated dataset ids from {', '.join(DATASETS)} (default %(default)s)")
@@ -50,7 +52,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--truth", choices=("all", "essential"), default="all",
                         help="truth channels to write: all, or only noise-free current and injected "
                              "components (compact files; default %(default)s)")
-    parser.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
+    parser.add_argument("--force", action="store_true",
+                        help="write into a non-empty DIR, overwriting files of the same name")
     parser.set_defaults(run=run)
 
 
@@ -87,12 +90,26 @@ def _effect_options(args: argparse.Namespace) -> dict:
     return options
 
 
+def _check_out_dir(args: argparse.Namespace) -> None:
+    """Refuse before any work: DIR is a file, or it holds anything and --force is not given."""
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise GreyboxError(f"{out}: is a file, not a directory")
+    if out.is_dir() and not args.force:
+        present = sorted(entry.name for entry in out.iterdir())
+        if present:
+            more = f" and {len(present) - 1} more exist" if len(present) > 1 else " exists"
+            raise GreyboxError(f"{out}: directory is not empty ({present[0]}{more}); nothing was written. "
+                               "Choose another directory or pass --force to write into it")
+
+
 def run(args: argparse.Namespace) -> int:
     axes = [a.strip().upper() for a in args.axis.split(",") if a.strip()]
     datasets = [d.strip().upper() for d in args.datasets.split(",") if d.strip()]
     if not axes or not datasets:
         raise GreyboxError("give at least one axis (--axis) and one dataset (--datasets)")
     options = _effect_options(args)
+    _check_out_dir(args)
     if args.cutting:
         options["cutting"] = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm,
                                          teeth=args.teeth)

