@@ -14,14 +14,14 @@ from greybox.twin import ESSENTIAL_TRUTH_CHANNELS, make_dataset, synthesize
 def test_synth_writes_one_file_per_dataset(tmp_path, capsys):
     out = tmp_path / "twin"
     status = main(["synth", "--axis", "X,Y", "--out", str(out), "--seed", "3", "--datasets", "A,P",
-                   "--duration", "6", "--effect", "position_periodic_force", "--strength", "0.15",
+                   "--duration", "10", "--effect", "position_periodic_force", "--strength", "0.15",
                    "--effect-param", "period_mm=5", "--cutting"])
     assert status == 0
     assert sorted(p.name for p in out.iterdir()) == ["X_A.mcap", "X_P.mcap", "Y_A.mcap", "Y_P.mcap"]
-    lines = capsys.readouterr().out.strip().splitlines()
+    lines = [line for line in capsys.readouterr().out.strip().splitlines() if not line.startswith("note:")]
     assert len(lines) == 4 and lines[0].startswith("X_A:") and "noise floor" in lines[0]
     log = read_log(out / "Y_A.mcap")
-    expected = make_dataset("Y", "A", seed=3, duration_s=6.0, effect="position_periodic_force",
+    expected = make_dataset("Y", "A", seed=3, duration_s=10.0, effect="position_periodic_force",
                             effect_strength=0.15, effect_params={"period_mm": 5.0}, cutting=True)
     assert log.axis == "Y" and log.dataset == "A" and log.attrs["seed"] == 3
     assert log.attrs["effect"] == {"name": "position_periodic_force", "strength_A": 0.15, "period_mm": 5.0,

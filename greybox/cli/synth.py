@@ -7,10 +7,10 @@ from pathlib import Path
 
 from ..errors import GreyboxError
 from ..twin.cutting import CuttingSpec
-from ..twin.datasets import ESSENTIAL_TRUTH_CHANNELS, synthesize
+from ..twin.datasets import ESSENTIAL_TRUTH_CHANNELS, SAMPLE_TIME_S, dataset_motion, synthesize
 from ..twin.effects import EFFECTS, effect_parameters
 from ..twin.noise import CurrentNoise
-from ..twin.trajectories import DATASETS, DEFAULT_DATASETS
+from ..twin.trajectories import DATASETS, DEFAULT_DATASETS, MIN_DURATION_S
 
 
 def add_parser(subparsers) -> None:
@@ -45,8 +45,10 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--teeth", type=int, default=CuttingSpec.teeth, metavar="Z",
                         help="number of cutter teeth (default %(default)s)")
     parser.add_argument("--duration", type=float, metavar="S",
-                        help="length [s] of the random datasets A, C (default 120) and P (default 60); "
-                             "B and D always cross the travel once back and forth per speed")
+                        help="length [s] of the random datasets A, C (default 120, at least 2; approximate: they "
+                             "end at rest after the move that crosses it) and P (default 60, at least 10; rounded "
+                             "up to whole 10 s envelope periods); B and D always cross the travel once back and "
+                             "forth per speed")
     parser.add_argument("--noise-std", type=float, default=CurrentNoise.std_A, metavar="A",
                         help="standard deviation [A] of the AR(1) current noise (default %(default)s)")
     parser.add_argument("--truth", choices=("all", "essential"), default="all",
@@ -103,12 +105,61 @@ def _check_out_dir(args: argparse.Namespace) -> None:
                                "Choose another directory or pass --force to write into it")
 
 
+#: Why a dataset needs MIN_DURATION_S, by dataset id.
+_MINIMUM_REASONS = {
+    "A": "0.5 s at rest at each end around at least one move",
+    "C": "0.5 s at rest at each end around at least one move",
+    "P": "it runs whole 10 s envelope periods",
+}
+#: Why a dataset's length differs from --duration, by dataset id.
+_DURATION_REASONS = {
+    "A": "A and C end at rest after the move that crosses it",
+    "C": "A and C end at rest after the move that crosses it",
+    "P": "P runs whole 10 s envelope periods",
+}
+
+
+def _check_duration(args: argparse.Namespace, axes, datasets) -> None:
+    """Refuse a --duration below a dataset's minimum; say which logs will be longer or shorter than asked.
+
+    Raises
+    ------
+    GreyboxError
+        If ``--duration`` is below :data:`~greybox.twin.trajectories.MIN_DURATION_S` of a requested dataset.
+    """
+    duration = args.duration
+    if duration is None or not duration > 0:  # non-positive values are refused where they are used
+        return
+    for key in datasets:
+        minimum = MIN_DURATION_S.get(key)
+        if minimum is not None and duration < minimum:
+            raise GreyboxError(f"--duration {duration:g}: dataset {key} needs at least {minimum:g} s "
+                               f"({_MINIMUM_REASONS[key]}); give --duration {minimum:g} or more, or leave {key} "
+                               "out of --datasets")
+    differ, reasons = [], []
+    for axis in axes:
+        for key in datasets:
+            if key not in MIN_DURATION_S:
+                continue
+            length_s = SAMPLE_TIME_S * int(dataset_motion(axis, key, args.seed, duration).duration_s / SAMPLE_TIME_S
+                                           + 1e-9)
+            if abs(length_s - duration) > 0.5:
+                differ.append(f"{axis}_{key} {length_s:.1f} s")
+                reasons.append(_DURATION_REASONS[key])
+    if differ:
+        print(f"note: --duration {duration:g} s gives {', '.join(differ)} ({'; '.join(dict.fromkeys(reasons))})")
+    fixed = [key for key in datasets if key in DATASETS and key not in MIN_DURATION_S]
+    if fixed:
+        print(f"note: --duration does not apply to {', '.join(fixed)} (once back and forth over the travel per speed)")
+
+
 def run(args: argparse.Namespace) -> int:
     axes = [a.strip().upper() for a in args.axis.split(",") if a.strip()]
     datasets = [d.strip().upper() for d in args.datasets.split(",") if d.strip()]
     if not axes or not datasets:
         raise GreyboxError("give at least one axis (--axis) and one dataset (--datasets)")
     options = _effect_options(args)
+    _check_duration(args, axes, datasets)
     _check_out_dir(args)
     if args.cutting:
         options["cutting"] = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm,

@@ -20,13 +20,14 @@ from .effects import EffectInputs, effect_current, effect_parameters
 from .noise import CurrentNoise
 from .plant import PlantParameters, default_plant_parameters, simulate_plant
 from .sensors import Sensors, quantise
-from .trajectories import DATASETS, DEFAULT_DATASETS, dataset_trajectory
+from .trajectories import DATASETS, DEFAULT_DATASETS, Trajectory, dataset_trajectory
 
 __all__ = [
     "SAMPLE_TIME_S",
     "TRUTH_CHANNELS",
     "ESSENTIAL_TRUTH_CHANNELS",
     "dataset_streams",
+    "dataset_motion",
     "make_dataset",
     "dataset_path",
     "synthesize",
@@ -62,6 +63,41 @@ def dataset_streams(seed: int, axis: str, dataset: str) -> tuple[np.random.Gener
     _check_seed(seed)
     sequence = np.random.SeedSequence([int(seed), ord(axis), ord(dataset)])
     return tuple(np.random.default_rng(child) for child in sequence.spawn(2))
+
+
+def dataset_motion(axis: str, dataset: str, seed: int, duration_s: float | None = None) -> Trajectory:
+    """The commanded motion of one dataset, drawn from the same stream as :func:`make_dataset` draws it.
+
+    Cheap (no plant simulation): tells the length [s] a dataset will have before synthesising it.
+
+    Parameters
+    ----------
+    axis : {"X", "Y"}
+        Axis of the synthetic machine.
+    dataset : {"A", "B", "C", "D", "P"}
+        Dataset id.
+    seed : int
+        Master seed.
+    duration_s : float, optional
+        Length [s] asked of A, C (default 120 s) and P (default 60 s); see
+        :data:`greybox.twin.trajectories.MIN_DURATION_S` for how it is met.
+
+    Returns
+    -------
+    Trajectory
+        Its ``duration_s`` is the length of the motion [s].
+
+    Raises
+    ------
+    GreyboxError
+        For an unknown axis or dataset, a bad seed or a non-positive duration.
+    """
+    geometry = axis_geometry(axis)
+    key = str(dataset).strip().upper()
+    if key not in DATASETS:
+        raise GreyboxError(f"unknown dataset {dataset!r}; choose from {', '.join(DATASETS)}")
+    trajectory_rng, _ = dataset_streams(seed, geometry.name, key)
+    return dataset_trajectory(geometry, key, trajectory_rng, duration_s)
 
 
 def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: str | None = None,
@@ -113,10 +149,8 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
     """
     geometry = axis_geometry(axis)
     key = str(dataset).strip().upper()
-    if key not in DATASETS:
-        raise GreyboxError(f"unknown dataset {dataset!r}; choose from {', '.join(DATASETS)}")
-    trajectory_rng, noise_rng = dataset_streams(seed, geometry.name, key)
-    trajectory = dataset_trajectory(geometry, key, trajectory_rng, duration_s)
+    trajectory = dataset_motion(geometry.name, dataset, seed, duration_s)
+    _, noise_rng = dataset_streams(seed, geometry.name, key)
     plant = plant if plant is not None else default_plant_parameters(geometry.name)
     noise = noise if noise is not None else CurrentNoise()
     sensors = sensors if sensors is not None else Sensors()
