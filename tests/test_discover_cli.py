@@ -39,8 +39,8 @@ def logs(tmp_path_factory):
 def test_discover_writes_findings_report_and_model(logs, tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(registry.MODEL_CLASSES, "augmented", AugmentedModel)
     out, model = tmp_path / "found.json", tmp_path / "model.gbm"
-    status = run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out),
-                      "--report", str(tmp_path / "report"), "--save-model", str(model), "--quiet",
+    status = run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out),
+                      "--out", str(tmp_path / "report"), "--save-model", str(model), "--quiet",
                       "--max-effects", "1"])
     assert status == 0
     document = json.loads(out.read_text())
@@ -58,16 +58,16 @@ def test_discover_writes_findings_report_and_model(logs, tmp_path, monkeypatch, 
 
 def test_outputs_never_overwrite_inputs_or_models(logs, tmp_path):
     with pytest.raises(GreyboxError, match="one of the input logs"):
-        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", logs[1], "--quiet"])
+        run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", logs[1], "--quiet"])
     findings = tmp_path / "findings.json"
     findings.write_text("keep")
     with pytest.raises(GreyboxError, match="use --force"):
-        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(findings), "--quiet"])
+        run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(findings), "--quiet"])
     assert findings.read_text() == "keep"
     existing = tmp_path / "model.gbm"
     existing.write_bytes(b"keep")
     with pytest.raises(GreyboxError, match="file exists"):
-        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(tmp_path / "a.json"),
+        run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(tmp_path / "a.json"),
                  "--save-model", str(existing), "--quiet"])
     assert existing.read_bytes() == b"keep"
 
@@ -75,17 +75,17 @@ def test_outputs_never_overwrite_inputs_or_models(logs, tmp_path):
 def test_bad_options_are_refused(logs, tmp_path):
     out = str(tmp_path / "a.json")
     with pytest.raises(GreyboxError, match="unknown effect"):
-        run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", out, "--effects", "gravity"])
+        run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", out, "--effects", "gravity"])
     with pytest.raises(GreyboxError, match="does not apply"):
-        run_cli(["--base", "stribeck", "--train", logs[0], "--test", logs[1], "--json", out, "--elements", "3"])
+        run_cli(["--model", "stribeck", "--train", logs[0], "--test", logs[1], "--json", out, "--elements", "3"])
     with pytest.raises(SystemExit):
-        run_cli(["--base", "augmented", "--train", logs[0], "--test", logs[1], "--json", out])
+        run_cli(["--model", "augmented", "--train", logs[0], "--test", logs[1], "--json", out])
 
 
 def test_effects_option_restricts_the_library(logs, tmp_path):
     out = tmp_path / "a.json"
-    run_cli(["--base", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out), "--quiet",
-             "--effects", "constant_offset,thermal_drift"])
+    run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out), "--quiet",
+             "--effects", "constant_offset", "thermal_drift"])
     document = json.loads(out.read_text())
     assert document["settings"]["candidates"] == ["constant_offset", "thermal_drift"]
     assert all(entry["name"] in ("constant_offset", "thermal_drift") for entry in document["effects"])

@@ -30,20 +30,20 @@ def add_parser(subparsers) -> None:
         "add the winning effect and refit jointly (at most --max-effects times), and report the error on the "
         "test logs before and after. Effects: " + ", ".join(EFFECT_NAMES) + ".",
     )
-    parser.add_argument("--base", required=True, choices=sorted(MODEL_CLASSES),
-                        help="base model kind (its linear parameters are refitted with the effects; svr and "
-                        "gmssvr have none and refit slowly)")
+    parser.add_argument("--model", required=True, choices=sorted(MODEL_CLASSES), metavar="KIND",
+                        help="kind of the base model: " + ", ".join(sorted(MODEL_CLASSES)) + " (its linear "
+                        "parameters are refitted with the effects; svr and gmssvr have none and refit slowly)")
     parser.add_argument("--train", required=True, nargs="+", metavar="LOG",
                         help="training logs (CSV, Parquet, MCAP or EMPS .mat), each a separate run")
     parser.add_argument("--test", required=True, nargs="+", metavar="LOG", help="test logs, each a separate run")
     parser.add_argument("--json", required=True, metavar="OUT", help="JSON file of the findings to write")
-    parser.add_argument("--report", metavar="DIR", help="also write the JSON and residual plots into DIR")
+    parser.add_argument("--out", metavar="DIR", help="also write a report into DIR: the JSON and residual plots")
     parser.add_argument("--save-model", metavar="MODEL", help="save the augmented model to this file (.gbm)")
     parser.add_argument("--force", action="store_true",
                         help="overwrite OUT, MODEL and the report's files if they exist")
     workflow = parser.add_argument_group("discovery options")
-    workflow.add_argument("--effects", metavar="NAMES",
-                          help="comma-separated effects to consider (default: the whole library)")
+    workflow.add_argument("--effects", nargs="+", metavar="NAME",
+                          help="effects to consider (default: the whole library)")
     workflow.add_argument("--max-effects", type=int, default=3, metavar="N", help="most effects to add (default 3)")
     workflow.add_argument("--alpha", type=float, default=0.05,
                           help="chance of naming an effect when nothing is missing (default 0.05)")
@@ -65,8 +65,8 @@ def _check_outputs(args) -> None:
     if args.save_model:
         check_output_path(args.save_model, overwrite=args.force, protect=inputs, error=ModelFileError,
                           inputs_name="one of the input logs")
-    if args.report:
-        directory = Path(args.report)
+    if args.out:
+        directory = Path(args.out)
         if directory.exists() and not directory.is_dir():
             raise GreyboxError(f"{directory}: exists and is not a directory")
         for name in REPORT_FILES:
@@ -75,15 +75,13 @@ def _check_outputs(args) -> None:
                                   inputs_name="one of the input logs")
 
 
-def _candidates(text: str | None) -> tuple[str, ...]:
-    if not text:
+def _candidates(names: list[str] | None) -> tuple[str, ...]:
+    if not names:
         return EFFECT_NAMES
-    names = tuple(name.strip() for name in text.split(",") if name.strip())
     unknown = [name for name in names if name not in EFFECT_NAMES]
-    if unknown or not names:
-        raise GreyboxError(f"unknown effect {', '.join(unknown) or '(none given)'}; "
-                           f"choose from {', '.join(EFFECT_NAMES)}")
-    return names
+    if unknown:
+        raise GreyboxError(f"unknown effect {', '.join(unknown)} (--effects); choose from {', '.join(EFFECT_NAMES)}")
+    return tuple(dict.fromkeys(names))
 
 
 def _format_parameters(parameters: dict) -> str:
@@ -126,7 +124,7 @@ def _print_summary(result) -> None:
 def run(args: argparse.Namespace) -> int:
     _check_outputs(args)
     names = _candidates(args.effects)
-    base = build_model(args.base, args)
+    base = build_model(args.model, args)
     started = time.perf_counter()
 
     def say(text: str) -> None:
@@ -143,8 +141,8 @@ def run(args: argparse.Namespace) -> int:
     document["logs"] = {"train": [str(p) for p in args.train], "test": [str(p) for p in args.test]}
     _print_summary(result)
     print(f"wrote {write_json(document, args.json)}")
-    if args.report:
-        for path in write_report(result, args.report, document):
+    if args.out:
+        for path in write_report(result, args.out, document):
             print(f"wrote {path}")
     if args.save_model:
         save_model(result.model, args.save_model, overwrite=args.force)
