@@ -105,3 +105,97 @@ def test_synth_says_when_a_log_is_not_as_long_as_asked(tmp_path, capsys):
     for key in "AP":  # the printed length is the written one
         written = read_log(out / f"X_{key}.mcap").duration
         assert (f"X_{key} {written:.1f} s" in note) == (abs(written - 15.0) > 0.5)
+
+
+# ---------------------------------------------------------------- evaluate: force logs, one row per test log
+def _force_log(dataset: str, seed: int, duration_s: float):
+    """A synthetic log turned into a force log [N] (as EMPS logs force), without truth channels."""
+    log = make_dataset("X", dataset, seed=seed, duration_s=duration_s)
+    return log.replace(effort=700.0 * log.effort, effort_unit="N", extras={})
+
+
+@pytest.fixture(scope="module")
+def force_files(tmp_path_factory):
+    """A Stribeck model fitted on a force log, two force test logs and one current log (MCAP)."""
+    from greybox.data.prepare import prepare
+    from greybox.friction import StribeckModel
+    from greybox.persistence import save_model
+
+    root = tmp_path_factory.mktemp("force")
+    model = save_model(StribeckModel().fit(prepare([_force_log("A", 1, 4.0)])), root / "stribeck.gbm")
+    paths = {"model": model}
+    for name, dataset, seed in (("first", "C", 2), ("second", "A", 3)):
+        paths[name] = root / f"{name}.mcap"
+        write_log(_force_log(dataset, seed, 3.0), paths[name])
+    paths["current"] = root / "current.mcap"
+    write_log(make_dataset("X", "C", seed=2, duration_s=3.0), paths["current"])
+    return paths
+
+
+def test_evaluate_report_of_force_logs_is_in_newtons(force_files, tmp_path, capsys):
+    import json
+
+    out = tmp_path / "report"
+    status, printed, err = _run(capsys, "evaluate", force_files["model"], "--test", force_files["first"],
+                                force_files["second"], "--out", out)
+    assert status == 0, err
+    assert "effort in N" in printed and "RMSE N" in printed
+    tables = (out / "tables.md").read_text()
+    assert "RMSE [N]" in tables and "max error [N]" in tables and "[A]" not in tables
+    assert "force in N" in tables
+    html = (out / "index.html").read_text()
+    assert "RMSE [N]" in html and "[A]" not in html
+    records = json.loads((out / "metrics.json").read_text())
+    assert {r["effort_unit"] for r in records} == {"N"}
+
+
+def test_report_figures_label_the_effort_unit(force_files, tmp_path):
+    from greybox.data.io import read_log
+    from greybox.data.prepare import prepare
+    from greybox.evaluate.figures import error_boxplot, residual_vs_position, time_comparison
+
+    runs = prepare([read_log(force_files["first"])])
+    predictions = {"stribeck": runs[0].effort * 0.9}
+    texts = {}
+    for name, draw in (("box", lambda p: error_boxplot([("test", runs, predictions)], p)),
+                       ("time", lambda p: time_comparison(runs, predictions, p)),
+                       ("residual", lambda p: residual_vs_position(runs, predictions, p))):
+        texts[name] = draw(tmp_path / f"{name}.svg").read_text()
+        assert "[A]" not in texts[name]
+    assert "absolute error [N]" in texts["box"] and "modelled force" in texts["box"]
+    assert "force [N]" in texts["time"] and "Measured and modelled force" in texts["time"]
+    assert "measured - model [N]" in texts["residual"]
+
+
+def test_evaluate_prints_a_row_per_test_log_before_the_pooled_rows(force_files, tmp_path, capsys):
+    import json
+
+    from greybox.data.io import read_log
+    from greybox.data.prepare import prepare
+    from greybox.metrics import rmse
+    from greybox.persistence import load_model
+
+    records_file = tmp_path / "m.json"
+    out = tmp_path / "report"
+    status, printed, err = _run(capsys, "evaluate", force_files["model"], "--test", force_files["first"],
+                                force_files["second"], "--json", records_file, "--out", out)
+    assert status == 0, err
+    lines = printed.splitlines()
+    first = next(i for i, line in enumerate(lines) if "log first" in line)
+    assert "log second" in lines[first + 1] and "all (pooled)" in lines[first + 2]
+    model = load_model(force_files["model"])
+    (record,) = json.loads(records_file.read_text())
+    for offset, name in enumerate(("first", "second")):
+        run = prepare([read_log(force_files[name])])[0]
+        fields = lines[first + offset].split()
+        assert fields[-5:-3] == [f"{name}", str(len(run))]
+        assert float(fields[-3]) == pytest.approx(rmse(run.effort, model.predict(run)), rel=1e-3)
+        assert float(fields[-2]) == pytest.approx(record["per_log"][name]["re"], abs=0.006)
+    assert "Test errors per log" in (out / "tables.md").read_text()
+
+
+def test_evaluate_refuses_logs_of_different_effort_units(force_files, capsys):
+    status, _, err = _run(capsys, "evaluate", force_files["model"], "--test", force_files["first"],
+                          force_files["current"])
+    assert status == 2 and err.count("\n") == 1
+    assert "--test: the logs carry effort in different units (first in N, current in A)" in err

@@ -54,13 +54,27 @@ def _check_outputs(args) -> None:
             raise GreyboxError(f"{target}: directory {target.parent} does not exist")
 
 
-def _print_records(records, unit: str) -> None:
-    print(f"  {'model':<24} {'regime':<14} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7} {'NMSE %':>8}")
+def _row(name: str, label: str, width: int, m) -> str:
+    return f"  {name:<24} {label:<{width}} {m['n']:>8d} {m['rmse']:>10.4g} {m['re']:>7.2f} {m['nmse']:>8.2f}"
+
+
+def _print_records(records, unit: str, run_names) -> None:
+    """Per model: one row per test log (when there are several), then the pooled rows per regime."""
+    per_log = len(run_names) > 1
+    labels = [f"log {name}" for name in run_names] if per_log else []
+    width = max([14, *map(len, labels)])
+    rows = "log / regime" if per_log else "regime"
+    print(f"  {'model':<24} {rows:<{width}} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7} {'NMSE %':>8}")
     for record in records:
+        name = record["model"][-24:]
+        if per_log:
+            for label, log in zip(labels, run_names):
+                print(_row(name, label, width, record["per_log"][log]))
+                name = ""
         for regime in REGIME_NAMES:
-            m = record["regimes"][regime]
-            name = record["model"][-24:] if regime == "all" else ""
-            print(f"  {name:<24} {regime:<14} {m['n']:>8d} {m['rmse']:>10.4g} {m['re']:>7.2f} {m['nmse']:>8.2f}")
+            label = "all (pooled)" if per_log and regime == "all" else regime
+            print(_row(name, label, width, record["regimes"][regime]))
+            name = ""
     print(f"  ({RE_NOTE})")
 
 
@@ -70,11 +84,15 @@ def run(args: argparse.Namespace) -> int:
     models = dict(zip(names, (load_model(path) for path in args.models)))
     runs = read_logs(args, args.test)
     run_names = _model_names(args.test)
+    units = dict.fromkeys(run.effort_unit for run in runs)
+    if len(units) > 1:
+        listed = ", ".join(f"{name} in {run.effort_unit}" for name, run in zip(run_names, runs))
+        raise GreyboxError(f"--test: the logs carry effort in different units ({listed}); evaluate them apart")
     unit = runs[0].effort_unit
     records, predictions = evaluate_models(models, runs, run_names)
     print(f"evaluated {len(models)} model(s) on {len(runs)} log(s), {sum(len(r) for r in runs)} samples, "
           f"effort in {unit}")
-    _print_records(records, unit)
+    _print_records(records, unit, run_names)
     if args.json:
         path = write_text_atomic(args.json, records_json(records))
         print(f"wrote {path}")

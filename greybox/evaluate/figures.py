@@ -10,6 +10,8 @@
 Every function takes the measured current of prepared runs and predictions
 keyed by model name (one array per run, or the runs concatenated), writes the
 figure with :func:`greybox.evaluate.plots.save_figure` and returns the path.
+Axes and default titles name the runs' effort: current [A], or force [N] for
+drives that log force (EMPS).
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from ..data.log import AxisLog
 from .plots import import_pyplot, save_figure
 from .report import MODEL_LABELS
 
-__all__ = ["MODEL_COLORS", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs"]
+__all__ = ["MODEL_COLORS", "effort_name", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs"]
 
 #: Line colours of the models, the same in every figure.
 MODEL_COLORS = {
@@ -42,6 +44,20 @@ _MEASURED = "#000000"
 
 def _color(model: str, k: int) -> str:
     return MODEL_COLORS.get(model, f"C{k % 10}")
+
+
+def effort_name(runs: Sequence[AxisLog]) -> tuple[str, str]:
+    """What the runs' effort is and its unit: ``("current", "A")`` or ``("force", "N")``.
+
+    Raises
+    ------
+    ValueError
+        If the runs carry different effort units.
+    """
+    units = sorted({run.effort_unit for run in runs})
+    if len(units) != 1:
+        raise ValueError(f"the runs carry effort in different units ({', '.join(units)}); draw them apart")
+    return ("current" if units[0] == "A" else "force"), units[0]
 
 
 def split_runs(runs: Sequence[AxisLog], prediction) -> list[np.ndarray]:
@@ -64,18 +80,18 @@ def split_runs(runs: Sequence[AxisLog], prediction) -> list[np.ndarray]:
 
 
 def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, object]]],
-                  path: str | os.PathLike, *, title: str = "Absolute error of the modelled current") -> Path:
+                  path: str | os.PathLike, *, title: str | None = None) -> Path:
     """Box plots of ``|I_model - I|`` per model, one panel per entry of ``panels``.
 
     Parameters
     ----------
     panels : sequence of (title, runs, predictions)
-        ``runs``: prepared runs whose ``effort`` is the measured current [A];
-        ``predictions``: ``{model: prediction}`` (concatenated or per run).
+        ``runs``: prepared runs whose ``effort`` is the measured current [A]
+        (or force [N]); ``predictions``: ``{model: prediction}`` (concatenated or per run).
     path : path-like
         PNG file to write.
-    title : str
-        Figure title.
+    title : str, optional
+        Figure title; default "Absolute error of the modelled current" (or force).
 
     Returns
     -------
@@ -83,6 +99,7 @@ def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, ob
         Boxes span the quartiles, whiskers the 5th to 95th percentiles;
         outliers are not drawn.
     """
+    noun, unit = effort_name([run for panel in panels for run in panel[1]])
     plt = import_pyplot(path)
     n_models = max(len(p[2]) for p in panels)
     figure, axes = plt.subplots(1, len(panels), figsize=(max(5.0, 1.0 + 0.9 * n_models) * len(panels), 4.5),
@@ -97,10 +114,10 @@ def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, ob
             patch.set_alpha(0.6)
         ax.set_xticks(range(1, len(names) + 1), [MODEL_LABELS.get(n, n) for n in names], rotation=30,
                       ha="right")
-        ax.set_ylabel("absolute error [A]")
+        ax.set_ylabel(f"absolute error [{unit}]")
         ax.set_title(panel_title)
         ax.grid(True, axis="y", alpha=0.3)
-    figure.suptitle(title)
+    figure.suptitle(title or f"Absolute error of the modelled {noun}")
     return save_figure(figure, path)
 
 
@@ -118,15 +135,15 @@ def _zoom_window(run: AxisLog, width_s: float) -> tuple[float, float]:
 
 def time_comparison(runs: Sequence[AxisLog], predictions: Mapping[str, object], path: str | os.PathLike, *,
                     names: Sequence[str] | None = None, zoom_s: float = 4.0, max_points: int = 20_000,
-                    title: str = "Measured and modelled current") -> Path:
+                    title: str | None = None) -> Path:
     """Measured and modelled current over time, each run in full and zoomed on a reversal.
 
     Parameters
     ----------
     runs : sequence of AxisLog
-        Prepared test runs; their ``effort`` is the measured current [A].
+        Prepared test runs; their ``effort`` is the measured current [A] (or force [N]).
     predictions : dict
-        ``{model: prediction}`` (concatenated or per run) [A].
+        ``{model: prediction}`` (concatenated or per run) [A] (or [N]).
     path : path-like
         PNG file to write.
     names : sequence of str, optional
@@ -135,13 +152,14 @@ def time_comparison(runs: Sequence[AxisLog], predictions: Mapping[str, object], 
         Width of the zoom window [s].
     max_points : int, default 20000
         Full-run curves are thinned to at most this many points for drawing.
-    title : str
-        Figure title.
+    title : str, optional
+        Figure title; default "Measured and modelled current" (or force).
 
     Returns
     -------
     pathlib.Path
     """
+    noun, unit = effort_name(runs)
     plt = import_pyplot(path)
     per_run = {model: split_runs(runs, p) for model, p in predictions.items()}
     if names is None:
@@ -165,17 +183,17 @@ def time_comparison(runs: Sequence[AxisLog], predictions: Mapping[str, object], 
         zoom.set_title(f"{names[i]}: {start:.1f} to {stop:.1f} s (around a reversal)")
         for ax in (full, zoom):
             ax.set_xlabel("time [s]")
-            ax.set_ylabel("current [A]")
+            ax.set_ylabel(f"{noun} [{unit}]")
             ax.grid(True, alpha=0.3)
     axes[0, 0].legend(loc="upper right", fontsize="small", ncol=min(3, 1 + len(per_run)))
-    figure.suptitle(title)
+    figure.suptitle(title or f"Measured and modelled {noun}")
     return save_figure(figure, path)
 
 
 def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, object], path: str | os.PathLike,
                          *, n_bins: int = 40, max_points: int = 20_000,
                          title: str = "Residual against position, by direction of motion") -> Path:
-    """Measured minus modelled current against the position, one panel per model.
+    """Measured minus modelled current (or force) against the position, one panel per model.
 
     Samples moving in +/- direction are drawn in two colours (thinned to at
     most ``max_points`` per panel, standstill left out), with the mean residual
@@ -184,9 +202,9 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
     Parameters
     ----------
     runs : sequence of AxisLog
-        Prepared runs (position [mm], velocity [mm/s], measured current [A]).
+        Prepared runs (position [mm], velocity [mm/s], measured current [A] or force [N]).
     predictions : dict
-        ``{model: prediction}`` (concatenated or per run) [A].
+        ``{model: prediction}`` (concatenated or per run) [A] (or [N]).
     path : path-like
         PNG file to write.
 
@@ -194,6 +212,7 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
     -------
     pathlib.Path
     """
+    unit = effort_name(runs)[1]
     plt = import_pyplot(path)
     position = np.concatenate([run.position for run in runs])
     velocity = np.concatenate([run.velocity for run in runs])
@@ -227,7 +246,7 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
     for ax in axes[-1]:
         ax.set_xlabel("position [mm]")
     for ax in axes[:, 0]:
-        ax.set_ylabel("measured - model [A]")
+        ax.set_ylabel(f"measured - model [{unit}]")
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
     axes[0, 0].legend(loc="upper right", fontsize="small")

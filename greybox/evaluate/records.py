@@ -23,9 +23,9 @@ import numpy as np
 
 from ..metrics import metrics_table
 from ..registry import model_kind
-from .figures import error_boxplot, residual_vs_position, time_comparison
+from .figures import effort_name, error_boxplot, residual_vs_position, time_comparison
 from .regimes import metrics_by_regime
-from .report import evaluation_table, regime_table, write_report
+from .report import evaluation_table, per_log_table, regime_table, write_report
 
 __all__ = ["NOISE_FLOOR", "TRUTH_CHANNEL", "metric_record", "evaluate_models", "write_evaluation_report"]
 
@@ -60,7 +60,7 @@ def metric_record(experiment: int | None, axis: str, model: str, dataset: str, m
         ``experiment``, ``axis``, ``model``, ``dataset``, ``rmse`` [A],
         ``re`` [%] (RMSE over mean absolute current), plus ``logs`` (e.g.
         ``"C+D"``), ``n``, ``nmse`` [%], ``max_error`` [A] and ``per_log``
-        (``{name: {"n", "rmse", "re"}}``).
+        (``{name: {"n", "rmse", "re", "nmse"}}``).
     """
     table = metrics_table(measured, modelled)
     record = {"experiment": experiment, "axis": axis, "model": model, "dataset": dataset,
@@ -70,7 +70,8 @@ def metric_record(experiment: int | None, axis: str, model: str, dataset: str, m
         record["per_log"] = {}
         for name, (y, y_hat) in per_log.items():
             part = metrics_table(y, y_hat)
-            record["per_log"][name] = {"n": part["n"], "rmse": part["rmse"], "re": part["re"]}
+            record["per_log"][name] = {"n": part["n"], "rmse": part["rmse"], "re": part["re"],
+                                       "nmse": part["nmse"]}
     return record
 
 
@@ -90,12 +91,19 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
     -------
     records : list of dict
         One ``test`` record per model (see
-        :func:`metric_record`) with ``kind`` and
-        ``regimes`` added, plus a ``noise_floor`` record when every run
+        :func:`metric_record`) with ``kind``, ``regimes`` and
+        ``effort_unit`` (the unit of RMSE and largest error: "A", or "N"
+        for force logs) added, plus a ``noise_floor`` record when every run
         carries the noise-free current.
     predictions : dict
-        ``{name: predicted current [A], runs concatenated}``.
+        ``{name: predicted current [A] (or force [N]), runs concatenated}``.
+
+    Raises
+    ------
+    ValueError
+        If the runs carry different effort units.
     """
+    _, unit = effort_name(runs)
     axis = "/".join(dict.fromkeys(run.axis for run in runs if run.axis))
     measured = np.concatenate([run.effort for run in runs])
     predictions = {name: model.predict(runs) for name, model in models.items()}
@@ -108,6 +116,7 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
         record = metric_record(None, axis, name, "test", measured, prediction, run_names, per_log)
         record["kind"] = model_kind(models[name]) if name in models else NOISE_FLOOR
         record["regimes"] = metrics_by_regime(runs, prediction)
+        record["effort_unit"] = unit
         records.append(record)
     return records, predictions
 
@@ -123,9 +132,9 @@ def write_evaluation_report(out_dir: str | os.PathLike, records: Sequence[Mappin
     records : sequence of dict
         Records of :func:`evaluate_models`.
     predictions : dict
-        ``{model: predicted current [A], runs concatenated}``.
+        ``{model: predicted current [A] (or force [N]), runs concatenated}``.
     runs : list of AxisLog
-        Prepared test runs.
+        Prepared test runs; tables and figures are labelled in their effort unit (A, or N for force logs).
     run_names : sequence of str
         Their names.
 
@@ -137,16 +146,22 @@ def write_evaluation_report(out_dir: str | os.PathLike, records: Sequence[Mappin
     out_dir = Path(out_dir)
     out_dir.mkdir(exist_ok=True)
     tests = "+".join(run_names)
+    noun, unit = effort_name(runs)
     models = {name: p for name, p in predictions.items() if name != NOISE_FLOOR}
     figures = [
-        (f"Absolute error of each model on {tests} (boxes: quartiles, whiskers: 5th-95th percentile)",
+        (f"Absolute error [{unit}] of each model on {tests} (boxes: quartiles, whiskers: 5th-95th percentile)",
          error_boxplot([(f"test on {tests}", runs, predictions)], out_dir / "error_boxplot.png")),
-        (f"Measured and modelled current on {tests}",
+        (f"Measured and modelled {noun} [{unit}] on {tests}",
          time_comparison(runs, models, out_dir / "time_comparison.png", names=run_names)),
-        (f"Measured minus modelled current against position, by direction of motion, on {tests}",
+        (f"Measured minus modelled {noun} [{unit}] against position, by direction of motion, on {tests}",
          residual_vs_position(runs, models, out_dir / "residual_position.png")),
     ]
-    files = write_report(out_dir, records, [evaluation_table(records), regime_table(records)], figures,
-                         title="greybox: model evaluation", intro=f"Models tested on {tests}.")
+    tables = [evaluation_table(records, unit=unit)]
+    if len(runs) > 1:
+        tables.append(per_log_table(records, unit=unit))
+    tables.append(regime_table(records))
+    files = write_report(out_dir, records, tables, figures,
+                         title="greybox: model evaluation",
+                         intro=f"Models tested on {tests}; the logs' effort is {noun} in {unit}.")
     files["figures"] = [path for _, path in figures]
     return files

@@ -61,6 +61,7 @@ __all__ = [
     "svr_generalisation_table",
     "timing_table",
     "evaluation_table",
+    "per_log_table",
     "regime_table",
     "report_tables",
     "tables_markdown",
@@ -377,13 +378,49 @@ def timing_table(timings: Sequence[Mapping]) -> Table:
     return Table("Fits", ["experiment", "axis", "model", "trained on", "fit [s]", "notes"], rows, notes)
 
 
-def evaluation_table(records: Sequence[Mapping], title: str = "Test errors") -> Table:
-    """Errors of each evaluated model: samples, RMSE [A], RE [%], NMSE [%], largest error [A]."""
-    header = ["model", "test logs", "samples", "RMSE [A]", "RE [%]", "NMSE [%]", "max error [A]"]
+def evaluation_table(records: Sequence[Mapping], title: str = "Test errors", *, unit: str = "A") -> Table:
+    """Errors of each evaluated model: samples, RMSE, RE [%], NMSE [%], largest error.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records.
+    title : str, default "Test errors"
+    unit : str, default "A"
+        Unit of the logs' effort, of RMSE and of the largest error: "A" for current, "N" for force logs.
+
+    Returns
+    -------
+    Table
+    """
+    header = ["model", "test logs", "samples", f"RMSE [{unit}]", "RE [%]", "NMSE [%]", f"max error [{unit}]"]
     rows = [[_label(r["model"]), r.get("logs", ""), str(r.get("n", "")), _number(r.get("rmse"), 4),
              _number(r.get("re"), 2), _number(r.get("nmse"), 2), _number(r.get("max_error"), 4)] for r in records]
     notes = [RE_NOTE, "NMSE = 100 mean((I_model - I)^2) / var(I) in % (Tjahjowidodo et al. 2005)."]
     return Table(title, header, rows, notes)
+
+
+def per_log_table(records: Sequence[Mapping], title: str = "Test errors per log", *, unit: str = "A") -> Table:
+    """Errors of each evaluated model on each test log (records carrying ``per_log``).
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records.
+    title : str, default "Test errors per log"
+    unit : str, default "A"
+        Unit of the logs' effort and of RMSE: "A" for current, "N" for force logs.
+
+    Returns
+    -------
+    Table
+        One row per model and log: samples, RMSE, RE [%], NMSE [%].
+    """
+    header = ["model", "test log", "samples", f"RMSE [{unit}]", "RE [%]", "NMSE [%]"]
+    rows = [[_label(r["model"]), log, str(m.get("n", "")), _number(m.get("rmse"), 4), _number(m.get("re"), 2),
+             _number(m.get("nmse"), 2)]
+            for r in records for log, m in (r.get("per_log") or {}).items()]
+    return Table(title, header, rows, [RE_NOTE])
 
 
 def regime_table(records: Sequence[Mapping], title: str = "RE per operating regime [%]") -> Table:
