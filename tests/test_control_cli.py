@@ -36,7 +36,7 @@ def model_files(tmp_path_factory):
 
 def test_twin_plant_with_fitted_models(tmp_path, capsys):
     out = tmp_path / "report"
-    assert run_cli("--plant", "twin-X", "--fit", "coulomb,stribeck", "--train-duration", 8, "--duration", 4,
+    assert run_cli("--plant", "twin-X", "--model", "coulomb", "stribeck", "--train-duration", 8, "--duration", 4,
                    "--out", out) == 0
     printed = capsys.readouterr().out
     assert "low-stroke" in printed and "high-stroke" in printed and "kp =" in printed
@@ -58,7 +58,7 @@ def test_twin_plant_with_fitted_models(tmp_path, capsys):
 
 def test_existing_report_is_kept_unless_forced(tmp_path, model_files):
     out = tmp_path / "report"
-    common = ["--plant", "twin-Y", "--models", model_files["coulomb"], "--reference", "low", "--duration", 2,
+    common = ["--plant", "twin-Y", "--model-file", model_files["coulomb"], "--reference", "low", "--duration", 2,
               "--out", out, "--quiet"]
     assert run_cli(*common) == 0
     before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
@@ -73,7 +73,7 @@ def test_model_plant_and_a_log_reference(tmp_path, model_files, capsys):
     log_path = tmp_path / "cut_17.csv"
     write_log(log, log_path)
     out = tmp_path / "report"
-    assert run_cli("--plant", model_files["gms"], "--models", model_files["coulomb"], model_files["gms"],
+    assert run_cli("--plant", model_files["gms"], "--model-file", model_files["coulomb"], model_files["gms"],
                    "--reference", log_path, "--out", out, "--disturbance-std", 0.02, "--quiet") == 0
     with open(out / "compensation.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
@@ -86,12 +86,12 @@ def test_model_plant_and_a_log_reference(tmp_path, model_files, capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--plant", "twin-Z", "--fit", "coulomb"], "not a model file"),
+    (["--plant", "twin-Z", "--model", "coulomb"], "not a model file"),
     (["--plant", "twin-X"], "no feed-forward model"),
-    (["--plant", "twin-X", "--fit", "magic"], "unknown model kind"),
-    (["--plant", "twin-X", "--train", "x.csv"], "--train needs --fit"),
-    (["--plant", "twin-X", "--fit", "coulomb", "--inertia", "heavy"], "--inertia"),
-    (["--plant", "twin-X", "--fit", "coulomb", "--reference", "medium"], "medium"),
+    (["--plant", "twin-X", "--model", "magic"], "unknown model kind"),
+    (["--plant", "twin-X", "--train", "x.csv"], "--train needs --model"),
+    (["--plant", "twin-X", "--model", "coulomb", "--inertia", "heavy"], "--inertia"),
+    (["--plant", "twin-X", "--model", "coulomb", "--reference", "medium"], "medium"),
 ])
 def test_bad_input_is_a_one_line_error(tmp_path, argv, message):
     with pytest.raises(GreyboxError, match=message):
@@ -100,14 +100,14 @@ def test_bad_input_is_a_one_line_error(tmp_path, argv, message):
 
 def test_static_model_and_model_plant_without_training_logs_are_refused(tmp_path, model_files):
     with pytest.raises(GreyboxError, match="cannot serve as the plant"):
-        run_cli("--plant", model_files["coulomb"], "--fit", "coulomb", "--out", tmp_path / "a")
+        run_cli("--plant", model_files["coulomb"], "--model", "coulomb", "--out", tmp_path / "a")
     with pytest.raises(GreyboxError, match="needs training logs"):
-        run_cli("--plant", model_files["gms"], "--fit", "coulomb", "--out", tmp_path / "b")
+        run_cli("--plant", model_files["gms"], "--model", "coulomb", "--out", tmp_path / "b")
 
 
 def test_a_damaged_plant_file_is_named_once(tmp_path):
     plant = tmp_path / "bad.gbm"
     plant.write_bytes(b"not a model")
     with pytest.raises(GreyboxError) as caught:
-        run_cli("--plant", plant, "--fit", "coulomb", "--out", tmp_path / "a")
+        run_cli("--plant", plant, "--model", "coulomb", "--out", tmp_path / "a")
     assert str(caught.value).count("bad.gbm") == 1

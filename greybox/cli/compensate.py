@@ -33,11 +33,12 @@ def add_parser(subparsers) -> None:
     )
     parser.add_argument("--plant", required=True, metavar="PLANT",
                         help="twin-X, twin-Y (the synthetic axis's truth plant) or a gms/lugre model file")
-    parser.add_argument("--models", nargs="+", default=[], metavar="MODEL", help="feed-forward model files (.gbm)")
-    parser.add_argument("--fit", metavar="KINDS",
-                        help=f"fit these model kinds for feed-forward, comma-separated ({', '.join(MODEL_CLASSES)}), "
-                        "on --train logs or, for a twin plant, on its synthetic datasets A and P")
-    parser.add_argument("--train", nargs="+", metavar="LOG", help="training logs for --fit")
+    parser.add_argument("--model-file", nargs="+", default=[], metavar="MODEL", dest="model_files",
+                        help="feed-forward model files (.gbm)")
+    parser.add_argument("--model", nargs="+", metavar="KIND", dest="kinds",
+                        help=f"fit models of these kinds for feed-forward ({', '.join(MODEL_CLASSES)}) on --train "
+                        "logs or, for a twin plant, on its synthetic datasets A and P")
+    parser.add_argument("--train", nargs="+", metavar="LOG", help="training logs of the --model kinds")
     parser.add_argument("--train-duration", type=float, default=60.0, metavar="S",
                         help="length [s] of each synthetic training dataset of a twin plant (default 60)")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
@@ -108,14 +109,14 @@ def _plant(args):
 def _fit_kinds(args) -> list[str]:
     from ..registry import MODEL_CLASSES
 
-    if not args.fit:
+    if not args.kinds:
         if args.train:
-            raise GreyboxError("--train needs --fit KINDS")
+            raise GreyboxError("--train needs --model KIND...")
         return []
-    kinds = [kind.strip().lower() for kind in args.fit.split(",") if kind.strip()]
+    kinds = [kind.strip().lower() for kind in args.kinds]
     unknown = [kind for kind in kinds if kind not in MODEL_CLASSES]
     if unknown or not kinds:
-        raise GreyboxError(f"unknown model kind {', '.join(unknown) or repr(args.fit)}; "
+        raise GreyboxError(f"unknown model kind {', '.join(unknown)} (--model); "
                            f"choose from {', '.join(MODEL_CLASSES)}")
     return list(dict.fromkeys(kinds))
 
@@ -128,7 +129,7 @@ def _training_runs(args, plant):
     if args.train:
         return read_logs(args, args.train)
     if not isinstance(plant, TwinPlant) or plant.axis is None:
-        raise GreyboxError("--fit with a model plant needs training logs: give --train LOG ...")
+        raise GreyboxError("--model with a model plant needs training logs: give --train LOG ...")
     _say(args, f"synthesising training data: axis {plant.axis}, datasets A and P, {args.train_duration:g} s each, "
                f"seed {args.seed}")
     return twin_training_runs(plant, seed=args.seed, duration_s=args.train_duration)
@@ -139,7 +140,7 @@ def _models(args, plant) -> dict:
     from ._build import build_model
 
     entries = []
-    for path in args.models:
+    for path in args.model_files:
         model = _load(path)
         entries.append((model_kind(model), Path(path).stem, model))
     kinds = _fit_kinds(args)
@@ -151,7 +152,7 @@ def _models(args, plant) -> dict:
             _say(args, f"fitted {kind} on {len(runs)} run(s) in {time.perf_counter() - started:.1f} s")
             entries.append((kind, "fitted", model))
     if not entries:
-        raise GreyboxError("no feed-forward model: give --models FILE ... or --fit KINDS")
+        raise GreyboxError("no feed-forward model: give --model KIND... or --model-file FILE...")
     counts = {}
     for kind, _, _ in entries:
         counts[kind] = counts.get(kind, 0) + 1
@@ -201,7 +202,7 @@ def _check_output(args) -> None:
     if out.exists() and not out.is_dir():
         raise GreyboxError(f"{out}: exists and is not a directory")
     targets = report_paths(_reference_names(args), out)
-    inputs = [p for p in [args.plant, *args.models, *(args.train or ()), *args.reference] if os.path.exists(p)]
+    inputs = [p for p in [args.plant, *args.model_files, *(args.train or ()), *args.reference] if os.path.exists(p)]
     for target in targets:
         if target.exists() and any(os.path.samefile(target, source) for source in inputs):
             raise GreyboxError(f"{target}: is one of the inputs; refusing to overwrite it")
@@ -233,7 +234,7 @@ def run(args: argparse.Namespace) -> int:
         relative = f"{100.0 * row['rms_vs_none']:.1f}" if row["rms_vs_none"] == row["rms_vs_none"] else ""
         print(f"  {row['reference'][:16]:<16} {row['feedforward'][:16]:<16} {1e3 * row['rms_error_mm']:>10.4g} "
               f"{1e3 * row['peak_error_mm']:>10.4g} {relative:>10}")
-    settings = {**study.settings, "model_files": list(args.models), "fitted": args.fit,
+    settings = {**study.settings, "model_files": list(args.model_files), "fitted": list(args.kinds or ()),
                 "training_logs": list(args.train or ())}
     written = write_report(study.results, args.out, settings=settings, force=args.force)
     for path in written:
