@@ -45,7 +45,7 @@ def main() -> None:
     parser.add_argument("--out", help="report directory (default: a new temporary directory)")
     parser.add_argument("--data", default=str(Path(__file__).resolve().parents[1] / "data"),
                         help="directory of the <axis>_<dataset>.mcap logs (default: the repository's data/)")
-    parser.add_argument("--axes", default="X,Y")
+    parser.add_argument("--axis", nargs="+", default=["X", "Y"], metavar="AXIS")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
@@ -53,7 +53,7 @@ def main() -> None:
     out = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="greybox-reproduce-"))
     if out.exists() and any(out.iterdir()):
         parser.error(f"{out} is not empty")
-    axes = [a for a in args.axes.split(",") if a]
+    axes = list(args.axis)
     cpu = _cpu_seconds()
     started = time.perf_counter()
     result = reproduce(out, args.data, axes=axes, quick=args.quick, jobs=args.jobs,

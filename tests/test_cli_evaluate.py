@@ -108,7 +108,7 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
     for d in "ABCD":
         write_log(trim(make_dataset("Y", d, seed=2, duration_s=5.0), stop_s=5.0), data / f"Y_{d}.mcap")
     out = tmp_path / "out"
-    assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axes", "Y", "--quick",
+    assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axis", "Y", "--quick",
                      "--jobs", "1", "--no-models"]) == 0
     captured = capsys.readouterr()
     assert "axis Y, experiment 2: gmssvr (GMS on A, SVR on B)" in captured.err  # progress display
@@ -117,4 +117,4 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
         (1, m) for m in ("coulomb", "stribeck", "lugre", "gms", "svr", "gmssvr", "noise_floor")} | {
         (2, m) for m in ("stribeck", "gms", "svr", "gmssvr", "gmssvr_eq8", "noise_floor")}
     assert "Table 3" in (out / "tables.md").read_text() and not (out / "models").exists()
-    assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axes", "Y"]) == 2  # not empty now
+    assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axis", "Y"]) == 2  # not empty now

@@ -34,7 +34,7 @@ def add_parser(subparsers) -> None:
         "every axis; writes metrics.json/csv, tables.md, PNG figures, index.html and the model files into DIR.",
     )
     parser.add_argument("--out", required=True, metavar="DIR", help="report directory (new or empty)")
-    parser.add_argument("--axes", default="X,Y", metavar="LIST", help="comma-separated axes (default X,Y)")
+    parser.add_argument("--axis", nargs="+", default=["X", "Y"], metavar="AXIS", help="axes to run (default: X Y)")
     parser.add_argument("--data", metavar="DIR",
                         help="directory of the <axis>_<dataset>.mcap logs (default: ./data, else the source tree's data/)")
     parser.add_argument("--quick", action="store_true",
@@ -60,9 +60,9 @@ class _Elapsed:
 
 
 def run(args: argparse.Namespace) -> int:
-    axes = [a.strip() for a in args.axes.split(",") if a.strip()]
+    axes = list(dict.fromkeys(a.strip() for a in args.axis if a.strip()))
     if not axes:
-        raise GreyboxError("--axes names no axis")
+        raise GreyboxError("--axis names no axis")
     if args.jobs < 1:
         raise GreyboxError(f"--jobs must be at least 1, got {args.jobs}")
     data_dir = Path(args.data) if args.data else default_data_dir()
@@ -77,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
         for dataset in datasets:
             find_log(data_dir, axis, dataset)
 
-    command = ["greybox", "reproduce", "--out", str(out_dir), "--axes", ",".join(axes), "--data", str(data_dir)]
+    command = ["greybox", "reproduce", "--out", str(out_dir), "--axis", *axes, "--data", str(data_dir)]
     command += ["--quick"] * args.quick
     progress = None if args.quiet else _Elapsed()
     result = reproduce(out_dir, data_dir, axes=axes, quick=args.quick, jobs=args.jobs,
