@@ -199,3 +199,25 @@ def test_evaluate_refuses_logs_of_different_effort_units(force_files, capsys):
                           force_files["current"])
     assert status == 2 and err.count("\n") == 1
     assert "--test: the logs carry effort in different units (first in N, current in A)" in err
+
+
+# ---------------------------------------------------------------- info: files of the same name
+def test_info_tells_files_of_the_same_name_apart(tmp_path, capsys):
+    paths = []
+    for run, seed in (("monday", 1), ("tuesday", 2)):
+        (tmp_path / run / "axis").mkdir(parents=True)
+        paths.append(tmp_path / run / "axis" / "X_A.mcap")
+        write_log(make_dataset("X", "A", seed=seed, duration_s=3.0), paths[-1])
+    status, printed, err = _run(capsys, "info", *paths)
+    assert status == 0, err
+    rows = printed.splitlines()[1:]
+    assert len(rows) == 2 and rows[0] != rows[1]
+    assert rows[0].startswith("monday/axis/X_A.mcap ") and rows[1].startswith("tuesday/axis/X_A.mcap ")
+
+
+def test_display_names_use_as_few_folders_as_needed():
+    from greybox.cli.info import display_names
+
+    assert display_names(["a/b/X.mcap", "c/b/X.mcap", "d/Y.mcap"]) == ["a/b/X.mcap", "c/b/X.mcap", "Y.mcap"]
+    assert display_names(["a/X.mcap", "X.mcap"]) == ["a/X.mcap", "X.mcap"]
+    assert display_names(["a/X.mcap", "a/X.mcap"]) == ["a/X.mcap", "a/X.mcap"]

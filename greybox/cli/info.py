@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import PurePath
 
 import numpy as np
 
@@ -62,21 +63,48 @@ def summarise(log: AxisLog) -> dict:
     return summary
 
 
+def display_names(paths) -> list[str]:
+    """Shortest trailing parts of the paths that tell the files apart: names, with folders where names repeat.
+
+    Parameters
+    ----------
+    paths : sequence of str
+        File paths.
+
+    Returns
+    -------
+    list of str
+        ``X_A.mcap`` for a name given once; ``run1/X_A.mcap`` and ``run2/X_A.mcap`` (as many
+        folders as needed) for names that repeat; the path as given for a file named twice.
+    """
+    parts = [PurePath(p).parts or (str(p),) for p in paths]
+    depth = [1] * len(parts)
+    while True:
+        names = ["/".join(q[-k:]) for q, k in zip(parts, depth)]
+        clashes = [i for i, name in enumerate(names)
+                   if names.count(name) > 1 and depth[i] < len(parts[i])]
+        if not clashes:
+            return names
+        for i in clashes:
+            depth[i] += 1
+
+
 def run(args: argparse.Namespace) -> int:
     summaries = [summarise(log) for log in read_logs(args, args.logs)]
     if args.json:
         for summary in summaries:
             print(json.dumps(summary))
         return 0
-    header = f"{'file':<28} {'axis':>4} {'set':>4} {'samples':>9} {'dt ms':>6} {'dur s':>8} " \
+    names = display_names([s["file"] or path for s, path in zip(summaries, args.logs)])
+    width = max([28, *map(len, names)])
+    header = f"{'file':<{width}} {'axis':>4} {'set':>4} {'samples':>9} {'dt ms':>6} {'dur s':>8} " \
              f"{'position mm':>19} {'vmax mm/min':>11} {'RMS effort':>12} {'noise':>8}"
     print(header)
-    for s in summaries:
-        name = s["file"].rsplit("/", 1)[-1][:28]
+    for name, s in zip(names, summaries):
         noise = f"{s['noise_floor_rmse_A']:.4f}" if "noise_floor_rmse_A" in s else "-"
         vmax = f"{s['speed_max_mm_min']:.0f}" if s["speed_max_mm_min"] is not None else "-"
         print(
-            f"{name:<28} {s['axis']:>4} {s['dataset']:>4} {s['samples']:>9d} {s['sample_time_ms']:>6.2f} "
+            f"{name:<{width}} {s['axis']:>4} {s['dataset']:>4} {s['samples']:>9d} {s['sample_time_ms']:>6.2f} "
             f"{s['duration_s']:>8.1f} {s['position_min_mm']:>9.2f}..{s['position_max_mm']:<8.2f} {vmax:>11} "
             f"{s['effort_rms']:>10.4f} {s['effort_unit']} {noise:>8}"
         )
