@@ -22,11 +22,11 @@ from greybox.twin.cutting import CuttingSpec
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _floats(text: str) -> tuple[float, ...]:
-    values = tuple(float(item) for item in text.split(",") if item.strip())
-    if not values or min(values) <= 0:
-        raise argparse.ArgumentTypeError(f"expected positive numbers separated by commas, got {text!r}")
-    return values
+def _positive(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
+    return value
 
 
 def main(argv=None) -> int:
@@ -34,9 +34,9 @@ def main(argv=None) -> int:
     parser.add_argument("--data", type=Path, default=ROOT / "data", help="folder of the shipped air cuts X_A...X_D")
     parser.add_argument("--axis-config", type=Path, default=ROOT / "examples" / "axis_x.toml")
     parser.add_argument("--seed", type=int, default=7, help="seed of the cutting logs (the shipped data use 2024)")
-    parser.add_argument("--models", default=",".join(KINDS), help="comma-separated model kinds")
-    parser.add_argument("--strengths", type=_floats, default=DEFAULT_STRENGTHS,
-                        help="cut strengths swept [A at 1000 mm/min, full engagement], comma-separated")
+    parser.add_argument("--model", nargs="+", default=list(KINDS), metavar="KIND", help="model kinds (default: all)")
+    parser.add_argument("--strengths", type=_positive, nargs="+", default=list(DEFAULT_STRENGTHS), metavar="A",
+                        help="cut strengths swept [A at 1000 mm/min, full engagement]")
     parser.add_argument("--strength", type=float, default=CuttingSpec().strength_A,
                         help="cut strength of the detailed table [A] (one of --strengths)")
     parser.add_argument("--target", type=float, default=0.95, help="correlation target")
@@ -47,10 +47,10 @@ def main(argv=None) -> int:
                         "test log (at the detailed strength) here")
     args = parser.parse_args(argv)
 
-    kinds = [k.strip() for k in args.models.split(",") if k.strip()]
+    kinds = list(dict.fromkeys(args.model))
     try:
         result = cutting_validation(args.data, args.axis_config, seed=args.seed, kinds=kinds,
-                                    strengths=args.strengths, strength=args.strength, target=args.target,
+                                    strengths=tuple(args.strengths), strength=args.strength, target=args.target,
                                     chunk_s=args.chunk_s, markdown_path=args.markdown, json_path=args.json,
                                     plot_dir=args.plot_dir, progress=lambda line: print(line, flush=True))
     except GreyboxError as error:

@@ -71,13 +71,13 @@ def test_strength_of_the_table_must_be_swept_and_kinds_registered():
 
 
 def test_the_script_runs_as_a_user_runs_it(tmp_path):
-    result = subprocess.run([sys.executable, str(SCRIPT), "--models", "coulomb", "--strengths", "0.5,2",
+    result = subprocess.run([sys.executable, str(SCRIPT), "--model", "coulomb", "--strengths", "0.5", "2",
                              "--strength", "0.5", "--json", str(tmp_path / "v.json")],
                             capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert result.returncode == 0, result.stderr
     assert "Correlation by cut strength" in result.stdout and "noise floor rms(truth_noise_A)" in result.stdout
     assert [row["model"] for row in json.loads((tmp_path / "v.json").read_text())["rows"]] == ["coulomb"] * 2
-    refused = subprocess.run([sys.executable, str(SCRIPT), "--models", "coulomb", "--strengths", "0.5,2",
+    refused = subprocess.run([sys.executable, str(SCRIPT), "--model", "coulomb", "--strengths", "0.5", "2",
                               "--strength", "1"], capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert refused.returncode == 2 and "not one of the swept strengths" in refused.stderr
     assert "Traceback" not in refused.stderr
