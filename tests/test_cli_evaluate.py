@@ -5,12 +5,14 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare, trim
 from greybox.evaluate.regimes import REGIME_NAMES
+from greybox.evaluate.report import CSV_COLUMNS
 from greybox.friction import GMSModel, StribeckModel
 from greybox.metrics import rmse
 from greybox.persistence import save_model
@@ -117,4 +119,7 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
         (1, m) for m in ("coulomb", "stribeck", "lugre", "gms", "svr", "gmssvr", "noise_floor")} | {
         (2, m) for m in ("stribeck", "gms", "svr", "gmssvr", "gmssvr_eq8", "noise_floor")}
     assert "Table 3" in (out / "tables.md").read_text() and not (out / "models").exists()
+    table = pd.read_csv(out / "metrics.csv")  # plain CSV: default settings read it
+    assert list(table.columns) == list(CSV_COLUMNS) and len(table) == len(records)
+    assert list(table["model"]) == [r["model"] for r in records] and list(table["n"]) == [r["n"] for r in records]
     assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axis", "Y"]) == 2  # not empty now

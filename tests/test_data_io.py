@@ -50,7 +50,8 @@ def test_write_replaces_atomically_and_leaves_no_temporary_file(tmp_path, make_l
     write_log(make_log(n=50), path)
     write_log(make_log(n=80), path)
     assert len(read_log(path)) == 80
-    assert [p.name for p in tmp_path.iterdir()] == [path.name]
+    sidecar = [f"{path.name}.json"] if suffix == ".csv" else []  # CSV metadata go to log.csv.json
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name, *sidecar]
     mode = os.stat(path).st_mode & 0o777
     umask = os.umask(0)
     os.umask(umask)
@@ -60,11 +61,11 @@ def test_write_replaces_atomically_and_leaves_no_temporary_file(tmp_path, make_l
 def test_failed_write_keeps_the_old_file(tmp_path, make_log):
     path = tmp_path / "log.csv"
     write_log(make_log(n=50), path)
-    before = path.read_bytes()
+    before = path.read_bytes(), (tmp_path / "log.csv.json").read_bytes()
     with pytest.raises(TypeError):
         write_log(make_log(n=50, attrs={"not json": object()}), path)
-    assert path.read_bytes() == before
-    assert [p.name for p in tmp_path.iterdir()] == ["log.csv"]
+    assert (path.read_bytes(), (tmp_path / "log.csv.json").read_bytes()) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["log.csv", "log.csv.json"]
 
 
 def test_refuses_to_overwrite_its_input(tmp_path, make_log):

@@ -54,7 +54,7 @@ def _expected(files):
 
 def _read_table(path: Path) -> pd.DataFrame:
     if path.suffix == ".csv":
-        return pd.read_csv(path, comment="#")
+        return pd.read_csv(path)
     if path.suffix == ".parquet":
         return pd.read_parquet(path)
     log = read_log(path, columns={"current_A": "current_measured_A"})
@@ -105,7 +105,7 @@ def test_without_axis_metadata_there_is_no_force(files, tmp_path, capsys):
     out = tmp_path / "out.csv"
     status, stdout, _ = _predict(capsys, files["model_path"], files["log_path"], "--out", out)
     assert status == 0 and "force" not in stdout.split("\n", 1)[1].split("wrote")[0]
-    assert "force_process_N" not in pd.read_csv(out, comment="#").columns
+    assert "force_process_N" not in pd.read_csv(out).columns
 
 
 def test_plot_is_written(files, tmp_path, capsys):
@@ -162,7 +162,7 @@ def test_channel_names_from_the_axis_config(files, tmp_path, capsys):
     out = tmp_path / "out.csv"
     status, _, stderr = _predict(capsys, files["model_path"], csv, "--out", out, "--axis-config", config)
     assert status == 0, stderr
-    table = pd.read_csv(out, comment="#")
+    table = pd.read_csv(out)
     np.testing.assert_array_equal(table["current_measured_A"], log.current)
 
 
@@ -205,5 +205,5 @@ def test_model_file_of_discover_predicts_in_chunks(files, tmp_path, capsys):
     assert status == 0, stderr
     assert "augmented model" in stdout and "6 chunk(s)" in stdout
     log = prepare([read_log(files["log_path"])])[0]
-    table = pd.read_csv(out, comment="#")
+    table = pd.read_csv(out)
     np.testing.assert_allclose(table["current_model_A"], model.predict(log), rtol=0, atol=1e-9)

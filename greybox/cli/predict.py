@@ -48,8 +48,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("model", metavar="MODEL", help="model file written by 'greybox train' (.gbm)")
     parser.add_argument("log", metavar="LOG", help="cutting log (CSV, Parquet, MCAP or EMPS .mat)")
     parser.add_argument("--out", required=True, metavar="OUT",
-                        help="table to write: .csv, .parquet or .mcap (MCAP: one message per sample, "
-                        "topic /process/<axis>)")
+                        help="table to write: .csv, .parquet or .mcap (CSV: plain, header first, metadata in "
+                        "OUT.json beside it; MCAP: one message per sample, topic /process/<axis>)")
     parser.add_argument("--axis-config", metavar="TOML",
                         help="axis metadata (torque constant, screw lead, gear ratio, efficiency, channel "
                         "names); adds force_process_N (see examples/axis_x.toml)")
@@ -59,7 +59,7 @@ def add_parser(subparsers) -> None:
                         "0.1; 0 draws none)")
     parser.add_argument("--chunk-s", type=_positive_seconds, default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
-    parser.add_argument("--force", action="store_true", help="overwrite OUT and PNG if they exist")
+    parser.add_argument("--force", action="store_true", help="overwrite OUT (and OUT.json) and PNG if they exist")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -81,14 +81,14 @@ def _read_log(args: argparse.Namespace, channels: dict):
 def run(args: argparse.Namespace) -> int:
     from ..data.axis_config import read_axis_config
     from ..evaluate.process import predict_process
-    from ..evaluate.process_io import check_output_path, output_format, write_process
+    from ..evaluate.process_io import check_output_path, output_paths, write_process
     from ..models.chunked import chunk_slices, samples_per_chunk
     from ..persistence import load_model
 
     inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else [])
     out = Path(args.out)
-    output_format(out)
-    check_output_path(out, overwrite=args.force, protect=inputs)
+    for target in output_paths(out):  # the table, and for CSV its metadata sidecar
+        check_output_path(target, overwrite=args.force, protect=inputs)
     if args.plot:
         plot = Path(args.plot)
         if plot.suffix.lower() not in _PLOT_SUFFIXES:
@@ -118,7 +118,8 @@ def run(args: argparse.Namespace) -> int:
               f"largest |process| {np.max(np.abs(result.force)):.4g} N "
               f"({result.force_constant_N_per_A:.6g} N/A from {Path(args.axis_config).name})")
     write_process(result, out, overwrite=args.force, protect=inputs)
-    print(f"wrote {out}")
+    for target in output_paths(out):
+        print(f"wrote {target}")
     if args.plot:
         from ..evaluate.process_plot import plot_process
 

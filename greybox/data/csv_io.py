@@ -1,17 +1,25 @@
 """CSV axis logs: one row per sample, one column per channel, unit suffix in each header.
 
-Written by :func:`write_csv`::
+Written by :func:`write_csv` as two files. ``x.csv`` is plain CSV, its first
+line the header, so that ``pandas.read_csv``, a spreadsheet or MATLAB's
+``readtable`` read it with default settings::
 
-    # greybox {"axis": "X", "dataset": "A", "effort_unit": "A", "attrs": {...}}
     time_s,position_mm,velocity_mm_s,current_A,truth_friction_A
     0.0,12.5,0.0,0.31,0.02
     ...
 
-Read by :func:`read_csv` (UTF-8, with or without byte-order mark): leading
-lines starting with ``#`` are comments; a
-``# greybox {...}`` comment restores the metadata. The delimiter is detected
-from the header line (comma, semicolon or tab); with a semicolon delimiter a
-decimal comma is accepted. Column names follow :mod:`greybox.data.units`.
+and the sidecar ``x.csv.json`` holds the metadata
+(:mod:`greybox.data.file_metadata`)::
+
+    {"axis": "X", "dataset": "A", "effort_unit": "A", "attrs": {...}}
+
+Read by :func:`read_csv` (UTF-8, with or without byte-order mark): the
+metadata come from the sidecar when there is one; leading lines starting with
+``#`` are comments, and a ``# greybox {...}`` comment (how earlier versions
+stored the metadata) restores them for a file without sidecar. The delimiter is
+detected from the header line (comma, semicolon or tab); with a semicolon
+delimiter a decimal comma is accepted. Column names follow
+:mod:`greybox.data.units`.
 """
 
 from __future__ import annotations
@@ -23,7 +31,7 @@ from typing import Mapping
 import pandas as pd
 
 from ..errors import LogError
-from .file_metadata import log_metadata, metadata_fields
+from .file_metadata import log_metadata, metadata_fields, read_sidecar, sidecar_path, sidecar_text
 from .log import AxisLog
 from .units import log_from_columns
 
@@ -57,7 +65,9 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
     Parameters
     ----------
     path : str or path-like
-        CSV file with a header row.
+        CSV file with a header row. Its metadata (axis, dataset, effort unit,
+        attrs) are read from the sidecar ``<path>.json`` if it exists, else
+        from a ``# greybox {...}`` comment line.
     columns : mapping of str to str, optional
         ``{canonical_name: header}`` for headers not named by the convention.
     sample_time : float, optional
@@ -72,9 +82,13 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
     ------
     LogError
         For a file without header or data rows, malformed rows, or columns
-        that do not give the required channels (see :func:`~greybox.data.units.log_from_columns`).
+        that do not give the required channels (see :func:`~greybox.data.units.log_from_columns`),
+        and for a sidecar that is not a JSON object.
     """
     comments, metadata, header = _preamble(path)
+    sidecar = read_sidecar(path)
+    if sidecar is not None:
+        metadata = sidecar
     if not header.strip():
         raise LogError(path, "no header row (the file holds only comments or blank lines)")
     delimiter = max((",", ";", "\t"), key=header.count)
@@ -96,8 +110,8 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
     return log_from_columns(table, source=path, columns=columns, sample_time=sample_time, **metadata_fields(metadata))
 
 
-def write_csv(log: AxisLog, path) -> None:
-    """Write an axis log as CSV with canonical headers and a metadata comment.
+def write_csv(log: AxisLog, path, *, metadata_path=None) -> None:
+    """Write an axis log as plain CSV with canonical headers, and its metadata as a JSON sidecar.
 
     Floats are written with the shortest text that reads back to the same
     value, so a round trip is exact.
@@ -106,8 +120,16 @@ def write_csv(log: AxisLog, path) -> None:
     ----------
     log : AxisLog
     path : str or path-like
-        Written in place; :func:`greybox.data.io.write_log` makes it atomic.
+        CSV file; its first line is the header. Written in place;
+        :func:`greybox.data.io.write_log` makes it atomic.
+    metadata_path : str or path-like, optional
+        Where to write the metadata JSON; default the sidecar of ``path``
+        (:func:`~greybox.data.file_metadata.sidecar_path`, ``<path>.json``).
+        :func:`greybox.data.io.write_log` passes a temporary file that then
+        replaces the sidecar.
     """
     with open(path, "w", encoding="utf-8", newline="") as stream:
-        stream.write(_METADATA_TAG + json.dumps(log_metadata(log)) + "\n")
         log.to_frame().to_csv(stream, index=False, lineterminator="\n")
+    side = sidecar_path(path) if metadata_path is None else metadata_path
+    with open(side, "w", encoding="utf-8", newline="\n") as stream:
+        stream.write(sidecar_text(log_metadata(log)))

@@ -1,17 +1,28 @@
 """The greybox metadata that CSV and Parquet logs carry beside their columns.
 
-One JSON object, ``{"axis", "dataset", "effort_unit", "attrs"}``: CSV keeps it
-in a ``# greybox {...}`` comment line, Parquet under the key ``greybox`` of the
-schema metadata. Every key is optional when reading.
+One JSON object, ``{"axis", "dataset", "effort_unit", "attrs"}``: a CSV file
+``x.csv`` keeps it in the sidecar file ``x.csv.json`` beside it (so the CSV
+itself starts with its header and any spreadsheet or ``pandas.read_csv`` reads
+it with default settings), Parquet under the key ``greybox`` of the schema
+metadata. Every key is optional when reading. CSV files written by earlier
+greybox versions hold it in a first ``# greybox {...}`` comment line instead,
+which is still read.
 """
 
 from __future__ import annotations
 
+import json
+import os
+from pathlib import Path
 from typing import Mapping
 
+from ..errors import LogError
 from .log import AxisLog
 
-__all__ = ["log_metadata", "metadata_fields"]
+__all__ = ["SIDECAR_SUFFIX", "log_metadata", "metadata_fields", "read_sidecar", "sidecar_path", "sidecar_text"]
+
+#: Appended to a CSV file's name to give its metadata file: ``x.csv`` -> ``x.csv.json``.
+SIDECAR_SUFFIX = ".json"
 
 
 def log_metadata(log: AxisLog) -> dict[str, object]:
@@ -34,3 +45,50 @@ def metadata_fields(metadata: Mapping[str, object]) -> dict[str, object]:
         "dataset": str(metadata.get("dataset", "")),
         "attrs": metadata.get("attrs", {}),
     }
+
+
+def sidecar_path(path: str | os.PathLike) -> Path:
+    """The metadata file beside a CSV file: its full name plus ``.json`` (``x.csv`` -> ``x.csv.json``).
+
+    The whole name is kept, rather than the extension replaced, so that the
+    sidecar never collides with a JSON file of the same stem (``metrics.csv``
+    and ``metrics.json`` of a report, ``x.csv`` and ``x.json`` of a user).
+    """
+    path = Path(path)
+    return path.with_name(path.name + SIDECAR_SUFFIX)
+
+
+def sidecar_text(metadata: Mapping[str, object]) -> str:
+    """The text of a sidecar file: the metadata object as indented JSON."""
+    return json.dumps(dict(metadata), indent=1) + "\n"
+
+
+def read_sidecar(path: str | os.PathLike) -> dict | None:
+    """The metadata object of the sidecar of ``path``, or None if there is no sidecar.
+
+    Parameters
+    ----------
+    path : path-like
+        The CSV file (not the sidecar).
+
+    Returns
+    -------
+    dict or None
+
+    Raises
+    ------
+    LogError
+        If the sidecar exists but is not UTF-8 JSON holding an object.
+    """
+    side = sidecar_path(path)
+    if not side.is_file():
+        return None
+    try:
+        metadata = json.loads(side.read_text(encoding="utf-8-sig"))
+    except UnicodeDecodeError as exc:
+        raise LogError(side, f"metadata file is not UTF-8 text (byte {exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise LogError(side, f"metadata file is not valid JSON (line {exc.lineno}: {exc.msg})") from None
+    if not isinstance(metadata, dict):
+        raise LogError(side, f"metadata file holds a JSON {type(metadata).__name__}, not an object")
+    return metadata

@@ -24,6 +24,7 @@ from typing import Mapping, Sequence
 
 from ..atomic import atomic_output
 from ..errors import GreyboxError, LogError
+from .file_metadata import sidecar_path
 from .log import AxisLog
 from .units import CANONICAL_NAMES, UNIT_FACTORS, parse_column_name
 from .validate import check_finite, check_time
@@ -137,6 +138,8 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
 
     The data go to a temporary file in the target directory, which then
     replaces ``path`` in one step, so a reader never sees a half-written file.
+    A CSV file gets its metadata in a sidecar ``<path>.json``
+    (:mod:`greybox.data.csv_io`), written the same way.
 
     Parameters
     ----------
@@ -166,6 +169,11 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
         if item.source and os.path.exists(path) and os.path.exists(item.source) and os.path.samefile(path, item.source):
             raise LogError(path, "refusing to overwrite the file the log was read from; choose another output path")
     writer = _handler(fmt, 2)
+    if fmt == "csv":  # two files, each replaced in one step: the plain CSV and its metadata sidecar
+        target = os.path.abspath(path)
+        with atomic_output(target) as temporary, atomic_output(sidecar_path(target)) as side:
+            writer(logs[0], str(temporary), metadata_path=str(side))
+        return
     with atomic_output(os.path.abspath(path)) as temporary:
         writer(logs if fmt == "mcap" else logs[0], str(temporary))
 

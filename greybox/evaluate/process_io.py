@@ -4,8 +4,10 @@ The columns are those of :meth:`greybox.evaluate.process.ProcessResult.columns`
 (``time_s``, ``current_measured_A``, ``current_model_A``, ``current_process_A``,
 ``force_process_N`` with axis metadata, ``position_mm``, ``velocity_mm_s``).
 
-* CSV: a ``# greybox {...}`` metadata comment, then a header row and one row
-  per sample, floats as their shortest exact text.
+* CSV: plain, the header row first, then one row per sample, floats as their
+  shortest exact text (``pandas.read_csv``, spreadsheets and MATLAB's
+  ``readtable`` read it with default settings); the metadata go to the
+  sidecar ``<name>.csv.json`` beside it (:mod:`greybox.data.file_metadata`).
 * Parquet: float64 columns, zstd, the metadata as JSON under the schema key
   ``greybox``.
 * MCAP: one channel ``/process/<axis>`` (``/process`` without a name), schema
@@ -29,10 +31,12 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_output, check_output_path
+from ..data.file_metadata import sidecar_path, sidecar_text
 from ..errors import GreyboxError
 from .process import ProcessResult
 
-__all__ = ["OUTPUT_FORMATS", "PROCESS_SCHEMA_NAME", "output_format", "check_output_path", "write_process"]
+__all__ = ["OUTPUT_FORMATS", "PROCESS_SCHEMA_NAME", "output_format", "output_paths", "check_output_path",
+           "write_process"]
 
 #: Output formats by file extension.
 OUTPUT_FORMATS = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet", ".mcap": "mcap"}
@@ -66,6 +70,18 @@ def output_format(path) -> str:
     return OUTPUT_FORMATS[suffix]
 
 
+def output_paths(path) -> list[Path]:
+    """Every file :func:`write_process` writes for ``path``: the table, and for CSV its metadata sidecar.
+
+    Raises
+    ------
+    GreyboxError
+        For an unknown extension (see :func:`output_format`).
+    """
+    path = Path(path)
+    return [path, sidecar_path(path)] if output_format(path) == "csv" else [path]
+
+
 def _metadata(result: ProcessResult) -> dict:
     return {"axis": result.axis, "dataset": "", "effort_unit": result.effort_unit, "attrs": result.attrs}
 
@@ -73,7 +89,6 @@ def _metadata(result: ProcessResult) -> dict:
 def _write_csv(result: ProcessResult, path) -> None:
     columns = result.columns()
     with open(path, "w", encoding="utf-8", newline="") as stream:
-        stream.write("# greybox " + json.dumps(_metadata(result)) + "\n")
         stream.write(",".join(columns) + "\n")
         text = [values.tolist() for values in columns.values()]
         template = ",".join(["%r"] * len(columns)) + "\n"
@@ -138,9 +153,10 @@ def write_process(result: ProcessResult, path, *, overwrite: bool = False, prote
     result : ProcessResult
         What :func:`greybox.evaluate.process.predict_process` returned.
     path : str or path-like
-        Output file (.csv, .parquet/.pq or .mcap).
+        Output file (.csv, .parquet/.pq or .mcap). A CSV file's metadata go
+        to its sidecar ``<path>.json``, written atomically as well.
     overwrite : bool, default False
-        Replace an existing ``path``.
+        Replace an existing ``path`` (and sidecar).
     protect : iterable of path-like
         Files that must never be replaced (the inputs), whatever ``overwrite``.
 
@@ -151,16 +167,22 @@ def write_process(result: ProcessResult, path, *, overwrite: bool = False, prote
     Raises
     ------
     GreyboxError
-        For an unknown extension, non-finite values, an existing file without
-        ``overwrite``, a protected file, or a missing directory.
+        For an unknown extension, non-finite values, an existing file (or
+        sidecar) without ``overwrite``, a protected file, or a missing directory.
     """
     path = Path(path)
     fmt = output_format(path)
-    check_output_path(path, overwrite=overwrite, protect=protect)
+    for target in output_paths(path):
+        check_output_path(target, overwrite=overwrite, protect=protect)
     for name, values in result.columns().items():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise GreyboxError(f"{path}: column '{name}' is not finite at sample {bad[0]}")
+    if fmt == "csv":
+        with atomic_output(path) as temporary, atomic_output(sidecar_path(path)) as side:
+            _write_csv(result, str(temporary))
+            side.write_text(sidecar_text(_metadata(result)), encoding="utf-8")
+        return path
     with atomic_output(path) as temporary:
         _WRITERS[fmt](result, str(temporary))
     return path
