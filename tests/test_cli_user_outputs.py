@@ -221,3 +221,127 @@ def test_display_names_use_as_few_folders_as_needed():
     assert display_names(["a/b/X.mcap", "c/b/X.mcap", "d/Y.mcap"]) == ["a/b/X.mcap", "c/b/X.mcap", "Y.mcap"]
     assert display_names(["a/X.mcap", "X.mcap"]) == ["a/X.mcap", "X.mcap"]
     assert display_names(["a/X.mcap", "a/X.mcap"]) == ["a/X.mcap", "a/X.mcap"]
+
+
+# ---------------------------------------------------------------- long logs: envelope and time window
+def _long_log(n: int = 200_000):
+    """A log of n samples at 2 ms with one single-sample spike of 5 A at sample 123 457."""
+    import numpy as np
+
+    from greybox.data.log import AxisLog
+
+    time = np.arange(n) * 0.002
+    effort = 0.5 * np.sin(2 * np.pi * 0.3 * time)
+    effort[123_457] = 5.0
+    return AxisLog(time=time, position=np.sin(0.1 * time), effort=effort, velocity=0.1 * np.cos(0.1 * time),
+                   axis="X", dataset="H")
+
+
+def test_envelope_keeps_the_range_of_every_bin_in_time_order():
+    import numpy as np
+
+    from greybox.evaluate.plots import envelope
+
+    time = np.arange(10_001) * 0.002
+    values = np.sin(time) + np.where(np.arange(time.size) == 4321, 3.0, 0.0)
+    t, v = envelope(time, values, max_points=100)
+    assert v.size <= 100 and v.max() == values.max() and v.min() == values.min()
+    assert np.all(np.diff(t) >= 0)  # the line follows the signal in time
+    assert np.isin(t, time).all() and np.array_equal(np.interp(t, time, values), v)  # samples, not invented
+    short_t, short_v = envelope(time[:50], values[:50], max_points=100)
+    assert np.array_equal(short_v, values[:50])
+
+
+def test_plot_of_a_long_log_is_an_envelope_and_a_window_shows_the_samples():
+    import matplotlib
+    import matplotlib.pyplot
+
+    matplotlib.use("Agg")
+    from greybox.evaluate.plots import ENVELOPE_POINTS, plot_log
+
+    log = _long_log()
+    figure = plot_log(log)
+    current = figure.axes[2].lines[0]
+    assert current.get_ydata().size <= ENVELOPE_POINTS and current.get_ydata().max() == 5.0
+    matplotlib.pyplot.close(figure)
+    figure = plot_log(log, window=(200.0, 205.0))
+    t = figure.axes[2].lines[0].get_xdata()
+    assert t.size == 2501 and t[0] == pytest.approx(200.0) and t[-1] == pytest.approx(205.0)
+    assert "200 to 205 s" in figure._suptitle.get_text()
+    matplotlib.pyplot.close(figure)
+
+
+def test_plot_window_option(short_log, tmp_path, capsys):
+    picture = tmp_path / "window.png"
+    status, out, err = _run(capsys, "plot", short_log, "--out", picture, "--window", "1", "2")
+    assert status == 0, err
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for window, message in ((("2", "1"), "--window 2 1: give START < END"),
+                            (("100", "200"), "--window 100 200: no sample in the window; X_A.mcap runs from 0 to")):
+        status, _, err = _run(capsys, "plot", short_log, "--out", tmp_path / "other.png", "--window", *window)
+        assert status == 2 and err.count("\n") == 1 and message in err
+    assert not (tmp_path / "other.png").exists()
+
+
+# ---------------------------------------------------------------- predict: dataset id, progress, wall time
+@pytest.fixture(scope="module")
+def predict_files(tmp_path_factory):
+    """A Stribeck model file and a 6 s cutting log of dataset C (MCAP)."""
+    from greybox.data.prepare import prepare
+    from greybox.friction import StribeckModel
+    from greybox.persistence import save_model
+
+    root = tmp_path_factory.mktemp("predict")
+    model = save_model(StribeckModel().fit(prepare([make_dataset("X", "A", seed=1, duration_s=4.0)])),
+                       root / "stribeck.gbm")
+    log = root / "cut.mcap"
+    write_log(make_dataset("X", "C", seed=2, duration_s=6.0, cutting=True), log)
+    return {"model": model, "log": log}
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet", ".mcap"])
+def test_predict_keeps_the_dataset_id(predict_files, tmp_path, capsys, suffix):
+    import json
+
+    from greybox.data.io import read_log
+
+    out = tmp_path / f"process{suffix}"
+    status, _, err = _run(capsys, "predict", predict_files["model"], predict_files["log"], "--out", out)
+    assert status == 0, err
+    if suffix == ".csv":
+        assert json.loads((tmp_path / "process.csv.json").read_text())["dataset"] == "C"
+    elif suffix == ".parquet":
+        import pyarrow.parquet as pq
+
+        assert json.loads(pq.read_schema(out).metadata[b"greybox"])["dataset"] == "C"
+    else:
+        assert read_log(out, columns={"current_A": "current_measured_A"}).dataset == "C"
+
+
+def test_process_picture_title_names_the_dataset(predict_files):
+    import matplotlib
+    import matplotlib.pyplot
+    import numpy as np
+
+    matplotlib.use("Agg")
+    from greybox.data.io import read_log
+    from greybox.data.prepare import prepare
+    from greybox.evaluate.process import predict_process
+    from greybox.evaluate.process_plot import plot_process
+    from greybox.persistence import load_model
+
+    log = prepare([read_log(predict_files["log"])])[0]
+    steps = []
+    result = predict_process(load_model(predict_files["model"]), log, chunk_s=2.5,
+                             progress=lambda *step: steps.append(step))
+    assert result.dataset == "C"
+    n = int(np.ceil(log.duration / 2.5 - 1e-9))
+    assert n > 1 and [step[:2] for step in steps] == [(k, n) for k in range(1, n + 1)]
+    assert steps[-1][2] == log.time[-1] and steps[0][2] == pytest.approx(2.5 - log.sample_time)
+    figure = plot_process(result)
+    assert figure._suptitle.get_text().startswith("axis X / dataset C")
+    matplotlib.pyplot.close(figure)
+    figure = plot_process(result, window=(1.0, 2.0))
+    assert "1 to 2 s" in figure._suptitle.get_text()
+    assert figure.axes[1].lines[0].get_xdata().min() >= 1.0 and figure.axes[1].lines[0].get_xdata().max() <= 2.0
+    matplotlib.pyplot.close(figure)

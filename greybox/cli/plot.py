@@ -9,13 +9,15 @@ from ..atomic import check_output_path
 from ..errors import GreyboxError
 from ..evaluate.plots import plot_log
 from ._options import add_log_arguments, read_logs
+from ._window import add_window_argument, check_window
 
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "plot",
         help="draw a log as a PNG",
-        description="Draw position, velocity and current over time, and current over velocity.",
+        description="Draw position, velocity and current over time, and current over velocity. A long log is "
+        "drawn as its envelope (minimum and maximum of each pixel column); --window draws a stretch of it.",
     )
     parser.add_argument("log", help="log file (CSV, Parquet, MCAP or EMPS .mat)")
     parser.add_argument("--out", required=True, metavar="PNG",
@@ -26,6 +28,7 @@ def add_parser(subparsers) -> None:
         action="store_true",
         help="draw the log as read, without deriving a missing velocity",
     )
+    add_window_argument(parser)
     add_log_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -45,6 +48,7 @@ def _check_out(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     _check_out(args)
     (log,) = read_logs(args, [args.log], prepare=not args.raw)
-    path = plot_log(log, args.out)
+    window = check_window(args.window, log.time, name=Path(args.log).name)
+    path = plot_log(log, args.out, window=window)
     print(f"wrote {path}")
     return 0

@@ -1,4 +1,12 @@
-"""Figures of axis logs and model results (matplotlib, written as PNG)."""
+"""Figures of axis logs and model results (matplotlib, written as PNG).
+
+Long signals are drawn as their envelope (:func:`envelope`): the minimum and
+the maximum of each of about 2000 consecutive bins of samples, more bins than
+an axis of these figures has pixel columns, so that an hour at 500 Hz draws
+as fast as a minute and shows every peak, rather than a band of overlapping
+lines. A time window (``window=(start_s, stop_s)``) shows the samples
+themselves.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +18,77 @@ import numpy as np
 from ..atomic import atomic_output
 from ..data.log import AxisLog
 
-__all__ = ["plot_log", "save_figure", "import_pyplot", "finish_figure"]
+__all__ = ["ENVELOPE_POINTS", "envelope", "envelope_indices", "plot_log", "save_figure", "import_pyplot",
+           "finish_figure", "window_title"]
+
+#: Points drawn per line at most: the minimum and maximum of 2000 bins (an axis of the figures here
+#: spans about 900-1300 pixel columns at their size and resolution).
+ENVELOPE_POINTS = 4000
+
+
+def envelope_indices(n_samples: int, max_points: int) -> np.ndarray:
+    """Start indices of the bins that thin a long signal for drawing while keeping its peaks.
+
+    The samples are split into about ``max_points / 2`` bins of equal count;
+    :func:`envelope` draws the minimum and maximum of each. Short signals are
+    kept whole.
+
+    Parameters
+    ----------
+    n_samples : int
+        Signal length.
+    max_points : int
+        Upper bound of points to draw per line.
+
+    Returns
+    -------
+    ndarray of int
+        Start index of every bin (all indices when ``n_samples <= max_points``).
+    """
+    if n_samples <= max_points:
+        return np.arange(n_samples)
+    size = int(np.ceil(2 * n_samples / max_points))
+    return np.arange(0, n_samples, size)
+
+
+def envelope(time, values, max_points: int = ENVELOPE_POINTS) -> tuple[np.ndarray, np.ndarray]:
+    """Points that draw a signal as its envelope: per bin of samples its minimum and its maximum, in time order.
+
+    Drawn as one line, each bin becomes a stroke between its minimum and its
+    maximum, taken at their own times and in the order they occur, so the
+    picture shows the full range of the signal in every pixel column, keeps
+    single-sample peaks and follows the signal from one bin to the next.
+
+    Parameters
+    ----------
+    time : array_like
+        Time [s], increasing.
+    values : array_like
+        Signal, same length (any unit).
+    max_points : int, default :data:`ENVELOPE_POINTS`
+        Upper bound of points returned; signals this short are returned whole.
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        Times [s] and values to draw.
+    """
+    time = np.asarray(time, dtype=float)
+    values = np.asarray(values, dtype=float)
+    starts = envelope_indices(values.size, max_points)
+    if starts.size == values.size:
+        return time, values
+    size = int(starts[1] - starts[0]) if starts.size > 1 else values.size
+    bins = np.pad(values, (0, starts.size * size - values.size), mode="edge").reshape(starts.size, size)
+    low = np.minimum(starts + np.argmin(bins, axis=1), values.size - 1)
+    high = np.minimum(starts + np.argmax(bins, axis=1), values.size - 1)
+    index = np.column_stack((np.minimum(low, high), np.maximum(low, high))).ravel()
+    return time[index], values[index]
+
+
+def window_title(window: tuple[float, float] | None) -> str:
+    """Suffix of a figure title naming a time window [s] (empty without one)."""
+    return "" if window is None else f", {window[0]:g} to {window[1]:g} s"
 
 
 def import_pyplot(path: str | os.PathLike | None):
@@ -70,7 +148,8 @@ def save_figure(figure, path: str | os.PathLike, *, dpi: int = 120) -> Path:
     return path
 
 
-def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points: int = 200_000):
+def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points: int = ENVELOPE_POINTS,
+             max_map_points: int = 200_000, window: tuple[float, float] | None = None):
     """Draw position, velocity and effort over time, and effort over velocity.
 
     Parameters
@@ -80,17 +159,30 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
         :func:`greybox.data.prepare.derive`).
     path : path-like, optional
         Write the figure there (PNG by extension) and close it.
-    max_points : int, default 200000
-        Longer logs are thinned by an integer stride for drawing only.
+    max_points : int, default :data:`ENVELOPE_POINTS`
+        Signals over time with more samples are drawn as their envelope
+        (:func:`envelope`: minimum and maximum per bin of samples).
+    max_map_points : int, default 200000
+        Effort over velocity: longer logs are thinned by an integer stride.
+    window : (float, float), optional
+        Draw only the samples with ``start <= time <= stop`` [s].
 
     Returns
     -------
     matplotlib.figure.Figure or pathlib.Path
         The figure, or the written file when ``path`` is given.
+
+    Raises
+    ------
+    LogError
+        If no sample lies in ``window``.
     """
+    if window is not None:
+        from ..data.prepare import trim
+
+        log = trim(log, *window)
     plt = import_pyplot(path)
-    stride = max(1, int(np.ceil(len(log) / max_points)))
-    t = log.time[::stride]
+    stride = max(1, int(np.ceil(len(log) / max_map_points)))
     effort = log.effort[::stride]
     effort_label = "motor current [A]" if log.effort_unit == "A" else "force [N]"
     has_velocity = log.velocity is not None
@@ -102,14 +194,14 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
     ax_eff = figure.add_subplot(grid[2, 0], sharex=ax_pos)
     ax_map = figure.add_subplot(grid[:, 1])
 
-    ax_pos.plot(t, log.position[::stride], lw=0.8)
+    ax_pos.plot(*envelope(log.time, log.position, max_points), lw=0.8)
     ax_pos.set_ylabel("position [mm]")
     if has_velocity:
-        ax_vel.plot(t, log.velocity[::stride], lw=0.8)
+        ax_vel.plot(*envelope(log.time, log.velocity, max_points), lw=0.8)
     else:
         ax_vel.text(0.5, 0.5, "velocity not logged", ha="center", va="center", transform=ax_vel.transAxes)
     ax_vel.set_ylabel("velocity [mm/s]")
-    ax_eff.plot(t, effort, lw=0.5)
+    ax_eff.plot(*envelope(log.time, log.effort, max_points), lw=0.5)
     ax_eff.set_ylabel(effort_label)
     ax_eff.set_xlabel("time [s]")
     for ax in (ax_pos, ax_vel):
@@ -126,7 +218,7 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
         ax.grid(True, alpha=0.3)
 
     name = " / ".join(p for p in (log.axis and f"axis {log.axis}", log.dataset and f"dataset {log.dataset}") if p)
-    title = name or "axis log"
+    title = (name or "axis log") + window_title(window)
     if log.source:
         title += f"  ({Path(log.source).name})"
     figure.suptitle(title)

@@ -39,13 +39,14 @@ axis is its opposite.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
 from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog, as_log_list
 from ..errors import GreyboxError
-from ..models.chunked import DEFAULT_CHUNK_S, predict_chunked
+from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, iter_chunks, samples_per_chunk
 from ..registry import model_kind
 
 __all__ = ["force_constant_N_per_A", "process_force", "ProcessResult", "predict_process"]
@@ -115,6 +116,8 @@ class ProcessResult:
         Axis name.
     source : str
         Log file.
+    dataset : str
+        Dataset id of the log (:attr:`greybox.data.log.AxisLog.dataset`), "" if it has none.
     attrs : dict
         JSON-able description (model kind and file, chunk length, axis constants).
     """
@@ -130,6 +133,7 @@ class ProcessResult:
     axis: str = ""
     source: str = ""
     attrs: dict = field(default_factory=dict)
+    dataset: str = ""
 
     @property
     def process(self) -> np.ndarray:
@@ -163,7 +167,8 @@ class ProcessResult:
 
 
 def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = None,
-                    chunk_s: float = DEFAULT_CHUNK_S) -> ProcessResult:
+                    chunk_s: float = DEFAULT_CHUNK_S,
+                    progress: Callable[[int, int, float], None] | None = None) -> ProcessResult:
     """Process share of the current of a cutting log, and its force.
 
     Parameters
@@ -177,6 +182,9 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
     chunk_s : float, default 60.0
         The model runs over chunks of this length [s], carrying its state
         (see :mod:`greybox.models.chunked`).
+    progress : callable, optional
+        Called after each chunk as ``progress(done, chunks, time_s)``: chunks
+        done, chunks in all, and the log time [s] reached.
 
     Returns
     -------
@@ -192,7 +200,12 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
     if len(runs) != 1:
         raise GreyboxError(f"predict_process takes one run, got {len(runs)}; call it once per log")
     (run,) = runs
-    predicted = predict_chunked(model, run, chunk_s=chunk_s)
+    n_chunks = len(chunk_slices(len(run), samples_per_chunk(run.sample_time, chunk_s)))
+    predicted = np.empty(len(run))
+    for done, (samples, current) in enumerate(iter_chunks(model, run, chunk_s=chunk_s), start=1):
+        predicted[samples] = current
+        if progress is not None:
+            progress(done, n_chunks, float(run.time[samples.stop - 1]))
     force = None
     factor = None
     attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s)}
@@ -213,4 +226,4 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
                          model=predicted, force=force, effort_unit=run.effort_unit,
                          force_constant_N_per_A=factor,
                          axis=run.axis or (axis_config.name if axis_config is not None else ""),
-                         source=run.source, attrs=attrs)
+                         source=run.source, attrs=attrs, dataset=run.dataset or "")

@@ -83,7 +83,7 @@ def output_paths(path) -> list[Path]:
 
 
 def _metadata(result: ProcessResult) -> dict:
-    return {"axis": result.axis, "dataset": "", "effort_unit": result.effort_unit, "attrs": result.attrs}
+    return {"axis": result.axis, "dataset": result.dataset, "effort_unit": result.effort_unit, "attrs": result.attrs}
 
 
 def _write_csv(result: ProcessResult, path) -> None:
@@ -135,7 +135,7 @@ def _write_mcap(result: ProcessResult, path) -> None:
                                            data=json.dumps(_schema(columns), indent=2).encode())
         channel_id = writer.register_channel(
             f"/process/{result.axis}" if result.axis else "/process", "json", schema_id,
-            {"axis": result.axis, "dataset": "", "effort_unit": result.effort_unit,
+            {"axis": result.axis, "dataset": result.dataset, "effort_unit": result.effort_unit,
              "attrs": json.dumps(metadata["attrs"])})
         for stamp, row in zip(stamps, rows):
             writer.add_message(channel_id, stamp, (template % row).encode(), stamp)

@@ -7,35 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .plots import finish_figure, import_pyplot
+from .plots import ENVELOPE_POINTS, envelope, envelope_indices, finish_figure, import_pyplot, window_title
 from .process import ProcessResult
 
 __all__ = ["envelope_indices", "moving_mean", "plot_process"]
-
-
-def envelope_indices(n_samples: int, max_points: int) -> np.ndarray:
-    """Indices that thin a long signal for drawing while keeping its peaks: the first sample of each bin.
-
-    The samples are split into about ``max_points / 2`` bins; callers draw the
-    minimum and maximum of each bin (see :func:`plot_process`). Short signals
-    are kept whole.
-
-    Parameters
-    ----------
-    n_samples : int
-        Signal length.
-    max_points : int
-        Upper bound of points to draw per line.
-
-    Returns
-    -------
-    ndarray of int
-        Start index of every bin (all indices when ``n_samples <= max_points``).
-    """
-    if n_samples <= max_points:
-        return np.arange(n_samples)
-    size = int(np.ceil(2 * n_samples / max_points))
-    return np.arange(0, n_samples, size)
 
 
 def moving_mean(values, window: int) -> np.ndarray:
@@ -64,18 +39,9 @@ def moving_mean(values, window: int) -> np.ndarray:
     return (sums[stop] - sums[start]) / (stop - start)
 
 
-def _min_max(time: np.ndarray, values: np.ndarray, starts: np.ndarray):
-    """Per bin the minimum and the maximum, in time order (exact when every bin holds one sample)."""
-    if starts.size == values.size:
-        return time, values
-    low = np.minimum.reduceat(values, starts)
-    high = np.maximum.reduceat(values, starts)
-    t = np.repeat(time[starts], 2)
-    return t, np.column_stack((low, high)).ravel()
-
-
-def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *, max_points: int = 100_000,
-                 mean_s: float = 0.1):
+def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *,
+                 max_points: int = ENVELOPE_POINTS, mean_s: float = 0.1,
+                 window: tuple[float, float] | None = None):
     """Draw velocity, measured and model current, and the process current over time.
 
     The process panel has a second scale in N when the force is known (the
@@ -90,23 +56,38 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
         Output of :func:`greybox.evaluate.process.predict_process`.
     path : path-like, optional
         Write the figure there (PNG, SVG or PDF by extension) and close it.
-    max_points : int, default 100000
-        Longer logs are drawn as the minimum and maximum of bins of samples.
+    max_points : int, default :data:`~greybox.evaluate.plots.ENVELOPE_POINTS`
+        Longer logs are drawn as their envelope, the minimum and maximum of
+        bins of samples (:func:`~greybox.evaluate.plots.envelope`).
     mean_s : float, default 0.1
         Window [s] of the moving mean of the process current; 0 draws none.
+    window : (float, float), optional
+        Draw only the samples with ``start <= time <= stop`` [s] (the moving
+        mean is taken over the whole log first).
 
     Returns
     -------
     matplotlib.figure.Figure or pathlib.Path
         The figure, or the written file when ``path`` is given.
+
+    Raises
+    ------
+    ValueError
+        If no sample lies in ``window``.
     """
+    shown = slice(None)
+    if window is not None:
+        first = np.searchsorted(result.time, window[0], "left")
+        stop = np.searchsorted(result.time, window[1], "right")
+        if first >= stop:
+            raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
+        shown = slice(first, stop)
     plt = import_pyplot(path)
     unit = result.effort_unit
     noun = "current" if unit == "A" else "force"
-    starts = envelope_indices(result.time.size, max_points)
 
     def line(ax, values, **style):
-        ax.plot(*_min_max(result.time, values, starts), **style)
+        ax.plot(*envelope(result.time[shown], values[shown], max_points), **style)
 
     figure, (ax_v, ax_i, ax_p) = plt.subplots(3, 1, sharex=True, figsize=(11, 8), layout="constrained",
                                               height_ratios=(1, 2, 2))
@@ -118,8 +99,8 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     ax_i.legend(loc="upper right", fontsize="small")
     line(ax_p, result.process, lw=0.6, color="tab:red", label=f"process {noun} = measured - model")
     if mean_s > 0 and result.time.size > 1:
-        window = max(1, int(round(mean_s / float(np.median(np.diff(result.time))))))
-        line(ax_p, moving_mean(result.process, window), lw=1.2, color="darkred",
+        mean_samples = max(1, int(round(mean_s / float(np.median(np.diff(result.time))))))
+        line(ax_p, moving_mean(result.process, mean_samples), lw=1.2, color="darkred",
              label=f"moving mean over {mean_s:g} s")
     ax_p.axhline(0.0, color="black", lw=0.5)
     ax_p.set_ylabel(f"process {noun} [{unit}]")
@@ -131,7 +112,9 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
         right.set_ylabel("process force [N]")
     for ax in (ax_v, ax_i, ax_p):
         ax.grid(True, alpha=0.3)
-    title = f"axis {result.axis}" if result.axis else "axis log"
+    title = " / ".join(part for part in (result.axis and f"axis {result.axis}",
+                                         result.dataset and f"dataset {result.dataset}") if part) or "axis log"
+    title += window_title(window)
     if result.source:
         title += f"  ({Path(result.source).name})"
     model = result.attrs.get("model_kind")
