@@ -90,12 +90,19 @@ def test_model_plant_and_a_log_reference(tmp_path, model_files, capsys):
     (["--plant", "twin-X"], "no feed-forward model"),
     (["--plant", "twin-X", "--model", "magic"], "unknown model kind"),
     (["--plant", "twin-X", "--train", "x.csv"], "--train needs --model"),
-    (["--plant", "twin-X", "--model", "coulomb", "--inertia", "heavy"], "--inertia"),
     (["--plant", "twin-X", "--model", "coulomb", "--reference", "medium"], "medium"),
 ])
 def test_bad_input_is_a_one_line_error(tmp_path, argv, message):
     with pytest.raises(GreyboxError, match=message):
         run_cli(*argv, "--duration", 1, "--train-duration", 4, "--out", tmp_path / "out", "--quiet")
+
+
+def test_bad_inertia_is_refused_by_the_option_parser(tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        run_cli("--plant", "twin-X", "--model", "coulomb", "--inertia", "heavy", "--out", tmp_path / "out")
+    assert stop.value.code == 2
+    assert "argument --inertia: must be plant, model or a non-negative number, got heavy" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
 
 
 def test_static_model_and_model_plant_without_training_logs_are_refused(tmp_path, model_files):

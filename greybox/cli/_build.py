@@ -7,6 +7,7 @@ import json
 
 from ..errors import GreyboxError
 from ..registry import model_class
+from ._types import POSITIVE_INT, SEED
 
 __all__ = ["add_model_arguments", "build_model"]
 
@@ -36,8 +37,9 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
     group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
     group.add_argument("--asymmetric", action="store_true",
                        help="separate Coulomb and viscous levels per direction (coulomb)")
-    group.add_argument("--elements", type=int, metavar="N", help="number of Maxwell-slip elements (gms; default 4)")
-    group.add_argument("--model-seed", type=int, metavar="N",
+    group.add_argument("--elements", type=POSITIVE_INT, metavar="N",
+                       help="number of Maxwell-slip elements (gms; default 4)")
+    group.add_argument("--model-seed", type=SEED, metavar="N",
                        help="seed of the identification: multi-start searches (lugre, gms) and SVR "
                        "subsets and hyperparameter search (svr, gmssvr); default 0")
     if settings:

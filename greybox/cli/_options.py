@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..data.log import AxisLog
+from ._types import FRACTION, POSITIVE, positive
 
 __all__ = ["add_log_arguments", "read_logs"]
 
@@ -29,13 +30,13 @@ def add_log_arguments(parser: argparse.ArgumentParser, *, prepare: bool = True) 
     group.add_argument("--topic", help="MCAP topic (channel) to read when a file holds several axes")
     group.add_argument(
         "--sample-time",
-        type=float,
+        type=positive("seconds"),
         metavar="S",
         help="sample time [s] for logs without a time column (time = row index * S)",
     )
     group.add_argument(
         "--time-tolerance",
-        type=float,
+        type=FRACTION,
         default=0.25,
         metavar="FRAC",
         help="allowed deviation of a time step from the nominal step, as a fraction of it (default 0.25)",
@@ -43,14 +44,14 @@ def add_log_arguments(parser: argparse.ArgumentParser, *, prepare: bool = True) 
     if prepare:
         group.add_argument(
             "--cutoff-hz",
-            type=float,
+            type=POSITIVE,
             metavar="HZ",
             help="cut-off [Hz] of the zero-phase 4th-order Butterworth low-pass applied to position before "
             "differentiating it (default min(50 Hz, 0.4 x Nyquist): 50 Hz at 2 ms and 1 ms, 2 Hz at 0.1 s)",
         )
         group.add_argument(
             "--resample",
-            type=float,
+            type=positive("seconds"),
             metavar="S",
             help="resample every log to a uniform step of S seconds before use",
         )

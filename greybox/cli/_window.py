@@ -6,6 +6,7 @@ import argparse
 import math
 
 from ..errors import GreyboxError
+from ._types import FINITE
 
 __all__ = ["add_window_argument", "check_window"]
 
@@ -23,7 +24,7 @@ def add_window_argument(parser: argparse.ArgumentParser, flag: str = "--window")
     parser.add_argument(
         flag,
         nargs=2,
-        type=float,
+        type=FINITE,
         metavar=("START", "END"),
         help="draw only the samples from START to END seconds of log time (default: the whole log; a long log "
         "is drawn as its envelope, the minimum and maximum of each pixel column)",

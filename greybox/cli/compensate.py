@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from ..errors import GreyboxError, ModelFileError
+from ._types import FINITE, NON_NEGATIVE, POSITIVE, SEED, WordOrNumber, positive
 
 __all__ = ["add_parser", "run"]
 
@@ -39,7 +40,7 @@ def add_parser(subparsers) -> None:
                         help=f"fit models of these kinds for feed-forward ({', '.join(MODEL_CLASSES)}) on --train "
                         "logs or, for a twin plant, on its synthetic datasets A and P")
     parser.add_argument("--train", nargs="+", metavar="LOG", help="training logs of the --model kinds")
-    parser.add_argument("--train-duration", type=float, default=60.0, metavar="S",
+    parser.add_argument("--train-duration", type=positive("seconds"), default=60.0, metavar="S",
                         help="length [s] of each synthetic training dataset of a twin plant (default 60)")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument("--force", action="store_true", help="overwrite existing report files in DIR")
@@ -47,29 +48,30 @@ def add_parser(subparsers) -> None:
     group.add_argument("--reference", nargs="+", default=list(STROKE_REFERENCES), metavar="REF",
                        help=f"low ({STROKES_MM['low']:g} mm stroke), high ({STROKES_MM['high']:g} mm stroke) or a "
                        "log whose position is the reference (default: low high)")
-    group.add_argument("--duration", type=float, default=60.0, metavar="S",
+    group.add_argument("--duration", type=positive("seconds"), default=60.0, metavar="S",
                        help="length [s] of the generated references (default 60)")
-    group.add_argument("--seed", type=int, default=0, metavar="N",
+    group.add_argument("--seed", type=SEED, default=0, metavar="N",
                        help="seed of the references, the synthetic training data and the disturbance (default 0)")
-    group.add_argument("--start", type=float, metavar="MM",
+    group.add_argument("--start", type=FINITE, metavar="MM",
                        help="start position [mm] of the generated references (default: the middle of the twin's "
                        "measurement window, 0 for a model plant)")
-    group.add_argument("--reference-step", type=float, metavar="S",
+    group.add_argument("--reference-step", type=positive("seconds"), metavar="S",
                        help="step [s] of the generated references (default: the feed-forward models' sample time, "
                        "else 0.002)")
     group = parser.add_argument_group("loop")
     group.add_argument("--inertia", default="plant", metavar="J",
+                       type=WordOrNumber(("plant", "model"), NON_NEGATIVE),
                        help="inertia of the feed-forward: 'plant' (the plant's, for every row; default), 'model' "
                        "(each model's own) or a value [A s^2/mm]")
-    group.add_argument("--bandwidth", type=float, metavar="HZ",
+    group.add_argument("--bandwidth", type=POSITIVE, metavar="HZ",
                        help="closed-loop bandwidth [Hz] of the PID pole placement (default 0.1 / (2 pi T))")
-    group.add_argument("--controller-period", type=float, metavar="S",
+    group.add_argument("--controller-period", type=positive("seconds"), metavar="S",
                        help="controller period [s], a divisor of the reference step (default: at most 0.25 ms)")
-    group.add_argument("--current-limit", type=float, default=10.0, metavar="A",
+    group.add_argument("--current-limit", type=POSITIVE, default=10.0, metavar="A",
                        help="saturation of the motor current [A] (default 10)")
-    group.add_argument("--resolution", type=float, default=1e-4, metavar="MM",
+    group.add_argument("--resolution", type=NON_NEGATIVE, default=1e-4, metavar="MM",
                        help="encoder resolution [mm] (default 0.0001)")
-    group.add_argument("--disturbance-std", type=float, default=0.0, metavar="A",
+    group.add_argument("--disturbance-std", type=NON_NEGATIVE, default=0.0, metavar="A",
                        help="standard deviation [A] of an AR(1) disturbance current (default 0: none)")
     parser.add_argument("--quiet", action="store_true", help="no progress messages")
     from ._options import add_log_arguments

@@ -19,6 +19,7 @@ from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model
 from ._options import add_log_arguments, read_logs
+from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED
 
 
 def add_parser(subparsers) -> None:
@@ -44,12 +45,13 @@ def add_parser(subparsers) -> None:
     workflow = parser.add_argument_group("discovery options")
     workflow.add_argument("--effects", nargs="+", metavar="NAME",
                           help="effects to consider (default: the whole library)")
-    workflow.add_argument("--max-effects", type=int, default=3, metavar="N", help="most effects to add (default 3)")
-    workflow.add_argument("--alpha", type=float, default=0.05,
+    workflow.add_argument("--max-effects", type=NON_NEGATIVE_INT, default=3, metavar="N",
+                          help="most effects to add (default 3)")
+    workflow.add_argument("--alpha", type=FRACTION, default=0.05,
                           help="chance of naming an effect when nothing is missing (default 0.05)")
-    workflow.add_argument("--null-replicates", type=int, default=99, metavar="B",
+    workflow.add_argument("--null-replicates", type=POSITIVE_INT, default=99, metavar="B",
                           help="simulated null data sets per step (default 99)")
-    workflow.add_argument("--seed", type=int, default=0, help="seed of the null simulations (default 0)")
+    workflow.add_argument("--seed", type=SEED, default=0, metavar="N", help="seed of the null simulations (default 0)")
     workflow.add_argument("--no-refit-base", action="store_true",
                           help="keep the base model's nonlinear shape when effects are added (faster)")
     add_model_arguments(parser, title="base model options", settings=False)

@@ -10,28 +10,10 @@ import numpy as np
 
 from ..errors import GreyboxError
 from ._options import add_log_arguments
+from ._types import non_negative, positive
 
 #: Output extensions accepted for the table and for the picture.
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
-
-
-def _seconds(text: str, *, allow_zero: bool) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (np.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
-        kind = "non-negative" if allow_zero else "positive"
-        raise argparse.ArgumentTypeError(f"must be a {kind} number of seconds, got {text}")
-    return value
-
-
-def _positive_seconds(text: str) -> float:
-    return _seconds(text, allow_zero=False)
-
-
-def _non_negative_seconds(text: str) -> float:
-    return _seconds(text, allow_zero=True)
 
 
 def add_parser(subparsers) -> None:
@@ -54,10 +36,10 @@ def add_parser(subparsers) -> None:
                         help="axis metadata (torque constant, screw lead, gear ratio, efficiency, channel "
                         "names); adds force_process_N (see examples/axis_x.toml)")
     parser.add_argument("--plot", metavar="PNG", help="also draw measured, model and process current (and force)")
-    parser.add_argument("--plot-mean-s", type=_non_negative_seconds, default=0.1, metavar="S",
+    parser.add_argument("--plot-mean-s", type=non_negative("seconds"), default=0.1, metavar="S",
                         help="window of the moving mean drawn over the process current, in seconds (default "
                         "0.1; 0 draws none)")
-    parser.add_argument("--chunk-s", type=_positive_seconds, default=DEFAULT_CHUNK_S, metavar="S",
+    parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
     parser.add_argument("--force", action="store_true", help="overwrite OUT (and OUT.json) and PNG if they exist")
     add_log_arguments(parser)

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..errors import GreyboxError
 from ..evaluate.report import check_output_dir
 from ..studies.experiments import EXPERIMENTS, find_log, reproduce
+from ._types import POSITIVE_INT
 
 
 def default_data_dir() -> Path:
@@ -39,7 +40,7 @@ def add_parser(subparsers) -> None:
                         help="directory of the <axis>_<dataset>.mcap logs (default: ./data, else the source tree's data/)")
     parser.add_argument("--quick", action="store_true",
                         help="smoke run: first 30 s of every log, small optimisation budgets")
-    parser.add_argument("--jobs", type=int, default=2, metavar="N",
+    parser.add_argument("--jobs", type=POSITIVE_INT, default=2, metavar="N",
                         help="worker processes; the axes run in parallel (default 2)")
     parser.add_argument("--force", action="store_true", help="write into a non-empty DIR")
     parser.add_argument("--no-models", action="store_true", help="do not save the fitted model files")

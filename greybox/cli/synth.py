@@ -11,6 +11,7 @@ from ..twin.datasets import ESSENTIAL_TRUTH_CHANNELS, SAMPLE_TIME_S, dataset_mot
 from ..twin.effects import EFFECTS, effect_parameters
 from ..twin.noise import CurrentNoise
 from ..twin.trajectories import DATASETS, DEFAULT_DATASETS, MIN_DURATION_S
+from ._types import FINITE, MAX_SEED, NON_NEGATIVE, POSITIVE, POSITIVE_INT, SEED, positive
 
 
 def add_parser(subparsers) -> None:
@@ -27,29 +28,30 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--axis", required=True, metavar="AXES", help="axis or comma-separated axes: X, Y or X,Y")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="output directory (created if missing; a non-empty one only with --force)")
-    parser.add_argument("--seed", required=True, type=int, metavar="N", help="master seed (non-negative integer)")
+    parser.add_argument("--seed", required=True, type=SEED, metavar="N",
+                        help=f"master seed (an integer from 0 to {MAX_SEED})")
     parser.add_argument("--datasets", default=",".join(DEFAULT_DATASETS), metavar="IDS",
                         help=f"comma-separated dataset ids from {', '.join(DATASETS)} (default %(default)s)")
     parser.add_argument("--effect", metavar="NAME",
                         help=f"add one hidden effect, kept as truth_effect_A: {', '.join(EFFECTS)}")
-    parser.add_argument("--strength", type=float, metavar="A",
+    parser.add_argument("--strength", type=FINITE, metavar="A",
                         help="strength of the hidden effect [A] (default 0.2)")
     parser.add_argument("--effect-param", action="append", default=[], metavar="KEY=VALUE",
                         help="further effect parameter, e.g. period_mm=5 (repeatable)")
     parser.add_argument("--cutting", action="store_true",
                         help="inject a milling-like cutting load, kept as truth_process_A")
-    parser.add_argument("--cutting-strength", type=float, default=CuttingSpec.strength_A, metavar="A",
+    parser.add_argument("--cutting-strength", type=NON_NEGATIVE, default=CuttingSpec.strength_A, metavar="A",
                         help="mean process current [A] at 1000 mm/min feed (default %(default)s)")
-    parser.add_argument("--spindle-rpm", type=float, default=CuttingSpec.spindle_rpm, metavar="RPM",
+    parser.add_argument("--spindle-rpm", type=POSITIVE, default=CuttingSpec.spindle_rpm, metavar="RPM",
                         help="spindle speed [1/min] of the tooth-passing ripple (default %(default)s)")
-    parser.add_argument("--teeth", type=int, default=CuttingSpec.teeth, metavar="Z",
+    parser.add_argument("--teeth", type=POSITIVE_INT, default=CuttingSpec.teeth, metavar="Z",
                         help="number of cutter teeth (default %(default)s)")
-    parser.add_argument("--duration", type=float, metavar="S",
+    parser.add_argument("--duration", type=positive("seconds"), metavar="S",
                         help="length [s] of the random datasets A, C (default 120, at least 2; approximate: they "
                              "end at rest after the move that crosses it) and P (default 60, at least 10; rounded "
                              "up to whole 10 s envelope periods); B and D always cross the travel once back and "
                              "forth per speed")
-    parser.add_argument("--noise-std", type=float, default=CurrentNoise.std_A, metavar="A",
+    parser.add_argument("--noise-std", type=NON_NEGATIVE, default=CurrentNoise.std_A, metavar="A",
                         help="standard deviation [A] of the AR(1) current noise (default %(default)s)")
     parser.add_argument("--truth", choices=("all", "essential"), default="all",
                         help="truth channels to write: all, or only noise-free current and injected "
