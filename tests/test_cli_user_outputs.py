@@ -345,3 +345,34 @@ def test_process_picture_title_names_the_dataset(predict_files):
     assert "1 to 2 s" in figure._suptitle.get_text()
     assert figure.axes[1].lines[0].get_xdata().min() >= 1.0 and figure.axes[1].lines[0].get_xdata().max() <= 2.0
     matplotlib.pyplot.close(figure)
+
+
+def test_predict_shows_progress_per_chunk_and_the_total_wall_time(predict_files, tmp_path, capsys):
+    out = tmp_path / "process.parquet"
+    status, printed, err = _run(capsys, "predict", predict_files["model"], predict_files["log"], "--out", out,
+                                "--chunk-s", "2.5")
+    assert status == 0, err
+    progress = err.splitlines()
+    chunks = len(progress)
+    assert chunks > 1 and all(line.startswith(f"predicting: chunk {k}/{chunks}, ")
+                              for k, line in enumerate(progress, start=1))
+    assert f"{chunks} chunk(s) of 2.5 s, dataset C" in printed
+    last = printed.strip().splitlines()[-1]
+    assert re.fullmatch(r"done in \d+\.\d\d s wall \(model \d+\.\d\d s\)", last)
+    status, printed, err = _run(capsys, "predict", predict_files["model"], predict_files["log"], "--out", out,
+                                "--force", "--quiet")
+    assert status == 0 and err == "" and printed.strip().splitlines()[-1].startswith("done in ")
+
+
+def test_predict_plot_window(predict_files, tmp_path, capsys):
+    out, picture = tmp_path / "process.parquet", tmp_path / "process.png"
+    status, printed, err = _run(capsys, "predict", predict_files["model"], predict_files["log"], "--out", out,
+                                "--plot", picture, "--plot-window", "1", "3", "--quiet")
+    assert status == 0, err
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for args, message in ((["--plot", tmp_path / "p.png", "--plot-window", "3", "1"], "--plot-window 3 1: give"),
+                          (["--plot-window", "1", "3"], "--plot-window needs --plot PNG")):
+        status, _, err = _run(capsys, "predict", predict_files["model"], predict_files["log"], "--out",
+                              tmp_path / "other.parquet", *args)
+        assert status == 2 and err.count("\n") == 1 and message in err
+    assert not (tmp_path / "other.parquet").exists() and not (tmp_path / "p.png").exists()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import numpy as np
 
 from ..errors import GreyboxError
 from ._options import add_log_arguments
+from ._window import add_window_argument, check_window
 from ._types import non_negative, positive
 
 #: Output extensions accepted for the table and for the picture.
@@ -41,7 +43,9 @@ def add_parser(subparsers) -> None:
                         "0.1; 0 draws none)")
     parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
+    add_window_argument(parser, "--plot-window")
     parser.add_argument("--force", action="store_true", help="overwrite OUT (and OUT.json) and PNG if they exist")
+    parser.add_argument("--quiet", action="store_true", help="no progress display (one line per chunk on stderr)")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -60,7 +64,34 @@ def _read_log(args: argparse.Namespace, channels: dict):
     return prepared
 
 
+def _progress(total_s: float, quiet: bool):
+    """Progress of the chunks on stderr, or None with --quiet: one line per chunk, updated in place on a terminal.
+
+    Parameters
+    ----------
+    total_s : float
+        Log time [s] at the last sample.
+    quiet : bool
+        The --quiet option.
+    """
+    if quiet:
+        return None
+    started = time.perf_counter()
+    terminal = sys.stderr.isatty()
+
+    def show(done: int, chunks: int, time_s: float) -> None:
+        text = (f"predicting: chunk {done}/{chunks}, {time_s:.1f} of {total_s:.1f} s of log, "
+                f"{time.perf_counter() - started:.1f} s elapsed")
+        if terminal:
+            print("\r" + text, end="\n" if done == chunks else "", file=sys.stderr, flush=True)
+        else:
+            print(text, file=sys.stderr, flush=True)
+
+    return show
+
+
 def run(args: argparse.Namespace) -> int:
+    run_started = time.perf_counter()
     from ..data.axis_config import read_axis_config
     from ..evaluate.process import predict_process
     from ..evaluate.process_io import check_output_path, output_paths, write_process
@@ -78,12 +109,16 @@ def run(args: argparse.Namespace) -> int:
         if plot.resolve() == out.resolve():
             raise GreyboxError(f"{plot}: --plot and --out name the same file")
         check_output_path(plot, overwrite=args.force, protect=inputs)
+    elif args.plot_window is not None:
+        raise GreyboxError("--plot-window needs --plot PNG")
     config = read_axis_config(args.axis_config) if args.axis_config else None
     model = load_model(args.model)
     log = _read_log(args, config.channels if config else {})
+    window = check_window(args.plot_window, log.time, "--plot-window", Path(args.log).name)
 
     started = time.perf_counter()
-    result = predict_process(model, log, axis_config=config, chunk_s=args.chunk_s)
+    result = predict_process(model, log, axis_config=config, chunk_s=args.chunk_s,
+                             progress=_progress(float(log.time[-1]), args.quiet))
     elapsed = time.perf_counter() - started
     result.attrs.update({"model_file": str(args.model), "log_file": str(args.log)})
     n_chunks = len(chunk_slices(len(log), samples_per_chunk(log.sample_time, args.chunk_s)))
@@ -91,8 +126,8 @@ def run(args: argparse.Namespace) -> int:
     noun = "current" if unit == "A" else "force"
     process = result.process
     print(f"predicted {Path(args.log).name} with the {result.attrs['model_kind']} model {Path(args.model).name}: "
-          f"{len(log)} samples, {log.duration:.1f} s, {n_chunks} chunk(s) of {args.chunk_s:g} s, "
-          f"in {elapsed:.2f} s")
+          f"{len(log)} samples, {log.duration:.1f} s, {n_chunks} chunk(s) of {args.chunk_s:g} s"
+          + (f", dataset {result.dataset}" if result.dataset else ""))
     print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} {unit}, "
           f"process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")
     if unit == "A" and result.force is not None:
@@ -105,8 +140,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         from ..evaluate.process_plot import plot_process
 
-        plot_process(result, args.plot, mean_s=args.plot_mean_s)
+        plot_process(result, args.plot, mean_s=args.plot_mean_s, window=window)
         print(f"wrote {args.plot}")
+    print(f"done in {time.perf_counter() - run_started:.2f} s wall (model {elapsed:.2f} s)")
     return 0
 
 
