@@ -4,7 +4,9 @@ Each sub-command lives in its own module of this package and provides
 ``add_parser(subparsers)``, which registers the sub-command and sets
 ``run=<callable(args) -> int>`` as its default. Errors caused by the user's
 input (:class:`greybox.errors.GreyboxError`) are printed as one line naming the
-file and the problem, with exit status 2 and no traceback.
+file and the problem, with exit status 2 and no traceback. Warnings issued while
+a command runs are printed as one ``note:`` line each; in both, a model
+hyperparameter is named by the option that sets it (:mod:`greybox.cli._notes`).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import importlib
 import sys
 
 from ..errors import GreyboxError
+from ._notes import command_notes, error_message
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
 COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate")
@@ -39,9 +42,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.run(args) or 0)
+        with command_notes(args):  # warnings as one-line notes naming options, not Python
+            return int(args.run(args) or 0)
     except GreyboxError as error:
-        print(f"greybox {args.command}: error: {error}", file=sys.stderr)
+        print(f"greybox {args.command}: error: {error_message(error, args)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"greybox {args.command}: interrupted", file=sys.stderr)

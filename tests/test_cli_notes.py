@@ -1,0 +1,112 @@
+"""Messages of the command speak the command line: options instead of Python keywords, warnings as one-line notes."""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+
+import pytest
+
+import greybox.cli as cli
+from greybox.cli._notes import command_notes, error_message, option_words
+from greybox.data.io import write_log
+from greybox.errors import GreyboxError, ParameterError
+from greybox.persistence import load_model
+from greybox.twin import make_dataset
+
+
+@pytest.fixture(scope="module")
+def air_cut(tmp_path_factory):
+    """A 4 s air cut of the synthetic X axis (MCAP)."""
+    path = tmp_path_factory.mktemp("notes") / "X_A.mcap"
+    write_log(make_dataset("X", "A", seed=2, duration_s=4.0), path)
+    return path
+
+
+def _main(capsys, *argv):
+    status = cli.main([str(arg) for arg in argv])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_refused_combination_names_the_options(air_cut, tmp_path, capsys):
+    out = tmp_path / "c.gbm"
+    status, _, err = _main(capsys, "train", "--model", "coulomb", "--offset", "--asymmetric", "--train", air_cut,
+                           "--out", out)
+    assert status == 2 and not out.exists()
+    (line,) = err.splitlines()
+    assert line.startswith("greybox train: error: ")
+    assert "--offset" in line and "--asymmetric" in line
+    assert "fit_offset" not in line and "=True" not in line and "asymmetric=" not in line
+
+
+def test_seed_out_of_range_through_set_names_the_seed_option(air_cut, tmp_path, capsys):
+    status, _, err = _main(capsys, "train", "--model", "gms", "--set", "random_state=-1", "--train", air_cut,
+                           "--out", tmp_path / "g.gbm")
+    assert status == 2
+    (line,) = err.splitlines()
+    assert "--model-seed" in line and "random_state" not in line
+
+
+def test_search_at_its_bound_is_one_note_naming_set_bounds(air_cut, tmp_path, capsys):
+    """An SVR search for C in an interval far too low ends at its upper end: a note, not a UserWarning."""
+    out = tmp_path / "svr.gbm"
+    status, printed, err = _main(capsys, "train", "--model", "svr", "--train", air_cut, "--out", out, "--quiet",
+                                 "--set", "n_calls=6", "--set", "n_subset=600", "--set", "epsilon=0.01",
+                                 "--set", "gamma=1", "--set", 'bounds={"C": [1e-5, 1e-4]}')
+    assert status == 0, err
+    assert load_model(out).at_bounds_ == ["C"]  # the search did end at its bound
+    notes = [line for line in err.splitlines() if line]
+    assert len(notes) == 1, err
+    assert notes[0].startswith("note: ") and "C = 0.0001" in notes[0]
+    assert "--set bounds='{\"C\": [LOW, HIGH]}'" in notes[0]
+    assert "UserWarning" not in err and ".py:" not in err and "bounds=)" not in err
+    assert "note:" not in printed
+
+
+def test_warnings_become_one_note_each_in_command_words(capsys):
+    args = argparse.Namespace(command="train", set=[])
+    before = warnings.showwarning
+    with command_notes(args) as notes:
+        for _ in range(3):
+            warnings.warn("gms: use asymmetric=True\n  or widen the search with bounds=", UserWarning, stacklevel=1)
+        warnings.warn("overflow encountered in exp", RuntimeWarning, stacklevel=1)
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        "note: gms: use --asymmetric or widen the search with --set bounds='{\"NAME\": [LOW, HIGH]}'",
+        "note: overflow encountered in exp"]
+    assert notes == err.splitlines() and warnings.showwarning is before
+
+
+def test_error_message_of_a_command_without_set():
+    args = argparse.Namespace(command="discover")  # discover offers no --set
+    error = ParameterError("n_starts must be a positive integer, got 0")
+    assert error_message(error, args) == ("n_starts (--set n_starts=VALUE of greybox train) must be a positive "
+                                          "integer, got 0")
+    plain = GreyboxError("data/x.csv: column 'position_mm' has NaN\n at t = 1 s")
+    assert error_message(plain, args) == "data/x.csv: column 'position_mm' has NaN at t = 1 s"
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("use asymmetric=True or fit_offset=True", "use --asymmetric or --offset"),
+    ("fit_offset=False keeps it", "no --offset keeps it"),
+    ("n_elements=4 is the default", "--elements 4 is the default"),
+    ("give n_elements=", "give --elements N"),
+    ("random_state must be an integer seed", "--model-seed must be an integer seed"),
+    ("try C=2.0", "try --set C=2.0"),
+    ("max_iter is too small", "--set max_iter is too small"),
+    # words that are not the Python spelling of a hyperparameter stay
+    ("C = 0.1 ended at the end", "C = 0.1 ended at the end"),
+    ("inertia must be finite, got nan", "inertia must be finite, got nan"),
+    ("RMSE=3 A, gms.n_elements_ = 4", "RMSE=3 A, gms.n_elements_ = 4"),
+    ("--columns position_mm=X1", "--columns position_mm=X1"),
+    ("asymmetric Coulomb levels", "asymmetric Coulomb levels"),
+])
+def test_option_words(text, expected):
+    assert option_words(text) == expected
+
+
+def test_bare_flag_name_is_the_option_only_in_a_message_about_parameters():
+    text = "choose asymmetric or fit_offset, not both"
+    assert option_words(text, parameters=True) == "choose --asymmetric or --offset, not both"
+    assert option_words(text) == "choose asymmetric or --offset, not both"
