@@ -219,8 +219,6 @@ def run(args: argparse.Namespace) -> int:
     from ..control.workflow import compensation_study
 
     _check_output(args)
-    if args.disturbance_std < 0:
-        raise GreyboxError(f"--disturbance-std must be non-negative, got {args.disturbance_std} A")
     plant = _plant(args)
     models = _models(args, plant)
     started = time.perf_counter()

@@ -64,8 +64,6 @@ def run(args: argparse.Namespace) -> int:
     axes = list(dict.fromkeys(a.strip() for a in args.axis if a.strip()))
     if not axes:
         raise GreyboxError("--axis names no axis")
-    if args.jobs < 1:
-        raise GreyboxError(f"--jobs must be at least 1, got {args.jobs}")
     data_dir = Path(args.data) if args.data else default_data_dir()
     if not data_dir.is_dir():
         hint = "" if args.data else " (no shipped data next to the package: give --data DIR)"
