@@ -80,10 +80,10 @@ def test_cutoff_help_states_the_default(command, capsys):
 
 
 # ---------------------------------------------------------------- synth --duration
-@pytest.mark.parametrize("datasets, duration, minimum", [("A,P", "5", "10"), ("C", "1", "2")])
+@pytest.mark.parametrize("datasets, duration, minimum", [(("A", "P"), "5", "10"), (("C",), "1", "2")])
 def test_synth_refuses_a_duration_below_the_minimum(tmp_path, capsys, datasets, duration, minimum):
     out = tmp_path / "twin"
-    status, _, err = _run(capsys, "synth", "--axis", "X", "--datasets", datasets, "--duration", duration,
+    status, _, err = _run(capsys, "synth", "--axis", "X", "--datasets", *datasets, "--duration", duration,
                           "--seed", "5", "--out", out)
     assert status == 2 and err.count("\n") == 1 and "Traceback" not in err
     assert f"--duration {duration}: dataset" in err and f"needs at least {minimum} s" in err
@@ -94,14 +94,14 @@ def test_synth_says_when_a_log_is_not_as_long_as_asked(tmp_path, capsys):
     from greybox.data.io import read_log
 
     out = tmp_path / "twin"
-    status, printed, err = _run(capsys, "synth", "--axis", "X", "--datasets", "A,P,D", "--duration", "15",
+    status, printed, err = _run(capsys, "synth", "--axis", "X", "--datasets", "A", "P", "D", "--duration", "15",
                                 "--seed", "5", "--out", out, "--truth", "essential")
     assert status == 0, err
-    note = printed.splitlines()[0]
+    note = err.splitlines()[0]
     length = read_log(out / "X_P.mcap").duration
     assert length == pytest.approx(20.0)
     assert note.startswith("note: --duration 15 s gives ") and "X_P 20.0 s" in note and "10 s envelope" in note
-    assert "note: --duration does not apply to D" in printed
+    assert "note: --duration does not apply to D" in err
     for key in "AP":  # the printed length is the written one
         written = read_log(out / f"X_{key}.mcap").duration
         assert (f"X_{key} {written:.1f} s" in note) == (abs(written - 15.0) > 0.5)

@@ -12,7 +12,7 @@ from greybox.twin import make_dataset
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 SHIPPED_SEED = 2024
-REGENERATE = "greybox synth --axis X,Y --out data --seed 2024 --truth essential"
+REGENERATE = "greybox synth --axis X Y --out data --seed 2024 --truth essential"
 
 
 def test_readme_documents_seed_and_command():

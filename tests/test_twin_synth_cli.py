@@ -13,7 +13,7 @@ from greybox.twin import ESSENTIAL_TRUTH_CHANNELS, make_dataset, synthesize
 
 def test_synth_writes_one_file_per_dataset(tmp_path, capsys):
     out = tmp_path / "twin"
-    status = main(["synth", "--axis", "X,Y", "--out", str(out), "--seed", "3", "--datasets", "A,P",
+    status = main(["synth", "--axis", "X", "Y", "--out", str(out), "--seed", "3", "--datasets", "A", "P",
                    "--duration", "10", "--effect", "position_periodic_force", "--strength", "0.15",
                    "--effect-param", "period_mm=5", "--cutting"])
     assert status == 0
@@ -34,7 +34,7 @@ def test_synth_writes_one_file_per_dataset(tmp_path, capsys):
 
 
 def test_synth_refuses_to_overwrite_without_force(tmp_path, capsys):
-    args = ["synth", "--axis", "X", "--out", str(tmp_path), "--seed", "1", "--datasets", "D,A", "--duration", "4"]
+    args = ["synth", "--axis", "X", "--out", str(tmp_path), "--seed", "1", "--datasets", "D", "A", "--duration", "4"]
     target = tmp_path / "X_A.mcap"
     target.write_bytes(b"user data")
     assert main(args) == 2
@@ -48,7 +48,7 @@ def test_synth_refuses_to_overwrite_without_force(tmp_path, capsys):
 
 @pytest.mark.parametrize("args, message", [
     (["--axis", "Z"], "unknown axis 'Z'"),
-    (["--axis", "X", "--datasets", "A,Q"], "unknown dataset 'Q'"),
+    (["--axis", "X", "--datasets", "A", "Q"], "unknown dataset 'Q'"),
     (["--axis", "X", "--effect", "cogging"], "unknown hidden effect 'cogging'"),
     (["--axis", "X", "--strength", "0.1"], "need --effect"),
     (["--axis", "X", "--effect", "thermal_drift", "--effect-param", "tau=2"], "no parameter 'tau'"),

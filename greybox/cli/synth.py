@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ..errors import GreyboxError
@@ -25,13 +26,13 @@ def add_parser(subparsers) -> None:
             + "; ".join(f"{k}: {v}" for k, v in DATASETS.items()) + "."
         ),
     )
-    parser.add_argument("--axis", required=True, metavar="AXES", help="axis or comma-separated axes: X, Y or X,Y")
+    parser.add_argument("--axis", required=True, nargs="+", metavar="AXIS", help="axes: X, Y or both (X Y)")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="output directory (created if missing; a non-empty one only with --force)")
     parser.add_argument("--seed", required=True, type=SEED, metavar="N",
                         help=f"master seed (an integer from 0 to {MAX_SEED})")
-    parser.add_argument("--datasets", default=",".join(DEFAULT_DATASETS), metavar="IDS",
-                        help=f"comma-separated dataset ids from {', '.join(DATASETS)} (default %(default)s)")
+    parser.add_argument("--datasets", nargs="+", default=list(DEFAULT_DATASETS), metavar="ID",
+                        help=f"dataset ids from {', '.join(DATASETS)} (default: {' '.join(DEFAULT_DATASETS)})")
     parser.add_argument("--effect", metavar="NAME",
                         help=f"add one hidden effect, kept as truth_effect_A: {', '.join(EFFECTS)}")
     parser.add_argument("--strength", type=FINITE, metavar="A",
@@ -149,20 +150,22 @@ def _check_duration(args: argparse.Namespace, axes, datasets) -> None:
                 differ.append(f"{axis}_{key} {length_s:.1f} s")
                 reasons.append(_DURATION_REASONS[key])
     if differ:
-        print(f"note: --duration {duration:g} s gives {', '.join(differ)} ({'; '.join(dict.fromkeys(reasons))})")
+        print(f"note: --duration {duration:g} s gives {', '.join(differ)} ({'; '.join(dict.fromkeys(reasons))})",
+              file=sys.stderr)
     fixed = [key for key in datasets if key in DATASETS and key not in MIN_DURATION_S]
     if fixed:
-        print(f"note: --duration does not apply to {', '.join(fixed)} (once back and forth over the travel per speed)")
+        print(f"note: --duration does not apply to {', '.join(fixed)} (once back and forth over the travel per speed)",
+              file=sys.stderr)
 
 
 def run(args: argparse.Namespace) -> int:
-    axes = [a.strip().upper() for a in args.axis.split(",") if a.strip()]
-    datasets = [d.strip().upper() for d in args.datasets.split(",") if d.strip()]
+    axes = list(dict.fromkeys(a.strip().upper() for a in args.axis if a.strip()))
+    datasets = list(dict.fromkeys(d.strip().upper() for d in args.datasets if d.strip()))
     if not axes or not datasets:
         raise GreyboxError("give at least one axis (--axis) and one dataset (--datasets)")
     options = _effect_options(args)
-    _check_duration(args, axes, datasets)
     _check_out_dir(args)
+    _check_duration(args, axes, datasets)
     if args.cutting:
         options["cutting"] = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm,
                                          teeth=args.teeth)
