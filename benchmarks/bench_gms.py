@@ -31,14 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-
-from greybox.friction.reference import gms_reference
-from greybox.friction.signals import STEP, motion_log, velocity_profile
-
 from greybox.friction import GMSModel
 from greybox.friction.gms import GMSState, simulate_gms
 from greybox.friction.kernels import gms_friction_kernel
+from greybox.friction.reference import gms_reference
+from greybox.friction.signals import STEP, motion_log, velocity_profile
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def parameters(n_elements: int) -> dict:
@@ -159,7 +158,8 @@ def main(argv=None) -> int:
         print(json.dumps(result))
     else:
         print(f"GMS N={args.elements}, {args.steps} steps: numba {ns:.2f} ns/step, plain Python {py_ns:.0f} ns/step "
-              f"({py_ns / ns:.0f}x), C -O2 " + ("n/a" if c_ns is None else f"{c_ns:.2f} ns/step (numba/C {ns / c_ns:.2f})"))
+              f"({py_ns / ns:.0f}x), C -O2 "
+              + ("n/a" if c_ns is None else f"{c_ns:.2f} ns/step (numba/C {ns / c_ns:.2f})"))
         print(f"GMS identification on {fit_n} samples: {fit_s:.1f} s, {fit_evals} simulations, "
               f"RMSE {fit_rmse:.4f} A (noise 0.02 A)")
     return 0

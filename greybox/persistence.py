@@ -49,9 +49,9 @@ from pathlib import Path
 
 import numpy as np
 
+from . import registry
 from .atomic import atomic_output
 from .errors import GreyboxError, ModelFileError
-from . import registry
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "save_model", "load_model"]
 

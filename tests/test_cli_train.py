@@ -74,7 +74,8 @@ def test_same_seed_gives_identical_model_files(tmp_path, capsys):
     files = []
     for name in ("a.gbm", "b.gbm"):
         files.append(tmp_path / name)
-        status, _, stderr = _train(capsys, "--model", "lugre", "--model-seed", "7", "--train", log_path, "--out", files[-1],
+        status, _, stderr = _train(capsys, "--model", "lugre", "--model-seed", "7", "--train", log_path,
+                                   "--out", files[-1],
                                    "--quiet")
         assert status == 0 and stderr == ""
     assert files[0].read_bytes() == files[1].read_bytes()

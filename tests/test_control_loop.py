@@ -5,8 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from greybox.control import (InertiaFeedForward, ModelFeedForward, ModelPlant, TwinPlant, compare_feedforwards,
-                             simulate_loop, stroke_reference)
+from greybox.control import (
+    InertiaFeedForward,
+    ModelFeedForward,
+    ModelPlant,
+    TwinPlant,
+    compare_feedforwards,
+    simulate_loop,
+    stroke_reference,
+)
 from greybox.control.loop import controller_periods
 from greybox.control.references import Reference
 from greybox.data.prepare import prepare

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import plant_reference as ref
 import pytest
 
-import plant_reference as ref
 from greybox.control.loop import controller_periods, simulate_loop
 from greybox.control.pid import ControllerSettings
 from greybox.control.plants import ModelPlant, TwinPlant, compiled_position_loop, fine_stride
@@ -41,7 +41,8 @@ def _fixed_model(which, offset=0.0, inertia=2.8e-4):
     if which == "gms":
         model = GMSModel()
         model.alpha_, model.k_ = np.array([0.1, 0.2, 0.3, 0.4]), np.array([30.0, 60.0, 20.0, 10.0])
-        model.slip_rate_, model.sigma_, model.s_0_, model.s_inf_, model.v_s_, model.viscous_ = 0.8, 0.02, 0.012, 0.008, 3.0, 0.006
+        model.slip_rate_, model.sigma_, model.s_0_ = 0.8, 0.02, 0.012
+        model.s_inf_, model.v_s_, model.viscous_ = 0.008, 3.0, 0.006
         model.n_evaluations_ = 0
     else:
         model = LuGreModel()

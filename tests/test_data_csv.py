@@ -99,7 +99,8 @@ def test_umich_cnc_mill_file_with_column_mapping(real_data):
     path = real_data("UMich_CNC_mill_tool_wear") / "experiment_01.csv"
     log = read_log(
         path,
-        columns={"position_mm": "X1_ActualPosition", "velocity_mm_s": "X1_ActualVelocity", "current_A": "X1_CurrentFeedback"},
+        columns={"position_mm": "X1_ActualPosition", "velocity_mm_s": "X1_ActualVelocity",
+                 "current_A": "X1_CurrentFeedback"},
         sample_time=0.1,
     )
     assert len(log) == 1055  # README: 1055 rows, 105.5 s at 10 Hz
@@ -121,7 +122,8 @@ def test_single_word_suffix_is_taken_as_a_unit_unless_the_quantity_is_mapped(tmp
 
 def test_byte_order_mark_and_comment_lines(tmp_path):
     path = tmp_path / "excel.csv"
-    path.write_bytes("\ufeff# exported 2024-05-02\ntime_s;position_mm;current_A\n0;1,5;2\n0,002;1,5;2\n".encode("utf-8"))
+    text = "\ufeff# exported 2024-05-02\ntime_s;position_mm;current_A\n0;1,5;2\n0,002;1,5;2\n"
+    path.write_bytes(text.encode("utf-8"))
     log = read_log(path)
     np.testing.assert_allclose(log.time, [0.0, 0.002])
     np.testing.assert_allclose(log.position, [1.5, 1.5])

@@ -5,9 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-
 from log_errors import assert_read_fails
-
 
 GOOD = {
     "time_s": np.arange(10) * 0.002,
@@ -70,7 +68,8 @@ def test_gap_beyond_tolerance(tmp_path, suffix):
 
 @table_formats
 def test_unknown_unit(tmp_path, suffix):
-    assert_read_fails(_case(tmp_path, suffix, position_mm=None, position_inch=GOOD["position_mm"]), "unknown unit 'inch'", "position_inch")
+    assert_read_fails(_case(tmp_path, suffix, position_mm=None, position_inch=GOOD["position_mm"]),
+                      "unknown unit 'inch'", "position_inch")
     assert_read_fails(_case(tmp_path, suffix, time_s=None, time_h=GOOD["time_s"]), "unknown unit 'h'")
 
 
@@ -96,7 +95,8 @@ def test_no_time_column_without_sample_time(tmp_path, suffix):
 
 @table_formats
 def test_mapped_column_not_in_file(tmp_path, suffix):
-    assert_read_fails(_case(tmp_path, suffix), "column 'X1_CurrentFeedback' (mapped to current_A) not found", columns={"current_A": "X1_CurrentFeedback"})
+    assert_read_fails(_case(tmp_path, suffix), "column 'X1_CurrentFeedback' (mapped to current_A) not found",
+                      columns={"current_A": "X1_CurrentFeedback"})
 
 
 @table_formats

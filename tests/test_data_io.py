@@ -6,11 +6,10 @@ import os
 
 import numpy as np
 import pytest
+from log_errors import assert_read_fails
 
 from greybox.data.io import format_of, parse_column_mapping, read_log, write_log
 from greybox.errors import GreyboxError, LogError
-
-from log_errors import assert_read_fails
 
 
 def test_missing_file(tmp_path):

@@ -6,13 +6,12 @@ import json
 
 import numpy as np
 import pytest
+from log_errors import assert_read_fails
 from mcap.reader import make_reader
 
 from greybox.data.io import read_log, write_log
 from greybox.data.mcap_io import SCHEMA_NAME, join_slices, scan_records
 from greybox.errors import LogError
-
-from log_errors import assert_read_fails
 
 
 def test_round_trip_keeps_values_extras_and_metadata(tmp_path, make_log):
@@ -123,7 +122,8 @@ def _write_with_mcap_library(path, messages, *, encoding="json", **writer_option
 
 def _sample_messages(n=300, *, indent=None):
     return [
-        (k * 1_000_000, json.dumps({"position_um": 1000.0 * k, "current_mA": 500.0, "temperature_C": 20.0 + k}, indent=indent).encode())
+        (k * 1_000_000, json.dumps({"position_um": 1000.0 * k, "current_mA": 500.0, "temperature_C": 20.0 + k},
+                                   indent=indent).encode())
         for k in range(n)
     ]
 
@@ -142,7 +142,8 @@ def test_files_of_other_writers_read_with_unit_conversion(tmp_path, options):
     from mcap.writer import CompressionType
 
     if "compression" in options:
-        options = {**options, "compression": {"lz4": CompressionType.LZ4, "none": CompressionType.NONE}[options["compression"]]}
+        kinds = {"lz4": CompressionType.LZ4, "none": CompressionType.NONE}
+        options = {**options, "compression": kinds[options["compression"]]}
     path = tmp_path / "other.mcap"
     _write_with_mcap_library(path, _sample_messages(), **options)
     log = read_log(path)

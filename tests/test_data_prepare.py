@@ -13,7 +13,8 @@ from greybox.errors import LogError
 
 def _sine(frequency_hz, n=5000, sample_time=0.002, amplitude_mm=50.0, **fields):
     time = np.arange(n) * sample_time
-    return AxisLog(time=time, position=amplitude_mm * np.sin(2 * np.pi * frequency_hz * time), effort=np.zeros(n), **fields)
+    return AxisLog(time=time, position=amplitude_mm * np.sin(2 * np.pi * frequency_hz * time), effort=np.zeros(n),
+                   **fields)
 
 
 def test_default_cutoff():
@@ -27,8 +28,10 @@ def test_derivatives_of_a_slow_sine_are_analytic():
     log = derive(_sine(0.5))
     omega = 2 * np.pi * 0.5
     inner = slice(100, -100)
-    np.testing.assert_allclose(log.velocity[inner], 50 * omega * np.cos(omega * log.time[inner]), atol=1e-3 * 50 * omega)
-    np.testing.assert_allclose(log.acceleration[inner], -50 * omega**2 * np.sin(omega * log.time[inner]), atol=1e-3 * 50 * omega**2)
+    np.testing.assert_allclose(log.velocity[inner], 50 * omega * np.cos(omega * log.time[inner]),
+                               atol=1e-3 * 50 * omega)
+    np.testing.assert_allclose(log.acceleration[inner], -50 * omega**2 * np.sin(omega * log.time[inner]),
+                               atol=1e-3 * 50 * omega**2)
     assert log.attrs["derivative_filter"] == {"cutoff_hz": 50.0, "order": 4, "derived": ["velocity", "acceleration"]}
 
 
@@ -58,7 +61,8 @@ def test_logged_velocity_is_kept_and_acceleration_comes_from_it():
     log = derive(base.replace(velocity=logged))
     assert np.array_equal(log.velocity, logged)
     inner = slice(100, -100)
-    np.testing.assert_allclose(log.acceleration[inner], -50 * omega**2 * np.sin(omega * base.time[inner]), atol=1e-3 * 50 * omega**2)
+    np.testing.assert_allclose(log.acceleration[inner], -50 * omega**2 * np.sin(omega * base.time[inner]),
+                               atol=1e-3 * 50 * omega**2)
     assert log.attrs["derivative_filter"]["derived"] == ["acceleration"]
 
 

@@ -7,8 +7,7 @@ import pytest
 
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
-from greybox.discover.locate import MOTION_STATES, motion_states, residual_by_regime, residual_profiles, \
-    structure_basis
+from greybox.discover.locate import MOTION_STATES, motion_states, residual_by_regime, residual_profiles, structure_basis
 from greybox.twin import make_dataset
 
 

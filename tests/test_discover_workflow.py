@@ -46,7 +46,9 @@ def test_effects_the_base_already_has_are_not_named():
 def test_structure_outside_the_library_is_reported_as_unexplained():
     # friction that grows only while accelerating forwards: no library effect has this shape
     train, test, _ = case_logs(StudyCase(None, 0.0, 1, "coulomb", DURATION_S))
-    add = lambda run: run.replace(effort=run.effort + 3e-4 * np.maximum(run.acceleration, 0.0))
+    def add(run):
+        return run.replace(effort=run.effort + 3e-4 * np.maximum(run.acceleration, 0.0))
+
     result = discover(CoulombModel(), add(train), add(test), seed=1)
     assert result.verdict == "unexplained_structure"
     assert result.steps[-1].families["acceleration"]["p_value"] <= 0.05

@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from greybox.friction.reference import gms_reference, lugre_reference
-from greybox.friction.signals import STEP, velocity_profile
 from greybox.friction.gms import GMSState, gms_trajectory, simulate_gms
 from greybox.friction.kernels import gms_friction_kernel, gms_trajectory_kernel, lugre_trajectory_kernel
 from greybox.friction.lugre import simulate_lugre
+from greybox.friction.reference import gms_reference, lugre_reference
+from greybox.friction.signals import STEP, velocity_profile
 
 
 def gms_parameters(n_elements, seed=0):

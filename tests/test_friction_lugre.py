@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.errors import ParameterError
 from greybox.friction import LuGreModel, stribeck_curve
 from greybox.friction.lugre import check_lugre_parameters, simulate_lugre
+from greybox.friction.signals import STEP, motion_log, velocity_profile
 
 PARAMS = {"sigma1": 0.02, "sigma2": 0.004, "coulomb": 0.6, "static": 0.9, "v_s": 3.0}
 
@@ -21,8 +21,8 @@ def fine_reference(velocity, sigma0):
     for v, g_v in zip(velocity, g):
         out.append(z)
         lam = sigma0 * abs(v) / g_v
-        sol = solve_ivp(lambda t, y: v - lam * y, (0.0, STEP), [z], method="Radau", rtol=1e-11, atol=1e-15,
-                        jac=lambda t, y: [[-lam]])
+        sol = solve_ivp(lambda t, y, v=v, lam=lam: v - lam * y, (0.0, STEP), [z], method="Radau", rtol=1e-11,
+                        atol=1e-15, jac=lambda t, y, lam=lam: [[-lam]])
         z = sol.y[0, -1]
     return np.array(out)
 

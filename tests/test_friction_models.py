@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.errors import LogError, ParameterError
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.friction.gms import simulate_gms
+from greybox.friction.signals import STEP, motion_log, velocity_profile
 
 QUICK = {
     "coulomb": lambda: CoulombModel(),

@@ -7,11 +7,11 @@ import pytest
 import scipy.io
 import scipy.signal
 
-from greybox.friction.signals import motion_log, velocity_profile
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
 from greybox.friction import CoulombModel, StribeckModel, stribeck_curve
 from greybox.friction.coulomb import coulomb_friction
+from greybox.friction.signals import motion_log, velocity_profile
 
 
 def log_with(current_of):

@@ -6,11 +6,16 @@ import numpy as np
 import pytest
 from scipy.optimize import lsq_linear
 
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.friction import stribeck_curve
 from greybox.friction.gms import simulate_gms
-from greybox.identify.initial import (distance_since_reversal, motion_direction, presliding_deflection,
-                                      sliding_mask, static_initial_guess)
+from greybox.friction.signals import STEP, motion_log, velocity_profile
+from greybox.identify.initial import (
+    distance_since_reversal,
+    motion_direction,
+    presliding_deflection,
+    sliding_mask,
+    static_initial_guess,
+)
 from greybox.identify.linear import bounded_lstsq
 
 

@@ -35,7 +35,7 @@ def test_unknown_effort_unit_is_rejected():
 def test_current_requires_ampere_effort():
     assert np.array_equal(make_log().current, np.ones(5))
     with pytest.raises(LogError, match="effort in N"):
-        make_log(effort_unit="N").current
+        _ = make_log(effort_unit="N").current
 
 
 def test_select_keeps_every_channel_aligned():

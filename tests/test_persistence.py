@@ -11,9 +11,8 @@ import numpy as np
 import pytest
 from sklearn.base import BaseEstimator
 
-from greybox import atomic
+from greybox import atomic, registry
 from greybox.errors import ModelFileError, ParameterError
-from greybox import registry
 from greybox.persistence import FORMAT_VERSION, load_model, save_model
 
 

@@ -6,18 +6,30 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import plant_reference as ref
 import pytest
 
-import plant_reference as ref
-from greybox.friction.reference import lugre_step_reference, stribeck_reference
-from greybox.friction.signals import STEP, velocity_profile
 from greybox.base import PlantLaw
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
-from greybox.friction.kernels import (gms_trajectory_kernel, lugre_decay_rate, lugre_exact_step,
-                                      lugre_trajectory_kernel, stribeck_at)
+from greybox.friction.kernels import (
+    gms_trajectory_kernel,
+    lugre_decay_rate,
+    lugre_exact_step,
+    lugre_trajectory_kernel,
+    stribeck_at,
+)
 from greybox.friction.plant_laws import MAX_STEP_RATIO, gms_plant_law, lugre_plant_law, stable_step
-from greybox.twin.plant import (default_plant_parameters, lag_decay, lagged_stribeck_ratio, maxwell_slip_kernel,
-                                maxwell_slip_update, stribeck_ratio, twin_plant_law)
+from greybox.friction.reference import lugre_step_reference, stribeck_reference
+from greybox.friction.signals import STEP, velocity_profile
+from greybox.twin.plant import (
+    default_plant_parameters,
+    lag_decay,
+    lagged_stribeck_ratio,
+    maxwell_slip_kernel,
+    maxwell_slip_update,
+    stribeck_ratio,
+    twin_plant_law,
+)
 
 FINE = 0.25e-3
 

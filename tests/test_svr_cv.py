@@ -60,7 +60,7 @@ def test_neighbouring_samples_stay_together():
     folds = blocked_folds([1200], n_folds=4, n_blocks=8)
     blocks = time_blocks([1200], 8)
     edges = {b.start for b in blocks} | {b.stop for b in blocks}
-    for train, test in folds:
+    for _, test in folds:
         label = np.zeros(1200, bool)
         label[test] = True
         changes = np.flatnonzero(label[1:] != label[:-1]) + 1

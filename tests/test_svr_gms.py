@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from multisine import multisine_motion
 from sklearn.exceptions import NotFittedError
 
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
 from greybox.friction.gms import GMSModel, simulate_gms
 from greybox.models.gmssvr import GMSSVRModel
-
-from multisine import multisine_motion
 
 TRUTH_GMS = dict(alpha=np.array([0.1, 0.2, 0.3, 0.4]), k=np.full(4, 80.0), C=2.0, sigma=0.01,
                  s_0=0.01, s_inf=0.006, v_s=5.0, mu=0.003)

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from multisine import multisine_motion
 from sklearn.base import clone
 
 from greybox.data.log import AxisLog
 from greybox.errors import LogError
 from greybox.models.svr import SVRCurrentModel, default_bounds, inertia_offset_proxy
-
-from multisine import multisine_motion
 
 J_TRUE = 2e-4  # A s^2/mm
 OFFSET_TRUE = 0.1  # A

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_svr_model import FIXED, sweep_run
 
 from greybox import persistence, registry
 from greybox.models.svr import SVRCurrentModel
-from test_svr_model import FIXED, sweep_run
 
 
 def test_saved_and_loaded_model_predicts_identically(tmp_path, monkeypatch):
@@ -24,9 +24,10 @@ def test_saved_and_loaded_model_predicts_identically(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("target", ["residual", "current"])
 def test_grey_box_model_with_nested_gms_stage_round_trips(tmp_path, monkeypatch, target):
+    from test_svr_gms import SVR_FIXED, gms_run, quick_gms
+
     from greybox.friction.gms import GMSModel
     from greybox.models.gmssvr import GMSSVRModel
-    from test_svr_gms import SVR_FIXED, gms_run, quick_gms
 
     monkeypatch.setitem(registry.MODEL_CLASSES, "gms", GMSModel)
     monkeypatch.setitem(registry.MODEL_CLASSES, "gmssvr", GMSSVRModel)

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..discover.effects import EFFECT_NAMES
 from ..atomic import check_output_path
+from ..discover.effects import EFFECT_NAMES
 from ..discover.report import REPORT_FILES, write_json, write_report
 from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError

@@ -11,8 +11,8 @@ import numpy as np
 
 from ..errors import GreyboxError
 from ._options import add_log_arguments
-from ._window import add_window_argument, check_window
 from ._types import non_negative, positive
+from ._window import add_window_argument, check_window
 
 #: Output extensions accepted for the table and for the picture.
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")

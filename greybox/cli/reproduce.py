@@ -37,7 +37,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--out", required=True, metavar="DIR", help="report directory (new or empty)")
     parser.add_argument("--axis", nargs="+", default=["X", "Y"], metavar="AXIS", help="axes to run (default: X Y)")
     parser.add_argument("--data", metavar="DIR",
-                        help="directory of the <axis>_<dataset>.mcap logs (default: ./data, else the source tree's data/)")
+                        help="directory of the <axis>_<dataset>.mcap logs "
+                        "(default: ./data, else the source tree's data/)")
     parser.add_argument("--quick", action="store_true",
                         help="smoke run: first 30 s of every log, small optimisation budgets")
     parser.add_argument("--jobs", type=POSITIVE_INT, default=2, metavar="N",

@@ -16,6 +16,7 @@ from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model
 from ._options import add_log_arguments, read_logs
 
+
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "train",

@@ -30,8 +30,8 @@ import numpy as np
 
 from ..atomic import write_text_atomic
 from ..errors import GreyboxError
-from ..provenance import provenance, provenance_line
 from ..evaluate.plots import finish_figure, import_pyplot
+from ..provenance import provenance, provenance_line
 from .loop import LoopResult
 
 __all__ = ["REPORT_FILES", "report_paths", "comparison_rows", "format_tables", "plot_tracking_errors",

@@ -52,7 +52,8 @@ def _preamble(path) -> tuple[int, dict, str]:
                     try:
                         metadata = json.loads(line[len(_METADATA_TAG):])
                     except json.JSONDecodeError as exc:
-                        raise LogError(path, f"line {comments + 1}: greybox metadata is not valid JSON ({exc.msg})") from None
+                        raise LogError(path, f"line {comments + 1}: greybox metadata is not valid JSON "
+                                             f"({exc.msg})") from None
                 comments += 1
     except UnicodeDecodeError as exc:
         raise LogError(path, f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None

@@ -54,7 +54,8 @@ def read_emps(path) -> AxisLog:
     missing = [name for name in EMPS_VARIABLES if name not in variables]
     if missing:
         found = sorted(name for name in variables if not name.startswith("__"))
-        raise LogError(path, f"missing EMPS variable(s) {', '.join(missing)}; the file holds {', '.join(found) or 'none'}")
+        raise LogError(path, f"missing EMPS variable(s) {', '.join(missing)}; "
+                             f"the file holds {', '.join(found) or 'none'}")
 
     def series(name):
         values = np.asarray(variables[name], dtype=np.float64)

@@ -83,7 +83,8 @@ def _check_encodable(log: AxisLog, path) -> None:
     for name, values in [("time_s", log.time)] + _sample_fields(log):
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
-            raise LogError(path, f"channel '{name}' holds {values[bad[0]]} at sample {bad[0]}; JSON messages carry finite numbers only")
+            raise LogError(path, f"channel '{name}' holds {values[bad[0]]} at sample {bad[0]}; "
+                                 "JSON messages carry finite numbers only")
     if len(log) and log.time.min() < 0:
         raise LogError(path, f"time reaches {log.time.min()} s; MCAP time stamps must be non-negative")
 
@@ -335,7 +336,8 @@ class _MessageCollector:
         except Exception as exc:  # pyarrow.ArrowInvalid and friends
             raise LogError(self.path, f"messages are not valid JSON objects ({str(exc).splitlines()[0]})") from None
         if table.num_rows != rows:
-            raise LogError(self.path, f"{rows} messages gave {table.num_rows} JSON objects; each message must hold one object")
+            raise LogError(self.path, f"{rows} messages gave {table.num_rows} JSON objects; "
+                                      "each message must hold one object")
         self.batches.append((rows, {name: _as_array(table.column(name)) for name in table.column_names}))
 
     def columns(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -348,9 +350,11 @@ class _MessageCollector:
         for name in names:
             parts = [batch.pop(name, None) for _, batch in self.batches]
             if all(part is None or part.dtype == np.float64 for part in parts):
-                parts = [np.full(rows, np.nan) if part is None else part for (rows, _), part in zip(self.batches, parts)]
+                parts = [np.full(rows, np.nan) if part is None else part
+                         for (rows, _), part in zip(self.batches, parts)]
             else:
-                parts = [np.full(rows, None, object) if part is None else part.astype(object) for (rows, _), part in zip(self.batches, parts)]
+                parts = [np.full(rows, None, object) if part is None else part.astype(object)
+                         for (rows, _), part in zip(self.batches, parts)]
             table[name] = np.concatenate(parts)
             del parts
         self.batches = []
@@ -398,7 +402,8 @@ def _walk(data: bytes, path) -> Iterable[tuple[np.ndarray, np.ndarray, np.ndarra
     if len(data) < 2 * len(_MAGIC) or data[: len(_MAGIC)] != _MAGIC:
         raise LogError(path, "not an MCAP file (the file does not start with the MCAP magic bytes)")
     if data[-len(_MAGIC):] != _MAGIC:
-        raise LogError(path, "truncated MCAP file: it does not end with the MCAP magic bytes (was the logger stopped before closing it?)")
+        raise LogError(path, "truncated MCAP file: it does not end with the MCAP magic bytes "
+                             "(was the logger stopped before closing it?)")
     buf = np.frombuffer(data, np.uint8)
     stop = len(data) - len(_MAGIC)
     opcodes, offsets, lengths, end = scan_records(buf, len(_MAGIC), stop)

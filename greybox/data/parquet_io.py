@@ -62,7 +62,8 @@ def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time:
     arrays = {}
     for name in table.column_names:
         column = table.column(name)
-        numeric = pa.types.is_integer(column.type) or pa.types.is_floating(column.type) or pa.types.is_boolean(column.type)
+        kind = column.type
+        numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
         arrays[name] = column.to_numpy() if numeric else column.to_numpy(zero_copy_only=False).astype(object)
     return log_from_columns(arrays, source=path, columns=columns, sample_time=sample_time, **metadata_fields(metadata))
 

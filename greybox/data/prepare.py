@@ -87,7 +87,8 @@ def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4) -> A
     nyquist = 0.5 / sample_time
     cutoff = default_cutoff(sample_time) if cutoff_hz is None else float(cutoff_hz)
     if not 0.0 < cutoff < nyquist:
-        raise LogError(source, f"filter cut-off {cutoff:g} Hz must lie between 0 and the Nyquist frequency {nyquist:g} Hz")
+        raise LogError(source, f"filter cut-off {cutoff:g} Hz must lie between 0 and the Nyquist frequency "
+                               f"{nyquist:g} Hz")
     if int(order) != order or order < 1:
         raise ValueError(f"filter order must be a positive integer, got {order!r}")
     sos = butter(int(order), cutoff, fs=1.0 / sample_time, output="sos")
@@ -133,7 +134,8 @@ def resample(log: AxisLog, sample_time: float) -> AxisLog:
     bad = np.flatnonzero(~(np.diff(log.time) > 0))
     if bad.size:
         k = int(bad[0]) + 1
-        raise LogError(source, f"time is not strictly increasing at sample {k} (t = {log.time[k]:.9g} s); cannot resample")
+        raise LogError(source, f"time is not strictly increasing at sample {k} (t = {log.time[k]:.9g} s); "
+                               "cannot resample")
     count = int(np.floor((log.time[-1] - log.time[0]) / sample_time * (1 + 1e-12))) + 1
     grid = log.time[0] + np.arange(count) * sample_time
 

@@ -154,7 +154,8 @@ def resolve_columns(
         if quantity in found:
             raise LogError(source, f"columns: quantity '{quantity}' is mapped twice")
         if column not in present:
-            raise LogError(source, f"column '{column}' (mapped to {key}) not found; columns in the file: {_listing(names)}")
+            raise LogError(source, f"column '{column}' (mapped to {key}) not found; "
+                                   f"columns in the file: {_listing(names)}")
         found[quantity] = (column, _unit_factor(quantity, unit, key, source))
 
     candidates: dict[str, list[tuple[str, str | None]]] = {}
@@ -169,7 +170,8 @@ def resolve_columns(
             listed = ", ".join(f"'{name}'" for name, _ in hits)
             raise LogError(
                 source,
-                f"several {quantity} columns ({listed}); choose one with columns={{'{CANONICAL_NAMES[quantity]}': ...}}",
+                f"several {quantity} columns ({listed}); "
+                f"choose one with columns={{'{CANONICAL_NAMES[quantity]}': ...}}",
             )
         name, unit = hits[0]
         found[quantity] = (name, _unit_factor(quantity, unit, name, source))
@@ -277,7 +279,8 @@ def log_from_columns(
 
     if time is not None:
         if sample_time is not None:
-            raise LogError(source, "this format carries its own time stamps; sample_time applies only to files without a time column")
+            raise LogError(source, "this format carries its own time stamps; "
+                                   "sample_time applies only to files without a time column")
         time_s = np.asarray(time, dtype=np.float64)
     elif "time" in found:
         if sample_time is not None:

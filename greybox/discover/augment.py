@@ -248,7 +248,7 @@ class AugmentedModel(CurrentModel):
             to_shape = (lambda s: 1.0 / s) if frequency else np.exp
             bounds = (1.0 / high, 1.0 / low) if frequency else (np.log(low), np.log(high))
 
-            def cost(s, i=i):
+            def cost(s, i=i, to_shape=to_shape):
                 trial = shapes[:i] + [float(to_shape(s))] + shapes[i + 1:]
                 return self._solve(runs, context, terms, trial, part, target)[1]
 

@@ -53,8 +53,8 @@ import numpy as np
 import scipy.sparse
 from threadpoolctl import threadpool_limits
 
-from ..data.log import AxisLog
 from ..base import LinearPart
+from ..data.log import AxisLog
 from .effects import PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
 from .locate import structure_basis
 from .noise import ResidualNoise

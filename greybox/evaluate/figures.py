@@ -230,7 +230,7 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
                                 sharex=True, sharey=True, layout="constrained")
     for ax, (model, prediction) in zip(axes.ravel(), predictions.items()):
         residual = measured - np.concatenate(split_runs(runs, prediction))
-        for label, mask, color, _ in directions:
+        for _, mask, color, _ in directions:
             index = np.flatnonzero(mask)
             shown = index[:: max(1, index.size // max_points)]
             ax.plot(position[shown], residual[shown], ".", ms=1, color=color, alpha=0.3)

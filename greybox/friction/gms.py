@@ -497,7 +497,8 @@ class GMSModel(CurrentModel):
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:
         """Columns ``z_1..z_N, w, v, a (, 1)`` at the fitted element shape (``w = sum_i alpha_i dz_i/dt``)."""
-        z, _, w, _, _ = gms_trajectory(run.velocity, run.sample_time, alpha=self.alpha_, C=self.slip_rate_, s_0=self.s_0_,
+        z, _, w, _, _ = gms_trajectory(run.velocity, run.sample_time, alpha=self.alpha_, C=self.slip_rate_,
+                                       s_0=self.s_0_,
                                        s_inf=self.s_inf_, v_s=self.v_s_)
         n = z.shape[1]
         columns = list(z.T) + [w, run.velocity, run.acceleration]
@@ -509,7 +510,8 @@ class GMSModel(CurrentModel):
 
     def linear_coefficients(self) -> np.ndarray:
         """``k_1..k_N, sigma, mu, J (, offset)``."""
-        return np.concatenate((self.k_, [self.sigma_, self.viscous_, self.J_], [self.offset_] if self.fit_offset else []))
+        return np.concatenate((self.k_, [self.sigma_, self.viscous_, self.J_],
+                               [self.offset_] if self.fit_offset else []))
 
     def set_linear_coefficients(self, values) -> None:
         """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model."""

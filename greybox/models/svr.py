@@ -33,7 +33,6 @@ from dataclasses import dataclass, field
 from typing import Callable, Collection, Mapping, Sequence
 
 import numpy as np
-
 from sklearn.utils.validation import check_is_fitted
 
 from ..base import EFFORT, Parameter

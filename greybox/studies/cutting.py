@@ -51,7 +51,6 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text_atomic
-from ..provenance import provenance, provenance_line
 from ..data.axis_config import read_axis_config
 from ..data.io import read_log
 from ..data.prepare import prepare
@@ -61,6 +60,7 @@ from ..evaluate.process import force_constant_N_per_A, predict_process
 from ..evaluate.report import MODEL_LABELS as LABELS
 from ..metrics import rmse
 from ..models.chunked import predict_chunked
+from ..provenance import provenance, provenance_line
 from ..registry import MODEL_CLASSES
 from ..twin import make_dataset
 from ..twin.cutting import CuttingSpec

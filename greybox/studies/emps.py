@@ -47,7 +47,6 @@ import numpy as np
 from scipy.signal import decimate
 
 from ..atomic import write_text_atomic
-from ..provenance import provenance, provenance_line
 from ..data.io import read_log
 from ..data.log import AxisLog
 from ..data.prepare import derive, trim
@@ -55,6 +54,7 @@ from ..errors import GreyboxError
 from ..evaluate.plots import import_pyplot, save_figure
 from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from ..metrics import relerr
+from ..provenance import provenance, provenance_line
 
 __all__ = ["TRAIN_FILE", "TEST_FILE", "PUBLISHED", "GREYBOX_MODELS", "IDIM_LS_MODELS", "MODEL_NAMES",
            "benchmark_log", "decimate_benchmark", "benchmark_relerr", "idim_ls", "learned_parameters",
