@@ -292,6 +292,19 @@ class CurrentModel(ModelProtocol):
                 raise
             raise ParameterError(f"a learned attribute is malformed: {error}") from None
 
+    def fit_summary(self) -> dict:
+        """Figures of the fit itself rather than of the model: data fitted on and what the search reports.
+
+        Returns
+        -------
+        dict
+            ``n_samples``, ``sample_time_s`` and the model's own fit statistics
+            (e.g. ``cost`` = NMSE / 100 of a least-squares search, ``cv_rmse``
+            of a hyperparameter search), names ending in their unit where they have one.
+        """
+        check_is_fitted(self)
+        return {"n_samples": self.n_samples_fit_, "sample_time_s": self.sample_time_, **self._fit_statistics()}
+
     # ---------------------------------------------------------------- shared parts
     def _effort(self, run: AxisLog, state, sample_time: float):
         friction, end = self._simulate(run, state, sample_time)
@@ -332,6 +345,9 @@ class CurrentModel(ModelProtocol):
 
     def _own_parameters(self) -> list[Parameter]:
         raise NotImplementedError
+
+    def _fit_statistics(self) -> dict:
+        return {}
 
 
 def _probe_run(sample_time: float, effort_unit: str) -> AxisLog:

@@ -215,3 +215,12 @@ def test_staged_fit_on_the_same_runs_is_the_fit(case, fitted, train_runs, unseen
     if stage is None:
         with pytest.raises(GreyboxError, match="one stage"):
             CASES[case]().fit_staged(train_runs[:1], train_runs[1:])
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_fit_summary_reports_the_data_and_the_search(case, fitted, train_runs):
+    summary = fitted[case].fit_summary()
+    assert summary["n_samples"] == sum(len(run) for run in train_runs)
+    assert summary["sample_time_s"] == pytest.approx(0.002)
+    if hasattr(fitted[case], "cv_rmse_"):
+        assert "optimised" in summary and "cv_rmse_A" in summary

@@ -101,6 +101,9 @@ def run(args: argparse.Namespace) -> int:
     print("parameters:")
     for line in describe_parameters(model):
         print(line)
+    print("fit:")
+    for name, value in model.fit_summary().items():
+        print(f"  {name:<18} = {_format_value(value)}")
     save_model(model, out, overwrite=args.force)
     reloaded = load_model(out)
     if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):

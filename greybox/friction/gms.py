@@ -425,6 +425,9 @@ class GMSModel(CurrentModel):
     def _n_params(self) -> int:
         return 2 * len(self.alpha_) + 6 + int(self.fit_offset)
 
+    def _fit_statistics(self) -> dict:
+        return {"cost": self.cost_, "n_evaluations": self.n_evaluations_}
+
     def _own_parameters(self) -> list[Parameter]:
         return [
             Parameter("alpha", self.alpha_, "-", "element fractions (sum 1)"),

@@ -213,6 +213,9 @@ class LuGreModel(CurrentModel):
     def _n_params(self) -> int:
         return 7 + int(self.fit_offset)
 
+    def _fit_statistics(self) -> dict:
+        return {"cost": self.cost_}
+
     def _own_parameters(self) -> list[Parameter]:
         return [
             Parameter("sigma0", self.sigma0_, f"{EFFORT}/mm", "bristle stiffness"),

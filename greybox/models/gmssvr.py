@@ -306,6 +306,10 @@ class GMSSVRModel(KernelRegressionModel):
     def _n_params(self) -> int:
         return int(self.dual_coef_.size) + 1 + self.gms_.n_params
 
+    def _fit_statistics(self) -> dict:
+        stage = {f"gms.{name}": value for name, value in self.gms_.fit_summary().items()}
+        return {**stage, **super()._fit_statistics()}
+
     def _own_parameters(self) -> list[Parameter]:
         stage = [Parameter(f"gms.{p.name}", p.value, p.unit, f"GMS stage: {p.description}")
                  for p in self.gms_.parameter_table() if p.name not in ("J", "offset")]

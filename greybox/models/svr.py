@@ -428,6 +428,11 @@ class KernelRegressionModel(CurrentModel):
             Parameter("intercept", self.intercept_, EFFORT, "SVR intercept"),
         ]
 
+    def _fit_statistics(self) -> dict:
+        unit = self.effort_unit_
+        return {"n_train": self.n_train_, "optimised": list(self.optimised_), f"cv_rmse_{unit}": self.cv_rmse_,
+                "at_bounds": list(self.at_bounds_)}
+
     def hyperparameters_table(self) -> dict[str, object]:
         """The SVR settings as in the paper's Table 2.
 
