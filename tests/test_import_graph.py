@@ -15,9 +15,12 @@ rules (DESIGN.md, "Layout"):
 
 An import names a module (``import greybox.twin.plant``, ``from ..twin import
 plant``) or a package's ``__init__`` (``from ..twin import make_dataset``).
-Importing a submodule also runs its parent packages' ``__init__``; that
-implicit step is not an edge here, or every module of a package whose
-``__init__`` imports it would be in a cycle with it.
+Importing a submodule from outside its package also runs the package's
+``__init__`` (and its parents'), so that is an edge too: ``identify.initial``
+importing ``friction.curves`` would run ``friction/__init__``, which imports
+the models, which import ``identify.initial`` — a cycle Python reports only
+at run time. From inside a package its own ``__init__`` is not an edge (it is
+already running or done).
 """
 
 from __future__ import annotations
@@ -95,8 +98,19 @@ def imports_of(module: str, path: Path, modules) -> list[tuple[str, int]]:
             targets = [_known(f"{stem}.{alias.name}", modules) or _known(stem, modules) for alias in node.names]
         else:
             continue
-        found += [(target, node.lineno) for target in targets if target is not None and target != module]
+        for target in targets:
+            if target is None or target == module:
+                continue
+            found.append((target, node.lineno))
+            found += [(package, node.lineno) for package in _parent_packages(target, modules)
+                      if not _within(module, package)]
     return sorted(set(found), key=lambda item: (item[1], item[0]))
+
+
+def _parent_packages(module: str, modules) -> list[str]:
+    """The packages of the package that contain ``module`` (the top package excluded: everything is inside it)."""
+    parts = module.split(".")
+    return [name for name in (".".join(parts[:end]) for end in range(2, len(parts))) if name in modules]
 
 
 def import_graph(package_dir: Path = PACKAGE_DIR) -> dict[str, dict[str, int]]:
@@ -258,3 +272,16 @@ def test_a_package_importing_its_own_modules_is_no_cycle(tmp_path):
         "pkg/b.py": "from .a import f\n\ndef g():\n    return f()\n",
     })
     assert cycles(import_graph(package)) == []
+
+
+def test_a_submodule_import_from_outside_runs_its_package_init(tmp_path):
+    """``b.x`` importing ``a.leaf`` runs ``a/__init__``, which imports ``a.model``, which imports ``b.x``."""
+    root = tmp_path / "pkg"
+    for folder in (root, root / "a", root / "b"):
+        folder.mkdir()
+        (folder / "__init__.py").write_text("")
+    (root / "a" / "__init__.py").write_text("from .model import Model\n")
+    (root / "a" / "model.py").write_text("from ..b.x import helper\n")
+    (root / "a" / "leaf.py").write_text("")
+    (root / "b" / "x.py").write_text("from ..a.leaf import *\n")
+    assert any("pkg.a" in line and "pkg.b.x" in line for line in cycles(import_graph(root)))
