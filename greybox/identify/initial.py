@@ -16,6 +16,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..curves import stribeck_curve
 from ..data.log import AxisLog
 from ..errors import LogError
 from .static import fit_stribeck
@@ -168,7 +169,7 @@ def presliding_deflection(runs: Sequence[AxisLog], static: dict[str, float], *, 
     for run in runs:
         v = run.velocity
         friction = run.effort - static["J"] * run.acceleration - static["offset"] - static["viscous"] * v
-        level = static["coulomb"] + (static["static"] - static["coulomb"]) * np.exp(-np.abs(v) / static["v_s"])
+        level = stribeck_curve(v, static["static"], static["coulomb"], static["v_s"])
         direction = motion_direction(v)
         distance = distance_since_reversal(run.time, v)
         starts = np.flatnonzero((direction[1:] != direction[:-1]) & (direction[1:] != 0)
