@@ -330,6 +330,13 @@ class CurrentModel(ModelProtocol):
                                f"log carries effort in {run.effort_unit}, the model was fitted on {self.effort_unit_}")
         return runs
 
+    def _check_flags(self, *names: str) -> None:
+        """Raise :class:`ParameterError` unless each named hyperparameter is a bool (``"False"`` is not one)."""
+        for name in names:
+            value = getattr(self, name)
+            if not isinstance(value, (bool, np.bool_)):
+                raise ParameterError(f"{name} must be True or False, got {value!r}")
+
     # ---------------------------------------------------------------- hooks
     def _check_params(self) -> None:
         return None

@@ -304,7 +304,8 @@ def load_model(path: str | PathLike):
                     f"up to {FORMAT_VERSION}: upgrade greybox"
                 )
             model = _Decoder(path, archive, version).estimator(document.get("model"), "model")
-    except (zipfile.BadZipFile, zlib.error, EOFError) as error:
+    except (zipfile.BadZipFile, zlib.error, EOFError, RuntimeError, NotImplementedError) as error:
+        # a flipped bit in a ZIP header may also read as "encrypted" or "unsupported compression"
         if zipfile.is_zipfile(path):
             raise ModelFileError(f"{path}: damaged model file (a ZIP archive whose content does not check out: "
                                  f"{error})") from None

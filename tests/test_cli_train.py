@@ -119,8 +119,12 @@ def test_training_log_is_never_overwritten(tmp_path, capsys):
     [
         (["--model", "gms", "--asymmetric"], "--asymmetric does not apply to the gms model"),
         (["--model", "coulomb", "--elements", "3"], "--elements does not apply to the coulomb model"),
-        (["--model", "lugre", "--set", "colour=red"], "has no hyperparameter 'colour'"),
+        (["--model", "lugre", "--set", "colour=red"], "--set colour=...: the lugre model has no such hyperparameter"),
         (["--model", "lugre", "--set", "n_starts"], "NAME=VALUE"),
+        (["--model", "gmssvr", "--set", "optimize=maybe"], "optimize must be True or False"),
+        (["--model", "gmssvr", "--set", 'bounds={"C": [1, 0]}'], "must satisfy 0 < low < high < inf"),
+        (["--model", "svr", "--set", "bounds=garbage"], "bounds must map hyperparameter names"),
+        (["--model", "coulomb", "--set", "fit_offset=yes"], "must be True or False, got 'yes'"),
     ],
 )
 def test_options_foreign_to_the_model_are_refused(tmp_path, capsys, arguments, message):
@@ -129,6 +133,13 @@ def test_options_foreign_to_the_model_are_refused(tmp_path, capsys, arguments, m
     status, _, stderr = _train(capsys, *arguments, "--train", log_path, "--out", tmp_path / "m.gbm")
     assert status == 2 and message in stderr
     assert not (tmp_path / "m.gbm").exists()
+
+
+@pytest.mark.parametrize("spelling", ["False", "false", "FALSE"])
+def test_set_takes_python_and_json_spellings_of_false(spelling):
+    from greybox.cli._build import parse_setting
+
+    assert parse_setting(spelling) is False and parse_setting("None") is None and parse_setting("2.5") == 2.5
 
 
 def test_bad_logs_are_named(tmp_path, capsys):

@@ -355,3 +355,21 @@ def test_format_1_files_are_read_with_the_old_attribute_names(tmp_path, gms_file
     assert (old.slip_rate_, old.viscous_, old.s_0_) == (reference.slip_rate_, reference.viscous_, reference.s_0_)
     run = _axis_run(3)
     np.testing.assert_array_equal(old.predict(run), reference.predict(run))
+
+
+def test_every_single_flipped_byte_is_one_model_file_error(tmp_path, gms_file):
+    """Whichever byte is damaged, loading ends in a ModelFileError (never another exception)."""
+    original = gms_file.read_bytes()
+    path = tmp_path / "flip.gbm"
+    failures = []
+    for position in range(len(original)):
+        data = bytearray(original)
+        data[position] ^= 0x10 if position % 2 else 0x01
+        path.write_bytes(bytes(data))
+        try:
+            load_model(path)
+        except ModelFileError:
+            pass
+        except Exception as error:  # noqa: BLE001 - the test looks for any other exception
+            failures.append(f"byte {position}: {type(error).__name__}: {error}")
+    assert not failures, "\n".join(failures[:5])

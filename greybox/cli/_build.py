@@ -9,7 +9,11 @@ from ..errors import GreyboxError
 from ..registry import model_class
 from ._types import POSITIVE_INT, SEED
 
-__all__ = ["add_model_arguments", "build_model"]
+__all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting"]
+
+
+class CommandLineError(GreyboxError):
+    """An error the command line words itself (its message names options already and is printed as is)."""
 
 #: Options that set a model hyperparameter: (option, attribute of the parsed arguments, hyperparameter).
 _MODEL_OPTIONS = (
@@ -72,12 +76,26 @@ def build_model(kind: str, args: argparse.Namespace):
         name, sep, text = setting.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise GreyboxError(f"--set expects NAME=VALUE, got {setting!r}")
+            raise CommandLineError(f"--set expects NAME=VALUE, got {setting!r}")
         if name not in accepted:
-            raise GreyboxError(f"the {kind} model has no hyperparameter {name!r} (--set); it has: "
-                               f"{', '.join(sorted(accepted))}")
-        try:
-            params[name] = json.loads(text)
-        except json.JSONDecodeError:
-            params[name] = text
+            offered = {hyperparameter: option for option, _, hyperparameter in _MODEL_OPTIONS}
+            takes = ", ".join(offered.get(other, f"--set {other}=...") for other in sorted(accepted))
+            raise CommandLineError(f"--set {name}=...: the {kind} model has no such hyperparameter; it takes {takes}")
+        params[name] = parse_setting(text)
     return model.set_params(**params)
+
+
+#: Python's and JSON's spellings of the constants a ``--set`` value may be.
+_CONSTANTS = {"true": True, "false": False, "null": None, "none": None}
+
+
+def parse_setting(text: str):
+    """The value of ``--set NAME=VALUE``: a JSON value; ``true``/``false``/``null`` in any case
+    (``False`` and ``None`` too); anything else as text (the model's checks refuse a wrong type)."""
+    stripped = text.strip()
+    if stripped.lower() in _CONSTANTS:
+        return _CONSTANTS[stripped.lower()]
+    try:
+        return json.loads(stripped)
+    except json.JSONDecodeError:
+        return text

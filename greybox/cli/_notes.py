@@ -22,7 +22,7 @@ import warnings
 from typing import Iterator
 
 from ..errors import ParameterError
-from ._build import _MODEL_OPTIONS
+from ._build import _MODEL_OPTIONS, CommandLineError
 
 __all__ = ["OPTION_OF", "command_notes", "error_message", "option_words"]
 
@@ -135,6 +135,8 @@ def _one_line(text: str) -> str:
 
 def error_message(error: BaseException, args: argparse.Namespace) -> str:
     """The text of a user-facing error of a command, hyperparameters spelt as options, on one line."""
+    if isinstance(error, CommandLineError):
+        return _one_line(error)
     return option_words(_one_line(error), parameters=isinstance(error, ParameterError),
                         settable=hasattr(args, "set"))
 

@@ -133,6 +133,7 @@ class AugmentedModel(CurrentModel):
 
     # ---------------------------------------------------------------- fitting
     def _check_params(self) -> None:
+        self._check_flags("refine_shapes", "refit_base")
         if self.base is not None and (not isinstance(self.base, CurrentModel) or isinstance(self.base, AugmentedModel)):
             raise ParameterError(f"base must be a current model other than AugmentedModel, "
                                  f"got {type(self.base).__name__}")

@@ -71,6 +71,7 @@ class CoulombModel(CurrentModel):
         self.min_speed = min_speed
 
     def _check_params(self) -> None:
+        self._check_flags("asymmetric", "fit_offset")
         if self.asymmetric and self.fit_offset:
             raise ParameterError("an offset and direction-dependent Coulomb levels are not separately "
                                  "identifiable: choose asymmetric or fit_offset, not both")

@@ -362,6 +362,7 @@ class GMSModel(CurrentModel):
         n = self.n_elements
         if not (isinstance(n, (int, np.integer)) and not isinstance(n, bool) and n >= 1):
             raise ParameterError(f"n_elements must be a positive integer, got {n!r}")
+        self._check_flags("fit_offset", "staged")
         check_search_settings(self)
 
     def _fit_runs(self, runs, progress) -> None:

@@ -174,6 +174,7 @@ class LuGreModel(CurrentModel):
         self.max_iter = max_iter
 
     def _check_params(self) -> None:
+        self._check_flags("fit_offset")
         check_search_settings(self)
 
     def _fit_runs(self, runs, progress) -> None:

@@ -55,6 +55,7 @@ class StribeckModel(CurrentModel):
         self.min_speed = min_speed
 
     def _check_params(self) -> None:
+        self._check_flags("fit_offset")
         if not (np.isfinite(self.min_speed) and self.min_speed >= 0.0):
             raise ParameterError(f"min_speed must be a non-negative speed, got {self.min_speed} mm/s")
 

@@ -302,6 +302,23 @@ def fit_svr_expansion(
     )
 
 
+def _check_bounds(bounds) -> None:
+    """Raise :class:`ParameterError` unless ``bounds`` is None or ``{name: (low, high)}`` with 0 < low < high < inf."""
+    if bounds is None:
+        return
+    if not isinstance(bounds, Mapping):
+        raise ParameterError(f"bounds must map hyperparameter names to (low, high), got {bounds!r}")
+    for name, interval in bounds.items():
+        if name not in HYPERPARAMETERS:
+            raise ParameterError(f"bounds name an unknown SVR hyperparameter {name!r}; expected {HYPERPARAMETERS}")
+        try:
+            low, high = (float(value) for value in interval)
+        except (TypeError, ValueError):
+            raise ParameterError(f"bounds of {name!r} must be two numbers (low, high), got {interval!r}") from None
+        if not (0.0 < low < high < np.inf):
+            raise ParameterError(f"bounds of {name!r} must satisfy 0 < low < high < inf, got {interval!r}")
+
+
 def _near_bound(value: float, interval: tuple[float, float], fraction: float = 0.01, end: str = "either") -> bool:
     """True if ``value`` lies within ``fraction`` of the log-width of ``interval`` from an end.
 
@@ -381,6 +398,8 @@ class KernelRegressionModel(CurrentModel):
             if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= least):
                 raise ParameterError(f"{name} must be an integer of at least {least}, got {value!r}")
         check_seed(self.random_state)
+        self._check_flags("optimize")
+        _check_bounds(self.bounds)
 
     def _fit_kernel(self, X, y, coverage, run_lengths: Sequence[int],
                     progress: Callable[[ProgressEvent], None] | None, *, stage: str = "SVR hyperparameters",
