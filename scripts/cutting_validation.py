@@ -45,6 +45,7 @@ def main(argv=None) -> int:
     parser.add_argument("--json", type=Path, help="write all figures here")
     parser.add_argument("--plot-dir", type=Path, help="write the correlation figure and one picture per model and "
                         "test log (at the detailed strength) here")
+    parser.add_argument("--force", action="store_true", help="overwrite existing outputs")
     args = parser.parse_args(argv)
 
     kinds = list(dict.fromkeys(args.model))
@@ -52,7 +53,8 @@ def main(argv=None) -> int:
         result = cutting_validation(args.data, args.axis_config, seed=args.seed, kinds=kinds,
                                     strengths=tuple(args.strengths), strength=args.strength, target=args.target,
                                     chunk_s=args.chunk_s, markdown_path=args.markdown, json_path=args.json,
-                                    plot_dir=args.plot_dir, progress=lambda line: print(line, flush=True))
+                                    plot_dir=args.plot_dir, progress=lambda line: print(line, flush=True),
+                                    force=args.force)
     except GreyboxError as error:
         parser.error(str(error))
     print()

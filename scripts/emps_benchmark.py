@@ -12,14 +12,17 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
 from greybox.errors import GreyboxError
 from greybox.studies.emps import MODEL_NAMES, TEST_FILE, TRAIN_FILE, emps_benchmark
 
-#: Default data folder: ``../shared/data/real/EMPS`` relative to the repository.
-DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real" / "EMPS"
+#: Default data folder: ``$GREYBOX_REAL_DATA/EMPS``, else ``../shared/data/real/EMPS`` beside the repository
+#: (as the tests look for it).
+DEFAULT_DATA = Path(os.environ.get("GREYBOX_REAL_DATA")
+                    or Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real") / "EMPS"
 
 
 def main(argv=None) -> int:
@@ -31,12 +34,14 @@ def main(argv=None) -> int:
                         help=f"folder with {TRAIN_FILE} and {TEST_FILE} (default: %(default)s)")
     parser.add_argument("--models", nargs="+", choices=MODEL_NAMES, default=list(MODEL_NAMES), metavar="NAME",
                         help=f"models to run (default: all of {', '.join(MODEL_NAMES)})")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the multi-start identifications")
+    parser.add_argument("--model-seed", type=int, default=0, help="seed of the multi-start identifications")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
+    parser.add_argument("--force", action="store_true", help="overwrite existing output files")
     args = parser.parse_args(argv)
     try:
         table = emps_benchmark(args.data, args.json, markdown_path=args.markdown, plot_path=args.plot,
-                               names=args.models, seed=args.seed, progress=None if args.quiet else True)
+                               names=args.models, seed=args.model_seed, progress=None if args.quiet else True,
+                               force=args.force)
     except GreyboxError as error:
         print(f"emps_benchmark: error: {error}", file=sys.stderr)
         return 2

@@ -81,3 +81,17 @@ def test_the_script_runs_as_a_user_runs_it(tmp_path):
                               "--strength", "1"], capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert refused.returncode == 2 and "not one of the swept strengths" in refused.stderr
     assert "Traceback" not in refused.stderr
+
+
+def test_existing_outputs_are_kept_without_force(tmp_path):
+    existing = tmp_path / "v.md"
+    existing.write_text("mine")
+    with pytest.raises(GreyboxError, match="exists"):
+        cutting_validation(DATA, AXIS_CONFIG, kinds=("coulomb",), strengths=(0.5,), strength=0.5,
+                           markdown_path=existing)
+    (tmp_path / "figures").mkdir()
+    (tmp_path / "figures" / "mine.png").write_bytes(b"x")
+    with pytest.raises(GreyboxError, match="not empty"):
+        cutting_validation(DATA, AXIS_CONFIG, kinds=("coulomb",), strengths=(0.5,), strength=0.5,
+                           plot_dir=tmp_path / "figures")
+    assert existing.read_text() == "mine"

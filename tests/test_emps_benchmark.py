@@ -10,6 +10,7 @@ on relerr.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -117,3 +118,24 @@ def test_missing_data_folder_is_reported(tmp_path):
     assert result.returncode == 2
     assert "nowhere" in result.stderr and "Traceback" not in result.stderr
     assert not (tmp_path / "x.json").exists()
+
+
+def test_outputs_never_replace_the_data_nor_an_existing_file_without_force(tmp_path):
+    data = tmp_path / "EMPS"
+    data.mkdir()
+    for name in (bench.TRAIN_FILE, bench.TEST_FILE):
+        (data / name).write_bytes(b"not the real data")  # never read: the refusal comes first
+    with pytest.raises(GreyboxError, match="EMPS data files"):
+        bench.emps_benchmark(data, data / bench.TRAIN_FILE, force=True)
+    existing = tmp_path / "emps.json"
+    existing.write_text("{}")
+    with pytest.raises(GreyboxError, match="exists"):
+        bench.emps_benchmark(data, existing)
+    assert (data / bench.TRAIN_FILE).read_bytes() == b"not the real data" and existing.read_text() == "{}"
+
+
+def test_the_script_finds_the_data_through_greybox_real_data(tmp_path):
+    env = {**os.environ, "GREYBOX_REAL_DATA": str(tmp_path / "elsewhere")}
+    result = subprocess.run([sys.executable, str(SCRIPT), "--json", str(tmp_path / "x.json")], env=env,
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 2 and str(tmp_path / "elsewhere" / "EMPS") in result.stderr

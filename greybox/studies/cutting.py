@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import write_text_atomic
+from ..atomic import check_output_path, write_text_atomic
 from ..data.axis_config import read_axis_config
 from ..data.io import read_log
 from ..data.prepare import prepare
@@ -249,7 +249,7 @@ class CuttingValidation:
 def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, *, seed: int = 7,
                        kinds=KINDS, strengths=DEFAULT_STRENGTHS, strength: float = CuttingSpec().strength_A,
                        target: float = 0.95, chunk_s: float = 60.0, markdown_path=None, json_path=None,
-                       plot_dir=None, progress=None) -> CuttingValidation:
+                       plot_dir=None, progress=None, force: bool = False) -> CuttingValidation:
     """Run the protocol: fit every kind on the air cuts, recover the cut of every log, write the outputs.
 
     Parameters
@@ -277,6 +277,8 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
         model and cutting log at the detailed strength.
     progress : callable, optional
         Receives one line of text at the start and per model and log.
+    force : bool, default False
+        Overwrite existing output files and write into a non-empty ``plot_dir``.
 
     Returns
     -------
@@ -285,8 +287,9 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
     Raises
     ------
     GreyboxError
-        If a kind is not registered or ``strength`` is not one of ``strengths``
-        (before any work), or a log cannot be read.
+        If a kind is not registered, ``strength`` is not one of ``strengths``,
+        or an output exists without ``force`` or is an input (before any
+        work), or a log cannot be read.
     """
     say = progress or (lambda line: None)
     strengths = tuple(strengths)
@@ -296,6 +299,12 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
     if not any(np.isclose(strength, s) for s in strengths):
         raise GreyboxError(f"strength {strength:g} is not one of the swept strengths {strengths}")
     data, axis_config = Path(data), Path(axis_config)
+    inputs = [data / name for name in TRAIN_FILES] + [axis_config]
+    for out in (markdown_path, json_path):
+        if out:
+            check_output_path(out, overwrite=force, protect=inputs, inputs_name="one of the inputs")
+    if plot_dir and Path(plot_dir).is_dir() and any(Path(plot_dir).iterdir()) and not force:
+        raise GreyboxError(f"{plot_dir}: directory is not empty; nothing was written (pass --force to write into it)")
     config = read_axis_config(axis_config)
     factor = force_constant_N_per_A(config)
     train = prepare([read_log(data / name) for name in TRAIN_FILES])

@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import decimate
 
-from ..atomic import write_text_atomic
+from ..atomic import check_output_path, write_text_atomic
 from ..data.io import read_log
 from ..data.log import AxisLog
 from ..data.prepare import derive, trim
@@ -361,7 +361,7 @@ def plot_curves(curves: dict, names, path: Path) -> None:
 
 
 def emps_benchmark(data: str | os.PathLike, json_path: str | os.PathLike, *, markdown_path=None, plot_path=None,
-                   names=MODEL_NAMES, seed: int = 0, progress=None) -> str:
+                   names=MODEL_NAMES, seed: int = 0, progress=None, force: bool = False) -> str:
     """Run the protocol and write its files: the JSON results, optionally the Markdown table and the figure.
 
     Parameters
@@ -380,6 +380,8 @@ def emps_benchmark(data: str | os.PathLike, json_path: str | os.PathLike, *, mar
         Seed of the multi-start identifications.
     progress : None, bool or callable, optional
         Progress of every greybox fit (see :meth:`greybox.estimator.CurrentModel.fit`).
+    force : bool, default False
+        Overwrite existing output files (never the data files).
 
     Returns
     -------
@@ -389,12 +391,14 @@ def emps_benchmark(data: str | os.PathLike, json_path: str | os.PathLike, *, mar
     Raises
     ------
     GreyboxError
-        If the directory of an output file or a data file does not exist;
-        nothing is written then.
+        If the directory of an output file or a data file does not exist, an
+        output is one of the data files, or an output exists and ``force`` is
+        false; nothing is written then.
     """
+    inputs = [Path(data) / TRAIN_FILE, Path(data) / TEST_FILE]
     for out in (json_path, markdown_path, plot_path):
-        if out is not None and not Path(out).resolve().parent.is_dir():
-            raise GreyboxError(f"{out}: directory {Path(out).resolve().parent} does not exist")
+        if out is not None:
+            check_output_path(out, overwrite=force, protect=inputs, inputs_name="one of the EMPS data files")
     results, curves = run_benchmark(Path(data), names, seed, progress=progress)
     machine = provenance()
     write_text_atomic(json_path, json.dumps({**results, "provenance": machine}, indent=2) + "\n")
