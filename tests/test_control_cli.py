@@ -86,7 +86,8 @@ def test_model_plant_and_a_log_reference(tmp_path, model_files, capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--plant", "twin-Z", "--model", "coulomb"], "not a model file"),
+    (["--plant", "twin-Z", "--model", "coulomb"], "no such twin; the twin plants are twin-X, twin-Y"),
+    (["--plant", "nope.gbm", "--model", "coulomb"], "nope.gbm: no such model file"),
     (["--plant", "twin-X"], "no feed-forward model"),
     (["--plant", "twin-X", "--model", "magic"], "unknown model kind"),
     (["--plant", "twin-X", "--train", "x.csv"], "--train needs --model"),

@@ -82,6 +82,12 @@ def test_bad_options_are_refused(logs, tmp_path):
         run_cli(["--model", "augmented", "--train", logs[0], "--test", logs[1], "--json", out])
 
 
+def test_a_null_too_small_for_alpha_is_refused_before_any_work(logs, tmp_path):
+    with pytest.raises(GreyboxError, match="--null-replicates 19 or more"):
+        run_cli(["--model", "coulomb", "--train", "missing.csv", "--test", "missing.csv", "--json",
+                 str(tmp_path / "a.json"), "--null-replicates", "9"])
+
+
 def test_effects_option_restricts_the_library(logs, tmp_path):
     out = tmp_path / "a.json"
     run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out), "--quiet",

@@ -99,8 +99,11 @@ def _plant(args):
     key = args.plant.strip().lower()
     if key in TWIN_PLANTS:
         return TwinPlant.for_axis(TWIN_PLANTS[key])
+    if key.startswith("twin-"):
+        raise GreyboxError(f"{args.plant}: no such twin; the twin plants are {', '.join(f'twin-{axis}' for axis in TWIN_PLANTS.values())} (--plant)")
     if not os.path.isfile(args.plant):
-        raise GreyboxError(f"{args.plant}: not a model file; the plant is twin-X, twin-Y or a gms/lugre model file")
+        raise GreyboxError(f"{args.plant}: no such model file; the plant is twin-X, twin-Y or a gms/lugre model "
+                           "file (--plant)")
     model = _load(args.plant)  # its errors name the file already
     try:
         return ModelPlant(model, name=Path(args.plant).stem)
@@ -200,6 +203,9 @@ def _check_output(args) -> None:
     """Refuse before any work when the report must not or cannot be written."""
     from ..control.report import report_paths
 
+    for value in args.reference:
+        if value not in STROKE_REFERENCES and not os.path.isfile(value):
+            raise GreyboxError(f"{value}: no such log; --reference takes low, high or log files")
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise GreyboxError(f"{out}: exists and is not a directory")

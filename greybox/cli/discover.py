@@ -17,7 +17,7 @@ from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
-from ._build import add_model_arguments, build_model
+from ._build import CommandLineError, add_model_arguments, build_model
 from ._options import add_log_arguments, read_logs
 from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED
 
@@ -124,6 +124,10 @@ def _print_summary(result) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if int(args.alpha * (args.null_replicates + 1)) < 1:  # the workflow's own condition, checked before any work
+        least = int(np.ceil(1.0 / args.alpha)) - 1
+        raise CommandLineError(f"--alpha {args.alpha:g} with --null-replicates {args.null_replicates} can never name an "
+                               f"effect: give --null-replicates {least} or more, or a larger --alpha")
     _check_outputs(args)
     names = _candidates(args.effects)
     base = build_model(args.model, args)
