@@ -110,3 +110,16 @@ def test_bare_flag_name_is_the_option_only_in_a_message_about_parameters():
     text = "choose asymmetric or fit_offset, not both"
     assert option_words(text, parameters=True) == "choose --asymmetric or --offset, not both"
     assert option_words(text) == "choose asymmetric or --offset, not both"
+
+
+@pytest.mark.parametrize("content, option", [
+    ("time_s,position_mm,velocity_mm_s\n0,0,0\n0.002,0,0\n0.004,0,0\n", "--columns NAME=COLUMN"),
+    ("time_s,position_mm,current_A\n0,0,0\n0.002,0,0\n0.004,0,0\n", "--sample-time applies"),
+])
+def test_log_errors_name_the_reading_options(tmp_path, capsys, content, option):
+    path = tmp_path / "log.csv"
+    path.write_text(content)
+    extra = ["--sample-time", "0.002"] if "sample-time" in option else []
+    status, _, err = _main(capsys, "info", str(path), *extra)
+    assert status == 2 and option in err
+    assert "columns=" not in err and "sample_time" not in err

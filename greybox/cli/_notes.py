@@ -21,7 +21,7 @@ import sys
 import warnings
 from typing import Iterator
 
-from ..errors import ParameterError
+from ..errors import LogError, ParameterError
 from ._build import _MODEL_OPTIONS, CommandLineError
 
 __all__ = ["OPTION_OF", "command_notes", "error_message", "option_words"]
@@ -133,10 +133,29 @@ def _one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
+#: The log readers' keyword arguments, as the options that set them (``add_log_arguments``).
+_READER_WORDS = (
+    (re.compile(r"columns=\{'(\w+)': '([^']*)'\}"), r"--columns \1=\2"),
+    (re.compile(r"columns=\{'(\w+)': \.\.\.\}"), r"--columns \1=COLUMN"),
+    (re.compile(r"(?<![\w\-])columns=(?![\w{])"), "--columns NAME=COLUMN"),
+    (re.compile(r"(?<![\w\-])sample_time(?![\w=])"), "--sample-time"),
+    (re.compile(r" \(or give the format explicitly\)"), ""),
+)
+
+
+def reader_words(text: str) -> str:
+    """Rewrite the log readers' keyword arguments in ``text`` into their options (``columns=`` -> ``--columns``)."""
+    for pattern, replacement in _READER_WORDS:
+        text = pattern.sub(replacement, text)
+    return text
+
+
 def error_message(error: BaseException, args: argparse.Namespace) -> str:
     """The text of a user-facing error of a command, hyperparameters spelt as options, on one line."""
     if isinstance(error, CommandLineError):
         return _one_line(error)
+    if isinstance(error, LogError):
+        return reader_words(_one_line(error))
     return option_words(_one_line(error), parameters=isinstance(error, ParameterError),
                         settable=hasattr(args, "set"))
 

@@ -111,11 +111,11 @@ def read_log(
         validation (see :func:`greybox.data.validate.check_time`).
     """
     path = os.fspath(path)
-    fmt = format_of(path, fmt)
     if not os.path.exists(path):
         raise LogError(path, "no such file")
     if os.path.isdir(path):
         raise LogError(path, "is a directory, not a log file")
+    fmt = format_of(path, fmt)
     if os.path.getsize(path) == 0:
         raise LogError(path, "empty file (0 bytes)")
     given = {"columns": columns, "topic": topic, "sample_time": sample_time}
