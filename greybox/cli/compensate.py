@@ -100,7 +100,8 @@ def _plant(args):
     if key in TWIN_PLANTS:
         return TwinPlant.for_axis(TWIN_PLANTS[key])
     if key.startswith("twin-"):
-        raise GreyboxError(f"{args.plant}: no such twin; the twin plants are {', '.join(f'twin-{axis}' for axis in TWIN_PLANTS.values())} (--plant)")
+        twins = ", ".join(f"twin-{axis}" for axis in TWIN_PLANTS.values())
+        raise GreyboxError(f"{args.plant}: no such twin; the twin plants are {twins} (--plant)")
     if not os.path.isfile(args.plant):
         raise GreyboxError(f"{args.plant}: no such model file; the plant is twin-X, twin-Y or a gms/lugre model "
                            "file (--plant)")

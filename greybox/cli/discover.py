@@ -126,8 +126,8 @@ def _print_summary(result) -> None:
 def run(args: argparse.Namespace) -> int:
     if int(args.alpha * (args.null_replicates + 1)) < 1:  # the workflow's own condition, checked before any work
         least = int(np.ceil(1.0 / args.alpha)) - 1
-        raise CommandLineError(f"--alpha {args.alpha:g} with --null-replicates {args.null_replicates} can never name an "
-                               f"effect: give --null-replicates {least} or more, or a larger --alpha")
+        raise CommandLineError(f"--alpha {args.alpha:g} with --null-replicates {args.null_replicates} can never name "
+                               f"an effect: give --null-replicates {least} or more, or a larger --alpha")
     _check_outputs(args)
     names = _candidates(args.effects)
     base = build_model(args.model, args)
