@@ -23,16 +23,25 @@ from ._notes import command_notes, error_message
 COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate")
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (the option, the problem) and exit status 2."""
+
+    def error(self, message: str):
+        """Print ``<prog>: error: <message> (see <prog> --help)`` on stderr and exit with status 2."""
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``greybox`` command."""
     from .. import __version__
 
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="greybox",
         description="Grey-box motor-current models of machine-tool feed axes.",
     )
     parser.add_argument("--version", action="version", version=f"greybox {__version__}")
-    subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                       parser_class=OneLineParser)
     for name in COMMANDS:
         importlib.import_module(f"{__name__}.{name}").add_parser(subparsers)
     return parser
