@@ -138,12 +138,6 @@ class SVRExpansion:
     at_bounds: list[str] = field(default_factory=list)
     n_train: int = 0
 
-    def predict(self, X) -> np.ndarray:
-        """Evaluate the regression at raw (unscaled) inputs ``X``, shape (n, n_features)."""
-        scaled = (np.asarray(X, dtype=np.float64) - self.input_mean) / self.input_scale
-        return rbf_expansion(scaled, self.support_vectors, self.dual_coef, self.intercept,
-                             self.hyperparameters["gamma"])
-
 
 def _train(X, y, hyper: Mapping[str, float]):
     """Train libsvm on standardised ``X``; return (support vectors, dual coefficients, intercept)."""
