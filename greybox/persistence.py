@@ -168,7 +168,8 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
 
     path = Path(path)
     if path.exists() and not overwrite:
-        raise ModelFileError(f"{path}: file exists; refusing to overwrite it")
+        raise ModelFileError(f"{path}: file exists; refusing to overwrite it "
+                             "(save_model(..., overwrite=True) replaces it)")
     if path.is_dir():
         raise ModelFileError(f"{path}: is a directory")
     encoder = _Encoder(path)

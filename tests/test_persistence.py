@@ -135,7 +135,7 @@ def test_same_model_gives_same_bytes(tmp_path, data):
 def test_existing_file_is_not_overwritten_unless_asked(tmp_path, data):
     path = tmp_path / "toy.gbm"
     path.write_bytes(b"user data")
-    with pytest.raises(ModelFileError, match="toy.gbm.*exists"):
+    with pytest.raises(ModelFileError, match=r"toy.gbm.*exists.*overwrite=True"):
         save_model(ToyModel(), path)
     assert path.read_bytes() == b"user data"
     save_model(ToyModel().fit(*data), path, overwrite=True)
