@@ -109,6 +109,10 @@ class CurrentModel(ModelProtocol):
         self._fit_runs(runs, make_progress(progress))
         return self
 
+    #: Hyperparameter that holds the first-stage model of a two-stage model (``None``: one stage). Options
+    #: of the command line that the model does not take but its first stage does are set there.
+    first_stage_param: str | None = None
+
     def first_stage(self):
         """Unfitted model of the first stage of a two-stage model; ``None`` for a one-stage model (default)."""
         return None

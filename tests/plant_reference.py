@@ -55,23 +55,31 @@ class GMSPlant:
 
 
 class LuGrePlant:
-    """LuGre bristles ``dz/dt = v - sigma0 |v| z / g(v)``, solved exactly over each step with ``v`` held."""
+    """LuGre bristles ``dz/dt = v - sigma0 |v| z / g(v)``, solved exactly over each step with ``v`` held.
+
+    ``sigma2``, ``coulomb``, ``static`` and ``v_s`` are numbers or pairs (positive motion, negative motion).
+    """
 
     def __init__(self, sigma0, sigma1, sigma2, coulomb, static, v_s):
-        self.sigma0, self.sigma1, self.sigma2 = sigma0, sigma1, sigma2
-        self.coulomb, self.static, self.v_s = coulomb, static, v_s
+        self.sigma0, self.sigma1 = sigma0, sigma1
+        self.sigma2, self.coulomb, self.static, self.v_s = (tuple(np.broadcast_to(np.asarray(x, dtype=float), 2))
+                                                            for x in (sigma2, coulomb, static, v_s))
         self.z, self.rate = 0.0, 0.0
 
     @classmethod
     def of(cls, m):
         """The plant of a fitted LuGreModel."""
+        if m.asymmetric:
+            return cls(m.sigma0_, m.sigma1_, (m.viscous_, m.viscous_neg_), (m.coulomb_, m.coulomb_neg_),
+                       (m.static_, m.static_neg_), (m.v_s_, m.v_s_neg_))
         return cls(m.sigma0_, m.sigma1_, m.viscous_, m.coulomb_, m.static_, m.v_s_)
 
     def friction(self, x, v):
-        return self.sigma0 * self.z + self.sigma1 * self.rate + self.sigma2 * v
+        return self.sigma0 * self.z + self.sigma1 * self.rate + self.sigma2[int(v < 0)] * v
 
     def advance(self, v, h):
-        g = self.coulomb + (self.static - self.coulomb) * math.exp(-abs(v) / self.v_s)
+        r = int(v < 0)
+        g = self.coulomb[r] + (self.static[r] - self.coulomb[r]) * math.exp(-abs(v) / self.v_s[r])
         lam = self.sigma0 * abs(v) / g
         if lam > 0:
             new = self.z * math.exp(-lam * h) + v * (1 - math.exp(-lam * h)) / lam

@@ -8,6 +8,7 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
+from greybox.data.prepare import prepare
 from greybox.persistence import load_model
 
 # Coulomb + viscous + offset truth: J [A s^2/mm], Fc [A], Fv [A s/mm], offset [A]
@@ -92,6 +93,46 @@ def test_emps_file_gives_the_benchmark_mass(tmp_path, capsys, real_data):
     assert "N s^2/mm" in stdout
 
 
+def _asymmetric_run(seed: int, n: int = 2000) -> AxisLog:
+    """A run whose friction is 1.5 A in positive and 0.9 A in negative motion."""
+    log = _run(seed, n=n)
+    levels = np.where(log.velocity > 0, 1.5, np.where(log.velocity < 0, -0.9, 0.0))
+    return log.replace(effort=TRUTH["J_"] * log.acceleration + levels + 0.01 * log.velocity)
+
+
+@pytest.mark.parametrize("kind, suffix", [("stribeck", ".csv"), ("lugre", ".mcap"), ("gms", ".parquet"),
+                                          ("gms", ".csv"), ("gmssvr", ".parquet")])
+def test_asymmetric_models_train_from_the_log_formats(tmp_path, capsys, kind, suffix):
+    log = _asymmetric_run(4)
+    log_path = tmp_path / f"run{suffix}"
+    write_log(log, log_path)
+    out = tmp_path / f"{kind}.gbm"
+    extra = ["--set", "optimize=false"] if kind == "gmssvr" else []
+    status, stdout, stderr = _train(capsys, "--model", kind, "--asymmetric", *extra, "--train", log_path,
+                                    "--out", out, "--quiet")
+    assert status == 0, stderr
+    model = load_model(out)
+    physical = model.gms_ if kind == "gmssvr" else model
+    assert physical.asymmetric
+    predicted = physical.predict(prepare([log])[0])
+    sliding = np.abs(log.velocity) > 20
+    error = predicted[sliding] - log.effort[sliding]
+    assert np.sqrt(np.mean(error ** 2)) < 0.1  # a symmetric model is 0.3 A off in each direction
+
+
+def test_emps_file_trains_an_asymmetric_gms_model(tmp_path, capsys, real_data):
+    out = tmp_path / "emps-gms.gbm"
+    status, stdout, stderr = _train(capsys, "--model", "gms", "--asymmetric", "--cutoff-hz", "100",
+                                    "--train", real_data("EMPS") / "DATA_EMPS.mat", "--out", out, "--quiet")
+    assert status == 0, stderr
+    model = load_model(out)
+    assert model.asymmetric and model.effort_unit_ == "N"
+    stiffness = float(np.sum(model.k_ * model.alpha_))
+    positive, negative = stiffness * model.s_inf_, stiffness * model.s_inf_neg_
+    assert 5.0 < positive < 60.0 and 5.0 < negative < 60.0  # sliding levels of tens of newtons
+    assert "s_inf_neg" in stdout and "viscous_neg" in stdout
+
+
 def test_existing_model_is_kept_unless_forced(tmp_path, capsys):
     log_path = tmp_path / "run.csv"
     write_log(_run(0), log_path)
@@ -117,7 +158,8 @@ def test_training_log_is_never_overwritten(tmp_path, capsys):
 @pytest.mark.parametrize(
     "arguments, message",
     [
-        (["--model", "gms", "--asymmetric"], "--asymmetric does not apply to the gms model"),
+        (["--model", "svr", "--asymmetric"], "--asymmetric does not apply to the svr model"),
+        (["--model", "gms", "--asymmetric", "--offset"], "choose --asymmetric or --offset, not both"),
         (["--model", "coulomb", "--elements", "3"], "--elements does not apply to the coulomb model"),
         (["--model", "lugre", "--set", "colour=red"], "--set colour=...: the lugre model has no such hyperparameter"),
         (["--model", "lugre", "--set", "n_starts"], "NAME=VALUE"),

@@ -5,8 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from greybox.friction.directions import direction_pair
 from greybox.friction.gms import GMSState, gms_trajectory, simulate_gms
-from greybox.friction.kernels import gms_friction_kernel, gms_trajectory_kernel, lugre_trajectory_kernel
+from greybox.friction.kernels import (
+    direction_curves,
+    gms_friction_kernel,
+    gms_trajectory_kernel,
+    lugre_trajectory_kernel,
+)
 from greybox.friction.lugre import simulate_lugre
 from greybox.friction.reference import gms_reference, lugre_reference
 from greybox.friction.signals import STEP, velocity_profile
@@ -21,8 +27,13 @@ def gms_parameters(n_elements, seed=0):
 
 def run_kernel(velocity, p, state=None):
     state = GMSState.at_rest(p["alpha"].size) if state is None else state
-    return gms_friction_kernel(velocity, STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"],
-                               p["C"], p["mu"], state.z, state.mode)
+    return gms_friction_kernel(velocity, STEP, p["alpha"], p["k"], p["sigma"], curves_of(p), p["C"],
+                               direction_pair(p["mu"], "mu"), state.z, state.mode)
+
+
+def curves_of(p):
+    return direction_curves(direction_pair(p["s_0"], "s_0"), direction_pair(p["s_inf"], "s_inf"),
+                            direction_pair(p["v_s"], "v_s"))
 
 
 @pytest.mark.parametrize("n_elements", [1, 4, 10])
@@ -85,15 +96,17 @@ def test_kernels_write_into_column_views():
     matrix = np.zeros((velocity.size, 7))
     modes = np.empty((velocity.size, 4), dtype=np.int8)
     rest = GMSState.at_rest(4)
-    gms_trajectory_kernel(velocity, STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["C"],
-                          p["mu"], rest.z, rest.mode, matrix[:, :4], modes, matrix[:, 4], matrix[:, 5])
+    gms_trajectory_kernel(velocity, STEP, p["alpha"], p["k"], p["sigma"], curves_of(p), p["C"],
+                          direction_pair(p["mu"], "mu"), rest.z, rest.mode, matrix[:, :4], modes, matrix[:, 4],
+                          matrix[:, 5])
     z, stick, w, friction, _ = gms_trajectory(velocity, STEP, **p)
     np.testing.assert_array_equal(matrix[:, :4], z)
     np.testing.assert_array_equal(matrix[:, 4], w)
     np.testing.assert_array_equal(matrix[:, 5], friction)
     assert np.all(matrix[:, 6] == 0.0)
     z_col = np.zeros((velocity.size, 2))
-    end = lugre_trajectory_kernel(velocity, STEP, 300.0, 0.6, 0.9, 3.0, 0.0, z_col[:, 0], z_col[:, 1])
+    end = lugre_trajectory_kernel(velocity, STEP, 300.0, direction_curves([0.9, 0.9], [0.6, 0.6], [3.0, 3.0]), 0.0,
+                                  z_col[:, 0], z_col[:, 1])
     _, z_ref, end_ref = simulate_lugre(velocity, STEP, sigma0=300.0, sigma1=0.0, sigma2=0.0, coulomb=0.6,
                                        static=0.9, v_s=3.0)
     np.testing.assert_array_equal(z_col[:, 0], z_ref)

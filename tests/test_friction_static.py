@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+import zipfile
+
 import numpy as np
 import pytest
 import scipy.io
@@ -12,6 +15,8 @@ from greybox.errors import ParameterError
 from greybox.friction import CoulombModel, StribeckModel, stribeck_curve
 from greybox.friction.coulomb import coulomb_friction
 from greybox.friction.signals import motion_log, velocity_profile
+from greybox.identify.static import fit_stribeck
+from greybox.persistence import load_model, save_model
 
 
 def log_with(current_of):
@@ -87,6 +92,112 @@ def test_stribeck_curve_decays_from_static_to_coulomb():
     v = np.array([-1e6, -3.0, 0.0, 3.0, 1e6])
     s = stribeck_curve(v, 0.9, 0.6, 3.0)
     np.testing.assert_allclose(s, [0.6, 0.6 + 0.3 / np.e, 0.9, 0.6 + 0.3 / np.e, 0.6])
+
+
+#: Different Stribeck curves for positive and negative motion (magnitudes for the negative one).
+ASYMMETRIC_TRUTH = {"coulomb": 0.6, "static": 0.9, "v_s": 3.0, "viscous": 0.004,
+                    "coulomb_neg": 0.7, "static_neg": 1.2, "v_s_neg": 8.0, "viscous_neg": 0.006}
+
+
+def asymmetric_stribeck(velocity, t):
+    """Friction of the asymmetric Stribeck model with the parameters ``t``, written out [A]."""
+    speed = np.abs(velocity)
+    positive = t["coulomb"] + (t["static"] - t["coulomb"]) * np.exp(-speed / t["v_s"]) + t["viscous"] * velocity
+    negative = (-(t["coulomb_neg"] + (t["static_neg"] - t["coulomb_neg"]) * np.exp(-speed / t["v_s_neg"]))
+                + t["viscous_neg"] * velocity)
+    return np.where(velocity > 0.0, positive, np.where(velocity < 0.0, negative, 0.0))
+
+
+@pytest.fixture(scope="module")
+def asymmetric_log():
+    return log_with(lambda g: 0.0015 * g.acceleration + asymmetric_stribeck(g.velocity, ASYMMETRIC_TRUTH))
+
+
+def test_asymmetric_stribeck_recovers_each_direction(asymmetric_log):
+    model = StribeckModel(asymmetric=True).fit(asymmetric_log)
+    for name, value in ASYMMETRIC_TRUTH.items():
+        assert getattr(model, name + "_") == pytest.approx(value, rel=1e-6), name
+    assert model.J_ == pytest.approx(0.0015, rel=1e-6)
+    assert model.offset_ == 0.0 and model.n_params == 9
+    np.testing.assert_allclose(model.predict(asymmetric_log), asymmetric_log.effort, rtol=0, atol=1e-6)
+    rows = {row.name: row.value for row in model.parameter_table()}
+    assert rows["v_s"] == model.v_s_ and rows["v_s_neg"] == model.v_s_neg_
+    assert rows["static_neg"] == model.static_neg_ and rows["coulomb"] == model.coulomb_
+
+
+def test_asymmetric_stribeck_fit_returns_both_directions(asymmetric_log):
+    g = asymmetric_log
+    params = fit_stribeck(g.velocity, g.acceleration, g.effort, asymmetric=True)
+    for name, value in ASYMMETRIC_TRUTH.items():
+        assert params[name] == pytest.approx(value, rel=1e-6), name
+    assert params["offset"] == 0.0 and params["sse"] < 1e-8
+
+
+def test_asymmetric_stribeck_with_equal_directions_is_the_symmetric_model():
+    log = log_with(lambda g: 0.001 * g.acceleration + np.sign(g.velocity) * stribeck_curve(g.velocity, 0.9, 0.6, 3.0)
+                   + 0.004 * g.velocity)
+    symmetric = StribeckModel().fit(log)
+    asymmetric = StribeckModel(asymmetric=True).fit(log)
+    for name in ("coulomb", "static", "v_s", "viscous"):  # odd data: both directions fit alike
+        assert getattr(asymmetric, name + "_neg_") == pytest.approx(getattr(asymmetric, name + "_"), rel=1e-6)
+    for name in ("J", "coulomb", "static", "v_s", "viscous"):
+        setattr(asymmetric, name + "_", getattr(symmetric, name + "_"))
+        if name != "J":
+            setattr(asymmetric, name + "_neg_", getattr(symmetric, name + "_"))
+    mirrored = log.replace(velocity=-log.velocity, acceleration=-log.acceleration)
+    np.testing.assert_array_equal(asymmetric.predict(log), symmetric.predict(log))
+    np.testing.assert_array_equal(asymmetric.predict(mirrored), -asymmetric.predict(log))
+
+
+def test_asymmetric_stribeck_refuses_an_offset(asymmetric_log):
+    with pytest.raises(ParameterError, match="not separately identifiable"):
+        StribeckModel(asymmetric=True, fit_offset=True).fit(asymmetric_log)
+    g = asymmetric_log
+    with pytest.raises(ParameterError, match="not separately identifiable"):
+        fit_stribeck(g.velocity, g.acceleration, g.effort, asymmetric=True, fit_offset=True)
+    with pytest.raises(ParameterError, match="asymmetric must be True or False"):
+        StribeckModel(asymmetric="True").fit(asymmetric_log)
+
+
+def test_asymmetric_stribeck_model_file_round_trip(asymmetric_log, tmp_path):
+    model = StribeckModel(asymmetric=True).fit(asymmetric_log)
+    loaded = load_model(save_model(model, tmp_path / "asymmetric.gbm"))
+    assert loaded.asymmetric and loaded.v_s_neg_ == model.v_s_neg_
+    unseen = motion_log(velocity_profile(8.0, seed=5))
+    np.testing.assert_array_equal(loaded.predict(unseen), model.predict(unseen))
+
+
+def test_symmetric_stribeck_file_without_the_asymmetric_flag_loads(asymmetric_log, tmp_path):
+    """A model file written before the asymmetric variant existed: no flag, no ``*_neg_`` attributes."""
+    model = StribeckModel(fit_offset=True).fit(asymmetric_log)
+    path = save_model(model, tmp_path / "symmetric.gbm")
+    with zipfile.ZipFile(path) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    content = json.loads(members["model.json"])
+    del content["model"]["params"]["asymmetric"]
+    assert not any(name.endswith("_neg_") for name in content["model"]["attributes"])
+    members["model.json"] = json.dumps(content).encode()
+    old = tmp_path / "old.gbm"
+    with zipfile.ZipFile(old, "w") as archive:
+        for name, data in members.items():
+            archive.writestr(name, data)
+    loaded = load_model(old)
+    assert not loaded.asymmetric
+    np.testing.assert_array_equal(loaded.predict(asymmetric_log), model.predict(asymmetric_log))
+    assert [row.name for row in loaded.parameter_table()] == [row.name for row in model.parameter_table()]
+
+
+def test_asymmetric_stribeck_linear_part_reproduces_the_prediction(asymmetric_log):
+    model = StribeckModel(asymmetric=True).fit(asymmetric_log)
+    part = model.linear_part(asymmetric_log)
+    assert part.names == ("J", "coulomb_pos", "static_pos", "coulomb_neg", "static_neg", "viscous_pos", "viscous_neg")
+    np.testing.assert_array_equal(part.lower, np.zeros(7))
+    np.testing.assert_allclose(part.columns @ model.linear_coefficients() + part.fixed, model.predict(asymmetric_log),
+                               rtol=0, atol=1e-12)
+    new = model.linear_coefficients() * np.array([1.0, 1.1, 0.9, 1.2, 0.8, 1.3, 0.7])
+    model.set_linear_coefficients(new)
+    np.testing.assert_array_equal(model.linear_coefficients(), new)
+    np.testing.assert_allclose(model.predict(asymmetric_log), part.columns @ new + part.fixed, rtol=0, atol=1e-12)
 
 
 def emps_log(path):

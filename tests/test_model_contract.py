@@ -34,17 +34,24 @@ from greybox.twin import make_dataset
 CASES = {
     "coulomb": lambda: CoulombModel(fit_offset=True),
     "stribeck": lambda: registry.model_class("stribeck")(),
+    "stribeck-asymmetric": lambda: registry.model_class("stribeck")(asymmetric=True),
     "lugre": lambda: LuGreModel(n_starts=1, max_iter=60),
+    "lugre-asymmetric": lambda: LuGreModel(asymmetric=True, n_starts=1, max_iter=60),
     "gms": lambda: GMSModel(n_starts=1, max_iter=60),
+    "gms-asymmetric": lambda: GMSModel(asymmetric=True, n_starts=1, max_iter=60),
     "svr": lambda: registry.model_class("svr")(optimize=False, n_subset=300),
     "gmssvr": lambda: registry.model_class("gmssvr")(optimize=False, n_subset=300,
                                                      gms=GMSModel(n_starts=1, max_iter=60)),
     "gmssvr-current": lambda: registry.model_class("gmssvr")(optimize=False, n_subset=300, target="current",
                                                              gms=GMSModel(n_starts=1, max_iter=60)),
+    "gmssvr-asymmetric": lambda: registry.model_class("gmssvr")(optimize=False, n_subset=300,
+                                                                gms=GMSModel(asymmetric=True, n_starts=1, max_iter=60)),
     "augmented-gms": lambda: AugmentedModel(base=GMSModel(n_starts=1, max_iter=60), refine_shapes=False,
                                             effects=[("thermal_drift", 3.0), ("position_periodic_force", 10.0),
                                                      "inertia_mismatch", "constant_offset"]),
     "augmented-coulomb": lambda: AugmentedModel(base=CoulombModel(), effects=["stribeck", "position_trend"]),
+    "augmented-gms_asymmetric": lambda: AugmentedModel(base=GMSModel(asymmetric=True, n_starts=1, max_iter=60),
+                                                       refine_shapes=False, effects=["constant_offset"]),
 }
 
 #: Learned attributes that describe the fit, the data scaling or a nested stage rather than a parameter.

@@ -12,6 +12,7 @@ import pytest
 from greybox.base import PlantLaw
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
 from greybox.friction.kernels import (
+    direction_curves,
     gms_trajectory_kernel,
     lugre_decay_rate,
     lugre_exact_step,
@@ -103,8 +104,9 @@ def test_gms_law_takes_the_models_element_step():
     n, N = velocity.size, GMS["alpha"].size
     z_out, mode_out = np.empty((n, N)), np.empty((n, N), dtype=np.int8)
     w_out, f_out = np.empty(n), np.empty(n)
-    gms_trajectory_kernel(velocity, STEP, GMS["alpha"], GMS["k"], GMS["sigma"], GMS["s_0"], GMS["s_inf"], GMS["v_s"],
-                          GMS["c"], GMS["mu"], np.zeros(N), np.zeros(N, dtype=np.int8), z_out, mode_out, w_out, f_out)
+    curves = direction_curves(np.full(2, GMS["s_0"]), np.full(2, GMS["s_inf"]), np.full(2, GMS["v_s"]))
+    gms_trajectory_kernel(velocity, STEP, GMS["alpha"], GMS["k"], GMS["sigma"], curves, GMS["c"], np.full(2, GMS["mu"]),
+                          np.zeros(N), np.zeros(N, dtype=np.int8), z_out, mode_out, w_out, f_out)
     state = law.state.copy()
     z, mode, rate = np.empty((n, N)), np.empty((n, N)), np.empty(n)
     for j, v in enumerate(velocity):
@@ -121,8 +123,8 @@ def test_lugre_law_takes_the_models_bristle_step():
     velocity = velocity_profile(6.0, seed=5)
     law = lugre_law()
     z_out, z_dot = np.empty(velocity.size), np.empty(velocity.size)
-    lugre_trajectory_kernel(velocity, STEP, LUGRE["sigma0"], LUGRE["coulomb"], LUGRE["static"], LUGRE["v_s"], 0.0,
-                            z_out, z_dot)
+    curves = direction_curves(np.full(2, LUGRE["static"]), np.full(2, LUGRE["coulomb"]), np.full(2, LUGRE["v_s"]))
+    lugre_trajectory_kernel(velocity, STEP, LUGRE["sigma0"], curves, 0.0, z_out, z_dot)
     state = law.state.copy()
     z = np.empty(velocity.size)
     for j, v in enumerate(velocity):
@@ -217,7 +219,8 @@ def test_stribeck_curve_is_the_models_curve():
 def test_lugre_exact_step_solves_the_bristle_equation(v):
     p = LUGRE
     z0, h = 2e-3, 2e-3
-    lam = lugre_decay_rate(abs(v), p["sigma0"], p["coulomb"], p["static"] - p["coulomb"], 1.0 / p["v_s"])
+    curves = direction_curves(np.full(2, p["static"]), np.full(2, p["coulomb"]), np.full(2, p["v_s"]))
+    lam = lugre_decay_rate(v, p["sigma0"], curves)
     got = lugre_exact_step(z0, v, lam, h)
     assert got == pytest.approx(lugre_step_reference(z0, v, p["sigma0"], p["coulomb"], p["static"], p["v_s"], h),
                                 rel=1e-13, abs=1e-18)

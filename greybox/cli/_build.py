@@ -40,9 +40,11 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
     group = parser.add_argument_group(title)
     group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
     group.add_argument("--asymmetric", action="store_true",
-                       help="separate Coulomb and viscous levels per direction (coulomb)")
+                       help="direction-dependent friction: sliding levels, Stribeck curve and viscous "
+                       "coefficient of their own for positive and negative motion (coulomb, stribeck, lugre, gms, "
+                       "and the GMS stage of gmssvr; not with --offset)")
     group.add_argument("--elements", type=POSITIVE_INT, metavar="N",
-                       help="number of Maxwell-slip elements (gms; default 4)")
+                       help="number of Maxwell-slip elements (gms and the GMS stage of gmssvr; default 4)")
     group.add_argument("--model-seed", type=SEED, metavar="N",
                        help="seed of the identification: multi-start searches (lugre, gms) and SVR "
                        "subsets and hyperparameter search (svr, gmssvr); default 0")
@@ -55,7 +57,9 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
 def build_model(kind: str, args: argparse.Namespace):
     """Return an unfitted model of ``kind`` with the hyperparameters given on the command line.
 
-    Options a command does not offer count as not given.
+    Options a command does not offer count as not given. An option the
+    model does not take but its first stage does (``--asymmetric``,
+    ``--elements``, ``--offset`` of gmssvr) is set on the first stage.
 
     Raises
     ------
@@ -64,14 +68,20 @@ def build_model(kind: str, args: argparse.Namespace):
     """
     model = model_class(kind)()
     accepted = model.get_params(deep=False)
-    params = {}
+    stage = model.first_stage()
+    params, stage_params = {}, {}
     for option, attribute, name in _MODEL_OPTIONS:
         value = getattr(args, attribute, None)
         if value is None or value is False:
             continue
-        if name not in accepted:
+        if name in accepted:
+            params[name] = value
+        elif stage is not None and name in stage.get_params(deep=False):
+            stage_params[name] = value  # e.g. --asymmetric of gmssvr: its GMS stage
+        else:
             raise GreyboxError(f"option {option} does not apply to the {kind} model")
-        params[name] = value
+    if stage_params:
+        params[model.first_stage_param] = stage.set_params(**stage_params)
     for setting in getattr(args, "set", None) or []:
         name, sep, text = setting.partition("=")
         name = name.strip()

@@ -32,6 +32,8 @@ __all__ = [
     "stribeck_at",
     "gms_sample",
     "gms_element_step",
+    "viscous_at",
+    "direction_curves",
     "lugre_decay_rate",
     "lugre_exact_step",
     "gms_friction_kernel",
@@ -117,7 +119,7 @@ def gms_element_step(z_old, mode, d, v_dt, s_i, alpha_i, c_dt, inv_s):
 
 
 @njit(cache=True, error_model="numpy")
-def gms_sample(v, sample_time, s_inf, s_drop, inv_v_s):
+def gms_sample(v, sample_time, curves):
     """Quantities of one GMS step shared by all elements.
 
     Parameters
@@ -126,15 +128,16 @@ def gms_sample(v, sample_time, s_inf, s_drop, inv_v_s):
         Velocity held over the step [mm/s].
     sample_time : float
         Step T [s].
-    s_inf, s_drop : float
-        ``s_inf`` and ``s_0 - s_inf`` of the Stribeck curve [mm].
-    inv_v_s : float
-        ``1 / v_s`` [s/mm].
+    curves : ndarray, shape (2, 3)
+        Break-away curve of each direction of motion (row 0 positive, row 1
+        negative motion): ``s_inf`` [mm], ``s_0 - s_inf`` [mm], ``1 / v_s``
+        [s/mm] (:func:`direction_curves`).
 
     Returns
     -------
     s : float
-        ``s(v) = s_inf + (s_0 - s_inf) exp(-|v| / v_s)`` [mm].
+        ``s(v) = s_inf + (s_0 - s_inf) exp(-|v| / v_s)`` of the direction of ``v`` [mm]
+        (the positive curve at rest, where no element moves).
     inv_s : float
         ``1 / s(v)`` [1/mm].
     d : int
@@ -142,30 +145,62 @@ def gms_sample(v, sample_time, s_inf, s_drop, inv_v_s):
     v_dt : float
         ``v T``: travel over the step [mm].
     """
-    s = stribeck_at(abs(v), s_inf, s_drop, inv_v_s)
     d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
+    row = 1 if d < 0 else 0
+    s = stribeck_at(abs(v), curves[row, 0], curves[row, 1], curves[row, 2])
     return s, 1.0 / s, d, v * sample_time
 
 
 @njit(cache=True, error_model="numpy")
-def lugre_decay_rate(speed, sigma0, f_c, f_drop, inv_v_s):
-    """Relaxation rate ``lambda = sigma0 |v| / g(v)`` [1/s] of the LuGre bristle equation.
+def viscous_at(v, viscous):
+    """Viscous friction ``mu(v) v`` [A] with ``viscous = (mu+, mu-)`` [A s/mm] for positive / negative motion."""
+    return (viscous[1] if v < 0.0 else viscous[0]) * v
 
-    ``dz/dt = v - lambda z`` with ``g(v) = F_c + (F_s - F_c) exp(-|v|/v_s)``
-    (:func:`stribeck_at`).
+
+def direction_curves(s_0, s_inf, v_s) -> np.ndarray:
+    """The ``curves`` argument of the GMS and LuGre kernels from the Stribeck curves of the two directions.
 
     Parameters
     ----------
-    speed : float
-        ``|v|`` [mm/s].
+    s_0, s_inf : (float, float)
+        The curve at rest and at high speed for positive and negative motion:
+        the GMS break-away deflection [mm] or the LuGre level ``F_s``, ``F_c`` [A].
+    v_s : (float, float)
+        Stribeck velocity for positive and negative motion [mm/s].
+
+    Returns
+    -------
+    ndarray, shape (2, 3)
+        Rows positive / negative motion: ``s_inf``, ``s_0 - s_inf``, ``1 / v_s``
+        (the arguments ``low``, ``drop``, ``inv_v_s`` of :func:`stribeck_at`).
+    """
+    s_0, s_inf, v_s = (np.asarray(x, dtype=float) for x in (s_0, s_inf, v_s))
+    return np.ascontiguousarray(np.column_stack((s_inf, s_0 - s_inf, 1.0 / v_s)))
+
+
+@njit(cache=True, error_model="numpy")
+def lugre_decay_rate(v, sigma0, curves):
+    """Relaxation rate ``lambda = sigma0 |v| / g(v)`` [1/s] of the LuGre bristle equation.
+
+    ``dz/dt = v - lambda z`` with the Stribeck curve of the direction of
+    motion, ``g(v) = F_c + (F_s - F_c) exp(-|v|/v_s)`` (:func:`stribeck_at`);
+    0 at rest, where ``g`` does not matter.
+
+    Parameters
+    ----------
+    v : float
+        Velocity [mm/s].
     sigma0 : float
         Bristle stiffness [A/mm].
-    f_c, f_drop : float
-        ``F_c`` and ``F_s - F_c`` [A].
-    inv_v_s : float
-        ``1 / v_s`` [s/mm].
+    curves : ndarray, shape (2, 3)
+        Stribeck curve of positive (row 0) and negative (row 1) motion:
+        ``F_c`` [A], ``F_s - F_c`` [A], ``1 / v_s`` [s/mm] (levels are
+        magnitudes; :func:`direction_curves` of ``F_s``, ``F_c``, ``v_s``;
+        equal rows for the symmetric model).
     """
-    return sigma0 * speed / stribeck_at(speed, f_c, f_drop, inv_v_s)
+    row = 1 if v < 0.0 else 0
+    speed = abs(v)
+    return sigma0 * speed / stribeck_at(speed, curves[row, 0], curves[row, 1], curves[row, 2])
 
 
 @njit(cache=True, error_model="numpy")
@@ -195,7 +230,7 @@ def lugre_exact_step(z, v, rate, step_s):
 
 # ------------------------------------------------------------------ run kernels
 @njit(cache=True, error_model="numpy")
-def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0):
+def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, curves, c, viscous, z0, mode0):
     """Friction of the Generalized Maxwell-Slip model, forward Euler at a constant step.
 
     Parameters
@@ -210,14 +245,13 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
         Element stiffnesses [A/mm].
     sigma : float
         Total micro-damping [A s/mm]; element i gets ``alpha_i * sigma``.
-    s_0, s_inf : float
-        Stribeck curve at rest and at high speed [mm] (deflection at break-away).
-    v_s : float
-        Stribeck velocity [mm/s].
+    curves : ndarray, shape (2, 3)
+        Break-away deflection curve ``s(v)`` of positive and negative motion
+        (:func:`direction_curves`; equal rows for the symmetric model).
     c : float
         Slip rate constant C [mm/s]; element i relaxes with ``alpha_i * C``.
-    mu : float
-        Viscous coefficient [A s/mm].
+    viscous : ndarray, shape (2,)
+        Viscous coefficient of positive and negative motion [A s/mm].
     z0 : ndarray, shape (N,)
         Initial element deflections [mm].
     mode0 : ndarray of int8, shape (N,)
@@ -226,7 +260,7 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
     Returns
     -------
     friction : ndarray, shape (n,)
-        ``mu v + sum_i (k_i z_i + alpha_i sigma dz_i/dt)`` [A].
+        ``mu(v) v + sum_i (k_i z_i + alpha_i sigma dz_i/dt)`` [A].
     z_end : ndarray, shape (N,)
         Deflections after the last step [mm].
     mode_end : ndarray of int8, shape (N,)
@@ -238,12 +272,10 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
     damping = sigma * alpha
     friction = np.empty(n)
     c_dt = c * sample_time
-    s_drop = s_0 - s_inf
-    inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        s, inv_s, d, v_dt = gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
-        f = mu * v
+        s, inv_s, d, v_dt = gms_sample(v, sample_time, curves)
+        f = viscous_at(v, viscous)
         for i in range(alpha.shape[0]):
             z_old = z[i]
             z_new, m = gms_element_step(z_old, mode[i], d, v_dt, alpha[i] * s, alpha[i], c_dt, inv_s)
@@ -255,13 +287,13 @@ def gms_friction_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s,
 
 
 @njit(cache=True, error_model="numpy")
-def gms_trajectory_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0,
+def gms_trajectory_kernel(velocity, sample_time, alpha, k, sigma, curves, c, viscous, z0, mode0,
                           z_out, mode_out, w_out, friction_out):
     """Element states and friction of the GMS model over a run (forward Euler, constant step).
 
     The element deflections do not depend on the stiffnesses ``k_i``, the
     damping ``sigma`` or the viscous coefficient, so the friction is linear in
-    those given this trajectory: ``F = z_out @ k + sigma * w_out + mu * v``
+    those given this trajectory: ``F = z_out @ k + sigma * w_out + mu(v) v``
     (the identification passes zeros for them and reads the states only).
     The outputs are written into arrays given by the caller (they may be
     column views of a regressor matrix). ``friction_out`` equals the output of
@@ -271,7 +303,7 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_
     ----------
     velocity : ndarray, shape (n,)
         Velocity [mm/s].
-    sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0, mode0
+    sample_time, alpha, k, sigma, curves, c, viscous, z0, mode0
         As in :func:`gms_friction_kernel`.
     z_out : ndarray, shape (n, N)
         Receives the deflection of each element at each sample, before its update [mm].
@@ -294,13 +326,11 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_
     mode = mode0.copy()
     damping = sigma * alpha
     c_dt = c * sample_time
-    s_drop = s_0 - s_inf
-    inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        s, inv_s, d, v_dt = gms_sample(v, sample_time, s_inf, s_drop, inv_v_s)
+        s, inv_s, d, v_dt = gms_sample(v, sample_time, curves)
         w = 0.0
-        f = mu * v
+        f = viscous_at(v, viscous)
         for i in range(alpha.shape[0]):
             z_old = z[i]
             z_out[j, i] = z_old
@@ -317,7 +347,7 @@ def gms_trajectory_kernel(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_
 
 
 @njit(cache=True, error_model="numpy")
-def lugre_trajectory_kernel(velocity, sample_time, sigma0, f_c, f_s, v_s, z0, z_out, z_dot_out):
+def lugre_trajectory_kernel(velocity, sample_time, sigma0, curves, z0, z_out, z_dot_out):
     """Bristle deflection of the LuGre model, exact zero-order-hold step.
 
     With the velocity held at ``v`` over a step the bristle equation
@@ -335,10 +365,10 @@ def lugre_trajectory_kernel(velocity, sample_time, sigma0, f_c, f_s, v_s, z0, z_
         Step T [s].
     sigma0 : float
         Bristle stiffness [A/mm].
-    f_c, f_s : float
-        Coulomb and static friction levels of ``g(v) = f_c + (f_s - f_c) exp(-|v|/v_s)`` [A].
-    v_s : float
-        Stribeck velocity [mm/s].
+    curves : ndarray, shape (2, 3)
+        Stribeck curve ``g(v) = F_c + (F_s - F_c) exp(-|v|/v_s)`` of positive
+        and negative motion (:func:`lugre_decay_rate`; equal rows for the
+        symmetric model).
     z0 : float
         Initial bristle deflection [mm].
     z_out : ndarray, shape (n,)
@@ -353,11 +383,9 @@ def lugre_trajectory_kernel(velocity, sample_time, sigma0, f_c, f_s, v_s, z0, z_
     """
     n = velocity.shape[0]
     z = z0
-    f_drop = f_s - f_c
-    inv_v_s = 1.0 / v_s
     for j in range(n):
         v = velocity[j]
-        lam = lugre_decay_rate(abs(v), sigma0, f_c, f_drop, inv_v_s)
+        lam = lugre_decay_rate(v, sigma0, curves)
         z_out[j] = z
         z_dot_out[j] = v - lam * z
         z = lugre_exact_step(z, v, lam, sample_time)

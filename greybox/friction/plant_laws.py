@@ -16,12 +16,16 @@ now at the fine step ``h`` instead of the log's sample time. The friction
 is explicit: it reads the deflections and the rate of the previous step.
 
 GMS (``N`` elements)
-    ``parameters = (mu, sigma, s_inf, s_0 - s_inf, 1 / v_s, C, alpha_1..N, k_1..N)``,
+    ``parameters = (mu+, mu-, sigma, C, curves, alpha_1..N, k_1..N)`` with ``curves`` the six
+    numbers ``s_inf, s_0 - s_inf, 1 / v_s`` of positive, then of negative motion
+    (:func:`greybox.friction.kernels.direction_curves`),
     ``state = (sum_i alpha_i dz_i/dt, z_1..N, mode_1..N)``;
-    ``F = mu v + sigma sum_i alpha_i dz_i/dt + sum_i k_i z_i``.
+    ``F = mu(v) v + sigma sum_i alpha_i dz_i/dt + sum_i k_i z_i``.
 LuGre
-    ``parameters = (sigma0, sigma1, sigma2, F_c, F_s - F_c, 1 / v_s)``,
-    ``state = (z, dz/dt)``; ``F = sigma0 z + sigma1 dz/dt + sigma2 v``.
+    ``parameters = (sigma0, sigma1, sigma2+, sigma2-, curves)`` with ``curves`` the six
+    numbers ``F_c, F_s - F_c, 1 / v_s`` of positive, then of negative motion
+    (:func:`greybox.friction.kernels.direction_curves` of ``F_s, F_c, v_s``; levels are magnitudes),
+    ``state = (z, dz/dt)``; ``F = sigma0 z + sigma1 dz/dt + sigma2(v) v``.
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ import numpy as np
 from numba import njit
 
 from ..base import PlantLaw
-from .kernels import gms_element_step, gms_sample, lugre_decay_rate, lugre_exact_step
+from .kernels import direction_curves, gms_element_step, gms_sample, lugre_decay_rate, lugre_exact_step, viscous_at
 
 __all__ = [
     "MAX_STEP_RATIO",
@@ -50,7 +54,7 @@ __all__ = [
 #: the internal step is chosen for; semi-implicit Euler is stable below 2.
 MAX_STEP_RATIO = 0.25
 
-_GMS_HEAD = 6  # mu, sigma, s_inf, s_drop, inv_v_s, C
+_GMS_HEAD = 10  # mu+, mu-, sigma, C, then s_inf, s_0 - s_inf, 1 / v_s of positive and of negative motion
 
 
 def stable_step(inertia: float, stiffness: float, damping: float) -> float:
@@ -82,9 +86,9 @@ def stable_step(inertia: float, stiffness: float, damping: float) -> float:
 # ------------------------------------------------------------------ GMS
 @njit(cache=True, error_model="numpy")
 def gms_plant_friction(parameters, state, position_mm, velocity_mm_s):
-    """GMS friction [A] ``mu v + sigma w + sum_i k_i z_i`` of the present state (layout in the module doc)."""
+    """GMS friction [A] ``mu(v) v + sigma w + sum_i k_i z_i`` of the present state (layout in the module doc)."""
     n = (parameters.shape[0] - _GMS_HEAD) // 2
-    force = parameters[0] * velocity_mm_s + parameters[1] * state[0]
+    force = viscous_at(velocity_mm_s, parameters[0:2]) + parameters[2] * state[0]
     for i in range(n):
         force += parameters[_GMS_HEAD + n + i] * state[1 + i]
     return force
@@ -98,8 +102,8 @@ def gms_plant_advance(parameters, state, velocity_mm_s, step_s):
     ``state[0]`` receives ``sum_i alpha_i dz_i/dt`` over the step [mm/s].
     """
     n = (parameters.shape[0] - _GMS_HEAD) // 2
-    s, inv_s, d, v_dt = gms_sample(velocity_mm_s, step_s, parameters[2], parameters[3], parameters[4])
-    c_dt = parameters[5] * step_s
+    s, inv_s, d, v_dt = gms_sample(velocity_mm_s, step_s, parameters[4:_GMS_HEAD].reshape((2, 3)))
+    c_dt = parameters[3] * step_s
     rate = 0.0
     for i in range(n):
         alpha_i = parameters[_GMS_HEAD + i]
@@ -118,14 +122,17 @@ def gms_plant_law(*, alpha, k, sigma, s_0, s_inf, v_s, c, mu, inertia, offset) -
     ----------
     alpha, k : array_like, shape (N,)
         Element fractions and stiffnesses [A/mm].
-    sigma, mu : float
-        Micro-damping and viscous coefficient [A s/mm].
-    s_0, s_inf : float
-        Break-away deflection at rest and at high speed [mm].
-    v_s : float
-        Stribeck velocity [mm/s].
+    sigma : float
+        Micro-damping [A s/mm].
+    s_0, s_inf : float or (float, float)
+        Break-away deflection at rest and at high speed [mm]; a pair gives
+        positive and negative motion their own.
+    v_s : float or (float, float)
+        Stribeck velocity [mm/s], one or one per direction.
     c : float
         Slip rate constant [mm/s].
+    mu : float or (float, float)
+        Viscous coefficient [A s/mm], one or one per direction.
     inertia : float
         ``J`` [A s^2/mm].
     offset : float
@@ -134,26 +141,27 @@ def gms_plant_law(*, alpha, k, sigma, s_0, s_inf, v_s, c, mu, inertia, offset) -
     Returns
     -------
     PlantLaw
-        Its internal step is stable for ``sum k`` and ``sigma + mu`` on the
+        Its internal step is stable for ``sum k`` and ``sigma + max mu`` on the
         inertia and below ``min(s_0, s_inf) / C``, where the forward-Euler
         slip step relaxes without overshoot.
     """
     alpha = np.asarray(alpha, dtype=float)
     k = np.asarray(k, dtype=float)
-    s_0, s_inf, v_s, c = float(s_0), float(s_inf), float(v_s), float(c)
-    head = [float(mu), float(sigma), s_inf, s_0 - s_inf, 1.0 / v_s, c]
+    s_0, s_inf, v_s, mu = (np.broadcast_to(np.asarray(x, dtype=float), (2,)) for x in (s_0, s_inf, v_s, mu))
+    c = float(c)
+    head = np.concatenate((mu, [float(sigma), c], direction_curves(s_0, s_inf, v_s).ravel()))
     parameters = np.ascontiguousarray(np.concatenate((head, alpha, k)))
     state = np.zeros(1 + 2 * alpha.size)
-    slip_step = min(s_0, s_inf) / c
-    step = min(stable_step(inertia, float(np.sum(k)), float(sigma + mu)), slip_step)
+    slip_step = float(min(s_0.min(), s_inf.min())) / c
+    step = min(stable_step(inertia, float(np.sum(k)), float(sigma + mu.max())), slip_step)
     return PlantLaw(gms_plant_friction, gms_plant_advance, parameters, state, step, float(inertia), float(offset))
 
 
 # ------------------------------------------------------------------ LuGre
 @njit(cache=True, error_model="numpy")
 def lugre_plant_friction(parameters, state, position_mm, velocity_mm_s):
-    """LuGre friction [A] ``sigma0 z + sigma1 dz/dt + sigma2 v`` of the present state."""
-    return parameters[0] * state[0] + parameters[1] * state[1] + parameters[2] * velocity_mm_s
+    """LuGre friction [A] ``sigma0 z + sigma1 dz/dt + sigma2(v) v`` of the present state (layout in the module doc)."""
+    return parameters[0] * state[0] + parameters[1] * state[1] + viscous_at(velocity_mm_s, parameters[2:4])
 
 
 @njit(cache=True, error_model="numpy")
@@ -164,7 +172,7 @@ def lugre_plant_advance(parameters, state, velocity_mm_s, step_s):
     ``state[1]`` receives ``dz/dt`` over the step [mm/s].
     """
     z = state[0]
-    rate = lugre_decay_rate(abs(velocity_mm_s), parameters[0], parameters[3], parameters[4], parameters[5])
+    rate = lugre_decay_rate(velocity_mm_s, parameters[0], parameters[4:10].reshape((2, 3)))
     z_new = lugre_exact_step(z, velocity_mm_s, rate, step_s)
     state[1] = (z_new - z) / step_s
     state[0] = z_new
@@ -177,12 +185,14 @@ def lugre_plant_law(*, sigma0, sigma1, sigma2, coulomb, static, v_s, inertia, of
     ----------
     sigma0 : float
         Bristle stiffness [A/mm].
-    sigma1, sigma2 : float
-        Bristle damping and viscous coefficient [A s/mm].
-    coulomb, static : float
-        ``F_c`` and ``F_s`` [A].
-    v_s : float
-        Stribeck velocity [mm/s].
+    sigma1 : float
+        Bristle damping [A s/mm].
+    sigma2 : float or (float, float)
+        Viscous coefficient [A s/mm], one or one per direction (positive, negative motion).
+    coulomb, static : float or (float, float)
+        ``F_c`` and ``F_s`` [A], magnitudes; a pair gives positive and negative motion their own.
+    v_s : float or (float, float)
+        Stribeck velocity [mm/s], one or one per direction.
     inertia : float
         ``J`` [A s^2/mm].
     offset : float
@@ -191,11 +201,12 @@ def lugre_plant_law(*, sigma0, sigma1, sigma2, coulomb, static, v_s, inertia, of
     Returns
     -------
     PlantLaw
-        Its internal step is stable for ``sigma0`` and ``sigma1 + sigma2`` on the inertia.
+        Its internal step is stable for ``sigma0`` and ``sigma1 + max sigma2`` on the inertia.
     """
-    coulomb = float(coulomb)
-    parameters = np.array([float(sigma0), float(sigma1), float(sigma2), coulomb, float(static) - coulomb,
-                           1.0 / float(v_s)])
-    step = stable_step(inertia, float(sigma0), float(sigma1 + sigma2))
+    sigma2, coulomb, static, v_s = (np.broadcast_to(np.asarray(x, dtype=float), (2,))
+                                    for x in (sigma2, coulomb, static, v_s))
+    parameters = np.concatenate(([float(sigma0), float(sigma1)], sigma2,
+                                 direction_curves(static, coulomb, v_s).ravel()))
+    step = stable_step(inertia, float(sigma0), float(sigma1 + sigma2.max()))
     return PlantLaw(lugre_plant_friction, lugre_plant_advance, parameters, np.zeros(2), step, float(inertia),
                     float(offset))

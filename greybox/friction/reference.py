@@ -12,10 +12,21 @@ from __future__ import annotations
 import math
 
 
+def _per_direction(value):
+    """``(positive, negative)`` from a number or a pair."""
+    if isinstance(value, (int, float)):
+        return (float(value), float(value))
+    positive, negative = value
+    return (float(positive), float(negative))
+
+
 def gms_reference(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu, z0=None, mode0=None,
                   slip_law="design"):
     """GMS friction by forward Euler; returns ``(friction, z_history, mode_history, z_end, mode_end)``.
 
+    ``s_0``, ``s_inf``, ``v_s`` and ``mu`` are numbers, or pairs (positive
+    motion, negative motion) for the direction-dependent model; at rest the
+    positive curve is used (no element moves there).
     ``slip_law="design"`` is the slip law of DESIGN.md,
     ``dz/dt = alpha_i C (sgn(v) - z / s_i)``. ``slip_law="sgn(1-z/s)"`` is
     the form ``sgn(v) alpha_i C (1 - z / s_i)`` found in several public
@@ -25,13 +36,15 @@ def gms_reference(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu
     z = [0.0] * n_el if z0 is None else [float(value) for value in z0]
     mode = [0] * n_el if mode0 is None else [int(value) for value in mode0]
     friction, z_history, mode_history = [], [], []
+    s_0, s_inf, v_s, mu = (_per_direction(x) for x in (s_0, s_inf, v_s, mu))
     for v in velocity:
         v = float(v)
-        s = s_inf + (s_0 - s_inf) * math.exp(-abs(v) / v_s)
         d = (v > 0.0) - (v < 0.0)
+        r = 1 if d < 0 else 0
+        s = s_inf[r] + (s_0[r] - s_inf[r]) * math.exp(-abs(v) / v_s[r])
         z_history.append(list(z))
         mode_history.append(list(mode))
-        f = mu * v
+        f = mu[r] * v
         for i in range(n_el):
             f += k[i] * z[i]
         for i in range(n_el):
@@ -56,15 +69,22 @@ def gms_reference(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu
 
 
 def lugre_reference(velocity, sample_time, sigma0, sigma1, sigma2, f_c, f_s, v_s, z0=0.0):
-    """LuGre friction with the exact zero-order-hold step; returns ``(friction, z_history, z_end)``."""
+    """LuGre friction with the exact zero-order-hold step; returns ``(friction, z_history, z_end)``.
+
+    ``sigma2``, ``f_c``, ``f_s`` and ``v_s`` are numbers, or pairs (positive
+    motion, negative motion; levels as magnitudes) for the direction-dependent
+    model; at rest the positive curve is used (the bristle rate is ``v`` there).
+    """
     z = float(z0)
     friction, z_history = [], []
+    sigma2, f_c, f_s, v_s = (_per_direction(x) for x in (sigma2, f_c, f_s, v_s))
     for v in velocity:
         v = float(v)
-        g = f_c + (f_s - f_c) * math.exp(-abs(v) / v_s)
+        r = 1 if v < 0.0 else 0
+        g = f_c[r] + (f_s[r] - f_c[r]) * math.exp(-abs(v) / v_s[r])
         lam = sigma0 * abs(v) / g
         z_history.append(z)
-        friction.append(sigma0 * z + sigma1 * (v - lam * z) + sigma2 * v)
+        friction.append(sigma0 * z + sigma1 * (v - lam * z) + sigma2[r] * v)
         if lam > 0.0:
             decay = math.exp(-lam * sample_time)
             z = z * decay + v * (1.0 - decay) / lam
@@ -79,7 +99,12 @@ def stribeck_reference(velocity, low, high, v_s):
 
 
 def lugre_step_reference(z, v, sigma0, f_c, f_s, v_s, step):
-    """Bristle deflection after one exact step of ``dz/dt = v - sigma0 |v| z / g(v)`` with ``v`` held."""
+    """Bristle deflection after one exact step of ``dz/dt = v - sigma0 |v| z / g(v)`` with ``v`` held.
+
+    ``f_c``, ``f_s``, ``v_s`` are numbers or pairs (positive motion, negative motion) as in :func:`lugre_reference`.
+    """
+    r = 1 if v < 0.0 else 0
+    f_c, f_s, v_s = (_per_direction(x)[r] for x in (f_c, f_s, v_s))
     lam = sigma0 * abs(v) / stribeck_reference(v, f_c, f_s, v_s)
     if lam == 0.0:
         return z + v * step

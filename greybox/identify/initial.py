@@ -19,10 +19,10 @@ import numpy as np
 from ..curves import stribeck_curve
 from ..data.log import AxisLog
 from ..errors import LogError
-from .static import fit_stribeck
+from .static import fit_coulomb, fit_stribeck
 
 __all__ = ["SLIDING_DISTANCE_MM", "DEFAULT_DEFLECTION_MM", "motion_direction", "distance_since_reversal",
-           "sliding_mask", "samples_at_speed", "static_initial_guess", "presliding_deflection",
+           "sliding_mask", "samples_at_speed", "static_initial_guess", "direction_level_ratio", "presliding_deflection",
            "check_motion"]
 
 #: Travel since the last reversal [mm] after which a sample counts as sliding.
@@ -135,6 +135,38 @@ def static_initial_guess(runs: Sequence[AxisLog], *, fit_offset: bool = False,
     if sum(int(m.sum()) for m in masks) < _MIN_SLIDING_SAMPLES:
         masks = [run.velocity != 0.0 for run in runs]
     return fit_stribeck(*_stack(runs, masks), fit_offset=fit_offset)
+
+
+def direction_level_ratio(runs: Sequence[AxisLog], *, min_distance: float = SLIDING_DISTANCE_MM,
+                          bounds: tuple[float, float] = (0.05, 20.0)) -> float:
+    """Ratio of the sliding friction level of negative to that of positive motion.
+
+    An asymmetric Coulomb + viscous fit (:func:`greybox.identify.static.fit_coulomb`)
+    of the sliding samples (all moving samples if fewer than 50 slide); the
+    ratio of its two Coulomb levels, clipped to ``bounds``. 1 when either
+    direction's level is not positive.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs.
+    min_distance : float, default :data:`SLIDING_DISTANCE_MM`
+        Travel since the last reversal from which a sample counts as sliding [mm].
+    bounds : (float, float)
+        Smallest and largest ratio returned.
+
+    Returns
+    -------
+    float
+        ``F_c- / F_c+``, dimensionless.
+    """
+    masks = [sliding_mask(run, min_distance) for run in runs]
+    if sum(int(m.sum()) for m in masks) < _MIN_SLIDING_SAMPLES:
+        masks = [run.velocity != 0.0 for run in runs]
+    levels = fit_coulomb(*_stack(runs, masks), asymmetric=True)
+    if not (levels["coulomb_pos"] > 0.0 and levels["coulomb_neg"] > 0.0):
+        return 1.0
+    return float(np.clip(levels["coulomb_neg"] / levels["coulomb_pos"], *bounds))
 
 
 def presliding_deflection(runs: Sequence[AxisLog], static: dict[str, float], *, fraction: float = 0.8,

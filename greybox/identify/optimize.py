@@ -30,7 +30,7 @@ from threadpoolctl import threadpool_limits
 from ..errors import ParameterError
 from .progress import ProgressEvent
 
-__all__ = ["METHODS", "SearchResult", "local_search", "multistart"]
+__all__ = ["METHODS", "SearchResult", "local_search", "multistart", "multistart_results"]
 
 #: Names of the local search methods.
 METHODS = ("nelder-mead", "least-squares")
@@ -211,6 +211,38 @@ def multistart(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, 
     SearchResult
         The best point over all starts; ``n_evaluations`` is the total.
     """
+    results = multistart_results(residuals, x0, lower, upper, scale=scale, n_starts=n_starts,
+                                 random_state=random_state, method=method, max_iter=max_iter, stage=stage,
+                                 progress=progress)
+    best = min(results, key=lambda result: (result.cost, result.start))
+    best.n_evaluations = sum(result.n_evaluations for result in results)
+    return best
+
+
+def multistart_results(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, scale,
+                       n_starts: int = 1, random_state=0, method: str = "nelder-mead",
+                       max_iter: int = 500, stage: str = "fit", progress=None,
+                       fixed_starts=()) -> list[SearchResult]:
+    """The result of every start, in the order of the starts.
+
+    The starts are ``x0``, then the ``fixed_starts`` (the same for every
+    seed: for instance points along a parameter whose cost is known to have
+    several basins), then the ``n_starts - 1`` perturbations of ``x0`` of
+    :func:`multistart`.
+
+    Parameters
+    ----------
+    residuals, x0, lower, upper, scale, method, max_iter, stage, progress, n_starts, random_state
+        As in :func:`multistart`.
+    fixed_starts : sequence of array_like, optional
+        Further deterministic starts (clipped into the bounds).
+
+    Returns
+    -------
+    list of SearchResult
+        One per start (``n_starts + len(fixed_starts)``); ``n_evaluations`` of each counts its own
+        start's evaluations.
+    """
     if n_starts < 1:
         raise ValueError(f"n_starts must be at least 1, got {n_starts}")
     x0, lower, upper = _check_bounds(x0, lower, upper)
@@ -218,14 +250,11 @@ def multistart(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, 
     rng = np.random.default_rng(random_state)
     starts = [x0] + [np.clip(x0 + scale * rng.standard_normal(x0.size), lower, upper)
                      for _ in range(n_starts - 1)]
-    best = None
-    total = 0
+    starts[1:1] = [np.clip(np.asarray(start, dtype=float), lower, upper) for start in fixed_starts]
+    results = []
     for index, start in enumerate(starts):
-        result = local_search(residuals, start, lower, upper, scale=scale, method=method,
-                              max_iter=max_iter, stage=stage, progress=progress, start=index,
-                              n_starts=n_starts, best_so_far=np.inf if best is None else best.cost)
-        total += result.n_evaluations
-        if best is None or result.cost < best.cost:
-            best = result
-    best.n_evaluations = total
-    return best
+        best_so_far = min((result.cost for result in results), default=np.inf)
+        results.append(local_search(residuals, start, lower, upper, scale=scale, method=method,
+                                    max_iter=max_iter, stage=stage, progress=progress, start=index,
+                                    n_starts=len(starts), best_so_far=best_so_far))
+    return results

@@ -7,13 +7,20 @@ inertia ``J`` estimated jointly:
   ``y = J a + F_c sgn(v) + F_v v (+ offset)``, optionally with separate
   Coulomb and viscous levels for the two directions of motion. Linear.
 - Stribeck + viscous:
-  ``y = J a + sgn(v) (F_c + (F_s - F_c) exp(-|v|/v_s)) + mu v (+ offset)``.
-  Linear in everything but ``v_s``: a separable least-squares fit searches
-  ``v_s`` (log grid, then a bounded scalar refinement) and solves the linear
-  parameters, constrained non-negative, at every trial.
+  ``y = J a + sgn(v) (F_c + (F_s - F_c) exp(-|v|/v_s)) + mu v (+ offset)``,
+  optionally with a separate curve ``F_c, F_s, v_s, mu`` for each direction
+  of motion. Linear in everything but ``v_s``: a separable least-squares fit
+  searches ``v_s`` (log grid, then a bounded scalar refinement) and solves the
+  linear parameters, constrained non-negative, at every trial. The two
+  Stribeck velocities of the asymmetric model are searched one direction at
+  a time (coordinate search) from the best common value: the friction
+  columns of the two directions touch disjoint samples, only ``J`` couples
+  them.
 """
 
 from __future__ import annotations
+
+from functools import partial
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -26,6 +33,10 @@ __all__ = ["fit_coulomb", "fit_stribeck", "stribeck_regressors", "velocity_range
 
 #: Number of log-spaced Stribeck velocities tried before the local refinement.
 _N_GRID = 40
+#: Tolerance of the refined log Stribeck velocities (relative tolerance of ``v_s``).
+_XATOL = 1e-6
+#: Most rounds of the coordinate search of the two Stribeck velocities of the asymmetric model.
+_MAX_ROUNDS = 20
 
 
 def velocity_range(velocity: np.ndarray) -> tuple[float, float]:
@@ -100,28 +111,98 @@ def fit_coulomb(velocity, acceleration, effort, *, asymmetric: bool = False,
             "viscous_neg": x[2], "offset": x[3] if fit_offset else 0.0}
 
 
-def stribeck_regressors(velocity, acceleration, v_s: float, fit_offset: bool) -> np.ndarray:
-    """Regressors of the Stribeck + viscous model for a given ``v_s`` [mm/s].
+def stribeck_regressors(velocity, acceleration, v_s, fit_offset: bool) -> np.ndarray:
+    """Regressors of the Stribeck + viscous model for given Stribeck velocities.
 
-    Columns: ``a``, ``sgn(v) (1 - e)``, ``sgn(v) e``, ``v`` (and ``1``), with
-    ``e = exp(-|v|/v_s)``; their coefficients are ``J``, ``F_c``, ``F_s``,
-    ``mu`` (and the offset).
+    Parameters
+    ----------
+    velocity, acceleration : ndarray, shape (n,)
+        Velocity [mm/s] and acceleration [mm/s^2].
+    v_s : float or (float, float)
+        Stribeck velocity [mm/s], or the pair ``(v_s+, v_s-)`` for positive and
+        negative motion (asymmetric model).
+    fit_offset : bool
+        Append a column of ones for the offset.
+
+    Returns
+    -------
+    ndarray, shape (n, p)
+        With ``e = exp(-|v|/v_s)``: columns ``a``, ``sgn(v) (1 - e)``,
+        ``sgn(v) e``, ``v`` (and ``1``), whose coefficients are ``J``, ``F_c``,
+        ``F_s``, ``mu`` (and the offset). For a pair, with ``e+``, ``e-`` of
+        ``v_s+``, ``v_s-``: ``a``, ``[v>0] (1 - e+)``, ``[v>0] e+``,
+        ``-[v<0] (1 - e-)``, ``-[v<0] e-``, ``v [v>0]``, ``v [v<0]`` (and ``1``)
+        for ``J``, ``F_c+``, ``F_s+``, ``F_c-``, ``F_s-``, ``mu+``, ``mu-``
+        (and the offset); the levels of negative motion are magnitudes.
     """
     v = np.asarray(velocity, dtype=float)
-    e = np.exp(-np.abs(v) / v_s)
-    sign = np.sign(v)
-    columns = [acceleration, sign * (1.0 - e), sign * e, v]
+    if np.ndim(v_s) == 0:
+        directions, viscous = [(np.sign(v), v_s)], [v]
+    else:
+        positive, negative = (v > 0.0).astype(float), (v < 0.0).astype(float)
+        directions, viscous = [(positive, v_s[0]), (-negative, v_s[1])], [v * positive, v * negative]
+    columns = [acceleration]
+    for sign, scale in directions:
+        e = np.exp(-np.abs(v) / scale)
+        columns += [sign * (1.0 - e), sign * e]
+    columns += viscous
     if fit_offset:
         columns.append(np.ones_like(v))
     return np.column_stack(columns)
 
 
-def _stribeck_bounds(fit_offset: bool):
-    lower = [0.0, 0.0, 0.0, 0.0] + ([-np.inf] if fit_offset else [])
+def _stribeck_bounds(asymmetric: bool, fit_offset: bool):
+    lower = [0.0] * (7 if asymmetric else 4) + ([-np.inf] if fit_offset else [])
     return np.array(lower), np.full(len(lower), np.inf)
 
 
-def fit_stribeck(velocity, acceleration, effort, *, fit_offset: bool = False,
+def _refine(cost, left: float, right: float, x: float, fx: float) -> tuple[float, float]:
+    """Bounded scalar minimisation of ``cost`` on ``[left, right]``; the point ``x`` of cost ``fx`` unless beaten."""
+    refined = minimize_scalar(cost, bounds=(left, right), method="bounded", options={"xatol": _XATOL})
+    return (float(refined.x), float(refined.fun)) if refined.fun < fx else (x, fx)
+
+
+def _grid_search(cost, grid: np.ndarray) -> tuple[float, float]:
+    """Minimiser of ``cost`` over ``grid``, refined between the grid neighbours of the best point, and its cost."""
+    costs = [cost(g) for g in grid]
+    best = int(np.argmin(costs))
+    return _refine(cost, grid[max(best - 1, 0)], grid[min(best + 1, len(grid) - 1)], grid[best], costs[best])
+
+
+def _along(cost, point: np.ndarray, axis: int, value: float) -> float:
+    """``cost`` at ``point`` with coordinate ``axis`` replaced by ``value``."""
+    trial = point.copy()
+    trial[axis] = value
+    return cost(trial)
+
+
+def _coordinate_search(cost, grid: np.ndarray) -> np.ndarray:
+    """Minimiser ``(log v_s+, log v_s-)`` of ``cost``, searched one direction at a time.
+
+    Starts from the best common value (grid search of ``cost(g, g)``); the first
+    round searches each direction over the whole ``grid``, the later ones refine
+    within one grid step of the present value, until a round moves neither
+    coordinate by more than the tolerance (at most :data:`_MAX_ROUNDS` rounds).
+    """
+    common, f = _grid_search(lambda g: cost(np.array([g, g])), grid)
+    x = np.array([common, common])
+    step = grid[1] - grid[0]
+    for round_ in range(_MAX_ROUNDS):
+        previous = x.copy()
+        for axis in (0, 1):
+            along = partial(_along, cost, x.copy(), axis)
+            if round_ == 0:
+                g, fg = _grid_search(along, grid)
+            else:
+                g, fg = _refine(along, max(x[axis] - step, grid[0]), min(x[axis] + step, grid[-1]), x[axis], f)
+            if fg < f:
+                x[axis], f = g, fg
+        if np.max(np.abs(x - previous)) <= _XATOL:
+            break
+    return x
+
+
+def fit_stribeck(velocity, acceleration, effort, *, asymmetric: bool = False, fit_offset: bool = False,
                  v_s_range: tuple[float, float] | None = None) -> dict[str, float]:
     """Stribeck + viscous friction and inertia by separable least squares.
 
@@ -129,37 +210,57 @@ def fit_stribeck(velocity, acceleration, effort, *, fit_offset: bool = False,
     ----------
     velocity, acceleration, effort : ndarray, shape (n,)
         Velocity [mm/s], acceleration [mm/s^2], current [A] (or force [N]).
+    asymmetric : bool, default False
+        Separate Stribeck curve (``F_c``, ``F_s``, ``v_s``) and viscous
+        coefficient for positive and negative motion.
     fit_offset : bool, default False
         Fit a constant offset [A].
     v_s_range : (float, float), optional
-        Search range of ``v_s`` [mm/s]; :func:`velocity_range` of the data by default.
+        Search range of ``v_s`` [mm/s] (of both directions);
+        :func:`velocity_range` of the data by default.
 
     Returns
     -------
     dict
         ``J`` [A s^2/mm], ``coulomb`` ``F_c`` [A], ``static`` ``F_s`` [A],
         ``v_s`` [mm/s], ``viscous`` ``mu`` [A s/mm], ``offset`` [A] (0 when not
-        fitted) and ``sse`` (sum of squared residuals [A^2]). ``J``, ``F_c``,
-        ``F_s`` and ``mu`` are constrained non-negative.
+        fitted) and ``sse`` (sum of squared residuals [A^2]). If
+        ``asymmetric``, ``coulomb``, ``static``, ``v_s`` and ``viscous`` are
+        those of positive motion and ``coulomb_neg``, ``static_neg`` (level
+        magnitudes [A]), ``v_s_neg`` [mm/s] and ``viscous_neg`` [A s/mm] those
+        of negative motion. ``J`` and all friction levels and viscous
+        coefficients are constrained non-negative.
+
+    Raises
+    ------
+    ParameterError
+        If ``asymmetric`` and ``fit_offset`` are both requested (the offset is
+        then not separable from the two Stribeck curves).
     """
+    if asymmetric and fit_offset:
+        raise ParameterError("an offset and direction-dependent Stribeck curves are not separately "
+                             "identifiable; use asymmetric=True or fit_offset=True, not both")
     lo, hi = velocity_range(velocity) if v_s_range is None else v_s_range
-    lower, upper = _stribeck_bounds(fit_offset)
+    lower, upper = _stribeck_bounds(asymmetric, fit_offset)
 
     def sse(log_v_s):
-        a = stribeck_regressors(velocity, acceleration, float(np.exp(log_v_s)), fit_offset)
+        v_s = tuple(np.exp(log_v_s)) if asymmetric else float(np.exp(log_v_s))
+        a = stribeck_regressors(velocity, acceleration, v_s, fit_offset)
         residual = bounded_lstsq(a, effort, lower, upper)[1]
         return float(residual @ residual)
 
     grid = np.linspace(np.log(lo), np.log(hi), _N_GRID)
     with threadpool_limits(limits=1, user_api="blas"):  # tall-and-thin products: no gain from threads
-        costs = [sse(g) for g in grid]
-        best = int(np.argmin(costs))
-        left, right = grid[max(best - 1, 0)], grid[min(best + 1, _N_GRID - 1)]
-        refined = minimize_scalar(sse, bounds=(left, right), method="bounded", options={"xatol": 1e-6})
-        log_v_s = refined.x if refined.fun < costs[best] else grid[best]
-        v_s = float(np.exp(log_v_s))
+        if asymmetric:
+            v_s = tuple(float(value) for value in np.exp(_coordinate_search(sse, grid)))
+        else:
+            v_s = float(np.exp(_grid_search(sse, grid)[0]))
         x, residual = bounded_lstsq(stribeck_regressors(velocity, acceleration, v_s, fit_offset), effort,
                                     lower, upper)
     x = [float(value) for value in x]
+    if asymmetric:
+        return {"J": x[0], "coulomb": x[1], "static": x[2], "v_s": v_s[0], "viscous": x[5],
+                "coulomb_neg": x[3], "static_neg": x[4], "v_s_neg": v_s[1], "viscous_neg": x[6],
+                "offset": 0.0, "sse": float(residual @ residual)}
     return {"J": x[0], "coulomb": x[1], "static": x[2], "viscous": x[3], "v_s": v_s,
             "offset": x[4] if fit_offset else 0.0, "sse": float(residual @ residual)}

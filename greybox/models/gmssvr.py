@@ -176,6 +176,8 @@ class GMSSVRModel(KernelRegressionModel):
         self.fit_gms(logs, progress=progress)
         return self.fit_svr(logs, progress=progress)
 
+    first_stage_param = "gms"
+
     def first_stage(self) -> GMSModel:
         """Unfitted GMS stage: a clone of ``gms`` (``GMSModel()`` by default)."""
         return clone(GMSModel() if self.gms is None else self.gms)
