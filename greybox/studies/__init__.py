@@ -7,7 +7,9 @@
 - :mod:`greybox.studies.discovery`: hidden effects, null data and gap closure
   of the discovery workflow (``scripts/discovery_study.py``);
 - :mod:`greybox.studies.emps`: the EMPS benchmark's protocol on the real
-  ball-screw drive (``scripts/emps_benchmark.py``).
+  ball-screw drive (``scripts/emps_benchmark.py``);
+- :mod:`greybox.studies.arts`: the friction models on the real ARTS-Lab
+  dry-friction device with backlash (``scripts/arts_benchmark.py``).
 
 Besides :mod:`greybox.twin` itself, only this package, :mod:`greybox.control`
 and :mod:`greybox.cli` import the twin (``tests/test_import_graph.py``); the

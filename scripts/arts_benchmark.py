@@ -1,0 +1,53 @@
+"""The ARTS friction benchmark: greybox's friction models on a real dry-friction device with backlash.
+
+Runs the protocol of :mod:`greybox.studies.arts` (train on the 0.25 Hz test of
+each amplitude, test on the other excitations; RE and relerr of the modelled
+force) and prints the Markdown tables.
+
+Usage::
+
+    python scripts/arts_benchmark.py --json arts.json --markdown arts.md --plot arts.png
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from greybox.errors import GreyboxError
+from greybox.studies.arts import MODEL_NAMES, arts_benchmark
+
+#: Default data folder: ``$GREYBOX_REAL_DATA/ARTS_friction_damper``, else ``../shared/data/real/ARTS_friction_damper``
+#: beside the repository (as the tests look for it).
+DEFAULT_DATA = Path(os.environ.get("GREYBOX_REAL_DATA")
+                    or Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real") / "ARTS_friction_damper"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--json", required=True, type=Path, metavar="OUT", help="JSON results file")
+    parser.add_argument("--markdown", type=Path, metavar="MD", help="Markdown tables")
+    parser.add_argument("--plot", type=Path, metavar="PNG", help="figure of force against displacement")
+    parser.add_argument("--data", type=Path, default=DEFAULT_DATA, metavar="DIR",
+                        help="folder with test0.npy ... test12.npy (default: %(default)s)")
+    parser.add_argument("--models", nargs="+", choices=MODEL_NAMES, default=list(MODEL_NAMES), metavar="NAME",
+                        help=f"models to run (default: all of {', '.join(MODEL_NAMES)})")
+    parser.add_argument("--model-seed", type=int, default=0, help="seed of the multi-start identifications")
+    parser.add_argument("--quiet", action="store_true", help="no progress display")
+    parser.add_argument("--force", action="store_true", help="overwrite existing output files")
+    args = parser.parse_args(argv)
+    try:
+        table = arts_benchmark(args.data, args.json, markdown_path=args.markdown, plot_path=args.plot,
+                               names=args.models, seed=args.model_seed, progress=None if args.quiet else True,
+                               force=args.force)
+    except GreyboxError as error:
+        print(f"arts_benchmark: error: {error}", file=sys.stderr)
+        return 2
+    print(table, end="")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
