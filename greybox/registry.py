@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from .discover.augment import AugmentedModel
 from .friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from .friction.backlash import BacklashModel
 from .models.gmssvr import GMSSVRModel
 from .models.svr import SVRCurrentModel
 
@@ -24,10 +25,12 @@ MODEL_CLASSES: dict[str, type] = {
     "gmssvr": GMSSVRModel,
 }
 
-#: Kinds that other workflows produce and model files may hold, but ``greybox train`` does not
-#: offer: the base model plus named effects of ``greybox discover``.
+#: Kinds that wrap another model and model files may hold, but ``greybox train --model`` does not
+#: name: the base model plus named effects of ``greybox discover``, and any model behind a backlash
+#: (``greybox train --backlash``).
 DERIVED_MODEL_CLASSES: dict[str, type] = {
     "augmented": AugmentedModel,
+    "backlash": BacklashModel,
 }
 
 

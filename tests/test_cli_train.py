@@ -9,6 +9,8 @@ import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
+from greybox.friction import CoulombModel
+from greybox.friction.backlash import BacklashModel
 from greybox.persistence import load_model
 
 # Coulomb + viscous + offset truth: J [A s^2/mm], Fc [A], Fv [A s/mm], offset [A]
@@ -131,6 +133,23 @@ def test_emps_file_trains_an_asymmetric_gms_model(tmp_path, capsys, real_data):
     positive, negative = stiffness * model.s_inf_, stiffness * model.s_inf_neg_
     assert 5.0 < positive < 60.0 and 5.0 < negative < 60.0  # sliding levels of tens of newtons
     assert "s_inf_neg" in stdout and "viscous_neg" in stdout
+
+
+def test_backlash_wraps_the_model_and_identifies_its_width(tmp_path, capsys):
+    log = _run(0, n=3000)
+    truth = BacklashModel(base=CoulombModel(fit_offset=True), width=2.0).fit(prepare([log])[0])
+    assert truth.base_.coulomb_pos_ == pytest.approx(TRUTH["coulomb_pos_"], rel=0.05)
+    log = log.replace(effort=truth.predict(prepare([log])[0]))  # Coulomb friction behind 2 mm of backlash
+    log_path = tmp_path / "run.parquet"
+    write_log(log, log_path)
+    out = tmp_path / "backlash.gbm"
+    status, stdout, stderr = _train(capsys, "--model", "coulomb", "--offset", "--backlash", "--train", log_path,
+                                    "--out", out)
+    assert status == 0, stderr
+    assert "backlash width" in stderr  # progress of the width search
+    model = load_model(out)
+    assert type(model).__name__ == "BacklashModel" and type(model.base_).__name__ == "CoulombModel"
+    assert model.width_ == pytest.approx(2.0, rel=0.05) and "width" in stdout
 
 
 def test_existing_model_is_kept_unless_forced(tmp_path, capsys):

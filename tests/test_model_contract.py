@@ -26,6 +26,7 @@ from greybox.discover.augment import AugmentedModel
 from greybox.errors import GreyboxError
 from greybox.estimator import CurrentModel
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
+from greybox.friction.backlash import BacklashModel
 from greybox.models.chunked import predict_chunked
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
@@ -50,6 +51,9 @@ CASES = {
                                             effects=[("thermal_drift", 3.0), ("position_periodic_force", 10.0),
                                                      "inertia_mismatch", "constant_offset"]),
     "augmented-coulomb": lambda: AugmentedModel(base=CoulombModel(), effects=["stribeck", "position_trend"]),
+    "backlash-coulomb": lambda: BacklashModel(base=CoulombModel(fit_offset=True)),
+    "backlash-gms_asymmetric": lambda: BacklashModel(base=GMSModel(asymmetric=True, n_starts=1, max_iter=60),
+                                                     width=0.05),
     "augmented-gms_asymmetric": lambda: AugmentedModel(base=GMSModel(asymmetric=True, n_starts=1, max_iter=60),
                                                        refine_shapes=False, effects=["constant_offset"]),
 }

@@ -6,6 +6,7 @@ import argparse
 import json
 
 from ..errors import GreyboxError
+from ..friction.backlash import BacklashModel
 from ..registry import model_class
 from ._types import POSITIVE_INT, SEED
 
@@ -25,7 +26,7 @@ _MODEL_OPTIONS = (
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model options",
-                        settings: bool = True) -> None:
+                        settings: bool = True, backlash: bool = False) -> None:
     """Add the options that set the hyperparameters of the model a command builds.
 
     Parameters
@@ -36,6 +37,8 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
         Heading of the option group in ``--help``.
     settings : bool, default True
         Also offer ``--set NAME=VALUE`` for any hyperparameter.
+    backlash : bool, default False
+        Also offer ``--backlash`` (a model behind an identified backlash).
     """
     group = parser.add_argument_group(title)
     group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
@@ -45,6 +48,11 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
                        "and the GMS stage of gmssvr; not with --offset)")
     group.add_argument("--elements", type=POSITIVE_INT, metavar="N",
                        help="number of Maxwell-slip elements (gms and the GMS stage of gmssvr; default 4)")
+    if backlash:
+        group.add_argument("--backlash", action="store_true",
+                           help="put the model behind a backlash whose width is identified from the data: no force "
+                           "passes while the motion crosses the gap after the force changes sign (slow: one fit "
+                           "of the model per trial width, about 18)")
     group.add_argument("--model-seed", type=SEED, metavar="N",
                        help="seed of the identification: multi-start searches (lugre, gms) and SVR "
                        "subsets and hyperparameter search (svr, gmssvr); default 0")
@@ -60,6 +68,7 @@ def build_model(kind: str, args: argparse.Namespace):
     Options a command does not offer count as not given. An option the
     model does not take but its first stage does (``--asymmetric``,
     ``--elements``, ``--offset`` of gmssvr) is set on the first stage.
+    ``--backlash`` wraps the model in a :class:`BacklashModel`.
 
     Raises
     ------
@@ -92,7 +101,8 @@ def build_model(kind: str, args: argparse.Namespace):
             takes = ", ".join(offered.get(other, f"--set {other}=...") for other in sorted(accepted))
             raise CommandLineError(f"--set {name}=...: the {kind} model has no such hyperparameter; it takes {takes}")
         params[name] = parse_setting(text)
-    return model.set_params(**params)
+    model.set_params(**params)
+    return BacklashModel(base=model) if getattr(args, "backlash", False) else model
 
 
 #: Python's and JSON's spellings of the constants a ``--set`` value may be.

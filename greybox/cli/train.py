@@ -36,7 +36,7 @@ def add_parser(subparsers) -> None:
     )
     parser.add_argument("--out", required=True, metavar="MODEL", help="model file to write (.gbm)")
     parser.add_argument("--force", action="store_true", help="overwrite MODEL if it exists")
-    add_model_arguments(parser)
+    add_model_arguments(parser, backlash=True)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
     add_log_arguments(parser)
     parser.set_defaults(run=run)

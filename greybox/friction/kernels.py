@@ -39,6 +39,7 @@ __all__ = [
     "gms_friction_kernel",
     "gms_trajectory_kernel",
     "lugre_trajectory_kernel",
+    "backlash_gap_kernel",
 ]
 
 
@@ -390,3 +391,65 @@ def lugre_trajectory_kernel(velocity, sample_time, sigma0, curves, z0, z_out, z_
         z_dot_out[j] = v - lam * z
         z = lugre_exact_step(z, v, lam, sample_time)
     return z
+
+
+@njit(cache=True, error_model="numpy")
+def backlash_gap_kernel(position, force, width, threshold, gap_low, gap_high, loaded, in_gap_out):
+    """Where a backlash of ``width`` is crossed, given the force transmitted through it.
+
+    The gap is crossed when the transmitted force changes sign: once the force
+    has been at least ``threshold`` in one direction (``loaded`` = its sign)
+    and then reaches the other sign, the contact opens at the present motor
+    position ``x`` and the motor must travel ``width`` to the other face: the
+    gap spans ``[x - width, x]`` after a positive load, ``[x, x + width]``
+    after a negative one. The motor leaving the span on either side closes the
+    contact (then ``loaded`` is 0 until the force reaches ``threshold`` again).
+
+    Parameters
+    ----------
+    position : ndarray, shape (n,)
+        Motor-side position [mm].
+    force : ndarray, shape (n,)
+        Force through the backlash [A or N] (not read inside a gap).
+    width : float
+        Backlash [mm], non-negative.
+    threshold : float
+        Force that counts as a load [A or N], non-negative.
+    gap_low, gap_high : float
+        Span of an open gap before the first sample [mm]; NaN when in contact.
+    loaded : int
+        Sign of the last load (+1, -1, or 0 for none yet).
+    in_gap_out : ndarray of bool, shape (n,)
+        Receives True for the samples inside the gap.
+
+    Returns
+    -------
+    gap_low, gap_high : float
+        Span of the gap after the last sample (NaN when in contact).
+    loaded : int
+        Sign of the last load after the last sample.
+    """
+    for j in range(position.shape[0]):
+        x = position[j]
+        if gap_low == gap_low:  # a gap is open
+            if gap_low <= x <= gap_high:
+                in_gap_out[j] = True
+                continue
+            gap_low = np.nan
+            gap_high = np.nan
+            loaded = 0
+        f = force[j]
+        if loaded != 0 and f * loaded < 0.0:
+            if loaded > 0:
+                gap_low, gap_high = x - width, x
+            else:
+                gap_low, gap_high = x, x + width
+            loaded = 0
+            in_gap_out[j] = True
+            continue
+        if f >= threshold:
+            loaded = 1
+        elif f <= -threshold:
+            loaded = -1
+        in_gap_out[j] = False
+    return gap_low, gap_high, loaded

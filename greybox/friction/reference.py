@@ -110,3 +110,32 @@ def lugre_step_reference(z, v, sigma0, f_c, f_s, v_s, step):
         return z + v * step
     decay = math.exp(-lam * step)
     return z * decay + v * (1.0 - decay) / lam
+
+
+def backlash_gap_reference(position, force, width, threshold, gap_low, gap_high, loaded):
+    """Samples inside the backlash gap, sample by sample; returns ``(in_gap, gap_low, gap_high, loaded)``.
+
+    The gap opens where the force reaches the sign opposite to the last load
+    (a load being a force of at least ``threshold``), at the motor position
+    ``x``: ``[x - width, x]`` after a positive load, ``[x, x + width]`` after a
+    negative one; the motor leaving that span closes it. ``gap_low`` NaN: in contact.
+    """
+    in_gap = []
+    for x, f in zip(position, force):
+        x, f = float(x), float(f)
+        if not math.isnan(gap_low):
+            if gap_low <= x <= gap_high:
+                in_gap.append(True)
+                continue
+            gap_low, gap_high, loaded = math.nan, math.nan, 0
+        if loaded != 0 and f * loaded < 0.0:
+            gap_low, gap_high = (x - width, x) if loaded > 0 else (x, x + width)
+            loaded = 0
+            in_gap.append(True)
+            continue
+        if f >= threshold:
+            loaded = 1
+        elif f <= -threshold:
+            loaded = -1
+        in_gap.append(False)
+    return in_gap, gap_low, gap_high, loaded

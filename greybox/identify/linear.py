@@ -67,5 +67,6 @@ def bounded_lstsq(a: np.ndarray, b: np.ndarray, lower=None, upper=None) -> tuple
             r_mat = root[:, None] * eigvec.T
             d_vec = (eigvec.T @ rhs) / root
             x_scaled = lsq_linear(r_mat, d_vec, bounds=(lo, hi), method="bvls").x
-        x[active] = x_scaled * inv
+        # bvls may end a rounding error outside a bound (e.g. -3e-13 for a stiffness bounded at 0)
+        x[active] = np.clip(x_scaled * inv, lower[active], upper[active])
     return x, a @ x - b
