@@ -33,7 +33,7 @@ import numpy as np
 
 from greybox.friction import GMSModel
 from greybox.friction.gms import GMSState, simulate_gms
-from greybox.friction.kernels import gms_friction_kernel
+from greybox.friction.kernels import direction_curves, gms_friction_kernel
 from greybox.friction.reference import gms_reference
 from greybox.friction.signals import STEP, motion_log, velocity_profile
 
@@ -56,7 +56,9 @@ def bench_velocity(n_steps: int) -> np.ndarray:
 def numba_runner(velocity, p):
     """Callable timing one run of the numba kernel [ns/step]; the kernel is compiled (or loaded) first."""
     rest = GMSState.at_rest(p["alpha"].size)
-    args = (STEP, p["alpha"], p["k"], p["sigma"], p["s_0"], p["s_inf"], p["v_s"], p["C"], p["mu"], rest.z, rest.mode)
+    curves = direction_curves((p["s_0"],) * 2, (p["s_inf"],) * 2, (p["v_s"],) * 2)  # the same in both directions
+    viscous = np.full(2, p["mu"])
+    args = (STEP, p["alpha"], p["k"], p["sigma"], curves, p["C"], viscous, rest.z, rest.mode)
     gms_friction_kernel(velocity[:10], *args)
     output = {}
 

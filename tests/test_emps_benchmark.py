@@ -88,16 +88,29 @@ def test_benchmark_samples_and_the_2ms_grid(logs, emps):
     assert np.isin(coarse.time, full.time).all()
 
 
+def test_every_friction_model_runs_symmetric_and_asymmetric():
+    for name in ("stribeck", "lugre", "gms"):
+        assert name in bench.MODEL_NAMES and f"{name}_asym" in bench.MODEL_NAMES
+        symmetric, step, _ = bench.GREYBOX_MODELS[name]
+        factory, asym_step, description = bench.GREYBOX_MODELS[f"{name}_asym"]
+        assert symmetric(7).fit_offset and not symmetric(7).asymmetric
+        model = factory(7)  # an asymmetric model takes no offset (it would not be identifiable)
+        assert model.asymmetric and not model.fit_offset
+        assert asym_step == step == 1 and "asymmetric" in description
+        if name != "stribeck":
+            assert model.random_state == 7  # --model-seed reaches the multi-start identification
+
+
 def test_script_writes_json_markdown_and_plot(tmp_path, emps):
     out, md, png = tmp_path / "emps.json", tmp_path / "emps.md", tmp_path / "emps.png"
     result = subprocess.run(
         [sys.executable, str(SCRIPT), "--data", str(emps), "--json", str(out), "--markdown", str(md),
-         "--plot", str(png), "--models", "coulomb_idim_ls", "coulomb", "stribeck", "--quiet"],
+         "--plot", str(png), "--models", "coulomb_idim_ls", "coulomb", "stribeck", "stribeck_asym", "--quiet"],
         capture_output=True, text=True, cwd=tmp_path, timeout=300,
     )
     assert result.returncode == 0, result.stderr
     models = json.loads(out.read_text())["models"]
-    assert list(models) == ["coulomb_idim_ls", "coulomb", "stribeck"]
+    assert list(models) == ["coulomb_idim_ls", "coulomb", "stribeck", "stribeck_asym"]
     for entry in models.values():
         assert 0 < entry["train_relerr"] < 10 and 0 < entry["test_relerr"] < 10
         assert entry["params"]
@@ -105,7 +118,11 @@ def test_script_writes_json_markdown_and_plot(tmp_path, emps):
     # the greybox models' parameters are their parameter tables: every value with its unit
     assert set(models["stribeck"]["units"]) == set(models["stribeck"]["params"])
     assert models["stribeck"]["units"]["v_s"] == "mm/s" and models["coulomb"]["units"]["offset"] == "N"
-    assert "| `stribeck` |" in md.read_text()
+    # the asymmetric model: a sliding curve and a viscous coefficient per direction, no offset
+    asym = models["stribeck_asym"]
+    assert asym["units"]["viscous_neg"] == "N s/mm" and "v_s_neg" in asym["params"] and asym["params"]["offset"] == 0.0
+    assert asym["n_params"] > models["stribeck"]["n_params"]
+    assert "| `stribeck` |" in md.read_text() and "| `stribeck_asym` | asymmetric" in md.read_text()
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
 
