@@ -19,7 +19,8 @@ from scipy.signal import butter, sosfiltfilt
 
 from greybox.data.arts import read_arts
 from greybox.errors import GreyboxError, LogError
-from greybox.friction import CoulombModel, StribeckModel
+from greybox.friction import CoulombModel, GMSModel, StribeckModel
+from greybox.friction.backlash import BacklashModel
 from greybox.studies import arts as bench
 
 REPO = Path(__file__).resolve().parents[1]
@@ -162,6 +163,16 @@ def test_subset_study_writes_its_files_and_reports_the_re_of_its_predictions(tmp
     assert md.read_text().startswith(table) and "Measured with greybox" in md.read_text()
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
+
+
+def test_a_model_behind_a_backlash_reports_its_width_and_offset(tmp_path, arts, monkeypatch):
+    quick = BacklashModel(base=GMSModel(fit_offset=True, n_starts=1, max_iter=30), width=3.0)
+    monkeypatch.setitem(bench.MODELS, "gms_backlash", (lambda seed: quick, "stand-in"))
+    out = tmp_path / "arts.json"
+    bench.arts_benchmark(arts, out, names=["gms_backlash"], train=["test1.npy"], test=["test4.npy"])
+    entry = json.loads(out.read_text())["models"]["gms_backlash"]
+    assert entry["fit_offset"] is True and entry["params"]["width"] == 3.0
+    assert entry["n_params"] == quick.base_.n_params  # a given width is not a fitted parameter
 
 
 def test_the_run_checks_names_split_and_files_before_reading(tmp_path, arts):

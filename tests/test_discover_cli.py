@@ -96,3 +96,15 @@ def test_effects_option_restricts_the_library(logs, tmp_path):
     assert document["settings"]["candidates"] == ["constant_offset", "thermal_drift"]
     assert all(entry["name"] in ("constant_offset", "thermal_drift") for entry in document["effects"])
     assert np.isfinite(document["test_rmse_before"])
+
+
+def test_an_asymmetric_base_is_discovered_on(logs, tmp_path):
+    model_path = tmp_path / "model.gbm"
+    status = run_cli(["--model", "stribeck", "--asymmetric", "--train", logs[0], "--test", logs[1],
+                      "--json", str(tmp_path / "found.json"), "--save-model", str(model_path), "--quiet",
+                      "--max-effects", "1"])
+    assert status == 0
+    loaded = load_model(model_path)
+    assert loaded.base_.asymmetric and loaded.base_.coulomb_neg_ > 0.0
+    names = [row.name for row in loaded.parameter_table()]
+    assert "base.coulomb_neg" in names and "base.v_s_neg" in names

@@ -182,7 +182,9 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None, *
         model.fit([logs[file] for file in train], progress=progress)
         predictions = {file: model.predict(log) for file, log in logs.items()}
         values, units = learned_parameters(model)
-        entry = {"description": MODELS[name][1], "fit_offset": bool(model.fit_offset)}
+        settings = model.get_params(deep=True)  # a model behind a backlash has its settings under base__
+        entry = {"description": MODELS[name][1],
+                 "fit_offset": bool(settings.get("fit_offset", settings.get("base__fit_offset")))}
         for role, files in (("train", train), ("test", test)):
             entry[role] = metrics_table(np.concatenate([logs[file].effort for file in files]),
                                         np.concatenate([predictions[file] for file in files]))
@@ -238,10 +240,12 @@ def plot_loops(curves: dict, names, path: Path) -> None:
     """Force against displacement (top) and time (bottom), measured and modelled, on :data:`PLOT_FILES`.
 
     One column per plotted test file (one per amplitude), all samples of the
-    file; up to four models (Stribeck, LuGre, GMS, asymmetric GMS if run).
+    file; the models Stribeck, LuGre, asymmetric GMS and the two GMS behind a backlash, those of them
+    that ran (else the first four run).
     """
     plt = import_pyplot(path)
-    shown = [n for n in ("stribeck", "lugre", "gms", "gms_asym") if n in names] or list(names)[:4]
+    preferred = ("stribeck", "lugre", "gms_asym", "gms_backlash", "gms_asym_backlash")
+    shown = [n for n in preferred if n in names] or list(names)[:4]
     files = [file for file in PLOT_FILES if file in curves] or list(curves)[-3:]
     fig, axes = plt.subplots(2, len(files), figsize=(6 * len(files), 10), constrained_layout=True, squeeze=False)
     for column, file in enumerate(files):
