@@ -274,6 +274,25 @@ def test_real_models_round_trip_bit_identically(tmp_path, model):
     assert loaded.predict(train).tobytes() == model.predict(train).tobytes()
 
 
+@pytest.mark.parametrize("kind", ["stribeck", "lugre", "gms"])
+def test_symmetric_model_files_from_before_the_asymmetric_option_still_load(tmp_path, kind):
+    """Files written before ``asymmetric`` existed lack it (and every ``_neg_`` attribute): they load as symmetric."""
+    model = registry.model_class(kind)(**({"max_iter": 40, "n_starts": 1} if kind != "stribeck" else {}))
+    train, test = [_axis_run(0)], _axis_run(2)
+    model.fit(train)
+    path = save_model(model, tmp_path / "old.gbm")
+
+    def as_before(document):
+        entry = document["model"]
+        assert entry["params"].pop("asymmetric") is False
+        assert not any(name.endswith("_neg_") for name in entry["attributes"])
+
+    _rewrite_json(path, as_before)
+    loaded = load_model(path)
+    assert loaded.asymmetric is False
+    assert loaded.predict(test).tobytes() == model.predict(test).tobytes()
+
+
 def test_registry_names_every_current_model():
     from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
     from greybox.models.gmssvr import GMSSVRModel

@@ -35,7 +35,7 @@ from ..identify.initial import (
 )
 from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_search_settings, local_search, multistart, multistart_results
-from ..identify.static import velocity_range
+from ..identify.static import check_direction_settings, velocity_range
 from .directions import direction_pair, viscous_columns
 from .kernels import direction_curves, gms_friction_kernel, gms_trajectory_kernel
 from .plant_laws import gms_plant_law
@@ -440,9 +440,7 @@ class GMSModel(CurrentModel):
         if not (isinstance(n, (int, np.integer)) and not isinstance(n, bool) and n >= 1):
             raise ParameterError(f"n_elements must be a positive integer, got {n!r}")
         self._check_flags("asymmetric", "fit_offset", "staged")
-        if self.asymmetric and self.fit_offset:
-            raise ParameterError("an offset and direction-dependent sliding levels are not separately "
-                                 "identifiable: choose asymmetric or fit_offset, not both")
+        check_direction_settings(self.asymmetric, self.fit_offset)
         check_search_settings(self)
 
     def _fit_runs(self, runs, progress) -> None:

@@ -16,7 +16,7 @@ from ..identify.initial import (
 )
 from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_search_settings, local_search, multistart
-from ..identify.static import fit_stribeck, velocity_range
+from ..identify.static import check_direction_settings, fit_stribeck, velocity_range
 from .directions import direction_pair, viscous_columns
 from .kernels import direction_curves, lugre_trajectory_kernel
 from .plant_laws import lugre_plant_law
@@ -280,9 +280,7 @@ class LuGreModel(CurrentModel):
 
     def _check_params(self) -> None:
         self._check_flags("fit_offset", "asymmetric")
-        if self.asymmetric and self.fit_offset:
-            raise ParameterError("an offset and direction-dependent friction levels are not separately "
-                                 "identifiable: choose asymmetric or fit_offset, not both")
+        check_direction_settings(self.asymmetric, self.fit_offset)
         check_search_settings(self)
 
     def _fit_runs(self, runs, progress) -> None:

@@ -9,7 +9,7 @@ from ..curves import stribeck_curve
 from ..errors import ParameterError
 from ..estimator import CurrentModel
 from ..identify.initial import check_motion, samples_at_speed
-from ..identify.static import fit_stribeck, stribeck_regressors
+from ..identify.static import check_direction_settings, fit_stribeck, stribeck_regressors
 
 __all__ = ["StribeckModel", "stribeck_curve"]
 
@@ -76,9 +76,7 @@ class StribeckModel(CurrentModel):
 
     def _check_params(self) -> None:
         self._check_flags("asymmetric", "fit_offset")
-        if self.asymmetric and self.fit_offset:
-            raise ParameterError("an offset and direction-dependent Stribeck curves are not separately "
-                                 "identifiable: choose asymmetric or fit_offset, not both")
+        check_direction_settings(self.asymmetric, self.fit_offset)
         if not (np.isfinite(self.min_speed) and self.min_speed >= 0.0):
             raise ParameterError(f"min_speed must be a non-negative speed, got {self.min_speed} mm/s")
 

@@ -29,7 +29,7 @@ from threadpoolctl import threadpool_limits
 from ..errors import ParameterError
 from .linear import bounded_lstsq
 
-__all__ = ["fit_coulomb", "fit_stribeck", "stribeck_regressors", "velocity_range"]
+__all__ = ["check_direction_settings", "fit_coulomb", "fit_stribeck", "stribeck_regressors", "velocity_range"]
 
 #: Number of log-spaced Stribeck velocities tried before the local refinement.
 _N_GRID = 40
@@ -37,6 +37,17 @@ _N_GRID = 40
 _XATOL = 1e-6
 #: Most rounds of the coordinate search of the two Stribeck velocities of the asymmetric model.
 _MAX_ROUNDS = 20
+
+
+def check_direction_settings(asymmetric: bool, fit_offset: bool) -> None:
+    """Raise :class:`ParameterError` if direction-dependent friction and an offset are both asked for.
+
+    An offset shifts the mean of the two directions' sliding levels, which
+    the two levels already set: the three are not separately identifiable.
+    """
+    if asymmetric and fit_offset:
+        raise ParameterError("an offset and direction-dependent friction levels are not separately "
+                             "identifiable: choose asymmetric or fit_offset, not both")
 
 
 def velocity_range(velocity: np.ndarray) -> tuple[float, float]:
@@ -87,9 +98,7 @@ def fit_coulomb(velocity, acceleration, effort, *, asymmetric: bool = False,
         If ``asymmetric`` and ``fit_offset`` are both requested (the offset is
         then not separable from the two Coulomb levels).
     """
-    if asymmetric and fit_offset:
-        raise ParameterError("an offset and direction-dependent Coulomb levels are not separately "
-                             "identifiable; use asymmetric=True or fit_offset=True, not both")
+    check_direction_settings(asymmetric, fit_offset)
     v = np.asarray(velocity, dtype=float)
     positive = (v > 0.0).astype(float)
     negative = (v < 0.0).astype(float)
@@ -237,9 +246,7 @@ def fit_stribeck(velocity, acceleration, effort, *, asymmetric: bool = False, fi
         If ``asymmetric`` and ``fit_offset`` are both requested (the offset is
         then not separable from the two Stribeck curves).
     """
-    if asymmetric and fit_offset:
-        raise ParameterError("an offset and direction-dependent Stribeck curves are not separately "
-                             "identifiable; use asymmetric=True or fit_offset=True, not both")
+    check_direction_settings(asymmetric, fit_offset)
     lo, hi = velocity_range(velocity) if v_s_range is None else v_s_range
     lower, upper = _stribeck_bounds(asymmetric, fit_offset)
 
