@@ -36,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from ..base import PlantLaw
+from .directions import direction_pair
 from .kernels import direction_curves, gms_element_step, gms_sample, lugre_decay_rate, lugre_exact_step, viscous_at
 
 __all__ = [
@@ -147,7 +148,8 @@ def gms_plant_law(*, alpha, k, sigma, s_0, s_inf, v_s, c, mu, inertia, offset) -
     """
     alpha = np.asarray(alpha, dtype=float)
     k = np.asarray(k, dtype=float)
-    s_0, s_inf, v_s, mu = (np.broadcast_to(np.asarray(x, dtype=float), (2,)) for x in (s_0, s_inf, v_s, mu))
+    s_0, s_inf, v_s, mu = (direction_pair(x, f"GMS {name}") for x, name in ((s_0, "s_0"), (s_inf, "s_inf"),
+                                                                          (v_s, "v_s"), (mu, "mu")))
     c = float(c)
     head = np.concatenate((mu, [float(sigma), c], direction_curves(s_0, s_inf, v_s).ravel()))
     parameters = np.ascontiguousarray(np.concatenate((head, alpha, k)))
@@ -203,8 +205,8 @@ def lugre_plant_law(*, sigma0, sigma1, sigma2, coulomb, static, v_s, inertia, of
     PlantLaw
         Its internal step is stable for ``sigma0`` and ``sigma1 + max sigma2`` on the inertia.
     """
-    sigma2, coulomb, static, v_s = (np.broadcast_to(np.asarray(x, dtype=float), (2,))
-                                    for x in (sigma2, coulomb, static, v_s))
+    sigma2, coulomb, static, v_s = (direction_pair(x, f"LuGre {name}") for x, name in (
+        (sigma2, "sigma2"), (coulomb, "Coulomb level"), (static, "static level"), (v_s, "v_s")))
     parameters = np.concatenate(([float(sigma0), float(sigma1)], sigma2,
                                  direction_curves(static, coulomb, v_s).ravel()))
     step = stable_step(inertia, float(sigma0), float(sigma1 + sigma2.max()))
