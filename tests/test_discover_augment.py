@@ -29,10 +29,10 @@ def test_joint_fit_is_one_least_squares_solve_over_base_and_terms(stroke):
     run = stroke.replace(effort=coulomb_current(stroke) + 0.1 + rng.normal(0, 0.05, len(stroke)))
     model = AugmentedModel(base=CoulombModel(), effects=[("constant_offset", None), ("thermal_drift", 7.0)],
                            refine_shapes=False, refit_base=False).fit(run)
-    context = model.context
+    context, (carried,) = model.context, model.with_base_friction(run)  # friction terms scale the base's friction
     columns = np.column_stack([model.base_.linear_part(run).columns,
-                               effect("constant_offset").columns(run, context),
-                               effect("thermal_drift").columns(run, context, 7.0)])
+                               effect("constant_offset").columns(carried, context),
+                               effect("thermal_drift").columns(carried, context, 7.0)])
     expected, *_ = np.linalg.lstsq(columns, run.effort, rcond=None)
     np.testing.assert_allclose(model.linear_coefficients(), expected, rtol=1e-8, atol=1e-12)
     np.testing.assert_allclose(model.predict(run), columns @ expected, atol=1e-10)
@@ -51,9 +51,10 @@ def test_inertia_mismatch_is_reported_in_the_inertia(stroke):
 
 @pytest.mark.parametrize("name, period", [("position_periodic_friction", 6.0), ("position_periodic_force", 2.5)])
 def test_a_periodic_term_recovers_period_amplitude_and_phase(stroke, name, period):
-    context = AugmentedModel(base=CoulombModel()).fit(stroke.replace(effort=coulomb_current(stroke))).context
+    plain = AugmentedModel(base=CoulombModel()).fit(stroke.replace(effort=coulomb_current(stroke)))
     amplitude, phase = 0.08, -0.7
-    hidden = effect(name).current(stroke, context, amplitude * np.array([np.cos(phase), np.sin(phase)]), period)
+    hidden = effect(name).current(plain.with_base_friction(stroke)[0], plain.context,
+                                  amplitude * np.array([np.cos(phase), np.sin(phase)]), period)
     rng = np.random.default_rng(1)
     run = stroke.replace(effort=coulomb_current(stroke) + hidden + rng.normal(0, 0.03, len(stroke)))
     model = AugmentedModel(base=CoulombModel(), effects=[(name, None)]).fit(run)
@@ -109,9 +110,10 @@ def test_saved_model_predicts_identically(stroke, tmp_path, monkeypatch):
 
 
 def test_two_terms_of_one_periodic_effect_stay_apart(stroke):
-    context = AugmentedModel(base=CoulombModel()).fit(stroke.replace(effort=coulomb_current(stroke))).context
-    hidden = effect("position_periodic_friction").current(stroke, context, [0.05, 0.0], 6.0) \
-        + effect("position_periodic_friction").current(stroke, context, [0.0, 0.04], 3.0)
+    plain = AugmentedModel(base=CoulombModel()).fit(stroke.replace(effort=coulomb_current(stroke)))
+    context, (carried,) = plain.context, plain.with_base_friction(stroke)
+    hidden = effect("position_periodic_friction").current(carried, context, [0.05, 0.0], 6.0) \
+        + effect("position_periodic_friction").current(carried, context, [0.0, 0.04], 3.0)
     rng = np.random.default_rng(5)
     run = stroke.replace(effort=coulomb_current(stroke) + hidden + rng.normal(0, 0.02, len(stroke)))
     model = AugmentedModel(base=CoulombModel(), effects=[("position_periodic_friction", 6.0),

@@ -108,3 +108,38 @@ def test_an_asymmetric_base_is_discovered_on(logs, tmp_path):
     assert loaded.base_.asymmetric and loaded.base_.coulomb_neg_ > 0.0
     names = [row.name for row in loaded.parameter_table()]
     assert "base.coulomb_neg" in names and "base.v_s_neg" in names
+
+
+def test_held_out_options_are_checked(logs, tmp_path):
+    out = str(tmp_path / "a.json")
+    with pytest.raises(GreyboxError, match="--held-out-blocks must be at least 2"):
+        run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", out, "--held-out-blocks", "1"])
+    with pytest.raises(SystemExit):  # argparse: a fraction in [0, 1) only
+        run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", out, "--min-gain", "1.5"])
+
+
+def test_base_misfit_is_reported_and_its_curve_saved(tmp_path, capsys):
+    # a Stribeck excess hidden on a Coulomb plant: the Coulomb base's own law misfits
+    directory = tmp_path / "logs"
+    directory.mkdir()
+    train, test, _ = case_logs(StudyCase("stribeck", 1.5, 2, "coulomb", 15.0))
+    paths = []
+    for name, log in (("train.csv", train), ("test.csv", test)):
+        write_log(log.replace(acceleration=None, extras={}, attrs={}), directory / name)
+        paths.append(str(directory / name))
+    out, model = tmp_path / "found.json", tmp_path / "model.gbm"
+    assert run_cli(["--model", "coulomb", "--train", paths[0], "--test", paths[1], "--json", str(out),
+                    "--save-model", str(model), "--quiet"]) == 0
+    document = json.loads(out.read_text())
+    assert document["verdict"] == "base_misfit" and document["effects"] == []
+    assert document["base_misfit"]["detected"] and document["base_misfit"]["held_out"]["passes"]
+    assert document["base_misfit"]["parameters"]["excess_at_rest_A"] > 0.0
+    assert document["test_rmse_after"] < document["test_rmse_before"]
+    assert load_model(model).effects_[0]["name"] == "velocity_curve"
+    assert "base misfit: the base model's friction along the speed is off" in capsys.readouterr().out
+    # without the refinement the same excess is a named Stribeck effect
+    assert run_cli(["--model", "coulomb", "--train", paths[0], "--test", paths[1], "--json", str(out), "--force",
+                    "--quiet", "--no-refine-base", "--max-effects", "1"]) == 0
+    document = json.loads(out.read_text())
+    assert [entry["name"] for entry in document["effects"]] == ["stribeck"]
+    assert document["base_misfit"] is None and document["settings"]["refine_base"] is False

@@ -30,7 +30,7 @@ def sine_stroke(n=6000, step=0.002, seed=0):
 
 def evidence(run, names, context=None, seed=0):
     model = AugmentedModel(base=CoulombModel()).fit(run)
-    return score_step([run], model.linear_part([run]), context or model.context, names,
+    return score_step(model.with_base_friction([run]), model.linear_part([run]), context or model.context, names,
                       rng=np.random.default_rng(seed), n_null=49)
 
 

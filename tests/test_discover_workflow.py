@@ -13,7 +13,7 @@ import json
 import numpy as np
 import pytest
 
-from greybox.discover.effects import EFFECT_NAMES
+from greybox.discover.effects import EFFECT_NAMES, VELOCITY_ONLY
 from greybox.discover.report import write_json
 from greybox.discover.workflow import VERDICTS, discover
 from greybox.errors import GreyboxError
@@ -32,7 +32,8 @@ def test_null_data_give_nothing_missing():
 @pytest.mark.parametrize("name", [name for name in EFFECT_NAMES if name not in ABSORBED])
 def test_a_hidden_effect_is_named_first_and_closes_the_gap_like_the_true_term(name):
     row = run_case(CoulombModel(), StudyCase(name, 1.0, 1, "coulomb", DURATION_S))
-    assert row["verdict"] == "named" and row["first_correct"], row
+    # a velocity-only effect is what the base refinement's velocity curve spans: found as base misfit
+    assert row["verdict"] == ("base_misfit" if name in VELOCITY_ONLY else "named") and row["first_correct"], row
     assert row["closure"] >= 0.8, row
     assert row["rmse_after"] < row["rmse_before"]
 
@@ -44,10 +45,11 @@ def test_effects_the_base_already_has_are_not_named():
 
 
 def test_structure_outside_the_library_is_reported_as_unexplained():
-    # friction that grows only while accelerating forwards: no library effect has this shape
+    # friction that grows only while accelerating forwards: no library effect has this shape; strong enough
+    # (about the noise RMS) to hold on held-out blocks
     train, test, _ = case_logs(StudyCase(None, 0.0, 1, "coulomb", DURATION_S))
     def add(run):
-        return run.replace(effort=run.effort + 3e-4 * np.maximum(run.acceleration, 0.0))
+        return run.replace(effort=run.effort + 3e-3 * np.maximum(run.acceleration, 0.0))
 
     result = discover(CoulombModel(), add(train), add(test), seed=1)
     assert result.verdict == "unexplained_structure"

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..atomic import check_output_path
 from ..discover.effects import EFFECT_NAMES
+from ..discover.heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN
 from ..discover.report import REPORT_FILES, write_json, write_report
 from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError
@@ -54,6 +55,14 @@ def add_parser(subparsers) -> None:
     workflow.add_argument("--seed", type=SEED, default=0, metavar="N", help="seed of the null simulations (default 0)")
     workflow.add_argument("--no-refit-base", action="store_true",
                           help="keep the base model's nonlinear shape when effects are added (faster)")
+    workflow.add_argument("--no-refine-base", action="store_true",
+                          help="do not refine the base model with a friction curve along the speed before naming "
+                          "effects (then stribeck and viscous_friction are candidates; see docs/discover.md)")
+    workflow.add_argument("--held-out-blocks", type=POSITIVE_INT, default=DEFAULT_BLOCKS, metavar="K",
+                          help=f"blocks of training time for the held-out test, at least 2 (default {DEFAULT_BLOCKS})")
+    workflow.add_argument("--min-gain", type=FRACTION, default=DEFAULT_MIN_GAIN, metavar="F",
+                          help="smallest share of the held-out residual's sum of squares an effect must remove to "
+                          f"be named (default {DEFAULT_MIN_GAIN:g})")
     add_model_arguments(parser, title="base model options", settings=False)
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_log_arguments(parser)
@@ -100,8 +109,22 @@ def _print_summary(result) -> None:
         print(f"     explains {100 * evidence['explained_fraction']:.2f} % of the residual at step "
               f"{evidence['step']} (passes beyond {100 * (evidence['threshold_fraction'] or np.inf):.3f} %, "
               f"p = {evidence['p_value']:.3f}); the joint refit {100 * evidence['refit_explained_fraction']:.2f} %")
+        held = evidence["held_out"]
+        print(f"     on held-out blocks of the training time it removes {100 * held['gain']:.2f} +- "
+              f"{100 * held['uncertainty']:.2f} % of the residual's sum of squares "
+              f"(needed: {100 * held['margin']:.2f} %)")
         if evidence["indistinguishable_from"]:
             print(f"     the data cannot tell it apart from: {', '.join(evidence['indistinguishable_from'])}")
+    misfit = result.base_misfit
+    if misfit and misfit["detected"]:
+        curve = misfit.get("held_out")
+        if misfit.get("parameters"):
+            print(f"  base misfit: the base model's friction along the speed is off; a flexible curve removes "
+                  f"{100 * curve['gain']:.2f} +- {100 * curve['uncertainty']:.2f} % of the held-out residual and is "
+                  f"kept ({_format_parameters(misfit['parameters'])})")
+        else:
+            print("  base misfit: the structure left lies along the velocity or the time since the motion changed "
+                  "(or does not hold on held-out blocks): the base model's own friction law misfits")
     last = result.steps[-1]
     if last.structure.passes:
         where = sorted(last.families.items(), key=lambda item: -item[1]["explained_fraction"])
@@ -109,7 +132,11 @@ def _print_summary(result) -> None:
               + ", ".join(f"{name} {100 * value['explained_fraction']:.2f} %" for name, value in where[:3]
                           if value["p_value"] <= last.alpha) + ")")
     for rejected in result.rejected:
-        print(f"  {rejected['name']} passed but its joint refit explained no more than chance: dropped")
+        if rejected["reason"] == "held_out":
+            print(f"  {rejected['name']} passed the null test but not the held-out test "
+                  f"({'; '.join(rejected['held_out']['reasons'])}): not named")
+        else:
+            print(f"  {rejected['name']} passed but its joint refit explained no more than chance: dropped")
     for label, gap in (("train", result.train), ("test", result.test)):
         if not gap:
             continue
@@ -128,6 +155,8 @@ def run(args: argparse.Namespace) -> int:
         least = int(np.ceil(1.0 / args.alpha)) - 1
         raise CommandLineError(f"--alpha {args.alpha:g} with --null-replicates {args.null_replicates} can never name "
                                f"an effect: give --null-replicates {least} or more, or a larger --alpha")
+    if args.held_out_blocks < 2:
+        raise CommandLineError(f"--held-out-blocks must be at least 2, got {args.held_out_blocks}")
     _check_outputs(args)
     names = _candidates(args.effects)
     base = build_model(args.model, args)
@@ -142,6 +171,8 @@ def run(args: argparse.Namespace) -> int:
     test = read_logs(args, args.test)
     result = discover(base, train, test, candidates=names, max_effects=args.max_effects, alpha=args.alpha,
                       n_null=args.null_replicates, seed=args.seed, refit_base=not args.no_refit_base,
+                      refine_base=not args.no_refine_base, held_out_blocks=args.held_out_blocks,
+                      min_gain=args.min_gain,
                       progress=say, fit_progress=None if args.quiet else ProgressPrinter(interval=5.0))
     document = result.to_dict()
     document["logs"] = {"train": [str(p) for p in args.train], "test": [str(p) for p in args.test]}

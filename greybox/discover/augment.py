@@ -13,7 +13,15 @@
    bounded scalar search of that fit's residual, one grid step around their
    start value;
 3. with ``refit_base``, the base is identified again on the effort minus the
-   terms (its shape may now move), and step 2 is repeated.
+   terms (its shape may now move), and step 2 is repeated; the new shape is
+   kept if the joint fit is then better.
+
+Friction terms scale the friction of the base as identified in step 1 (or 3),
+over its level (:meth:`~greybox.discover.effects.EffectContext.friction_shape`):
+a friction that changes along the travel or with time is the base's friction
+law scaled, its Stribeck curve and pre-sliding included. That base is held
+(``friction_shape_base_``) while the joint solve moves the base's linear
+parameters, so that the solve stays one linear least-squares problem.
 
 The prediction is ``J a + base friction + sum of terms + offset``. A
 ``constant_offset`` term is reported in ``offset_`` and an
@@ -41,7 +49,7 @@ from ..estimator import CurrentModel, check_runs
 from ..friction.gms import GMSModel
 from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
-from .effects import PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
+from .effects import BASE_FRICTION, PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
 from .projection import Nuisance, PositionScan, added_squares
 
 __all__ = ["AugmentedModel", "normalise_effects"]
@@ -111,6 +119,15 @@ class AugmentedModel(CurrentModel):
         One entry per term: ``name``, ``shape`` (or None), ``coefficients``
         (one per column of the effect) and ``parameters`` (physical values,
         names ending in their unit).
+    friction_level_ : float or None
+        Level of the base model's friction on the training runs [A, or N]
+        (90th percentile of ``|F|``): friction terms scale the friction of
+        ``friction_shape_base_`` over this level (see
+        :meth:`EffectContext.friction_shape`). None in files written before it
+        existed: the terms then scale the direction of motion.
+    friction_shape_base_ : CurrentModel or None
+        The base model as identified (before the joint solve moved its linear
+        parameters), whose friction the friction terms scale.
     velocity_scale_mm_s_ : float
         ``v_e`` used [mm/s].
     position_range_mm_ : tuple of float
@@ -174,16 +191,26 @@ class AugmentedModel(CurrentModel):
         return self
 
     def _fit_terms(self, runs: list[AxisLog], base, progress) -> None:
-        context = EffectContext.from_runs(runs, self.velocity_scale_mm_s)
+        context = replace(EffectContext.from_runs(runs, self.velocity_scale_mm_s),
+                          friction_level=_friction_level(runs, base))
         terms = [(effect(name), shape) for name, shape in normalise_effects(self.effects)]
         target = np.concatenate([run.effort for run in runs])
         with threadpool_limits(limits=1, user_api="blas"):
-            shapes, coefficients = self._joint_fit(runs, base, context, terms, [s for _, s in terms], target)
+            shape_base = copy.deepcopy(base)
+            carried = _with_friction(runs, shape_base)
+            shapes, coefficients = self._joint_fit(carried, base, context, terms, [s for _, s in terms], target)
             if self.refit_base and terms:
-                term_current = self._term_currents(runs, context, terms, shapes, coefficients)
+                term_current = self._term_currents(carried, context, terms, shapes, coefficients)
                 shifted = [run.replace(effort=run.effort - part) for run, part in zip(runs, term_current)]
-                base = clone(self._template()).fit(shifted, progress=progress)
-                shapes, coefficients = self._joint_fit(runs, base, context, terms, shapes, target)
+                new_base = clone(self._template()).fit(shifted, progress=progress)
+                new_shape_base = copy.deepcopy(new_base)
+                new_carried = _with_friction(runs, new_shape_base)
+                new_shapes, new_coefficients = self._joint_fit(new_carried, new_base, context, terms, shapes, target)
+                # the base's new shape also changes the friction the terms scale: keep it only if it fits better
+                before = _squares(base, carried, context, terms, shapes, coefficients, target)
+                if _squares(new_base, new_carried, context, terms, new_shapes, new_coefficients, target) <= before:
+                    base, shape_base, shapes, coefficients = new_base, new_shape_base, new_shapes, new_coefficients
+        self.friction_shape_base_ = shape_base if context.friction_level is not None else None
         self._store(base, context, terms, shapes, coefficients[base.linear_coefficients().size:])
 
     def _joint_fit(self, runs, base, context, terms, shapes, target) -> tuple[list, np.ndarray]:
@@ -276,6 +303,7 @@ class AugmentedModel(CurrentModel):
 
     def _store(self, base, context, terms, shapes, coefficients) -> None:
         self.base_ = base
+        self.friction_level_ = context.friction_level
         self.velocity_scale_mm_s_ = float(context.velocity_scale_mm_s)
         self.position_range_mm_ = tuple(float(value) for value in context.position_range_mm)
         self.effects_ = []
@@ -298,19 +326,36 @@ class AugmentedModel(CurrentModel):
     def context(self) -> EffectContext:
         """Scales of the effect regressors, fixed at fit time."""
         check_is_fitted(self, "effects_")
-        return EffectContext(self.velocity_scale_mm_s_, tuple(self.position_range_mm_))
+        return EffectContext(self.velocity_scale_mm_s_, tuple(self.position_range_mm_),
+                             friction_level=getattr(self, "friction_level_", None))
+
+    def with_base_friction(self, logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
+        """The runs with the fitted base model's friction as their :data:`BASE_FRICTION` channel.
+
+        The effect columns of :meth:`linear_part` and of the discovery's
+        scores are built from such runs (friction effects scale the base's friction).
+        """
+        runs = self._check_predict_runs(logs)
+        shape_base = getattr(self, "friction_shape_base_", None)
+        return _with_friction(runs, shape_base) if shape_base is not None else runs
 
     def initial_state(self):
-        """``(initial state of the base model, None)``: the run's start time is taken from its first chunk."""
-        return self.base_.initial_state(), None
+        """``(base model's initial state, the scaled friction's, None)``: the run's start time comes from its
+        first chunk."""
+        shape_base = getattr(self, "friction_shape_base_", None)
+        return self.base_.initial_state(), None if shape_base is None else shape_base.initial_state(), None
 
     def _simulate(self, run: AxisLog, state, sample_time):
-        base_state, run_start_s = state
+        base_state, shape_state, run_start_s = state
         if run_start_s is None:
             run_start_s = float(run.time[0])
         base_friction, base_end = self.base_.friction_chunk(run, base_state, sample_time=sample_time)
         context = replace(self.context, run_start_s=run_start_s)
-        return base_friction + self._effect_friction(run, context), (base_end, run_start_s)
+        shape_base = getattr(self, "friction_shape_base_", None)
+        if shape_base is not None:
+            scaled, shape_state = shape_base.friction_chunk(run, shape_state, sample_time=sample_time)
+            run = run.replace(extras={**run.extras, BASE_FRICTION: scaled})
+        return base_friction + self._effect_friction(run, context), (base_end, shape_state, run_start_s)
 
     def _own_parameters(self) -> list[Parameter]:
         base = [Parameter(f"base.{p.name}", p.value, p.unit, f"base model: {p.description}")
@@ -339,7 +384,7 @@ class AugmentedModel(CurrentModel):
         dict
             ``"<index>:<name>"`` (1-based, in the order of ``effects_``) -> current.
         """
-        runs = self._check_predict_runs(logs)
+        runs = self.with_base_friction(logs)
         return {f"{i + 1}:{e['name']}": np.concatenate([effect(e["name"]).current(run, self.context,
                                                                                   e["coefficients"], e["shape"])
                                                         for run in runs])
@@ -351,7 +396,7 @@ class AugmentedModel(CurrentModel):
         Columns: the base's linear parameters, then every term's columns
         (named ``"<effect>.<column>"``).
         """
-        runs = self._check_predict_runs(logs)
+        runs = self.with_base_friction(logs)
         part = _joined([self.base_.linear_part(run) for run in runs])
         names, blocks = list(part.names), [part.columns]
         for entry in self.effects_:
@@ -413,6 +458,24 @@ def _check_separation(terms, shapes, runs, context) -> None:
                         f"two {term.name} terms with periods {shapes[j]:.6g} and {shapes[i]:.6g} mm: "
                         f"closer than {PERIOD_SEPARATION_STEPS} steps of the period scan "
                         f"({step:.4g} 1/mm), the data cannot tell them apart")
+
+
+def _squares(base, carried, context, terms, shapes, coefficients, target) -> float:
+    """Residual sum of squares of the base (at its solved linear parameters) plus the terms."""
+    terms_current = AugmentedModel._term_currents(carried, context, terms, shapes, coefficients)
+    residual = target - base.predict(carried) - np.concatenate(terms_current)
+    return float(residual @ residual)
+
+
+def _friction_level(runs: Sequence[AxisLog], base) -> float | None:
+    """90th percentile of the base model's ``|friction|`` over the runs [A, or N]; None if it is zero."""
+    level = float(np.percentile(np.abs(base.friction(runs)), 90.0))
+    return level if level > 0.0 and np.isfinite(level) else None
+
+
+def _with_friction(runs: Sequence[AxisLog], base) -> list[AxisLog]:
+    """The runs with ``base``'s friction as their :data:`BASE_FRICTION` channel."""
+    return [run.replace(extras={**run.extras, BASE_FRICTION: base.friction(run)}) for run in runs]
 
 
 def _joined(parts: list[LinearPart]) -> LinearPart:

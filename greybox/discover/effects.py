@@ -7,7 +7,11 @@ position, a time constant, a Stribeck velocity); the discovery workflow scans
 it over :meth:`Effect.shape_grid` and refines it by least squares.
 
 With the direction of motion ``d = tanh(v / v_e)`` (``v_e`` the
-:class:`EffectContext`'s velocity scale), ``u`` the position scaled to
+:class:`EffectContext`'s velocity scale), ``f`` the friction the effects
+modulate (:meth:`EffectContext.friction_shape`: the base model's own friction
+over its level, so that a friction changing along the travel or with time is
+the base's friction law scaled, pre-sliding and Stribeck curve included;
+``d`` when there is no base model), ``u`` the position scaled to
 ``[-1, 1]`` over the position range of the training data (and held at its end
 values beyond: a trend is not extrapolated), ``t`` the time since
 the start of the run and ``x``, ``v``, ``a`` position [mm], velocity [mm/s]
@@ -16,16 +20,16 @@ and acceleration [mm/s^2]:
 ========================== =========================================== ================
 name                       columns                                     shape
 ========================== =========================================== ================
-direction_asymmetry        ``max(d, 0)``, ``v max(d, 0)``              -
+direction_asymmetry        ``max(f, 0)``, ``v max(d, 0)``              -
 constant_offset            ``1``                                       -
-position_trend             ``u d``, ``(3 u^2 - 1) / 2 * d``            -
-position_periodic_friction ``sin(2 pi x / P) d``, ``cos(2 pi x / P) d`` ``P`` [mm]
+position_trend             ``u f``, ``(3 u^2 - 1) / 2 * f``            -
+position_periodic_friction ``sin(2 pi x / P) f``, ``cos(2 pi x / P) f`` ``P`` [mm]
 position_periodic_force    ``sin(2 pi x / P)``, ``cos(2 pi x / P)``    ``P`` [mm]
-thermal_drift              ``(1 - exp(-t / tau)) d``                   ``tau`` [s]
+thermal_drift              ``(1 - exp(-t / tau)) f``                   ``tau`` [s]
 inertia_mismatch           ``a``                                       -
 viscous_friction           ``v``                                       -
 stribeck                   ``exp(-|v| / v_s) d``                       ``v_s`` [mm/s]
-load_dependent_friction    ``|a| d``                                   -
+load_dependent_friction    ``|a| f``                                   -
 ========================== =========================================== ================
 
 The names are those of the synthetic axis's hidden effects
@@ -44,8 +48,8 @@ import numpy as np
 from ..data.log import AxisLog
 from ..errors import GreyboxError
 
-__all__ = ["EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "PERIOD_SEPARATION_STEPS", "effect", "period_grid",
-           "period_scan",
+__all__ = ["BASE_FRICTION", "EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "REFINEMENTS", "VELOCITY_ONLY",
+           "VELOCITY_CURVE_SCALES", "PERIOD_SEPARATION_STEPS", "effect", "period_grid", "period_scan", "scan_periods",
            "default_velocity_scale"]
 
 #: Periods are scanned at this many points per periodogram resolution ``1 / range``.
@@ -61,6 +65,8 @@ _MAX_PERIODS = 4000
 PERIOD_SEPARATION_STEPS = 2
 #: Points of the logarithmic grids of time constants and Stribeck velocities.
 _LOG_GRID_POINTS = 24
+#: Extra channel of a run holding the base model's friction [A, or N] (see :meth:`EffectContext.friction_shape`).
+BASE_FRICTION = "base_friction"
 
 
 def default_velocity_scale(runs: Sequence[AxisLog]) -> float:
@@ -90,11 +96,17 @@ class EffectContext:
         Time [s] at which the run started, for effects of the time since the
         start of the run; ``None``: the first sample of the log passed. Set it
         when a log is a part of a run (a chunk of a long run).
+    friction_level : float, optional
+        Level of the base model's friction [A, or N] (its 90th percentile
+        ``|F|`` on the training runs) that the friction effects scale; the runs
+        then carry the base friction as the extra channel :data:`BASE_FRICTION`.
+        ``None``: no base model, friction effects scale the direction of motion.
     """
 
     velocity_scale_mm_s: float
     position_range_mm: tuple[float, float]
     run_start_s: float | None = None
+    friction_level: float | None = None
 
     @classmethod
     def from_runs(cls, runs: Sequence[AxisLog], velocity_scale_mm_s: float | None = None) -> "EffectContext":
@@ -111,6 +123,15 @@ class EffectContext:
     def direction(self, run: AxisLog) -> np.ndarray:
         """Smoothed direction of motion ``tanh(v / v_e)`` (-1 ... 1)."""
         return np.tanh(run.velocity / self.velocity_scale_mm_s)
+
+    def friction_shape(self, run: AxisLog) -> np.ndarray:
+        """What friction effects scale: the base model's friction over its level, or ``d`` without a base."""
+        if self.friction_level is None:
+            return self.direction(run)
+        if BASE_FRICTION not in run.extras:
+            raise GreyboxError(f"the run carries no '{BASE_FRICTION}' channel: friction effects scale the base "
+                               "model's friction (see AugmentedModel.with_base_friction)")
+        return run.extras[BASE_FRICTION] / self.friction_level
 
     def elapsed(self, run: AxisLog) -> np.ndarray:
         """Time since the start of the run [s] (see ``run_start_s``)."""
@@ -243,6 +264,19 @@ def period_scan(runs: Sequence[AxisLog], context: EffectContext) -> tuple[float,
     return step, 1.0 / (np.arange(first, last + 1) * step)
 
 
+def scan_periods(runs: Sequence[AxisLog], context: EffectContext, excluded: Sequence[float] = ()
+                 ) -> tuple[float, np.ndarray]:
+    """:func:`period_scan` without the periods within :data:`PERIOD_SEPARATION_STEPS` steps of ``excluded`` [mm].
+
+    Those periods are in the model already (a periodic effect named again takes another period).
+    """
+    step, grid = period_scan(runs, context)
+    if len(excluded):
+        distance = np.abs(1.0 / grid[:, None] - 1.0 / np.asarray(excluded, dtype=float)[None, :])
+        grid = grid[np.all(distance > PERIOD_SEPARATION_STEPS * step, axis=1)]
+    return step, grid
+
+
 def period_grid(runs: Sequence[AxisLog], context: EffectContext) -> np.ndarray:
     """Periods [mm] scanned for the position-periodic effects (see :func:`period_scan`)."""
     return period_scan(runs, context)[1]
@@ -269,7 +303,7 @@ def _legendre_2(u):
 
 
 def _friction_weight(run, context):
-    return context.direction(run)
+    return context.friction_shape(run)
 
 
 def _force_weight(run, context):
@@ -320,8 +354,8 @@ _PERIOD = ShapeParameter("period_mm", "frequency", period_grid)
 _LIBRARY = (
     Effect("direction_asymmetry", "friction differs with the direction of motion (level and viscous part)",
            ("positive_level", "positive_viscous"),
-           lambda run, c, s: np.maximum(c.direction(run), 0.0)[:, None] * np.column_stack((np.ones(len(run)),
-                                                                                         run.velocity)),
+           lambda run, c, s: np.column_stack((np.maximum(c.friction_shape(run), 0.0),
+                                              run.velocity * np.maximum(c.direction(run), 0.0))),
            _asymmetry_parameters),
     Effect("constant_offset", "constant effort: gravity, weight compensation or a current bias",
            ("one",),
@@ -330,7 +364,7 @@ _LIBRARY = (
     Effect("position_trend", "friction changing smoothly along the travel",
            ("trend_linear", "trend_quadratic"),
            lambda run, c, s: np.column_stack((c.unit_position(run), _legendre_2(c.unit_position(run))))
-           * c.direction(run)[:, None],
+           * c.friction_shape(run)[:, None],
            _trend_parameters),
     Effect("position_periodic_friction", "friction periodic in position, flipping with the direction "
            "(ball-screw preload ripple)",
@@ -341,7 +375,7 @@ _LIBRARY = (
            _periodic(_force_weight), _amplitude_phase, _PERIOD, _force_weight),
     Effect("thermal_drift", "friction changing with the time since the start of the run",
            ("drift",),
-           lambda run, c, s: (1.0 - np.exp(-c.elapsed(run) / s)) * c.direction(run),
+           lambda run, c, s: (1.0 - np.exp(-c.elapsed(run) / s)) * c.friction_shape(run),
            _with_shape("change_{E}", "time_constant_s"),
            ShapeParameter("time_constant_s", "log", _time_constant_grid)),
     Effect("inertia_mismatch", "inertia the model lacks (e.g. a workpiece on the table)",
@@ -359,7 +393,7 @@ _LIBRARY = (
            ShapeParameter("v_s_mm_s", "log", _stribeck_velocity_grid)),
     Effect("load_dependent_friction", "friction growing with the axial (inertial) load",
            ("load",),
-           lambda run, c, s: np.abs(run.acceleration) * c.direction(run),
+           lambda run, c, s: np.abs(run.acceleration) * c.friction_shape(run),
            _single("friction_per_acceleration_{E}_s2_per_mm")),
 )
 
@@ -369,15 +403,52 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in _LIBRARY}
 #: Effect names in library order.
 EFFECT_NAMES: tuple[str, ...] = tuple(EFFECTS)
 
+#: Speeds of the velocity curve's columns, in units of ``v_e`` (``v_e`` is 1 % of the 99th percentile speed,
+#: so the last is about the top speed).
+VELOCITY_CURVE_SCALES = (3.0, 7.0, 17.0, 40.0, 100.0)
+
+
+def _velocity_curve(run, context, shape):
+    speed = np.abs(run.velocity)[:, None]
+    scales = context.velocity_scale_mm_s * np.asarray(VELOCITY_CURVE_SCALES)[None, :]
+    return np.exp(-speed / scales) * context.direction(run)[:, None]
+
+
+def _curve_parameters(coefficients, context, shape, unit):
+    def excess(speed):
+        return float(np.exp(-speed / (context.velocity_scale_mm_s * np.asarray(VELOCITY_CURVE_SCALES)))
+                     @ coefficients)
+    top = context.velocity_scale_mm_s * VELOCITY_CURVE_SCALES[-1]
+    return {f"excess_at_rest_{unit}": excess(0.0), f"excess_at_tenth_top_speed_{unit}": excess(0.1 * top),
+            f"excess_at_top_speed_{unit}": excess(top), "top_speed_mm_s": float(top)}
+
+
+#: Refinements of the base model, not named effects: a flexible friction curve along the speed, the same in
+#: both directions, that any velocity-only friction law the base model lacks projects onto (a Stribeck curve
+#: of another shape, viscous friction that is not linear). The workflow fits it before naming anything and
+#: reports it as *base misfit*.
+REFINEMENTS: dict[str, Effect] = {
+    "velocity_curve": Effect("velocity_curve", "friction along the speed that the base model's own curve "
+                             "misses (the same in both directions)",
+                             tuple(f"curve_{i}" for i in range(len(VELOCITY_CURVE_SCALES))),
+                             _velocity_curve, _curve_parameters),
+}
+
+#: Library effects that depend on the velocity alone: the velocity curve spans them (base misfit, not a
+#: missing effect).
+VELOCITY_ONLY = ("viscous_friction", "stribeck")
+
 
 def effect(name: str) -> Effect:
-    """Return the library effect ``name``.
+    """Return the library effect or base refinement (:data:`REFINEMENTS`) ``name``.
 
     Raises
     ------
     GreyboxError
         If there is no such effect.
     """
+    if name in REFINEMENTS:
+        return REFINEMENTS[name]
     if name not in EFFECTS:
         raise GreyboxError(f"unknown effect {name!r}; the library has {', '.join(EFFECT_NAMES)}")
     return EFFECTS[name]

@@ -55,7 +55,7 @@ from threadpoolctl import threadpool_limits
 
 from ..base import LinearPart
 from ..data.log import AxisLog
-from .effects import PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
+from .effects import Effect, EffectContext, effect, scan_periods
 from .locate import structure_basis
 from .noise import ResidualNoise
 from .projection import Nuisance, PositionScan, added_squares
@@ -187,10 +187,7 @@ class _Candidate:
         self.periodic = term.shape is not None and term.shape.scale == "frequency"
         self.grid = None if self.periodic else term.shape_grid(runs, context)
         if self.periodic:
-            self.frequency_step, self.grid = period_scan(runs, context)
-            if len(excluded_periods):
-                distance = np.abs(1.0 / self.grid[:, None] - 1.0 / np.asarray(excluded_periods)[None, :])
-                self.grid = self.grid[np.all(distance > PERIOD_SEPARATION_STEPS * self.frequency_step, axis=1)]
+            self.frequency_step, self.grid = scan_periods(runs, context, excluded_periods)
 
     def columns(self, shape) -> np.ndarray:
         return np.concatenate([self.term.columns(run, self.context, shape) for run in self.runs])

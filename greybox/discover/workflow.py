@@ -12,15 +12,32 @@
 3. the gap on the test runs: the base model alone against the augmented
    model (RMSE, RE and per regime), and the residual by regime before and after.
 
-Verdicts: ``"named"`` (at least one effect added), ``"unexplained_structure"``
-(nothing from the library passes, but the generic structure test does: the
-model misses something the library does not name) and ``"nothing_missing"``.
+Before any effect is named, the base model is *refined* (``refine_base``): a
+flexible friction curve along the speed (:data:`greybox.discover.effects.REFINEMENTS`)
+joins its linear columns in every test, so that a base whose velocity-only
+friction law is only approximately right does not make velocity-only effects
+(``stribeck``, ``viscous_friction``) look missing. When the curve lowers the
+error on held-out blocks of the training runs it is kept in the model and
+reported as *base misfit*. Every winner of a step must also pass the held-out
+test (:mod:`greybox.discover.heldout`): fitted on four fifths of the training
+time, it must lower the error on the fifth, beyond a margin calibrated for
+its flexibility; a periodic one must also carry over from one direction of
+travel to the other.
+
+Verdicts: ``"named"`` (at least one effect added), ``"base_misfit"`` (nothing
+named, but the base model's own law is what misfits: the velocity curve
+lowers the held-out error, or the structure left lies along the velocity or
+the time since the motion changed only, or does not hold on held-out blocks),
+``"unexplained_structure"`` (nothing from the library passes, but structure
+along the position or the acceleration remains that also holds on held-out
+blocks beyond chance: the model misses something
+the library does not name) and ``"nothing_missing"``.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Sequence
 
 import numpy as np
@@ -33,14 +50,23 @@ from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
 from ..metrics import metrics_table
 from ..provenance import provenance
 from .augment import AugmentedModel
-from .effects import EFFECT_NAMES, effect
+from .effects import EFFECT_NAMES, VELOCITY_ONLY, effect
 from .evidence import StepEvidence, score_step
-from .locate import residual_by_regime, residual_profiles
+from .heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN, HeldOutTest
+from .locate import residual_by_regime, residual_profiles, structure_basis
 
 __all__ = ["VERDICTS", "DiscoveryResult", "discover"]
 
 #: Possible verdicts.
-VERDICTS = ("named", "nothing_missing", "unexplained_structure")
+VERDICTS = ("named", "base_misfit", "nothing_missing", "unexplained_structure")
+
+#: Structure families outside what the base model's physics (friction along the velocity and the motion's
+#: history, inertia linear in the acceleration) can express, and that blocks of time can test (bins of the
+#: time since the start cannot be fitted on one stretch of time and checked on another): structure along
+#: them that holds on held-out blocks is unexplained.
+_FOREIGN_FAMILIES = ("position_direction", "acceleration")
+#: The base refinement.
+_CURVE = "velocity_curve"
 
 
 @dataclass
@@ -61,7 +87,13 @@ class DiscoveryResult:
     steps : list of StepEvidence
         The evidence of every step (the last one found nothing more, or hit ``max_effects``).
     rejected : list of dict
-        Winners dropped because their joint refit explained no more than chance.
+        Winners dropped because their joint refit explained no more than chance
+        or because they failed the held-out test (``reason``).
+    base_misfit : dict or None
+        The base refinement (None without ``refine_base``): ``detected``,
+        the velocity curve's ``held_out`` evidence and, when kept, its
+        ``parameters``; and the held-out evidence of the structure families
+        (``structure``) when structure remains.
     train, test : dict
         Metrics before (base alone) and after (augmented) on the training and
         test runs: ``rmse``/``re`` before and after, per-regime metrics and the
@@ -89,6 +121,7 @@ class DiscoveryResult:
     settings: dict
     seconds: float
     unit: str = "A"
+    base_misfit: dict | None = None
     residuals: dict = field(default_factory=dict, repr=False)
 
     def to_dict(self) -> dict:
@@ -108,6 +141,7 @@ class DiscoveryResult:
                                     "explained_fraction": last.structure.explained_fraction,
                                     "families": last.families},
             "more_effects_pass": bool(last.winner is not None),
+            "base_misfit": self.base_misfit,
             "rejected": self.rejected,
             "train": self.train,
             "test": self.test,
@@ -156,17 +190,35 @@ def _gap(runs, before, after) -> dict:
     }
 
 
-def _evidence_entry(step_index: int, step: StepEvidence, name: str, gain: float) -> dict:
+def _evidence_entry(step_index: int, step: StepEvidence, name: str, gain: float, held_out) -> dict:
     score = step.candidates[name]
     entry = {"step": step_index + 1, **score.to_dict(), "refit_explained_fraction": gain,
-             "indistinguishable_from": list(step.indistinguishable),
+             "held_out": held_out.to_dict(), "indistinguishable_from": list(step.indistinguishable),
              "comparisons": step.comparisons}
     return entry
 
 
+def _scoring_part(model: AugmentedModel, runs, refine_base: bool):
+    """The model's linear part, with the velocity curve's columns added when refining and not yet in it."""
+    part = model.linear_part(runs)
+    if not refine_base or any(entry["name"] == _CURVE for entry in model.effects_):
+        return part
+    curve = np.concatenate([effect(_CURVE).columns(run, model.context) for run in runs])
+    return replace(part, columns=np.hstack((part.columns, curve)), names=part.names + tuple(
+        f"{_CURVE}.{name}" for name in effect(_CURVE).column_names),
+        lower=np.concatenate((part.lower, np.full(curve.shape[1], -np.inf))),
+        upper=np.concatenate((part.upper, np.full(curve.shape[1], np.inf))))
+
+
+def _held_out(runs, part, target, context, settings, rng) -> HeldOutTest:
+    return HeldOutTest(runs, part.columns, target - part.fixed, context, n_blocks=settings["held_out_blocks"],
+                       min_gain=settings["min_gain"], rng=rng)
+
+
 def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[AxisLog] | None = None, *,
              candidates: Sequence[str] = EFFECT_NAMES, max_effects: int = 3, alpha: float = 0.05,
-             n_null: int = 99, seed: int = 0, refit_base: bool = True,
+             n_null: int = 99, seed: int = 0, refit_base: bool = True, refine_base: bool = True,
+             held_out_blocks: int = DEFAULT_BLOCKS, min_gain: float = DEFAULT_MIN_GAIN,
              progress: Callable[[str], None] | None = None, fit_progress=None) -> DiscoveryResult:
     """Find the effects a base model misses, add them, and measure the gap before and after.
 
@@ -177,7 +229,7 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     train : AxisLog or list of AxisLog
         Prepared training runs.
     test : AxisLog or list of AxisLog, optional
-        Prepared test runs, for the gap before and after.
+        Prepared test runs, for the gap before and after (never used to decide anything).
     candidates : sequence of str, default all library effects
         Effects to consider.
     max_effects : int, default 3
@@ -192,6 +244,15 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     refit_base : bool, default True
         Identify the base's nonlinear shape again with every added effect
         (see :class:`AugmentedModel`).
+    refine_base : bool, default True
+        Refine the base with a flexible friction curve along the speed
+        before naming anything (module notes); velocity-only library effects
+        are then not candidates (the curve spans them).
+    held_out_blocks : int, default 5
+        Contiguous blocks of training time for the held-out test (at least 2).
+    min_gain : float, default 0.02
+        Smallest held-out gain worth a name: fraction of the held-out
+        residual's sum of squares a term must remove (in [0, 1)).
     progress : callable, optional
         Receives one line of text per stage.
     fit_progress : None, bool or callable, optional
@@ -214,12 +275,28 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     if not 0.0 < alpha < 1.0 or n_null < 1 or int(np.floor(alpha * (n_null + 1))) < 1:
         raise GreyboxError(f"alpha = {alpha} with {n_null} null replicates can never pass: "
                            "use at least 1 / alpha - 1 replicates")
+    if not (isinstance(min_gain, (int, float)) and 0.0 <= min_gain < 1.0):
+        raise GreyboxError(f"min_gain must be a fraction in [0, 1), got {min_gain!r}")
+    held_out_settings = {"held_out_blocks": held_out_blocks, "min_gain": float(min_gain)}
     rng = np.random.default_rng(seed)
     n_samples = sum(len(run) for run in train)
     say(f"fitting the base model {type(base).__name__} on {len(train)} run(s), {n_samples} samples")
     base_model = clone(base).fit(train, progress=fit_progress)
     model = AugmentedModel(base=base, refit_base=refit_base).fit_terms(train, base=base_model)
     target = np.concatenate([run.effort for run in train])
+    base_misfit = None
+    if refine_base:
+        names = [name for name in names if name not in VELOCITY_ONLY]
+        part = model.linear_part(train)
+        curve = _held_out(train, part, target, model.context, held_out_settings, rng).evaluate(effect(_CURVE))
+        base_misfit = {"detected": curve.passes, "held_out": curve.to_dict(), "parameters": None}
+        say(f"base refinement: a friction curve along the speed lowers the held-out error by "
+            f"{100 * curve.gain:.2f} +- {100 * curve.uncertainty:.2f} % "
+            + ("(kept: base misfit)" if curve.passes else "(not kept)"))
+        if curve.passes:
+            model = AugmentedModel(base=base, effects=[(_CURVE, None)], refit_base=refit_base).fit_terms(
+                train, base=base_model, progress=fit_progress)
+            base_misfit["parameters"] = model.effects_[0]["parameters"]
     rss = _rss(model, train, target)
     named, steps, rejected = [], [], []
     remaining = list(names)
@@ -229,7 +306,9 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
         for entry in model.effects_:
             if effect(entry["name"]).shape is not None and effect(entry["name"]).shape.scale == "frequency":
                 periods.setdefault(entry["name"], []).append(entry["shape"])
-        step = score_step(train, model.linear_part(train), model.context, remaining, rng=rng, n_null=n_null,
+        part = _scoring_part(model, train, refine_base)
+        carried = model.with_base_friction(train)
+        step = score_step(carried, part, model.context, remaining, rng=rng, n_null=n_null,
                           alpha=alpha, excluded_periods=periods)
         steps.append(step)
         if step.winner is None:
@@ -240,31 +319,50 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
             say(f"  {step.winner} also passes, but {max_effects} effects were added already")
             break
         winner = step.candidates[step.winner]
+        held_out = _held_out(carried, part, target, model.context, held_out_settings, rng).evaluate(
+            effect(winner.name), winner.shape, excluded_periods=periods.get(winner.name, ()))
+        if not held_out.passes:
+            say(f"  {winner.name} passes the null test (explains {100 * winner.explained_fraction:.2f} %) but not "
+                f"the held-out test: {'; '.join(held_out.reasons)}")
+            rejected.append({"name": winner.name, "step": len(steps), "reason": "held_out",
+                             "explained_fraction": winner.explained_fraction, "held_out": held_out.to_dict()})
+            remaining.remove(winner.name)
+            continue
         pairs = [(e["name"], e["shape"]) for e in model.effects_] + [(winner.name, winner.shape)]
         say(f"  {winner.name} passes (explains {100 * winner.explained_fraction:.2f} % of the residual, "
-            f"p = {winner.p_value:.3f}); refitting jointly")
+            f"p = {winner.p_value:.3f}; held-out gain {100 * held_out.gain:.2f} +- {100 * held_out.uncertainty:.2f} "
+            f"%); refitting jointly")
         trial = AugmentedModel(base=base, effects=pairs, refit_base=refit_base).fit_terms(
             train, base=base_model, progress=fit_progress)
         trial_rss = _rss(trial, train, target)
         gain = (rss - trial_rss) / rss
         if not gain > winner.null_q95:
             say(f"  {winner.name} dropped: the joint refit explains {100 * gain:.3f} % only")
-            rejected.append({"name": winner.name, "step": len(steps), "refit_explained_fraction": gain,
-                             "null_q95": winner.null_q95})
+            rejected.append({"name": winner.name, "step": len(steps), "reason": "refit",
+                             "refit_explained_fraction": gain, "null_q95": winner.null_q95})
             remaining.remove(winner.name)
             continue
         model, rss = trial, trial_rss
         entry = model.effects_[-1]
         named.append({"name": entry["name"], "parameters": entry["parameters"],
-                      "evidence": _evidence_entry(len(steps) - 1, step, winner.name, gain)})
+                      "evidence": _evidence_entry(len(steps) - 1, step, winner.name, gain, held_out)})
         if effect(winner.name).shape is None or effect(winner.name).shape.scale != "frequency":
             remaining.remove(winner.name)
-    if named:
-        verdict = "named"
-    elif steps[-1].structure.passes:
-        verdict = "unexplained_structure"
-    else:
-        verdict = "nothing_missing"
+    verdict = "named" if named else None
+    if steps[-1].structure.passes and not named:
+        part = _scoring_part(model, train, refine_base)
+        families = structure_basis(train)
+        tester = _held_out(train, part, target, model.context, {**held_out_settings, "min_gain": 0.0}, rng)
+        foreign = {name: tester.evaluate(None, columns=families[name].toarray())
+                   for name in _FOREIGN_FAMILIES if name in families}
+        base_misfit = base_misfit or {"detected": False, "held_out": None, "parameters": None}
+        base_misfit["structure"] = {name: value.to_dict() for name, value in foreign.items()}
+        if any(value.passes for value in foreign.values()):
+            verdict = "unexplained_structure"
+        else:
+            base_misfit["detected"] = True
+    if verdict is None:
+        verdict = "base_misfit" if base_misfit and base_misfit["detected"] else "nothing_missing"
     say(f"verdict: {verdict}" + (": " + ", ".join(e["name"] for e in named) if named else ""))
 
     train_gap, residuals = _gap(train, base_model.predict(train), model.predict(train)), {}
@@ -277,12 +375,12 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     settings = {"base": type(base).__name__, "base_params": {k: _jsonable(v) for k, v in
                                                              base.get_params(deep=False).items()},
                 "candidates": names, "max_effects": max_effects, "alpha": alpha, "n_null": n_null, "seed": seed,
-                "refit_base": refit_base, "train_samples": n_samples,
-                "test_samples": int(sum(len(run) for run in test))}
+                "refit_base": refit_base, "refine_base": refine_base, **held_out_settings,
+                "train_samples": n_samples, "test_samples": int(sum(len(run) for run in test))}
     return DiscoveryResult(verdict=verdict, effects=named, base_model=base_model, model=model, steps=steps,
                            rejected=rejected, train=train_gap, test=test_gap, settings=settings,
                            seconds=time.perf_counter() - started, unit=train[0].effort_unit,
-                           residuals=residuals)
+                           residuals=residuals, base_misfit=base_misfit)
 
 
 def _jsonable(value):

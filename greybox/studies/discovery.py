@@ -50,7 +50,7 @@ from ..data.io import read_log
 from ..data.log import AxisLog
 from ..data.prepare import prepare
 from ..discover.augment import AugmentedModel
-from ..discover.effects import EFFECT_NAMES, EffectContext, effect
+from ..discover.effects import EFFECT_NAMES, VELOCITY_ONLY, EffectContext, effect
 from ..discover.noise import ResidualNoise
 from ..discover.report import write_json
 from ..discover.workflow import discover
@@ -62,9 +62,9 @@ from ..twin import effect_current as twin_effect_current
 from .emps import BORDER as EMPS_BORDER
 from .emps import decimate_benchmark
 
-__all__ = ["PLANTS", "TRUE_SHAPES", "HIDDEN_LIBRARY_TERMS", "ABSORBED", "SECTIONS", "StudyCase", "case_logs",
-           "null_logs", "run_case", "run_null", "summarise", "benchmark_relerr", "emps_section", "markdown",
-           "run_section"]
+__all__ = ["PLANTS", "TRUE_SHAPES", "wilson_interval", "HIDDEN_LIBRARY_TERMS", "ABSORBED", "SECTIONS", "StudyCase",
+           "case_logs", "null_logs", "run_case", "run_null", "summarise", "benchmark_relerr", "emps_section",
+           "markdown", "run_section"]
 
 #: Plants a case may use.
 PLANTS = ("coulomb", "twin")
@@ -184,6 +184,11 @@ def null_logs(base, train: AxisLog, test: AxisLog, seed: int) -> tuple[AxisLog, 
             test.replace(effort=model.predict(test) + test_noise.simulate(1, rng)[0][:, 0]))
 
 
+def _curve_kept(result) -> bool:
+    """The base refinement found base misfit and kept its velocity curve."""
+    return bool(result.base_misfit and result.base_misfit["detected"] and result.base_misfit["parameters"])
+
+
 def _correct(case: StudyCase, entry: dict) -> bool:
     if entry["name"] != case.effect:
         return False
@@ -227,8 +232,11 @@ def run_case(base, case: StudyCase, *, background: frozenset = frozenset(), n_nu
            "parameters": [entry["parameters"] for entry in result.effects],
            "correct": any(_correct(case, entry) for entry in result.effects),
            "first_correct": bool(result.effects) and _correct(case, result.effects[0]),
+           "base_misfit": bool(result.base_misfit and result.base_misfit["detected"]),
            "spurious": [name for name in named if name != case.effect and name not in background],
            "rmse_before": result.test["rmse_before"], "rmse_after": result.test["rmse_after"]}
+    if case.effect in VELOCITY_ONLY:  # the base refinement's velocity curve spans it: found as base misfit
+        row["correct"] = row["first_correct"] = _curve_kept(result)
     row["rmse_oracle"] = row["closure"] = None
     if case.effect is not None:
         oracle = AugmentedModel(base=base, effects=[(case.effect, TRUE_SHAPES.get(case.effect))],
@@ -252,7 +260,7 @@ def run_null(base, seed: int, *, plant: str = "coulomb", duration_s: float = 30.
             "named": [entry["name"] for entry in result.effects], "seconds": time.perf_counter() - started}
 
 
-def _wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
+def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
     """95 % Wilson score interval of a proportion."""
     if n == 0:
         return float("nan"), float("nan")
@@ -288,9 +296,9 @@ def summarise(cases: list[dict], nulls: list[dict], *, min_ratio: float = 0.5) -
         cell.append(row)
     return {
         "false_positive": {"rate": false / len(nulls) if nulls else None, "n": len(nulls), "count": false,
-                           "interval_95": _wilson(false, len(nulls))},
+                           "interval_95": wilson_interval(false, len(nulls))},
         "accuracy": {"rate": named / len(eligible) if eligible else None, "n": len(eligible), "count": named,
-                     "interval_95": _wilson(named, len(eligible)), "min_ratio": min_ratio},
+                     "interval_95": wilson_interval(named, len(eligible)), "min_ratio": min_ratio},
         "spurious_rate": (sum(bool(row["spurious"]) for row in eligible) / len(eligible)) if eligible else None,
         "closure": {"median": float(np.median(closures)) if closures else None, "n": len(closures),
                     "share_at_least_0.8": (float(np.mean(np.asarray(closures) >= 0.8)) if closures else None)},
