@@ -17,7 +17,8 @@
    kept if the joint fit is then better.
 
 Friction terms scale the friction of the base as identified in step 1 (or 3),
-over its level (:meth:`~greybox.discover.effects.EffectContext.friction_shape`):
+less its viscous part (a friction level that changes along the travel or with
+time scales the sliding friction, not the lubricant's viscous drag), over its level (:meth:`~greybox.discover.effects.EffectContext.friction_shape`):
 a friction that changes along the travel or with time is the base's friction
 law scaled, its Stribeck curve and pre-sliding included. That base is held
 (``friction_shape_base_``) while the joint solve moves the base's linear
@@ -46,6 +47,7 @@ from ..base import LinearPart, Parameter
 from ..data.log import AxisLog
 from ..errors import GreyboxError, ParameterError
 from ..estimator import CurrentModel, check_runs
+from ..friction.directions import viscous_columns
 from ..friction.gms import GMSModel
 from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
@@ -121,13 +123,16 @@ class AugmentedModel(CurrentModel):
         names ending in their unit).
     friction_level_ : float or None
         Level of the base model's friction on the training runs [A, or N]
-        (90th percentile of ``|F|``): friction terms scale the friction of
+        (90th percentile of ``|F|``, viscous part taken off): friction terms scale the friction of
         ``friction_shape_base_`` over this level (see
         :meth:`EffectContext.friction_shape`). None in files written before it
         existed: the terms then scale the direction of motion.
     friction_shape_base_ : CurrentModel or None
         The base model as identified (before the joint solve moved its linear
-        parameters), whose friction the friction terms scale.
+        parameters), whose friction less its viscous part the friction terms scale.
+    friction_shape_viscous_ : dict
+        That base's viscous coefficients (``viscous`` or ``viscous_pos``,
+        ``viscous_neg``) [A s/mm, or N s/mm], taken off its friction.
     velocity_scale_mm_s_ : float
         ``v_e`` used [mm/s].
     position_range_mm_ : tuple of float
@@ -191,26 +196,29 @@ class AugmentedModel(CurrentModel):
         return self
 
     def _fit_terms(self, runs: list[AxisLog], base, progress) -> None:
+        viscous = _viscous_coefficients(base, runs[0])
         context = replace(EffectContext.from_runs(runs, self.velocity_scale_mm_s),
-                          friction_level=_friction_level(runs, base))
+                          friction_level=_friction_level(runs, base, viscous))
         terms = [(effect(name), shape) for name, shape in normalise_effects(self.effects)]
         target = np.concatenate([run.effort for run in runs])
         with threadpool_limits(limits=1, user_api="blas"):
             shape_base = copy.deepcopy(base)
-            carried = _with_friction(runs, shape_base)
+            carried = _with_friction(runs, shape_base, viscous)
             shapes, coefficients = self._joint_fit(carried, base, context, terms, [s for _, s in terms], target)
             if self.refit_base and terms:
                 term_current = self._term_currents(carried, context, terms, shapes, coefficients)
                 shifted = [run.replace(effort=run.effort - part) for run, part in zip(runs, term_current)]
                 new_base = clone(self._template()).fit(shifted, progress=progress)
-                new_shape_base = copy.deepcopy(new_base)
-                new_carried = _with_friction(runs, new_shape_base)
+                new_shape_base, new_viscous = copy.deepcopy(new_base), _viscous_coefficients(new_base, runs[0])
+                new_carried = _with_friction(runs, new_shape_base, new_viscous)
                 new_shapes, new_coefficients = self._joint_fit(new_carried, new_base, context, terms, shapes, target)
                 # the base's new shape also changes the friction the terms scale: keep it only if it fits better
                 before = _squares(base, carried, context, terms, shapes, coefficients, target)
                 if _squares(new_base, new_carried, context, terms, new_shapes, new_coefficients, target) <= before:
                     base, shape_base, shapes, coefficients = new_base, new_shape_base, new_shapes, new_coefficients
+                    viscous = new_viscous
         self.friction_shape_base_ = shape_base if context.friction_level is not None else None
+        self.friction_shape_viscous_ = viscous
         self._store(base, context, terms, shapes, coefficients[base.linear_coefficients().size:])
 
     def _joint_fit(self, runs, base, context, terms, shapes, target) -> tuple[list, np.ndarray]:
@@ -337,7 +345,7 @@ class AugmentedModel(CurrentModel):
         """
         runs = self._check_predict_runs(logs)
         shape_base = getattr(self, "friction_shape_base_", None)
-        return _with_friction(runs, shape_base) if shape_base is not None else runs
+        return _with_friction(runs, shape_base, self.friction_shape_viscous_) if shape_base is not None else runs
 
     def initial_state(self):
         """``(base model's initial state, the scaled friction's, None)``: the run's start time comes from its
@@ -354,6 +362,7 @@ class AugmentedModel(CurrentModel):
         shape_base = getattr(self, "friction_shape_base_", None)
         if shape_base is not None:
             scaled, shape_state = shape_base.friction_chunk(run, shape_state, sample_time=sample_time)
+            scaled = _without_viscous(scaled, run.velocity, self.friction_shape_viscous_)
             run = run.replace(extras={**run.extras, BASE_FRICTION: scaled})
         return base_friction + self._effect_friction(run, context), (base_end, shape_state, run_start_s)
 
@@ -467,15 +476,33 @@ def _squares(base, carried, context, terms, shapes, coefficients, target) -> flo
     return float(residual @ residual)
 
 
-def _friction_level(runs: Sequence[AxisLog], base) -> float | None:
-    """90th percentile of the base model's ``|friction|`` over the runs [A, or N]; None if it is zero."""
-    level = float(np.percentile(np.abs(base.friction(runs)), 90.0))
+def _friction_level(runs: Sequence[AxisLog], base, viscous: dict) -> float | None:
+    """90th percentile of ``|friction|`` of the base less its viscous part over the runs [A, or N]; None if zero."""
+    friction = np.concatenate([run.extras[BASE_FRICTION] for run in _with_friction(runs, base, viscous)])
+    level = float(np.percentile(np.abs(friction), 90.0))
     return level if level > 0.0 and np.isfinite(level) else None
 
 
-def _with_friction(runs: Sequence[AxisLog], base) -> list[AxisLog]:
-    """The runs with ``base``'s friction as their :data:`BASE_FRICTION` channel."""
-    return [run.replace(extras={**run.extras, BASE_FRICTION: base.friction(run)}) for run in runs]
+def _viscous_coefficients(base, run: AxisLog) -> dict[str, float]:
+    """The base's viscous coefficients by the names of its linear part (``viscous``, or ``viscous_pos/neg``)."""
+    names = base.linear_part(run).names
+    values = base.linear_coefficients()
+    return {name: float(value) for name, value in zip(names, values) if name.startswith("viscous")}
+
+
+def _without_viscous(friction: np.ndarray, velocity: np.ndarray, viscous: dict) -> np.ndarray:
+    """``friction`` minus the viscous part of the coefficients ``viscous`` (:func:`_viscous_coefficients`)."""
+    if not viscous:
+        return friction
+    columns, names = viscous_columns(velocity, asymmetric=len(viscous) == 2)
+    return friction - sum(column * viscous[name] for column, name in zip(columns, names))
+
+
+def _with_friction(runs: Sequence[AxisLog], base, viscous: dict) -> list[AxisLog]:
+    """The runs with ``base``'s friction less its viscous part as their :data:`BASE_FRICTION` channel."""
+    return [run.replace(extras={**run.extras, BASE_FRICTION: _without_viscous(base.friction(run), run.velocity,
+                                                                              viscous)})
+            for run in runs]
 
 
 def _joined(parts: list[LinearPart]) -> LinearPart:

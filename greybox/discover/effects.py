@@ -9,7 +9,7 @@ it over :meth:`Effect.shape_grid` and refines it by least squares.
 With the direction of motion ``d = tanh(v / v_e)`` (``v_e`` the
 :class:`EffectContext`'s velocity scale), ``f`` the friction the effects
 modulate (:meth:`EffectContext.friction_shape`: the base model's own friction
-over its level, so that a friction changing along the travel or with time is
+less its viscous part, over its level, so that a friction changing along the travel or with time is
 the base's friction law scaled, pre-sliding and Stribeck curve included;
 ``d`` when there is no base model), ``u`` the position scaled to
 ``[-1, 1]`` over the position range of the training data (and held at its end
@@ -65,7 +65,8 @@ _MAX_PERIODS = 4000
 PERIOD_SEPARATION_STEPS = 2
 #: Points of the logarithmic grids of time constants and Stribeck velocities.
 _LOG_GRID_POINTS = 24
-#: Extra channel of a run holding the base model's friction [A, or N] (see :meth:`EffectContext.friction_shape`).
+#: Extra channel of a run holding the base model's friction less its viscous part [A, or N]
+#: (see :meth:`EffectContext.friction_shape`).
 BASE_FRICTION = "base_friction"
 
 
@@ -97,9 +98,10 @@ class EffectContext:
         start of the run; ``None``: the first sample of the log passed. Set it
         when a log is a part of a run (a chunk of a long run).
     friction_level : float, optional
-        Level of the base model's friction [A, or N] (its 90th percentile
-        ``|F|`` on the training runs) that the friction effects scale; the runs
-        then carry the base friction as the extra channel :data:`BASE_FRICTION`.
+        Level of the base model's friction less its viscous part [A, or N]
+        (its 90th percentile ``|F|`` on the training runs) that the friction
+        effects scale; the runs then carry that friction as the extra channel
+        :data:`BASE_FRICTION`.
         ``None``: no base model, friction effects scale the direction of motion.
     """
 
@@ -125,7 +127,7 @@ class EffectContext:
         return np.tanh(run.velocity / self.velocity_scale_mm_s)
 
     def friction_shape(self, run: AxisLog) -> np.ndarray:
-        """What friction effects scale: the base model's friction over its level, or ``d`` without a base."""
+        """What friction effects scale: the base's friction less its viscous part over its level, or ``d``."""
         if self.friction_level is None:
             return self.direction(run)
         if BASE_FRICTION not in run.extras:
