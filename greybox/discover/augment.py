@@ -16,11 +16,12 @@
    terms (its shape may now move), and step 2 is repeated; the new shape is
    kept if the joint fit is then better.
 
-Friction terms scale the friction of the base as identified in step 1 (or 3),
-less its viscous part (a friction level that changes along the travel or with
-time scales the sliding friction, not the lubricant's viscous drag), over its level (:meth:`~greybox.discover.effects.EffectContext.friction_shape`):
-a friction that changes along the travel or with time is the base's friction
-law scaled, its Stribeck curve and pre-sliding included. That base is held
+Friction terms scale the friction of the base as identified in step 1 (or
+3) less its viscous part, over its level
+(:meth:`~greybox.discover.effects.EffectContext.friction_shape`): a friction
+that changes along the travel or with time is the base's sliding friction law
+scaled, its Stribeck curve and pre-sliding included, not the lubricant's
+viscous drag. That base is held
 (``friction_shape_base_``) while the joint solve moves the base's linear
 parameters, so that the solve stays one linear least-squares problem.
 
