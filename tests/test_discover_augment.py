@@ -134,3 +134,19 @@ def test_refinement_never_brings_a_period_next_to_another_of_the_same_effect():
     assert 1.0 / low == pytest.approx(0.23 - 2 * step) and 1.0 / high == pytest.approx(0.17 + 2 * step)
     # a term far away leaves the bracket as it is
     assert _apart(5.0, 4.0, 6.0, [1.0], step) == (pytest.approx(4.0), pytest.approx(6.0))
+
+
+def test_a_model_file_from_before_the_friction_scaling_loads_and_scales_the_direction(stroke, tmp_path):
+    rng = np.random.default_rng(7)
+    run = stroke.replace(effort=coulomb_current(stroke) + rng.normal(0, 0.03, len(stroke)))
+    model = AugmentedModel(base=CoulombModel(), effects=[("thermal_drift", 7.0)]).fit(run)
+    for name in ("friction_level_", "friction_shape_base_", "friction_shape_viscous_"):
+        delattr(model, name)  # as written by greybox before friction terms scaled the base's friction
+    path = save_model(model, tmp_path / "old.gbm")
+    loaded = load_model(path)
+    assert loaded.context.friction_level is None
+    (coefficient,), tau = loaded.effects_[0]["coefficients"], loaded.effects_[0]["shape"]
+    expected = coefficient * (1.0 - np.exp(-(run.time - run.time[0]) / tau)) * np.tanh(
+        run.velocity / loaded.velocity_scale_mm_s_)
+    np.testing.assert_allclose(loaded.term_currents(run)["1:thermal_drift"], expected, rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(loaded.predict(run), model.predict(run))

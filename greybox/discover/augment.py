@@ -44,7 +44,7 @@ from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 from threadpoolctl import threadpool_limits
 
-from ..base import LinearPart, Parameter
+from ..base import EFFORT, LinearPart, Parameter
 from ..data.log import AxisLog
 from ..errors import GreyboxError, ParameterError
 from ..estimator import CurrentModel, check_runs
@@ -372,6 +372,10 @@ class AugmentedModel(CurrentModel):
                 for p in self.base_.parameter_table()]
         terms = [Parameter(f"{i + 1}:{e['name']}.{name}", value, "(in the name)", f"added effect {e['name']}")
                  for i, e in enumerate(self.effects_) for name, value in e["parameters"].items()]
+        level = getattr(self, "friction_level_", None)
+        if level is not None:
+            terms.append(Parameter("friction_level", level, EFFORT, "level of the base's sliding friction that "
+                                   "friction terms scale (90th percentile of its magnitude on the training runs)"))
         return base + terms
 
     def _effect_friction(self, run: AxisLog, context: EffectContext) -> np.ndarray:

@@ -30,7 +30,7 @@ lowers the held-out error, or the structure left lies along the velocity or
 the time since the motion changed only, or does not hold on held-out blocks),
 ``"unexplained_structure"`` (nothing from the library passes, but structure
 along the position or the acceleration remains that also holds on held-out
-blocks beyond chance: the model misses something
+blocks beyond the margin: the model misses something
 the library does not name) and ``"nothing_missing"``.
 """
 
@@ -352,7 +352,7 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     if steps[-1].structure.passes and not named:
         part = _scoring_part(model, train, refine_base)
         families = structure_basis(train)
-        tester = _held_out(train, part, target, model.context, {**held_out_settings, "min_gain": 0.0}, rng)
+        tester = _held_out(train, part, target, model.context, held_out_settings, rng)
         foreign = {name: tester.evaluate(None, columns=families[name].toarray())
                    for name in _FOREIGN_FAMILIES if name in families}
         base_misfit = base_misfit or {"detected": False, "held_out": None, "parameters": None}
