@@ -428,7 +428,8 @@ def markdown(section: str, settings: dict, summary: dict, cases: list, nulls: li
             elif name in ABSORBED:
                 text += f" ({cell['nothing_missing']} nothing_missing)"
             row.append(text)
-        lines.append(f"| {name}{' (absorbed)' if name in ABSORBED else ''} | " + " | ".join(row) + " |")
+        label = " (absorbed)" if name in ABSORBED else " (found as base misfit)" if name in VELOCITY_ONLY else ""
+        lines.append(f"| {name}{label} | " + " | ".join(row) + " |")
     if settings.get("background"):
         lines += ["", "Background (named on the plain logs, the plant's own structure): "
                   + "; ".join(f"seed {seed}: {', '.join(names) or 'none'}"

@@ -162,8 +162,23 @@ def _percent(rate: dict) -> str:
             if rate["n"] else "-")
 
 
-def family_markdown(settings: dict, summary: dict, seconds: float) -> str:
-    """The study's tables: figures against targets, and per hidden effect and ratio."""
+def _axis_table(rows: list[dict], seed: int, ratio: float) -> list[str]:
+    """One axis, case by case: what was named and the test RMSE before and after, beside the noise."""
+    lines = [f"Axis {seed}, case by case (hidden effect at {ratio:g} x the noise RMS):", "",
+             "| hidden | verdict | named, in order | test RMSE before -> after (oracle) [A] | noise [A] |",
+             "|---|---|---|---|---|"]
+    for row in rows:
+        if row["seed"] != seed or (row["effect"] is not None and row["ratio"] != ratio):
+            continue
+        oracle = "" if row["rmse_oracle"] is None else f" ({row['rmse_oracle']:.4f})"
+        lines.append(f"| {row['effect'] or 'nothing'} | {row['verdict']} | {', '.join(row['named']) or '-'} | "
+                     f"{row['rmse_before']:.4f} -> {row['rmse_after']:.4f}{oracle} | {row['noise_rms_A']:.4f} |")
+    return lines
+
+
+def family_markdown(settings: dict, summary: dict, seconds: float, rows: list[dict] | None = None) -> str:
+    """The study's tables: figures against targets, per hidden effect and ratio, and (with ``rows``) the
+    first axis case by case at the largest ratio."""
     lines = [
         f"Hysteresis family ({settings['seeds']} axes, seeds {settings['first_seed']}-"
         f"{settings['first_seed'] + settings['seeds'] - 1}), base model {settings['base']}, two training and two "
@@ -188,6 +203,8 @@ def family_markdown(settings: dict, summary: dict, seconds: float) -> str:
             lines.append(f"| {name if name != 'None' else 'none (null axis)'} | {ratio} | {cell['n']} | "
                          f"{cell['first']} | {', '.join(cell['verdicts'])} | {closure} | "
                          f"{', '.join(cell['spurious']) or '-'} |")
+    if rows:
+        lines += [""] + _axis_table(rows, settings["first_seed"], max(settings["ratios"]))
     return "\n".join(lines) + "\n"
 
 
@@ -255,7 +272,7 @@ def run_family_study(json_path: str | os.PathLike, *, markdown_path=None, seeds:
                 f"first_correct={row['first_correct']} closure={closure} ({row['seconds']:.0f} s)")
             save()
     summary = save()
-    text = family_markdown(settings, summary, time.perf_counter() - started)
+    text = family_markdown(settings, summary, time.perf_counter() - started, rows)
     if markdown_path:
         write_text_atomic(markdown_path, text)
     return text
