@@ -153,5 +153,5 @@ def test_augmented_chunks_need_the_run_start_and_the_base_state(augmented, cut_l
     slices = chunk_slices(len(cut_log), samples_per_chunk(step, CHUNK_S))
     restarted = np.concatenate([augmented.predict_chunk(cut_log.select(s), sample_time=step)[0] for s in slices])
     assert np.max(np.abs(restarted - augmented.predict(cut_log))) > 1e-3
-    base_state, run_start = augmented.initial_state()
-    assert isinstance(base_state, GMSState) and run_start is None
+    base_state, scaled_state, run_start = augmented.initial_state()  # scaled: the friction the terms scale
+    assert isinstance(base_state, GMSState) and isinstance(scaled_state, GMSState) and run_start is None
