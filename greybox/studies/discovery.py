@@ -235,7 +235,7 @@ def run_case(base, case: StudyCase, *, background: frozenset = frozenset(), n_nu
            "base_misfit": bool(result.base_misfit and result.base_misfit["detected"]),
            "spurious": [name for name in named if name != case.effect and name not in background],
            "rmse_before": result.test["rmse_before"], "rmse_after": result.test["rmse_after"]}
-    if case.effect in VELOCITY_ONLY:  # the base refinement's velocity curve spans it: found as base misfit
+    if case.effect in VELOCITY_ONLY and case.effect not in ABSORBED:  # the velocity curve spans it: base misfit
         row["correct"] = row["first_correct"] = _curve_kept(result)
     row["rmse_oracle"] = row["closure"] = None
     if case.effect is not None:
