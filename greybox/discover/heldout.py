@@ -113,6 +113,8 @@ class HeldOutGain:
         Periodic effects: ``{"positive_to_negative", "negative_to_positive"}`` gains.
     passes : bool
         All conditions hold.
+    reasons : list of str
+        One line per condition that fails (empty when it passes).
     """
 
     gain: float
@@ -129,8 +131,7 @@ class HeldOutGain:
     def to_dict(self) -> dict:
         """JSON-able summary."""
         return {"gain": self.gain, "uncertainty": self.uncertainty, "positive_blocks": self.positive_blocks,
-                "margin": self.margin,
-                "null_q95": self.null_q95, "blocks": self.blocks, "shapes": self.shapes,
+                "margin": self.margin, "null_q95": self.null_q95, "blocks": self.blocks, "shapes": self.shapes,
                 "direction_transfer": self.direction_transfer, "passes": self.passes,
                 "reasons": list(self.reasons)}
 
