@@ -132,11 +132,12 @@ def test_base_misfit_is_reported_and_its_curve_saved(tmp_path, capsys):
                     "--save-model", str(model), "--quiet"]) == 0
     document = json.loads(out.read_text())
     assert document["verdict"] == "base_misfit" and document["effects"] == []
-    assert document["base_misfit"]["detected"] and document["base_misfit"]["held_out"]["passes"]
-    assert document["base_misfit"]["parameters"]["excess_at_rest_A"] > 0.0
+    curve = document["base_misfit"]["refinements"]["velocity_curve"]
+    assert document["base_misfit"]["detected"] and curve["kept"] and curve["held_out"]["passes"]
+    assert curve["parameters"]["excess_at_rest_A"] > 0.0
     assert document["test_rmse_after"] < document["test_rmse_before"]
     assert load_model(model).effects_[0]["name"] == "velocity_curve"
-    assert "base misfit: the base model's friction along the speed is off" in capsys.readouterr().out
+    assert "base misfit: velocity_curve (friction along the speed" in capsys.readouterr().out
     # without the refinement the same excess is a named Stribeck effect
     assert run_cli(["--model", "coulomb", "--train", paths[0], "--test", paths[1], "--json", str(out), "--force",
                     "--quiet", "--no-refine-base", "--max-effects", "1"]) == 0

@@ -45,11 +45,15 @@ def test_effects_the_base_already_has_are_not_named():
 
 
 def test_structure_outside_the_library_is_reported_as_unexplained():
-    # friction that grows only while accelerating forwards: no library effect has this shape; strong enough
-    # (about the noise RMS) to hold on held-out blocks
+    # a force growing with the square of the acceleration, in its direction: the library's inertia term is
+    # linear in the acceleration and no other effect has this shape; without a mean (friction growing only
+    # while accelerating forwards, max(a, 0), has one, which a constant offset rightly takes); strong enough
+    # to hold on held-out blocks
     train, test, _ = case_logs(StudyCase(None, 0.0, 1, "coulomb", DURATION_S))
+    scale = np.percentile(np.abs(train.acceleration), 99.0)
+
     def add(run):
-        return run.replace(effort=run.effort + 3e-3 * np.maximum(run.acceleration, 0.0))
+        return run.replace(effort=run.effort + 3e-3 * run.acceleration * np.abs(run.acceleration) / scale)
 
     result = discover(CoulombModel(), add(train), add(test), seed=1)
     assert result.verdict == "unexplained_structure"

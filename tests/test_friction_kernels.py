@@ -12,9 +12,10 @@ from greybox.friction.kernels import (
     gms_friction_kernel,
     gms_trajectory_kernel,
     lugre_trajectory_kernel,
+    play_operator_kernel,
 )
 from greybox.friction.lugre import simulate_lugre
-from greybox.friction.reference import gms_reference, lugre_reference
+from greybox.friction.reference import gms_reference, lugre_reference, play_operator_reference
 from greybox.friction.signals import STEP, velocity_profile
 
 
@@ -111,3 +112,27 @@ def test_kernels_write_into_column_views():
                                        static=0.9, v_s=3.0)
     np.testing.assert_array_equal(z_col[:, 0], z_ref)
     assert end == end_ref
+
+
+def test_play_operator_kernel_matches_python_reference():
+    rng = np.random.default_rng(4)
+    position = np.cumsum(rng.normal(0.0, 0.004, 3000))
+    widths = np.array([0.001, 0.003, 0.01, 0.03])
+    start = rng.uniform(-1.0, 1.0, widths.size)
+    states, after = np.empty((position.size, widths.size)), start.copy()
+    play_operator_kernel(position, widths, after, states)
+    rows, expected_after = play_operator_reference(position, widths, start)
+    np.testing.assert_array_equal(states, np.array(rows))
+    np.testing.assert_array_equal(after, expected_after)
+
+
+def test_play_operator_is_rate_independent_and_saturates_after_its_width():
+    widths = np.array([0.002, 0.02])
+    coarse = np.array([0.0, 0.01, 0.03, 0.025, 0.0])
+    fine = np.interp(np.linspace(0.0, 4.0, 401), np.arange(5.0), coarse)   # the same path, 100 times the samples
+    states = [np.empty((path.size, 2)) for path in (coarse, fine)]
+    for path, out in zip((coarse, fine), states):
+        play_operator_kernel(path, widths, np.zeros(2), out)
+    np.testing.assert_allclose(states[1][::100], states[0], atol=1e-12)
+    np.testing.assert_allclose(states[0][:, 0], [0.0, 1.0, 1.0, -1.0, -1.0], atol=1e-12)   # 2 um: saturated
+    np.testing.assert_allclose(states[0][:, 1], [0.0, 0.5, 1.0, 0.75, -0.5], atol=1e-12)   # 20 um: follows

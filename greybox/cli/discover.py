@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import check_output_path
-from ..discover.effects import EFFECT_NAMES
+from ..discover.effects import EFFECT_NAMES, effect
 from ..discover.heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN
 from ..discover.report import REPORT_FILES, write_json, write_report
 from ..discover.workflow import discover
@@ -117,12 +117,13 @@ def _print_summary(result) -> None:
             print(f"     the data cannot tell it apart from: {', '.join(evidence['indistinguishable_from'])}")
     misfit = result.base_misfit
     if misfit and misfit["detected"]:
-        curve = misfit.get("held_out")
-        if misfit.get("parameters"):
-            print(f"  base misfit: the base model's friction along the speed is off; a flexible curve removes "
-                  f"{100 * curve['gain']:.2f} +- {100 * curve['uncertainty']:.2f} % of the held-out residual and is "
-                  f"kept ({_format_parameters(misfit['parameters'])})")
-        else:
+        kept = {name: entry for name, entry in misfit["refinements"].items() if entry["kept"]}
+        for name, entry in kept.items():
+            held = entry["held_out"]
+            print(f"  base misfit: {name} ({effect(name).summary}) removes {100 * held['gain']:.2f} +- "
+                  f"{100 * held['uncertainty']:.2f} % of the held-out residual and is kept "
+                  f"({_format_parameters(entry['parameters'])})")
+        if not kept:
             print("  base misfit: the structure left lies along the velocity or the time since the motion changed "
                   "(or does not hold on held-out blocks): the base model's own friction law misfits")
     last = result.steps[-1]

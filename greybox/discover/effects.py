@@ -47,9 +47,11 @@ import numpy as np
 
 from ..data.log import AxisLog
 from ..errors import GreyboxError
+from ..friction.kernels import play_operator_kernel
 
 __all__ = ["BASE_FRICTION", "EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "REFINEMENTS", "VELOCITY_ONLY",
-           "VELOCITY_CURVE_SCALES", "PERIOD_SEPARATION_STEPS", "effect", "period_grid", "period_scan", "scan_periods",
+           "VELOCITY_CURVE_SCALES", "PRESLIDING_WIDTHS_MM",
+           "PRESLIDING_SPEED_SCALES", "PERIOD_SEPARATION_STEPS", "effect", "period_grid", "period_scan", "scan_periods",
            "default_velocity_scale"]
 
 #: Periods are scanned at this many points per periodogram resolution ``1 / range``.
@@ -425,15 +427,61 @@ def _curve_parameters(coefficients, context, shape, unit):
             f"excess_at_top_speed_{unit}": excess(top), "top_speed_mm_s": float(top)}
 
 
-#: Refinements of the base model, not named effects: a flexible friction curve along the speed, the same in
-#: both directions, that any velocity-only friction law the base model lacks projects onto (a Stribeck curve
-#: of another shape, viscous friction that is not linear). The workflow fits it before naming anything and
-#: reports it as *base misfit*.
+#: Break-away displacements [mm] of the pre-sliding refinement's play operators: 1 um to 0.1 mm, the range of
+#: the pre-sliding displacements of the rolling contacts of feed drives (ball screws, linear guides).
+PRESLIDING_WIDTHS_MM = (0.001, 0.003, 0.01, 0.03, 0.1)
+#: Speeds [units of ``v_e``] at which the pre-sliding refinement's hysteresis may weaken (its products with
+#: ``exp(-|v| / v_k)``): near rest, at a sixth of the top speed and at the top speed.
+PRESLIDING_SPEED_SCALES = (3.0, 17.0, 100.0)
+
+
+def _presliding(run, context, shape):
+    widths = np.asarray(PRESLIDING_WIDTHS_MM, dtype=float)
+    states = np.empty((len(run), widths.size))
+    play_operator_kernel(np.ascontiguousarray(run.position, dtype=float), widths, np.zeros(widths.size), states)
+    speed = np.abs(run.velocity)[:, None]
+    weakening = [states * np.exp(-speed / (context.velocity_scale_mm_s * scale)) for scale in PRESLIDING_SPEED_SCALES]
+    return np.hstack([states] + weakening)
+
+
+def _presliding_parameters(coefficients, context, shape, unit):
+    coefficients = np.asarray(coefficients, dtype=float).reshape(1 + len(PRESLIDING_SPEED_SCALES), -1)
+
+    def excess(speed):
+        factors = np.concatenate(([1.0], np.exp(-speed / (context.velocity_scale_mm_s
+                                                          * np.asarray(PRESLIDING_SPEED_SCALES)))))
+        return float(factors @ coefficients.sum(axis=1))
+    top = context.velocity_scale_mm_s * VELOCITY_CURVE_SCALES[-1]
+    return {f"excess_deflected_at_rest_{unit}": excess(0.0), f"excess_deflected_at_top_speed_{unit}": excess(top),
+            "top_speed_mm_s": float(top)}
+
+
+#: Refinements of the base model, not named effects; the workflow fits them before naming anything and
+#: reports them as *base misfit*:
+#:
+#: - ``velocity_curve``: a flexible friction curve along the speed, the same in both directions, that any
+#:   velocity-only friction law the base model lacks projects onto (a Stribeck curve of another shape,
+#:   viscous friction that is not linear);
+#: - ``presliding_hysteresis``: rate-independent pre-sliding hysteresis of another shape than the base's,
+#:   as a weighted sum of play-operator states (:func:`greybox.friction.kernels.play_operator_kernel`, break-away
+#:   displacements :data:`PRESLIDING_WIDTHS_MM`, each state also weakened with the speed,
+#:   :data:`PRESLIDING_SPEED_SCALES`). The states start at 0 at the first sample of a run (its history
+#:   before is unknown) and forget it within twice the largest width of travel (0.2 mm).
+#:
+#: Both are odd in the motion, the same law in both directions, and depend on the velocity and the
+#: position's recent path only: none can stand in for an effect of the position, the time or a direction.
 REFINEMENTS: dict[str, Effect] = {
     "velocity_curve": Effect("velocity_curve", "friction along the speed that the base model's own curve "
                              "misses (the same in both directions)",
                              tuple(f"curve_{i}" for i in range(len(VELOCITY_CURVE_SCALES))),
                              _velocity_curve, _curve_parameters),
+    "presliding_hysteresis": Effect(
+        "presliding_hysteresis", "pre-sliding hysteresis the base model's elements miss (the same in both "
+        "directions)",
+        tuple(f"play_{i}" for i in range(len(PRESLIDING_WIDTHS_MM)))
+        + tuple(f"play_{i}_weakening_{j}" for j in range(len(PRESLIDING_SPEED_SCALES))
+                for i in range(len(PRESLIDING_WIDTHS_MM))),
+        _presliding, _presliding_parameters),
 }
 
 #: Library effects that depend on the velocity alone: the velocity curve spans them (base misfit, not a

@@ -13,19 +13,20 @@
    model (RMSE, RE and per regime), and the residual by regime before and after.
 
 Before any effect is named, the base model is *refined* (``refine_base``): a
-flexible friction curve along the speed (:data:`greybox.discover.effects.REFINEMENTS`)
-joins its linear columns in every test, so that a base whose velocity-only
-friction law is only approximately right does not make velocity-only effects
-(``stribeck``, ``viscous_friction``) look missing. When the curve lowers the
-error on held-out blocks of the training runs it is kept in the model and
-reported as *base misfit*. Every winner of a step must also pass the held-out
+flexible friction curve along the speed and a bank of pre-sliding hysteresis
+states (:data:`greybox.discover.effects.REFINEMENTS`) join its linear columns
+in every test, so that a base whose friction law is only approximately right
+(another Stribeck curve, another pre-sliding shape) does not make effects look
+missing; velocity-only effects (``stribeck``, ``viscous_friction``) are then
+not candidates. Each refinement that lowers the error on held-out blocks of
+the training runs is kept in the model and reported as *base misfit*. Every winner of a step must also pass the held-out
 test (:mod:`greybox.discover.heldout`): fitted on four fifths of the training
 time, it must lower the error on the fifth, beyond a margin calibrated for
 its flexibility; a periodic one must also carry over from one direction of
 travel to the other.
 
 Verdicts: ``"named"`` (at least one effect added), ``"base_misfit"`` (nothing
-named, but the base model's own law is what misfits: the velocity curve
+named, but the base model's own law is what misfits: a refinement
 lowers the held-out error, or the structure left lies along the velocity or
 the time since the motion changed only, or does not hold on held-out blocks),
 ``"unexplained_structure"`` (nothing from the library passes, but structure
@@ -50,7 +51,7 @@ from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
 from ..metrics import metrics_table
 from ..provenance import provenance
 from .augment import AugmentedModel
-from .effects import EFFECT_NAMES, VELOCITY_ONLY, effect
+from .effects import EFFECT_NAMES, REFINEMENTS, VELOCITY_ONLY, effect
 from .evidence import StepEvidence, score_step
 from .heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN, HeldOutTest
 from .locate import residual_by_regime, residual_profiles, structure_basis
@@ -65,8 +66,6 @@ VERDICTS = ("named", "base_misfit", "nothing_missing", "unexplained_structure")
 #: time since the start cannot be fitted on one stretch of time and checked on another): structure along
 #: them that holds on held-out blocks is unexplained.
 _FOREIGN_FAMILIES = ("position_direction", "acceleration")
-#: The base refinement.
-_CURVE = "velocity_curve"
 
 
 @dataclass
@@ -90,8 +89,9 @@ class DiscoveryResult:
         Winners dropped because their joint refit explained no more than chance
         or because they failed the held-out test (``reason``).
     base_misfit : dict or None
-        The base refinement (None without ``refine_base``): ``detected``,
-        the velocity curve's ``held_out`` evidence and, when kept, its
+        The base refinements (None without ``refine_base``): ``detected``
+        and per refinement (``refinements``, by name) whether it was
+        ``kept``, its ``held_out`` evidence and, when kept, its
         ``parameters``; and the held-out evidence of the structure families
         (``structure``) when structure remains.
     train, test : dict
@@ -199,15 +199,39 @@ def _evidence_entry(step_index: int, step: StepEvidence, name: str, gain: float,
 
 
 def _scoring_part(model: AugmentedModel, runs, refine_base: bool):
-    """The model's linear part, with the velocity curve's columns added when refining and not yet in it."""
+    """The model's linear part, with the columns of the refinements not in it added when refining."""
     part = model.linear_part(runs)
-    if not refine_base or any(entry["name"] == _CURVE for entry in model.effects_):
+    if not refine_base:
         return part
-    curve = np.concatenate([effect(_CURVE).columns(run, model.context) for run in runs])
-    return replace(part, columns=np.hstack((part.columns, curve)), names=part.names + tuple(
-        f"{_CURVE}.{name}" for name in effect(_CURVE).column_names),
-        lower=np.concatenate((part.lower, np.full(curve.shape[1], -np.inf))),
-        upper=np.concatenate((part.upper, np.full(curve.shape[1], np.inf))))
+    kept = {entry["name"] for entry in model.effects_}
+    for name in REFINEMENTS:
+        if name in kept:
+            continue
+        columns = np.concatenate([effect(name).columns(run, model.context) for run in runs])
+        part = replace(part, columns=np.hstack((part.columns, columns)),
+                       names=part.names + tuple(f"{name}.{column}" for column in effect(name).column_names),
+                       lower=np.concatenate((part.lower, np.full(columns.shape[1], -np.inf))),
+                       upper=np.concatenate((part.upper, np.full(columns.shape[1], np.inf))))
+    return part
+
+
+def _refine(model, base, base_model, train, target, settings, rng, refit_base, say, fit_progress):
+    """Test each base refinement on held-out blocks in turn; keep those that pass. Returns ``(model, misfit)``."""
+    misfit, kept = {"detected": False, "refinements": {}}, []
+    for name in REFINEMENTS:
+        held_out = _held_out(train, model.linear_part(train), target, model.context, settings, rng).evaluate(
+            effect(name))
+        entry = {"kept": held_out.passes, "held_out": held_out.to_dict(), "parameters": None}
+        say(f"base refinement {name} ({effect(name).summary}): held-out gain {100 * held_out.gain:.2f} +- "
+            f"{100 * held_out.uncertainty:.2f} % " + ("(kept: base misfit)" if held_out.passes else "(not kept)"))
+        if held_out.passes:
+            kept.append((name, None))
+            model = AugmentedModel(base=base, effects=kept, refit_base=refit_base).fit_terms(
+                train, base=base_model, progress=fit_progress)
+            entry["parameters"] = model.effects_[-1]["parameters"]
+        misfit["refinements"][name] = entry
+    misfit["detected"] = bool(kept)
+    return model, misfit
 
 
 def _held_out(runs, part, target, context, settings, rng) -> HeldOutTest:
@@ -245,9 +269,9 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
         Identify the base's nonlinear shape again with every added effect
         (see :class:`AugmentedModel`).
     refine_base : bool, default True
-        Refine the base with a flexible friction curve along the speed
-        before naming anything (module notes); velocity-only library effects
-        are then not candidates (the curve spans them).
+        Refine the base with a flexible friction curve along the speed and
+        pre-sliding hysteresis states before naming anything (module notes);
+        velocity-only library effects are then not candidates (the curve spans them).
     held_out_blocks : int, default 5
         Contiguous blocks of training time for the held-out test (at least 2).
     min_gain : float, default 0.02
@@ -287,16 +311,8 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     base_misfit = None
     if refine_base:
         names = [name for name in names if name not in VELOCITY_ONLY]
-        part = model.linear_part(train)
-        curve = _held_out(train, part, target, model.context, held_out_settings, rng).evaluate(effect(_CURVE))
-        base_misfit = {"detected": curve.passes, "held_out": curve.to_dict(), "parameters": None}
-        say(f"base refinement: a friction curve along the speed lowers the held-out error by "
-            f"{100 * curve.gain:.2f} +- {100 * curve.uncertainty:.2f} % "
-            + ("(kept: base misfit)" if curve.passes else "(not kept)"))
-        if curve.passes:
-            model = AugmentedModel(base=base, effects=[(_CURVE, None)], refit_base=refit_base).fit_terms(
-                train, base=base_model, progress=fit_progress)
-            base_misfit["parameters"] = model.effects_[0]["parameters"]
+        model, base_misfit = _refine(model, base, base_model, train, target, held_out_settings, rng, refit_base,
+                                     say, fit_progress)
     rss = _rss(model, train, target)
     named, steps, rejected = [], [], []
     remaining = list(names)
@@ -355,7 +371,7 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
         tester = _held_out(train, part, target, model.context, held_out_settings, rng)
         foreign = {name: tester.evaluate(None, columns=families[name].toarray())
                    for name in _FOREIGN_FAMILIES if name in families}
-        base_misfit = base_misfit or {"detected": False, "held_out": None, "parameters": None}
+        base_misfit = base_misfit or {"detected": False, "refinements": {}}
         base_misfit["structure"] = {name: value.to_dict() for name, value in foreign.items()}
         if any(value.passes for value in foreign.values()):
             verdict = "unexplained_structure"

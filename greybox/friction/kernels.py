@@ -40,6 +40,7 @@ __all__ = [
     "gms_trajectory_kernel",
     "lugre_trajectory_kernel",
     "backlash_gap_kernel",
+    "play_operator_kernel",
 ]
 
 
@@ -453,3 +454,39 @@ def backlash_gap_kernel(position, force, width, threshold, gap_low, gap_high, lo
             loaded = -1
         in_gap_out[j] = False
     return gap_low, gap_high, loaded
+
+
+@njit(cache=True, error_model="numpy")
+def play_operator_kernel(position, widths, state, out):
+    """States of a bank of play (elasto-plastic) operators driven by the position.
+
+    Operator ``k`` follows the position with slope ``1 / widths[k]`` and is
+    clamped to ``[-1, 1]``: ``s_k <- clip(s_k + (x_j - x_{j-1}) / widths[k], -1, 1)``.
+    It is the deflection of a Maxwell-slip element of break-away displacement
+    ``widths[k]`` over that displacement, rate independent; a weighted sum of
+    such states spans rate-independent pre-sliding hysteresis (Prandtl-Ishlinskii).
+
+    Parameters
+    ----------
+    position : ndarray, shape (n,)
+        Position [mm].
+    widths : ndarray, shape (m,)
+        Break-away displacements [mm], positive.
+    state : ndarray, shape (m,)
+        States before the first sample, each in ``[-1, 1]``; updated in place to the
+        states after the last sample.
+    out : ndarray, shape (n, m)
+        Receives the states at every sample (sample 0: ``state`` as passed).
+    """
+    for k in range(widths.shape[0]):
+        out[0, k] = state[k]
+    for j in range(1, position.shape[0]):
+        step = position[j] - position[j - 1]
+        for k in range(widths.shape[0]):
+            s = state[k] + step / widths[k]
+            if s > 1.0:
+                s = 1.0
+            elif s < -1.0:
+                s = -1.0
+            state[k] = s
+            out[j, k] = s

@@ -186,7 +186,7 @@ def null_logs(base, train: AxisLog, test: AxisLog, seed: int) -> tuple[AxisLog, 
 
 def _curve_kept(result) -> bool:
     """The base refinement found base misfit and kept its velocity curve."""
-    return bool(result.base_misfit and result.base_misfit["detected"] and result.base_misfit["parameters"])
+    return bool(result.base_misfit and result.base_misfit["refinements"]["velocity_curve"]["kept"])
 
 
 def _correct(case: StudyCase, entry: dict) -> bool:

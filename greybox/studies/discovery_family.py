@@ -13,7 +13,12 @@ at a given RMS relative to the noise, trains on two logs and tests on two
 others (four independent trajectories). It is scored against an *oracle*: the
 base model fitted to the training effort minus the true hidden current, and
 predicting the test effort with the true hidden current added. Gap closure =
-(test RMSE before - after) / (before - oracle).
+(test RMSE before - after) / (before - oracle). The base refinements of the
+workflow (:data:`greybox.discover.effects.REFINEMENTS`) fix part of the base's
+own misfit, which the oracle does not, so this closure can exceed 1 without the
+effect being found well; the *effect closure* compares like with like: before
+= the base with the refinements the workflow kept, oracle = the same fitted to
+the training effort minus the true hidden current, plus that current.
 
 On a null axis the verdicts ``nothing_missing`` and ``base_misfit`` are right;
 ``named`` and ``unexplained_structure`` are false. On an effect axis a named
@@ -32,6 +37,8 @@ from sklearn.base import clone
 
 from ..atomic import write_text_atomic
 from ..data.prepare import prepare
+from ..discover.augment import AugmentedModel
+from ..discover.effects import REFINEMENTS
 from ..discover.report import write_json
 from ..discover.workflow import discover
 from ..friction import GMSModel
@@ -77,7 +84,8 @@ def run_family_case(case: FamilyCase, *, base=None, n_null: int = 99) -> dict:
         ``first_correct``, ``spurious`` (named effects not hidden),
         ``false_positive`` (null axes: a verdict other than
         :data:`ACCEPTED_NULL_VERDICTS`), the test RMSE before, after and of
-        the oracle [A], ``closure``, each named effect's held-out gain, and ``seconds``.
+        the oracle [A], ``closure``, ``closure_effect`` (given the refinements
+        kept) with ``rmse_oracle_refined``, each named effect's held-out gain, and ``seconds``.
     """
     started = time.perf_counter()
     base = GMSModel() if base is None else base
@@ -98,18 +106,34 @@ def run_family_case(case: FamilyCase, *, base=None, n_null: int = 99) -> dict:
                                                                                            info)
     row["spurious"] = [name for name in named if name != case.effect]
     row["false_positive"] = case.effect is None and result.verdict not in ACCEPTED_NULL_VERDICTS
-    row["rmse_oracle"] = row["closure"] = None
+    row["rmse_oracle"] = row["closure"] = row["closure_effect"] = None
     if case.effect is not None:
-        hidden_train, hidden_test = info["hidden_A"][:2], info["hidden_A"][2:]
-        shifted = [run.replace(effort=run.effort - hidden) for run, hidden in zip(train, hidden_train)]
-        oracle = clone(base).fit(shifted)
-        predicted = np.concatenate([oracle.predict(run) + hidden for run, hidden in zip(test, hidden_test)])
-        row["rmse_oracle"] = rmse(np.concatenate([run.effort for run in test]), predicted)
-        gain = row["rmse_before"] - row["rmse_oracle"]
-        if gain > 0.01 * row["rmse_before"]:
-            row["closure"] = (row["rmse_before"] - row["rmse_after"]) / gain
+        row.update(_closures(base, result, train, test, info))
     row["seconds"] = time.perf_counter() - started
     return row
+
+
+def _closures(base, result, train, test, info) -> dict:
+    """Gap closures against the oracle: with the base alone, and given the base refinements kept."""
+    measured = np.concatenate([run.effort for run in test])
+    hidden_train, hidden_test = info["hidden_A"][:2], info["hidden_A"][2:]
+    shifted = [run.replace(effort=run.effort - hidden) for run, hidden in zip(train, hidden_train)]
+    oracle = clone(base).fit(shifted)
+    after = result.test["rmse_after"]
+    refinements = [(entry["name"], None) for entry in result.model.effects_ if entry["name"] in REFINEMENTS]
+    refined_before, refined_oracle = result.base_model, oracle
+    if refinements:
+        refined_before = AugmentedModel(base=base, effects=refinements).fit_terms(train, base=result.base_model)
+        refined_oracle = AugmentedModel(base=base, effects=refinements).fit_terms(shifted, base=oracle)
+    out = {}
+    for key, before_model, oracle_model in (("closure", result.base_model, oracle),
+                                            ("closure_effect", refined_before, refined_oracle)):
+        before = rmse(measured, np.concatenate([before_model.predict(run) for run in test]))
+        best = rmse(measured, np.concatenate([oracle_model.predict(run) + hidden
+                                              for run, hidden in zip(test, hidden_test)]))
+        out["rmse_oracle" if key == "closure" else "rmse_oracle_refined"] = best
+        out[key] = (before - after) / (before - best) if before - best > 0.01 * before else None
+    return out
 
 
 def _rate(count: int, n: int) -> dict:
@@ -125,13 +149,14 @@ def summarise_family(rows: list[dict], *, min_ratio: float = 0.5) -> dict:
         ``null_right`` (share of null axes with an accepted verdict),
         ``spurious`` (share of all cases naming an effect that was not
         hidden), ``first_correct`` (share of effect cases at RMS ratio >=
-        ``min_ratio`` naming the hidden effect first), ``closure`` (share of
-        those cases with a closure >= 0.8, and the median) and
+        ``min_ratio`` naming the hidden effect first), ``closure`` and
+        ``closure_effect`` (share of those cases with a closure >= 0.8, and the median) and
         ``by_effect`` (per effect and ratio: cases, named first, named, median closure).
     """
     nulls = [row for row in rows if row["effect"] is None]
     effects = [row for row in rows if row["effect"] is not None and row["ratio"] >= min_ratio]
     closures = [row["closure"] for row in effects if row["closure"] is not None]
+    effect_closures = [row.get("closure_effect") for row in effects if row.get("closure_effect") is not None]
     by_effect = {}
     for row in rows:
         cell = by_effect.setdefault(str(row["effect"]), {}).setdefault(f"{row['ratio']:g}", [])
@@ -143,6 +168,8 @@ def summarise_family(rows: list[dict], *, min_ratio: float = 0.5) -> dict:
         "first_correct": _rate(sum(row["first_correct"] for row in effects), len(effects)),
         "closure": {**_rate(sum(c >= 0.8 for c in closures), len(effects)),
                     "median": float(np.median(closures)) if closures else None},
+        "closure_effect": {**_rate(sum(c >= 0.8 for c in effect_closures), len(effects)),
+                           "median": float(np.median(effect_closures)) if effect_closures else None},
         "min_ratio": min_ratio,
         "by_effect": {name: {ratio: {"n": len(cell), "first": sum(r["first_correct"] for r in cell),
                                      "named": sum(r["correct"] for r in cell),
@@ -150,6 +177,10 @@ def summarise_family(rows: list[dict], *, min_ratio: float = 0.5) -> dict:
                                      "median_closure": (float(np.median([r["closure"] for r in cell
                                                                          if r["closure"] is not None]))
                                                         if any(r["closure"] is not None for r in cell) else None),
+                                     "median_effect_closure": (
+                                         float(np.median([r["closure_effect"] for r in cell
+                                                          if r.get("closure_effect") is not None]))
+                                         if any(r.get("closure_effect") is not None for r in cell) else None),
                                      "spurious": sorted({name for r in cell for name in r["spurious"]})}
                              for ratio, cell in cells.items()}
                       for name, cells in by_effect.items()},
@@ -160,6 +191,10 @@ def _percent(rate: dict) -> str:
     low, high = rate["interval_95"]
     return (f"{rate['count']}/{rate['n']} = {100 * rate['rate']:.1f} % (95 % CI {100 * low:.1f}-{100 * high:.1f} %)"
             if rate["n"] else "-")
+
+
+def _median(rate: dict) -> str:
+    return "-" if rate.get("median") is None else format(rate["median"], ".2f")
 
 
 def _axis_table(rows: list[dict], seed: int, ratio: float) -> list[str]:
@@ -193,13 +228,18 @@ def family_markdown(settings: dict, summary: dict, seconds: float, rows: list[di
         f"| >= 90 % |",
         f"| gap closure vs the true term >= 0.8, same cases | {_percent(summary['closure'])}; median "
         f"{'-' if summary['closure']['median'] is None else format(summary['closure']['median'], '.2f')} | >= 90 % |",
+        f"| the same, given the base refinements kept | {_percent(summary['closure_effect'])}; median "
+        f"{_median(summary['closure_effect'])} | >= 90 % |",
         "",
-        "| hidden effect | RMS / noise | cases | named first | verdicts | median closure | spurious names |",
+        "| hidden effect | RMS / noise | cases | named first | verdicts | median closure (effect closure) "
+        "| spurious names |",
         "|---|---|---|---|---|---|---|",
     ]
     for name, cells in summary["by_effect"].items():
         for ratio, cell in cells.items():
             closure = "-" if cell["median_closure"] is None else f"{cell['median_closure']:.2f}"
+            if cell.get("median_effect_closure") is not None:
+                closure += f" ({cell['median_effect_closure']:.2f})"
             lines.append(f"| {name if name != 'None' else 'none (null axis)'} | {ratio} | {cell['n']} | "
                          f"{cell['first']} | {', '.join(cell['verdicts'])} | {closure} | "
                          f"{', '.join(cell['spurious']) or '-'} |")
