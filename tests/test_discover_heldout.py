@@ -12,11 +12,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from greybox.data.prepare import prepare
 from greybox.discover.augment import AugmentedModel
 from greybox.discover.effects import effect
 from greybox.discover.heldout import HeldOutTest, _solve, block_labels
 from greybox.errors import GreyboxError
-from greybox.data.prepare import prepare
 from greybox.friction import CoulombModel, GMSModel
 from greybox.studies.discovery import StudyCase, case_logs
 from greybox.studies.hysteresis_axis import FamilyCase, family_logs
