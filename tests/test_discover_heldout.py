@@ -146,7 +146,7 @@ def test_presliding_hysteresis_of_another_shape_is_spanned_by_the_presliding_ref
         passes += result.passes
         gains.append(result.gain)
         curve_gains.append(tester.evaluate(effect("velocity_curve")).gain)
-    assert passes >= 2 and np.median(gains) > 0.1 and np.median(gains) > 3.0 * max(np.median(curve_gains), 0.0)
+    assert passes >= 2 and np.median(gains) > 0.05 and np.median(gains) > 3.0 * max(np.median(curve_gains), 0.0)
     # the same motion with the current the GMS law itself gives, plus white noise: nothing to refine
     rng = np.random.default_rng(8)
     own = [run.replace(effort=model.predict(run) + rng.normal(0.0, 0.02, len(run))) for run in train]

@@ -120,8 +120,8 @@ def test_play_operator_kernel_matches_python_reference():
     widths = np.array([0.001, 0.003, 0.01, 0.03])
     start = rng.uniform(-1.0, 1.0, widths.size)
     states, after = np.empty((position.size, widths.size)), start.copy()
-    play_operator_kernel(position, widths, after, states)
-    rows, expected_after = play_operator_reference(position, widths, start)
+    play_operator_kernel(position, widths, after, -0.01, states)
+    rows, expected_after = play_operator_reference(position, widths, start, -0.01)
     np.testing.assert_array_equal(states, np.array(rows))
     np.testing.assert_array_equal(after, expected_after)
 
@@ -132,7 +132,12 @@ def test_play_operator_is_rate_independent_and_saturates_after_its_width():
     fine = np.interp(np.linspace(0.0, 4.0, 401), np.arange(5.0), coarse)   # the same path, 100 times the samples
     states = [np.empty((path.size, 2)) for path in (coarse, fine)]
     for path, out in zip((coarse, fine), states):
-        play_operator_kernel(path, widths, np.zeros(2), out)
+        play_operator_kernel(path, widths, np.zeros(2), path[0], out)
     np.testing.assert_allclose(states[1][::100], states[0], atol=1e-12)
     np.testing.assert_allclose(states[0][:, 0], [0.0, 1.0, 1.0, -1.0, -1.0], atol=1e-12)   # 2 um: saturated
     np.testing.assert_allclose(states[0][:, 1], [0.0, 0.5, 1.0, 0.75, -0.5], atol=1e-12)   # 20 um: follows
+    # in two chunks, the second starting from the first's end state and last position: the same states
+    state, chunks = np.zeros(2), [np.empty((150, 2)), np.empty((fine.size - 150, 2))]
+    play_operator_kernel(fine[:150], widths, state, fine[0], chunks[0])
+    play_operator_kernel(fine[150:], widths, state, fine[149], chunks[1])
+    np.testing.assert_array_equal(np.vstack(chunks), states[1])

@@ -131,12 +131,13 @@ def test_bad_chunk_lengths_and_units(models, cut_log):
 
 @pytest.fixture(scope="module")
 def augmented(train_log):
-    """A model of 'greybox discover': GMS base plus a drift with the time since the run start and a ripple."""
+    """A model of 'greybox discover': GMS base plus a drift with the time since the run start, a ripple and the
+    pre-sliding refinement (its play-operator states carry over from chunk to chunk)."""
     from greybox.discover.augment import AugmentedModel
 
     return AugmentedModel(base=GMSModel(n_starts=1, max_iter=80),
                           effects=[("thermal_drift", 3.0), ("position_periodic_force", 10.0),
-                                   "inertia_mismatch"], refine_shapes=False).fit(train_log)
+                                   "inertia_mismatch", "presliding_hysteresis"], refine_shapes=False).fit(train_log)
 
 
 def test_augmented_model_of_discover_chunks_like_one_shot(augmented, cut_log):
@@ -153,5 +154,6 @@ def test_augmented_chunks_need_the_run_start_and_the_base_state(augmented, cut_l
     slices = chunk_slices(len(cut_log), samples_per_chunk(step, CHUNK_S))
     restarted = np.concatenate([augmented.predict_chunk(cut_log.select(s), sample_time=step)[0] for s in slices])
     assert np.max(np.abs(restarted - augmented.predict(cut_log))) > 1e-3
-    base_state, scaled_state, run_start = augmented.initial_state()  # scaled: the friction the terms scale
-    assert isinstance(base_state, GMSState) and isinstance(scaled_state, GMSState) and run_start is None
+    base_state, scaled_state, run_start, presliding = augmented.initial_state()  # scaled: what the terms scale
+    assert isinstance(base_state, GMSState) and isinstance(scaled_state, GMSState)
+    assert run_start is None and presliding is None

@@ -52,7 +52,8 @@ from ..friction.directions import viscous_columns
 from ..friction.gms import GMSModel
 from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
-from .effects import BASE_FRICTION, PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan
+from .effects import (BASE_FRICTION, PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan,
+                      presliding_states)
 from .projection import Nuisance, PositionScan, added_squares
 
 __all__ = ["AugmentedModel", "normalise_effects"]
@@ -60,6 +61,8 @@ __all__ = ["AugmentedModel", "normalise_effects"]
 #: Terms reported in the model's inertia and offset rather than in its friction.
 _INERTIA_TERM = "inertia_mismatch"
 _OFFSET_TERM = "constant_offset"
+#: The base refinement whose play-operator states carry over from chunk to chunk.
+_PRESLIDING_TERM = "presliding_hysteresis"
 
 
 def normalise_effects(effects) -> list[tuple[str, float | None]]:
@@ -349,23 +352,26 @@ class AugmentedModel(CurrentModel):
         return _with_friction(runs, shape_base, self.friction_shape_viscous_) if shape_base is not None else runs
 
     def initial_state(self):
-        """``(base model's initial state, the scaled friction's, None)``: the run's start time comes from its
-        first chunk."""
+        """``(base model's initial state, the scaled friction's, None, None)``: the run's start time and the
+        pre-sliding states' start come from its first chunk."""
         shape_base = getattr(self, "friction_shape_base_", None)
-        return self.base_.initial_state(), None if shape_base is None else shape_base.initial_state(), None
+        return self.base_.initial_state(), None if shape_base is None else shape_base.initial_state(), None, None
 
     def _simulate(self, run: AxisLog, state, sample_time):
-        base_state, shape_state, run_start_s = state
+        base_state, shape_state, run_start_s, presliding_start = state
         if run_start_s is None:
             run_start_s = float(run.time[0])
         base_friction, base_end = self.base_.friction_chunk(run, base_state, sample_time=sample_time)
-        context = replace(self.context, run_start_s=run_start_s)
+        context = replace(self.context, run_start_s=run_start_s, presliding_start=presliding_start)
+        if any(entry["name"] == _PRESLIDING_TERM for entry in self.effects_):
+            presliding_start = presliding_states(run, context)[1]
         shape_base = getattr(self, "friction_shape_base_", None)
         if shape_base is not None:
             scaled, shape_state = shape_base.friction_chunk(run, shape_state, sample_time=sample_time)
             scaled = _without_viscous(scaled, run.velocity, self.friction_shape_viscous_)
             run = run.replace(extras={**run.extras, BASE_FRICTION: scaled})
-        return base_friction + self._effect_friction(run, context), (base_end, shape_state, run_start_s)
+        return base_friction + self._effect_friction(run, context), (base_end, shape_state, run_start_s,
+                                                                     presliding_start)
 
     def _own_parameters(self) -> list[Parameter]:
         base = [Parameter(f"base.{p.name}", p.value, p.unit, f"base model: {p.description}")

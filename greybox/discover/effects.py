@@ -50,8 +50,8 @@ from ..errors import GreyboxError
 from ..friction.kernels import play_operator_kernel
 
 __all__ = ["BASE_FRICTION", "EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "REFINEMENTS", "VELOCITY_ONLY",
-           "VELOCITY_CURVE_SCALES", "PRESLIDING_WIDTHS_MM",
-           "PRESLIDING_SPEED_SCALES", "PERIOD_SEPARATION_STEPS", "effect", "period_grid", "period_scan", "scan_periods",
+           "VELOCITY_CURVE_SCALES", "PRESLIDING_WIDTHS_MM", "presliding_states",
+           "PERIOD_SEPARATION_STEPS", "effect", "period_grid", "period_scan", "scan_periods",
            "default_velocity_scale"]
 
 #: Periods are scanned at this many points per periodogram resolution ``1 / range``.
@@ -105,12 +105,18 @@ class EffectContext:
         effects scale; the runs then carry that friction as the extra channel
         :data:`BASE_FRICTION`.
         ``None``: no base model, friction effects scale the direction of motion.
+    presliding_start : tuple, optional
+        ``(states, position_mm)``: the pre-sliding refinement's play-operator
+        states (:func:`presliding_states`) at the position [mm] of the sample
+        before the log passed, for a log that is a chunk of a run. ``None``:
+        the run starts with the log, the states at 0.
     """
 
     velocity_scale_mm_s: float
     position_range_mm: tuple[float, float]
     run_start_s: float | None = None
     friction_level: float | None = None
+    presliding_start: tuple | None = None
 
     @classmethod
     def from_runs(cls, runs: Sequence[AxisLog], velocity_scale_mm_s: float | None = None) -> "EffectContext":
@@ -430,30 +436,39 @@ def _curve_parameters(coefficients, context, shape, unit):
 #: Break-away displacements [mm] of the pre-sliding refinement's play operators: 1 um to 0.1 mm, the range of
 #: the pre-sliding displacements of the rolling contacts of feed drives (ball screws, linear guides).
 PRESLIDING_WIDTHS_MM = (0.001, 0.003, 0.01, 0.03, 0.1)
-#: Speeds [units of ``v_e``] at which the pre-sliding refinement's hysteresis may weaken (its products with
-#: ``exp(-|v| / v_k)``): near rest, at a sixth of the top speed and at the top speed.
-PRESLIDING_SPEED_SCALES = (3.0, 17.0, 100.0)
+
+
+def presliding_states(run: AxisLog, context: EffectContext) -> tuple[np.ndarray, tuple]:
+    """States of the pre-sliding refinement's play operators over a run, and where they end.
+
+    Returns
+    -------
+    states : ndarray, shape (n, len(PRESLIDING_WIDTHS_MM))
+        The states (-1 ... 1) at every sample, from ``context.presliding_start`` (zeros when None).
+    end : tuple
+        ``(states at the last sample, its position [mm])``: the ``presliding_start`` of the next chunk.
+    """
+    widths = np.asarray(PRESLIDING_WIDTHS_MM, dtype=float)
+    position = np.ascontiguousarray(run.position, dtype=float)
+    if context.presliding_start is None:
+        state, previous = np.zeros(widths.size), float(position[0])
+    else:
+        state, previous = np.array(context.presliding_start[0], dtype=float), float(context.presliding_start[1])
+    states = np.empty((position.size, widths.size))
+    play_operator_kernel(position, widths, state, previous, states)
+    return states, (tuple(float(value) for value in state), float(position[-1]))
 
 
 def _presliding(run, context, shape):
-    widths = np.asarray(PRESLIDING_WIDTHS_MM, dtype=float)
-    states = np.empty((len(run), widths.size))
-    play_operator_kernel(np.ascontiguousarray(run.position, dtype=float), widths, np.zeros(widths.size), states)
-    speed = np.abs(run.velocity)[:, None]
-    weakening = [states * np.exp(-speed / (context.velocity_scale_mm_s * scale)) for scale in PRESLIDING_SPEED_SCALES]
-    return np.hstack([states] + weakening)
+    states = presliding_states(run, context)[0]
+    held = states[:, :1]
+    return np.hstack((held - context.direction(run)[:, None], states[:, 1:] - held))
 
 
 def _presliding_parameters(coefficients, context, shape, unit):
-    coefficients = np.asarray(coefficients, dtype=float).reshape(1 + len(PRESLIDING_SPEED_SCALES), -1)
-
-    def excess(speed):
-        factors = np.concatenate(([1.0], np.exp(-speed / (context.velocity_scale_mm_s
-                                                          * np.asarray(PRESLIDING_SPEED_SCALES)))))
-        return float(factors @ coefficients.sum(axis=1))
-    top = context.velocity_scale_mm_s * VELOCITY_CURVE_SCALES[-1]
-    return {f"excess_deflected_at_rest_{unit}": excess(0.0), f"excess_deflected_at_top_speed_{unit}": excess(top),
-            "top_speed_mm_s": float(top)}
+    coefficients = np.asarray(coefficients, dtype=float)
+    return {f"held_excess_at_rest_{unit}": float(coefficients[0]),
+            f"excess_just_after_reversal_{unit}": float(-2.0 * coefficients[1:].sum())}
 
 
 #: Refinements of the base model, not named effects; the workflow fits them before naming anything and
@@ -462,11 +477,15 @@ def _presliding_parameters(coefficients, context, shape, unit):
 #: - ``velocity_curve``: a flexible friction curve along the speed, the same in both directions, that any
 #:   velocity-only friction law the base model lacks projects onto (a Stribeck curve of another shape,
 #:   viscous friction that is not linear);
-#: - ``presliding_hysteresis``: rate-independent pre-sliding hysteresis of another shape than the base's,
-#:   as a weighted sum of play-operator states (:func:`greybox.friction.kernels.play_operator_kernel`, break-away
-#:   displacements :data:`PRESLIDING_WIDTHS_MM`, each state also weakened with the speed,
-#:   :data:`PRESLIDING_SPEED_SCALES`). The states start at 0 at the first sample of a run (its history
-#:   before is unknown) and forget it within twice the largest width of travel (0.2 mm).
+#: - ``presliding_hysteresis``: friction held at rest and pre-sliding hysteresis of another shape than the
+#:   base's. With ``s_k`` the states of play operators (:func:`greybox.friction.kernels.play_operator_kernel`)
+#:   of break-away displacements :data:`PRESLIDING_WIDTHS_MM`, the first (1 um) being the direction of the
+#:   last motion ``h``: the columns ``h - d`` (friction held at rest beyond what the velocity curve gives
+#:   there; zero once moving) and ``s_k - h`` for the wider operators (pre-sliding transients over the first
+#:   ``2 w_k`` of travel after a reversal; zero once they have passed). Zero in steady sliding, so they do not
+#:   compete with the base's and the velocity curve's friction levels. The states start at 0 at the first
+#:   sample of a run (its history before is unknown; they forget it within 0.2 mm of travel) and carry over
+#:   from chunk to chunk of a run (``EffectContext.presliding_start``).
 #:
 #: Both are odd in the motion, the same law in both directions, and depend on the velocity and the
 #: position's recent path only: none can stand in for an effect of the position, the time or a direction.
@@ -476,11 +495,9 @@ REFINEMENTS: dict[str, Effect] = {
                              tuple(f"curve_{i}" for i in range(len(VELOCITY_CURVE_SCALES))),
                              _velocity_curve, _curve_parameters),
     "presliding_hysteresis": Effect(
-        "presliding_hysteresis", "pre-sliding hysteresis the base model's elements miss (the same in both "
-        "directions)",
-        tuple(f"play_{i}" for i in range(len(PRESLIDING_WIDTHS_MM)))
-        + tuple(f"play_{i}_weakening_{j}" for j in range(len(PRESLIDING_SPEED_SCALES))
-                for i in range(len(PRESLIDING_WIDTHS_MM))),
+        "presliding_hysteresis", "friction held at rest and pre-sliding hysteresis the base model misses (the "
+        "same in both directions)",
+        ("held_at_rest",) + tuple(f"transient_{i}" for i in range(1, len(PRESLIDING_WIDTHS_MM))),
         _presliding, _presliding_parameters),
 }
 

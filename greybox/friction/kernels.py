@@ -457,7 +457,7 @@ def backlash_gap_kernel(position, force, width, threshold, gap_low, gap_high, lo
 
 
 @njit(cache=True, error_model="numpy")
-def play_operator_kernel(position, widths, state, out):
+def play_operator_kernel(position, widths, state, previous_position, out):
     """States of a bank of play (elasto-plastic) operators driven by the position.
 
     Operator ``k`` follows the position with slope ``1 / widths[k]`` and is
@@ -473,15 +473,18 @@ def play_operator_kernel(position, widths, state, out):
     widths : ndarray, shape (m,)
         Break-away displacements [mm], positive.
     state : ndarray, shape (m,)
-        States before the first sample, each in ``[-1, 1]``; updated in place to the
-        states after the last sample.
+        States at ``previous_position``, each in ``[-1, 1]``; updated in place to the
+        states at the last sample.
+    previous_position : float
+        Position [mm] the states belong to: the last sample of the previous chunk
+        of the run, or ``position[0]`` at the start of a run.
     out : ndarray, shape (n, m)
-        Receives the states at every sample (sample 0: ``state`` as passed).
+        Receives the states at every sample.
     """
-    for k in range(widths.shape[0]):
-        out[0, k] = state[k]
-    for j in range(1, position.shape[0]):
-        step = position[j] - position[j - 1]
+    previous = previous_position
+    for j in range(position.shape[0]):
+        step = position[j] - previous
+        previous = position[j]
         for k in range(widths.shape[0]):
             s = state[k] + step / widths[k]
             if s > 1.0:

@@ -141,15 +141,16 @@ def backlash_gap_reference(position, force, width, threshold, gap_low, gap_high,
     return in_gap, gap_low, gap_high, loaded
 
 
-def play_operator_reference(position, widths, state):
+def play_operator_reference(position, widths, state, previous_position):
     """Play-operator states sample by sample; returns ``(rows, state_after)``.
 
-    Each state follows the position with slope ``1 / width`` and stays in ``[-1, 1]``.
+    Each state follows the position from ``previous_position`` with slope
+    ``1 / width`` and stays in ``[-1, 1]``.
     """
     state = [float(value) for value in state]
-    rows = [list(state)]
-    for previous, present in zip(position[:-1], position[1:]):
-        step = float(present) - float(previous)
+    rows, previous = [], float(previous_position)
+    for present in position:
+        step, previous = float(present) - previous, float(present)
         state = [min(1.0, max(-1.0, value + step / float(width))) for value, width in zip(state, widths)]
         rows.append(list(state))
     return rows, state
