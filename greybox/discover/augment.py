@@ -52,8 +52,15 @@ from ..friction.directions import viscous_columns
 from ..friction.gms import GMSModel
 from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
-from .effects import (BASE_FRICTION, PERIOD_SEPARATION_STEPS, Effect, EffectContext, effect, period_scan,
-                      presliding_states)
+from .effects import (
+    BASE_FRICTION,
+    PERIOD_SEPARATION_STEPS,
+    Effect,
+    EffectContext,
+    effect,
+    period_scan,
+    presliding_states,
+)
 from .projection import Nuisance, PositionScan, added_squares
 
 __all__ = ["AugmentedModel", "normalise_effects"]
