@@ -56,8 +56,9 @@ def add_parser(subparsers) -> None:
     workflow.add_argument("--no-refit-base", action="store_true",
                           help="keep the base model's nonlinear shape when effects are added (faster)")
     workflow.add_argument("--no-refine-base", action="store_true",
-                          help="do not refine the base model with a friction curve along the speed before naming "
-                          "effects (then stribeck and viscous_friction are candidates; see docs/discover.md)")
+                          help="do not refine the base model (a friction curve along the speed, friction held at rest "
+                          "and pre-sliding transients) before naming effects (then stribeck and viscous_friction "
+                          "are candidates; see docs/discover.md)")
     workflow.add_argument("--held-out-blocks", type=POSITIVE_INT, default=DEFAULT_BLOCKS, metavar="K",
                           help=f"blocks of training time for the held-out test, at least 2 (default {DEFAULT_BLOCKS})")
     workflow.add_argument("--min-gain", type=FRACTION, default=DEFAULT_MIN_GAIN, metavar="F",

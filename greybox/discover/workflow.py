@@ -13,13 +13,14 @@
    model (RMSE, RE and per regime), and the residual by regime before and after.
 
 Before any effect is named, the base model is *refined* (``refine_base``): a
-flexible friction curve along the speed and a bank of pre-sliding hysteresis
-states (:data:`greybox.discover.effects.REFINEMENTS`) join its linear columns
-in every test, so that a base whose friction law is only approximately right
-(another Stribeck curve, another pre-sliding shape) does not make effects look
-missing; velocity-only effects (``stribeck``, ``viscous_friction``) are then
-not candidates. Each refinement that lowers the error on held-out blocks of
-the training runs is kept in the model and reported as *base misfit*. Every winner of a step must also pass the held-out
+flexible friction curve along the speed, and the friction held at rest with
+pre-sliding transients (:data:`greybox.discover.effects.REFINEMENTS`), join its
+linear columns in every test, so that a base whose friction law is only
+approximately right (another Stribeck curve, another pre-sliding shape) does
+not make effects look missing; velocity-only effects (``stribeck``,
+``viscous_friction``) are then not candidates. Each refinement that lowers the
+error on held-out blocks of the training runs is kept in the model and
+reported as *base misfit*. Every winner of a step must also pass the held-out
 test (:mod:`greybox.discover.heldout`): fitted on four fifths of the training
 time, it must lower the error on the fifth, beyond a margin calibrated for
 its flexibility; a periodic one must also carry over from one direction of
