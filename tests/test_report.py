@@ -109,8 +109,9 @@ def test_experiment_table_layout_and_paper_column():
     assert [row[0] for row in table.rows] == ["Stribeck", "GMS+SVR", "noise floor (noise-free current)"]
     gmssvr = table.rows[1]
     assert gmssvr[1:5] == ["0.0800", "8.00", "0.1600", "16.00"]
-    assert gmssvr[5] == f"{PAPER_RE[(2, 'X', 'gmssvr')]:.0f}" and gmssvr[10] == f"{PAPER_RE[(2, 'Y', 'gmssvr')]:.0f}"
-    assert table.rows[0][5] == "–"  # unknown published figure: blank, not invented
+    assert gmssvr[5] == f"{PAPER_RE[(2, 'X', 'gmssvr')]:.1f}" and gmssvr[10] == f"{PAPER_RE[(2, 'Y', 'gmssvr')]:.1f}"
+    assert table.rows[0][5] == "10.1" and table.rows[0][10] == "25.3"  # the paper's Table 4, Stribeck
+    assert table.rows[2][5] == "–"  # a row the paper does not have: blank, not invented
     assert RE_NOTE in table.notes
     assert any("GMS on A, SVR on B" in note for note in table.notes)
     assert "C+D" in table.title

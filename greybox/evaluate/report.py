@@ -80,21 +80,19 @@ MODEL_LABELS = {
     "noise_floor": "noise floor (noise-free current)",
 }
 
-#: Published test RE [%] of Rüppel et al. (2024), keyed by (experiment, axis, model).
-#: Only the abstract's figures could be found: the grey-box model's error over
-#: the full working range, 7 % on the x-axis and 12 % on the y-axis
-#: (experiment 2, tested on C + D). The full Tables 3 and 4 were not retrieved.
+#: Published test RE [%] of Rüppel et al. (2024), keyed by (experiment, axis, model): Table 3 (train A,
+#: test C) and Table 4 (train A + B, test C + D) of the paper, as given in ``../shared/papers/README.md``.
 PAPER_RE: dict[tuple[int, str, str], float] = {
-    (2, "X", "gmssvr"): 7.0,
-    (2, "Y", "gmssvr"): 12.0,
+    (1, "X", "stribeck"): 11.4, (1, "X", "svr"): 12.6, (1, "X", "gms"): 11.9,
+    (1, "Y", "stribeck"): 14.9, (1, "Y", "svr"): 14.4, (1, "Y", "gms"): 13.4,
+    (2, "X", "stribeck"): 10.1, (2, "X", "svr"): 42.2, (2, "X", "gms"): 11.0, (2, "X", "gmssvr"): 7.1,
+    (2, "Y", "stribeck"): 25.3, (2, "Y", "svr"): 51.3, (2, "Y", "gms"): 25.0, (2, "Y", "gmssvr"): 12.0,
 }
 
 #: Where the published figures come from, printed under every experiment table.
 PAPER_SOURCE = (
-    "Paper: Rüppel et al., J. Machine Engineering 24(1) 2024, measured on a Mazak VARIAXIS i-600. "
-    "Only the abstract's figures were available to us (GMS+SVR 7 % on the x-axis and 12 % on the "
-    "y-axis over the full working range, read here as experiment 2's test on C + D); the other cells of "
-    "the paper's Tables 3 and 4 could not be retrieved and are left blank (–) rather than guessed. "
+    "Paper: Rüppel et al., J. Machine Engineering 24(1) 2024, Tables 3 and 4, measured on a Mazak VARIAXIS "
+    "i-600; models the paper did not run are blank (–). "
     "Our figures come from the synthetic axis, not from the paper's machine."
 )
 
@@ -237,7 +235,7 @@ def experiment_table(records: Sequence[Mapping], experiment: int, *, title: str 
             test = index.get((experiment, axis, model, "test"), {})
             row += [_number(train.get("rmse"), 4), _number(train.get("re"), 2),
                     _number(test.get("rmse"), 4), _number(test.get("re"), 2),
-                    _number(paper.get((experiment, axis, model)), 0)]
+                    _number(paper.get((experiment, axis, model)), 1)]
         rows.append(row)
     test_logs = _ordered(r.get("logs", "") for r in mine if r["dataset"] == "test")
     default_title = f"Experiment {experiment}" + (f": test on {test_logs[0]}" if len(test_logs) == 1 else "")
