@@ -90,13 +90,14 @@ class LuGrePlant:
 
 
 class TwinPlant:
-    """The twin's elasto-plastic elements with a lagged Stribeck ratio, viscous term and position factor."""
+    """The twin's elasto-plastic elements with a lagged Stribeck ratio, viscous term, position factor and cogging."""
 
     def __init__(self, p, friction=True):
         scale = 1.0 if friction else 0.0
         self.p = p
         self.k = [scale * k for k in p.stiffness_A_mm]
         self.viscous = scale * p.viscous_A_s_mm
+        self.cogging = scale * p.cogging_A
         self.D = list(p.breakaway_deflection_mm)
         self.d = [0.0] * len(self.k)
         self.level, self.elastic = 1.0, 0.0
@@ -104,8 +105,10 @@ class TwinPlant:
     def friction(self, x, v):
         p = self.p
         u = (2 * x - p.travel_mm[0] - p.travel_mm[1]) / (p.travel_mm[1] - p.travel_mm[0])
-        g = 1 + p.preload_gain * u**4 + p.lead_gain * math.sin(2 * math.pi * x / p.lead_mm + p.lead_phase_rad)
-        return g * self.elastic + self.viscous * v
+        g = 1 + p.preload_gain * u**4 + p.tilt_gain * u + p.lead_gain * math.sin(
+            2 * math.pi * x / p.lead_mm + p.lead_phase_rad)
+        cogging = self.cogging * math.sin(2 * math.pi * x / p.cogging_period_mm + p.cogging_phase_rad)
+        return g * self.elastic + self.viscous * v + cogging
 
     def advance(self, v, h):
         p = self.p

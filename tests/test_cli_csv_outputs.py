@@ -33,9 +33,14 @@ PROCESS_COLUMNS = ["time_s", "current_measured_A", "current_model_A", "current_p
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
-    """Two small model files trained on a short air cut, and a short cutting log (MCAP)."""
+    """Two small model files trained on a short air cut, and a short cutting log (MCAP).
+
+    The air cut moves both ways (8 s of dataset A; its first 6 s go one way only): on motion in one
+    direction the GMS fit is degenerate (its inertia comes out 0), and the GMS model must serve as a plant.
+    """
     root = tmp_path_factory.mktemp("csv_outputs")
-    train = prepare([make_dataset("X", "A", seed=3, duration_s=6.0)])[0]
+    train = prepare([make_dataset("X", "A", seed=3, duration_s=8.0)])[0]
+    assert train.velocity.min() < -1.0 and train.velocity.max() > 1.0
     paths = {"coulomb": save_model(CoulombModel().fit(train), root / "coulomb.gbm"),
              "gms": save_model(GMSModel(n_starts=1, max_iter=40).fit(train), root / "gms.gbm")}
     paths["log"] = root / "X_C.mcap"

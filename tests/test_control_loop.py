@@ -19,7 +19,7 @@ from greybox.control.references import Reference
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
-from greybox.twin import CurrentNoise, make_dataset
+from greybox.twin import CurrentNoise, default_plant_parameters, make_dataset
 
 WINDOW_CENTRE_MM = -250.0
 
@@ -81,7 +81,10 @@ def test_a_disturbance_is_seeded_and_the_same_for_every_feedforward():
 def test_saturation_limits_the_current_and_the_integral_does_not_wind_up():
     plant = TwinPlant.for_axis("X")
     reference = stroke_reference("high", 4.0, seed=2, start_mm=WINDOW_CENTRE_MM)
-    limit = 1.3  # below the breakaway current at some samples: the loop must saturate
+    # the X axis slides with 1.1-1.6 A on this stroke (friction 1.1-1.2 A at -250 mm, viscous up to 0.3 A,
+    # cogging 0.1 A): 1.6 A is above 99 % of the unsaturated loop's current but below its peaks, so the
+    # loop must saturate at a few samples
+    limit = 1.6
     result = simulate_loop(plant, reference, InertiaFeedForward(plant.inertia_A_s2_mm), current_limit_A=limit)
     assert np.all(np.abs(result.current_A) <= limit + 1e-12)
     assert 0.0 < result.saturated_fraction < 0.5
@@ -113,15 +116,35 @@ def plant_runs():
 
 
 @pytest.fixture(scope="module")
-def comparison(plant_runs):
-    plant = TwinPlant.for_axis("X")
-    j = plant.inertia_A_s2_mm
+def feedforwards(plant_runs):
+    """No friction feed-forward, and the Coulomb, LuGre and GMS models fitted on the plant's logs."""
+    j = TwinPlant.for_axis("X").inertia_A_s2_mm
     models = {"coulomb": CoulombModel(), "lugre": LuGreModel(n_starts=2), "gms": GMSModel(n_starts=2)}
-    feedforwards = [InertiaFeedForward(j)] + [ModelFeedForward(m.fit(plant_runs), j, name)
-                                              for name, m in models.items()]
-    references = [stroke_reference(kind, 12.0, seed=7, start_mm=WINDOW_CENTRE_MM) for kind in ("low", "high")]
+    return [InertiaFeedForward(j)] + [ModelFeedForward(m.fit(plant_runs), j, name) for name, m in models.items()]
+
+
+def _compare(plant, feedforwards, kinds):
+    references = [stroke_reference(kind, 12.0, seed=7, start_mm=WINDOW_CENTRE_MM) for kind in kinds]
     results = compare_feedforwards(plant, references, feedforwards)
     return {(r.reference.name, r.feedforward_name): r.rms_error_mm for r in results}
+
+
+@pytest.fixture(scope="module")
+def comparison(feedforwards):
+    return _compare(TwinPlant.for_axis("X"), feedforwards, ("low", "high"))
+
+
+@pytest.fixture(scope="module")
+def sliding_comparison(feedforwards):
+    """The high stroke on the X plant without its cogging current, the one load no friction model describes.
+
+    With the cogging current (0.1 A at 20-130 Hz on this stroke) the loop error it causes dominates what
+    the Coulomb feed-forward leaves: even the plant's exact friction as feed-forward only comes to about
+    0.8 times the Coulomb error, so the friction models cannot be told apart there. Without it, the exact
+    friction comes to about 0.25 times the Coulomb error (both measured when the twin was recalibrated).
+    """
+    plant = TwinPlant(default_plant_parameters("X").replace(cogging_A=0.0))
+    return {name: value for (_, name), value in _compare(plant, feedforwards, ("high",)).items()}
 
 
 def test_dynamic_friction_models_track_the_low_stroke_reference_best(comparison):
@@ -132,12 +155,21 @@ def test_dynamic_friction_models_track_the_low_stroke_reference_best(comparison)
         assert rms[dynamic] < 0.5 * rms["coulomb"]
 
 
-def test_friction_feedforward_helps_in_gross_sliding(comparison):
-    """On the high stroke the axis mostly slides: even the Coulomb level removes much of the friction."""
+def test_friction_feedforward_helps_in_gross_sliding(comparison, sliding_comparison):
+    """On the high stroke the axis mostly slides: even the Coulomb level removes much of the friction.
+
+    The dynamic models also describe the Stribeck drop and the pre-sliding at the reversals, and track
+    better still. The margin is set by the plant: with a Coulomb ratio of 0.9 and breakaway deflections of
+    0.1-5 um the twin is close to a Coulomb relay, so the Coulomb feed-forward leaves little for them to
+    remove (when the twin was recalibrated, fitted GMS and LuGre came to about 0.55 times its error on this
+    stroke, 0.55-0.75 on other seeds, and the exact friction as feed-forward to about 0.25).
+    """
     rms = {name: value for (reference, name), value in comparison.items() if reference == "high-stroke"}
     assert rms["coulomb"] < 0.9 * rms["none"]
-    assert rms["gms"] < 0.5 * rms["coulomb"]
-    assert rms["lugre"] < 0.5 * rms["coulomb"]
+    rms = sliding_comparison
+    assert rms["coulomb"] < 0.9 * rms["none"]
+    assert rms["gms"] < 0.7 * rms["coulomb"]
+    assert rms["lugre"] < 0.7 * rms["coulomb"]
 
 
 def test_the_exact_dynamic_model_as_feedforward_of_itself_as_plant(plant_runs):

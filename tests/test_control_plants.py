@@ -145,10 +145,25 @@ def _ramp(speed, duration=1.0, start=-250.0, step=0.002):
 
 @pytest.mark.parametrize("speed", [-20.0, 8.0])
 def test_twin_plant_slides_with_its_steady_friction(speed):
+    """In steady sliding the twin's load is its steady friction plus the cogging current of the position.
+
+    The cogging current (period 10/24 mm: 19-48 Hz at these speeds) makes the velocity ripple a little,
+    so the loop's current equals friction plus cogging only on average (J a averages out); without
+    cogging the axis slides at constant velocity and its current is the friction sample by sample.
+    """
     plant = TwinPlant.for_axis("X")
     result = simulate_loop(plant, _ramp(speed), resolution_mm=0.0)
     late = result.reference.time > 0.6
-    expected = plant.params.steady_friction(speed, result.position_mm[late])
+    position = result.position_mm[late]
+    cogging = plant.params.cogging_current(position)
+    assert np.ptp(cogging) > 1.5 * plant.params.cogging_A  # the run went over whole cogging periods
+    expected = plant.params.steady_friction(speed, position) + cogging
+    np.testing.assert_allclose(result.plant_friction_A[late], expected, rtol=2e-3)
+    assert np.mean(result.current_A[late]) == pytest.approx(np.mean(expected), rel=1e-3)
+
+    flat = TwinPlant(plant.params.replace(cogging_A=0.0))
+    result = simulate_loop(flat, _ramp(speed), resolution_mm=0.0)
+    expected = flat.params.steady_friction(speed, result.position_mm[late])
     np.testing.assert_allclose(result.plant_friction_A[late], expected, rtol=2e-3)
     # the loop's current carries the friction in steady sliding (its acceleration is zero)
     np.testing.assert_allclose(result.current_A[late], expected, rtol=5e-3)

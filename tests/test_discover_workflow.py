@@ -19,6 +19,7 @@ from greybox.discover.workflow import VERDICTS, discover
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel
 from greybox.studies.discovery import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
+from greybox.twin import CurrentNoise
 
 DURATION_S = 20.0
 
@@ -45,15 +46,25 @@ def test_effects_the_base_already_has_are_not_named():
 
 
 def test_structure_outside_the_library_is_reported_as_unexplained():
-    # a force growing with the square of the acceleration, in its direction: the library's inertia term is
-    # linear in the acceleration and no other effect has this shape; without a mean (friction growing only
-    # while accelerating forwards, max(a, 0), has one, which a constant offset rightly takes); strong enough
-    # to hold on held-out blocks
+    # a force of fixed size in the direction of the acceleration whenever the axis really accelerates
+    # (tanh(a / a_s), a_s = 2 % of the 99th percentile |a|, far above the differentiation noise of a
+    # cruising axis): the library's inertia term is linear in the acceleration and no other effect has
+    # this shape; odd, so without a mean (friction growing only while accelerating forwards, max(a, 0),
+    # has one, which a constant offset rightly takes). Its RMS is twice the current noise's std, so it
+    # holds on held-out blocks. Not a|a| any more: the acceleration family's quantile bins put all
+    # |a| > ~1 mm/s^2 in one bin per sign (a cruising axis fills the others), so a force growing with |a|
+    # carries over from block to block only as far as the blocks happen to share their mix of
+    # accelerations, which the recalibrated trajectories (few dwells, back-to-back moves) no longer give.
     train, test, _ = case_logs(StudyCase(None, 0.0, 1, "coulomb", DURATION_S))
-    scale = np.percentile(np.abs(train.acceleration), 99.0)
+    a_s = 0.02 * np.percentile(np.abs(train.acceleration), 99.0)
+
+    def unit(run):
+        return np.tanh(run.acceleration / a_s)
+
+    strength = 2.0 * CurrentNoise().std_A / np.sqrt(np.mean(unit(train) ** 2))
 
     def add(run):
-        return run.replace(effort=run.effort + 3e-3 * run.acceleration * np.abs(run.acceleration) / scale)
+        return run.replace(effort=run.effort + strength * unit(run))
 
     result = discover(CoulombModel(), add(train), add(test), seed=1)
     assert result.verdict == "unexplained_structure"

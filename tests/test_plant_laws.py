@@ -28,6 +28,7 @@ from greybox.twin.plant import (
     lagged_stribeck_ratio,
     maxwell_slip_kernel,
     maxwell_slip_update,
+    simulate_plant,
     stribeck_ratio,
     twin_plant_law,
 )
@@ -133,12 +134,34 @@ def test_lugre_law_takes_the_models_bristle_step():
     np.testing.assert_array_equal(z, z_out)
 
 
+def _dyadic_velocity(v, step, bits=40):
+    """``v`` nudged so that every displacement ``step * v`` is a multiple of 2^-bits mm, exactly in floating point.
+
+    Summed from a dyadic start (0, -250 mm) such displacements give positions whose differences are the
+    displacements again, bit for bit: the prescribed-motion kernel (which steps by ``x[i] - x[i-1]``) and a
+    law (which steps by ``h v``) then move their elements by the same amount.
+    """
+    target = np.round(step * v * 2.0**bits) / 2.0**bits
+    out = target / step
+    for i in range(out.size):
+        while step * out[i] != target[i]:
+            out[i] = np.nextafter(out[i], math.inf if step * out[i] < target[i] else -math.inf)
+    return out
+
+
 def test_twin_law_follows_the_twins_prescribed_motion_kernel():
-    """Along a prescribed motion the twin's law gives the Maxwell-slip current of maxwell_slip_kernel."""
+    """Along a prescribed motion the twin's law gives the Maxwell-slip current of maxwell_slip_kernel.
+
+    The kernel steps the elements by the position difference, the law by ``h v``; with a general velocity
+    the two displacements differ by the rounding of the summed position (~1e-16 mm), which the stiff
+    elements (sum k_i ~ 2600 A/mm) turn into ~1e-12 A. On displacements exact in floating point (dyadic,
+    see _dyadic_velocity) both take the same steps, and the currents must agree bit for bit.
+    """
     p = default_plant_parameters("X")
     t = np.arange(4001) * FINE
-    v = 6.0 * np.cos(2 * np.pi * 3.0 * t) + 2.0 * np.sin(2 * np.pi * 17.0 * t) + 1.0
+    v = _dyadic_velocity(6.0 * np.cos(2 * np.pi * 3.0 * t) + 2.0 * np.sin(2 * np.pi * 17.0 * t) + 1.0, FINE)
     x = np.concatenate(([0.0], np.cumsum(FINE * v[1:])))
+    np.testing.assert_array_equal(np.diff(x), FINE * v[1:])  # the same displacements for kernel and law
     expected = maxwell_slip_kernel(x, v, FINE, 1, p.stiffness_A_mm, np.asarray(p.breakaway_deflection_mm),
                                    p.coulomb_ratio, p.stribeck_velocity_mm_s, p.stribeck_shape, p.lag_time_s)
     law = twin_plant_law(p)
@@ -148,17 +171,50 @@ def test_twin_law_follows_the_twins_prescribed_motion_kernel():
     for i in range(1, t.size):
         law.advance(law.parameters, state, v[i], FINE)
         got.append(state[1])
-    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(got, expected)
     assert np.ptp(expected) > 1.5  # slid both ways
+
+
+@pytest.mark.parametrize("axis", ["X", "Y"])
+def test_twin_law_load_is_simulate_plants_friction_plus_cogging(axis):
+    """The law's friction (position factor with preload, tilt and lead, plus cogging) is simulate_plant's
+    friction plus cogging current along the same prescribed motion, up to the rounding of the two formulas."""
+    p = default_plant_parameters(axis)
+    t = np.arange(4001) * FINE
+    v = _dyadic_velocity(6.0 * np.cos(2 * np.pi * 3.0 * t) + 2.0 * np.sin(2 * np.pi * 17.0 * t) + 1.0, FINE)
+    x = np.concatenate(([-250.0], -250.0 + np.cumsum(FINE * v[1:])))
+
+    class Prescribed:
+        @staticmethod
+        def evaluate(time):
+            assert time.size == t.size
+            return x, v, np.zeros_like(x)
+
+    response = simulate_plant(p, Prescribed(), 501, 8 * FINE)
+    law = twin_plant_law(p)
+    state = law.state.copy()
+    state[0] = stribeck_ratio(v[0], p.coulomb_ratio, p.stribeck_velocity_mm_s, p.stribeck_shape)
+    got = [law.friction(law.parameters, state, x[0], v[0])]
+    for i in range(1, t.size):
+        law.advance(law.parameters, state, v[i], FINE)
+        if i % 8 == 0:
+            got.append(law.friction(law.parameters, state, x[i], v[i]))
+    expected = response.friction_A + response.cogging_A
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * np.max(np.abs(expected)))
+    assert np.ptp(response.cogging_A) > 1.5 * p.cogging_A and np.ptp(expected) > 1.5
 
 
 # ------------------------------------------------------------------ analytic facts
 @pytest.mark.parametrize("speed", [-25.0, -0.8, 2.0, 40.0])
 def test_laws_slide_with_their_steady_friction(speed):
-    """At constant velocity every law settles on its Stribeck curve plus the viscous term."""
+    """At constant velocity every law settles on its Stribeck curve plus the viscous term.
+
+    The twin's law also carries the cogging current of its position (its friction is the plant's whole
+    position-dependent load); the position factor is flat here.
+    """
     n = int(0.5 / FINE)  # 0.5 s: the twin's lag (15 ms) and every slip transient have died out
     gms, lugre = gms_law(), lugre_law()
-    p = default_plant_parameters("X").replace(preload_gain=0.0, lead_gain=0.0)
+    p = default_plant_parameters("X").replace(preload_gain=0.0, lead_gain=0.0, tilt_gain=0.0)
     twin = twin_plant_law(p)
     friction = {}
     for name, law in (("gms", gms), ("lugre", lugre), ("twin", twin)):
@@ -171,7 +227,9 @@ def test_laws_slide_with_their_steady_friction(speed):
     assert friction["gms"] == pytest.approx(math.copysign(K * s, speed) + GMS["mu"] * speed, rel=1e-9)
     g = LUGRE["coulomb"] + (LUGRE["static"] - LUGRE["coulomb"]) * math.exp(-abs(speed) / LUGRE["v_s"])
     assert friction["lugre"] == pytest.approx(math.copysign(g, speed) + LUGRE["sigma2"] * speed, rel=1e-6)
-    assert friction["twin"] == pytest.approx(p.steady_friction(speed, 17.0), rel=1e-9)
+    cogging = float(p.cogging_current(17.0))
+    assert abs(cogging) > 0.5 * p.cogging_A  # x = 17 mm is not a zero of the cogging current
+    assert friction["twin"] == pytest.approx(p.steady_friction(speed, 17.0) + cogging, rel=1e-9)
 
 
 def test_stable_step_of_stiffness_and_damping_on_the_inertia():

@@ -38,4 +38,7 @@ def test_shipped_file_matches_regeneration(axis, dataset):
     np.testing.assert_allclose(log.extras["truth_current_A"], expected.extras["truth_current_A"],
                                atol=0.5e-6 + 1e-12)
     noise_floor = np.sqrt(np.mean((log.current - log.extras["truth_current_A"]) ** 2))
-    assert 0.05 < noise_floor < 0.08
+    assert log.attrs["noise"]["std_A"] == pytest.approx(0.09)  # the recalibrated noise of the paper's axes
+    assert 0.08 < noise_floor < 0.10
+    # AR(1) noise of std 0.09 A plus 1 mA quantisation; 25 000-120 000 samples pin the floor within 3 %
+    assert noise_floor == pytest.approx(np.hypot(log.attrs["noise"]["std_A"], 1e-3 / np.sqrt(12)), rel=0.03)

@@ -7,9 +7,9 @@ import pytest
 
 from greybox.errors import GreyboxError
 from greybox.twin.axes import AXES, axis_geometry
-from greybox.twin.motion import MotionLimits, MotionProfile
+from greybox.twin.motion import MotionLimits, MotionProfile, _Sine
 from greybox.twin.presliding import PreslidingExcitation, rectangular_envelope
-from greybox.twin.trajectories import dataset_trajectory
+from greybox.twin.trajectories import dataset_trajectory, random_window_trajectory
 
 MM_MIN = 1.0 / 60.0
 STEP = 2.5e-4
@@ -33,11 +33,45 @@ def test_random_datasets_stay_in_the_window_and_speed_range(axis, dataset):
     assert speeds.size > 5
     assert np.all(speeds >= 100.0 * MM_MIN * (1 - 1e-9)) and np.all(speeds <= 2000.0 * MM_MIN * (1 + 1e-4))
     assert trajectory.description["oscillations"] >= 1
-    # reversals and dwells
+    # sine oscillations peak between 300 mm/min (recalibrated lower bound) and 2000 mm/min
+    peaks = np.array([p.amplitude_mm * p.peak_speed_per_mm() for p in trajectory.motion._pieces
+                      if isinstance(p, _Sine)])
+    assert peaks.size == trajectory.description["oscillations"]
+    assert np.all(peaks >= 300.0 * MM_MIN * (1 - 1e-9)) and np.all(peaks <= 2000.0 * MM_MIN * (1 + 1e-4))
+    # reversals; after the initial 0.5 s at rest the axis keeps moving except for rare short dwells
     moving = np.abs(v) > 1e-9
     assert np.count_nonzero(np.diff(np.sign(v[moving])) != 0) >= 4
-    assert np.count_nonzero(~moving) * STEP > 1.0
-    assert v[0] == 0.0 and v[-1] == 0.0 and 35.0 <= trajectory.duration_s <= 80.0
+    starts, ends = standstills(~moving)
+    assert starts[0] == 0 and (ends[0] - 1) * STEP == pytest.approx(0.5, abs=STEP)
+    dwell_s = (ends[1:] - starts[1:]) * STEP
+    assert np.all(dwell_s <= trajectory.description["dwell_s"][1] + STEP)
+    assert dwell_s.sum() < 0.01 * trajectory.duration_s
+    # starts and ends at rest (the last sample of the grid may lie a little before the end of the motion)
+    end = trajectory.motion.evaluate(np.array([trajectory.duration_s]))
+    assert v[0] == 0.0 and end[1][0] == 0.0 and end[2][0] == pytest.approx(0.0, abs=1e-6)
+    assert 35.0 <= trajectory.duration_s <= 80.0
+
+
+def standstills(at_rest):
+    """Start and end (exclusive) indices of the runs of samples at rest."""
+    edges = np.diff(np.concatenate(([0], at_rest.astype(int), [0])))
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+
+
+@pytest.mark.parametrize("dwell_probability", [0.0, 1.0])
+def test_random_dataset_dwells_have_the_configured_length(dwell_probability):
+    geometry = axis_geometry("X")
+    trajectory = random_window_trajectory(geometry, np.random.default_rng(4), duration_s=40.0,
+                                          dwell_probability=dwell_probability, dwell_s=(0.02, 0.1))
+    t, x, v, a = sampled(trajectory)
+    starts, ends = standstills(np.abs(v) <= 1e-9)
+    assert (ends[-1] - starts[-1]) * STEP >= 0.1 - STEP  # the final rest
+    dwell_s = (ends[1:-1] - starts[1:-1]) * STEP  # between the initial and the final rest
+    if dwell_probability == 0.0:
+        assert dwell_s.size == 0  # reversals pass through zero speed without stopping
+    else:  # after every move and every oscillation
+        assert dwell_s.size >= trajectory.description["moves"] + trajectory.description["oscillations"] - 1
+        assert np.all(dwell_s >= 0.02 - STEP) and np.all(dwell_s <= 0.1 + STEP)
 
 
 @pytest.mark.parametrize("axis", ["X", "Y"])

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 from ..errors import GreyboxError
+from ..evaluate.pattern import paper_pattern
 from ..evaluate.report import check_output_dir
 from ..studies.experiments import EXPERIMENTS, find_log, reproduce
 from ._types import POSITIVE_INT
@@ -88,4 +89,10 @@ def run(args: argparse.Namespace) -> int:
     for name in ("metrics_json", "metrics_csv", "tables", "html"):
         print(f"  {result.files[name]}")
     print(f"  {len(result.files['figures'])} figures, {len(result.files['models'])} model files in {out_dir}")
+    checks = paper_pattern(result.records)
+    if checks:
+        print(f"the paper's pattern: {sum(c['met'] for c in checks)} of {len(checks)} checks met")
+        for c in checks:
+            print(f"  {'met    ' if c['met'] else 'not met'} {c['check']} ({c['axis']}): {c['ours']} "
+                  f"(target {c['target']}, paper {c['paper']})")
     return 0

@@ -21,6 +21,7 @@ Files written by :func:`write_report`:
 ``tables.md``
     Markdown tables (:class:`~greybox.evaluate.table.Table`): one per experiment in the layout of
     the paper's Tables 3 and 4 with the published figures beside ours, the
+    checks of the paper's pattern (:mod:`greybox.evaluate.pattern`), the
     SVR hyperparameters like the paper's Table 2, the noise-floor ratio of the
     grey-box model, the sole SVR's change from training to each test log, and
     the fit times.
@@ -41,6 +42,8 @@ from typing import Iterable, Mapping, Sequence
 from ..atomic import write_text_atomic
 from ..provenance import provenance, provenance_line
 from .html import write_html
+from .paper import PAPER_RE, PAPER_SOURCE
+from .pattern import paper_pattern, paper_pattern_table
 from .table import Table
 
 __all__ = [
@@ -79,22 +82,6 @@ MODEL_LABELS = {
     "gmssvr_eq8": "GMS+SVR (eq. 8)",
     "noise_floor": "noise floor (noise-free current)",
 }
-
-#: Published test RE [%] of Rüppel et al. (2024), keyed by (experiment, axis, model): Table 3 (train A,
-#: test C) and Table 4 (train A + B, test C + D) of the paper, as given in ``../shared/papers/README.md``.
-PAPER_RE: dict[tuple[int, str, str], float] = {
-    (1, "X", "stribeck"): 11.4, (1, "X", "svr"): 12.6, (1, "X", "gms"): 11.9,
-    (1, "Y", "stribeck"): 14.9, (1, "Y", "svr"): 14.4, (1, "Y", "gms"): 13.4,
-    (2, "X", "stribeck"): 10.1, (2, "X", "svr"): 42.2, (2, "X", "gms"): 11.0, (2, "X", "gmssvr"): 7.1,
-    (2, "Y", "stribeck"): 25.3, (2, "Y", "svr"): 51.3, (2, "Y", "gms"): 25.0, (2, "Y", "gmssvr"): 12.0,
-}
-
-#: Where the published figures come from, printed under every experiment table.
-PAPER_SOURCE = (
-    "Paper: Rüppel et al., J. Machine Engineering 24(1) 2024, Tables 3 and 4, measured on a Mazak VARIAXIS "
-    "i-600; models the paper did not run are blank (–). "
-    "Our figures come from the synthetic axis, not from the paper's machine."
-)
 
 #: The definition of RE, printed wherever RE is.
 RE_NOTE = (
@@ -478,6 +465,8 @@ def report_tables(records: Sequence[Mapping], hyperparameters: Sequence[Mapping]
               for e in experiments]
     if hyperparameters:
         tables.append(hyperparameter_table(hyperparameters))
+    if paper_pattern(records):
+        tables.append(paper_pattern_table(records))
     if noise_floor_ratios(records):
         tables.append(noise_floor_table(records))
     if svr_generalisation(records):

@@ -37,7 +37,7 @@ __all__ = [
 SAMPLE_TIME_S = 0.002
 
 #: Truth channels a synthetic log carries (the last two only with an effect or cutting).
-TRUTH_CHANNELS = ("truth_current_A", "truth_friction_A", "truth_inertia_A", "truth_noise_A",
+TRUTH_CHANNELS = ("truth_current_A", "truth_friction_A", "truth_inertia_A", "truth_cogging_A", "truth_noise_A",
                   "truth_effect_A", "truth_process_A")
 
 #: Truth channels kept in compact files: the noise-free current (for the noise
@@ -128,7 +128,7 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
     plant : PlantParameters, optional
         Truth plant; default :func:`default_plant_parameters` of the axis.
     noise : CurrentNoise, optional
-        Current noise; default ``CurrentNoise()`` (0.065 A, lag-1 correlation 0.7).
+        Current noise; default ``CurrentNoise()`` (0.09 A, lag-1 correlation 0.7).
     sensors : Sensors, optional
         Resolutions of the logged channels.
 
@@ -138,7 +138,7 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         Time [s] at 2 ms steps from 0, encoder position [mm], actual velocity
         [mm/s], noisy quantised current [A]; acceleration is not logged.
         Extras: ``truth_current_A`` (noise-free current), ``truth_friction_A``,
-        ``truth_inertia_A``, ``truth_noise_A`` (logged minus noise-free current),
+        ``truth_inertia_A``, ``truth_cogging_A``, ``truth_noise_A`` (logged minus noise-free current),
         and ``truth_effect_A`` / ``truth_process_A`` when injected.
         ``attrs`` holds the seed, plant, trajectory, noise, sensors, effect and cutting settings.
 
@@ -158,7 +158,8 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
     n = int(np.floor(trajectory.duration_s / SAMPLE_TIME_S + 1e-9)) + 1
     time = np.round(np.arange(n) * SAMPLE_TIME_S, 9)
     response = simulate_plant(plant, trajectory.motion, n, SAMPLE_TIME_S)
-    truth = {"truth_friction_A": response.friction_A, "truth_inertia_A": response.inertia_A}
+    truth = {"truth_friction_A": response.friction_A, "truth_inertia_A": response.inertia_A,
+             "truth_cogging_A": response.cogging_A}
     attrs = {
         "generator": "greybox.twin",
         "seed": int(seed),

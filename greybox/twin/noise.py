@@ -21,13 +21,13 @@ class CurrentNoise:
 
     Parameters
     ----------
-    std_A : float, default 0.065
+    std_A : float, default 0.09
         Standard deviation [A] of the noise.
     lag1_correlation : float, default 0.7
         Correlation ``phi`` of two consecutive samples, in [0, 1).
     """
 
-    std_A: float = 0.065
+    std_A: float = 0.09
     lag1_correlation: float = 0.7
 
     def __post_init__(self):

@@ -72,8 +72,11 @@ def _fitting_speed(limits: MotionLimits, distance_mm: float, speed_mm_s: float) 
     return low
 
 
-def _random_leg(profile: MotionProfile, rng, low_mm, high_mm, speeds_mm_s) -> bool:
-    """Append one move through 1-3 random speed levels and a short dwell; False if none fits."""
+def _random_leg(profile: MotionProfile, rng, low_mm, high_mm, speeds_mm_s, dwell) -> bool:
+    """Append one move through 1-3 random speed levels and maybe a short dwell; False if none fits.
+
+    ``dwell = (probability, shortest_s, longest_s)`` of the dwell after the move.
+    """
     room_up, room_down = high_mm - profile.position_mm, profile.position_mm - low_mm
     direction = 1.0 if rng.uniform() < room_up / (room_up + room_down) else -1.0
     room = room_up if direction > 0 else room_down
@@ -89,36 +92,45 @@ def _random_leg(profile: MotionProfile, rng, low_mm, high_mm, speeds_mm_s) -> bo
         if levels[0] < speeds_mm_s[0]:
             return False
     profile.move(direction * distance, levels, levels * cruise_s)
-    if rng.uniform() < 0.5:
-        profile.hold(rng.uniform(0.05, 0.5))
+    if rng.uniform() < dwell[0]:
+        profile.hold(rng.uniform(dwell[1], dwell[2]))
     return True
 
 
-def _oscillation(profile: MotionProfile, rng, low_mm, high_mm, speeds_mm_s) -> None:
-    """Oscillate a few periods around the present position (after a move to the centre if near an edge)."""
+def _oscillation(profile: MotionProfile, rng, low_mm, high_mm, speeds_mm_s, dwell) -> None:
+    """Oscillate a few periods around the present position (after a move to the centre if near an edge).
+
+    ``speeds_mm_s`` bounds the peak speed; ``dwell`` as in :func:`_random_leg`.
+    """
     centre, half = 0.5 * (low_mm + high_mm), 0.5 * (high_mm - low_mm)
     room = min(profile.position_mm - low_mm, high_mm - profile.position_mm)
     if room < 0.4 * half:
         offset = centre - profile.position_mm
         profile.move(offset, [_fitting_speed(profile.limits, abs(offset), float(_log_uniform(rng, *speeds_mm_s)))])
-        profile.hold(rng.uniform(0.05, 0.5))
+        if rng.uniform() < dwell[0]:
+            profile.hold(rng.uniform(dwell[1], dwell[2]))
         room = half
     peak_speed = float(_log_uniform(rng, *speeds_mm_s))
     angular_frequency = max(2.0 * np.pi * rng.uniform(0.2, 1.0), peak_speed / (0.9 * room))
-    profile.oscillate(peak_speed, angular_frequency, periods=float(rng.integers(3, 7)), ramp_periods=1.0)
-    profile.hold(rng.uniform(0.05, 0.5))
+    profile.oscillate(peak_speed, angular_frequency, periods=float(rng.integers(3, 7)), ramp_periods=0.5)
+    if rng.uniform() < dwell[0]:
+        profile.hold(rng.uniform(dwell[1], dwell[2]))
 
 
 def random_window_trajectory(geometry: AxisGeometry, rng: np.random.Generator, duration_s: float = 120.0,
                              speeds_mm_min=(100.0, 2000.0), limits: MotionLimits | None = None,
-                             margin_mm: float = 1.0) -> Trajectory:
+                             margin_mm: float = 1.0, dwell_probability: float = 0.02,
+                             dwell_s=(0.02, 0.1), sine_peak_mm_min=(300.0, 2000.0)) -> Trajectory:
     """Random velocity steps alternating with sinusoidal movements inside the window (datasets A, C).
 
     Blocks of 15-30 s of random moves (1-3 speed levels each, log-uniform in
-    ``speeds_mm_min``, reversals, dwells of 0-0.5 s) alternate with enveloped
-    sine oscillations around the present position (0.2-1 Hz or slower when the
-    amplitude would not fit, 3-6 periods, peak speed log-uniform in
-    ``speeds_mm_min``); near an edge the axis first moves to the window centre.
+    ``speeds_mm_min``, reversals) alternate with sine oscillations around the
+    present position (0.2-1 Hz or slower when the amplitude would not fit, 3-6
+    periods, a sin^2 envelope rising and falling over half a period, peak speed
+    log-uniform in ``sine_peak_mm_min``); near an edge the axis first moves to
+    the window centre. After a move or an oscillation the axis dwells with
+    probability ``dwell_probability``; it rests 0.5 s at the start and 0.1 s at
+    the end.
 
     Parameters
     ----------
@@ -134,9 +146,18 @@ def random_window_trajectory(geometry: AxisGeometry, rng: np.random.Generator, d
         Acceleration and jerk limits.
     margin_mm : float, default 1.0
         Distance [mm] kept from the window edges.
+    dwell_probability : float, default 0.02
+        Probability of a dwell after a random move or an oscillation.
+    dwell_s : tuple of float, default (0.02, 0.1)
+        Shortest and longest dwell [s], drawn uniformly.
+    sine_peak_mm_min : tuple of float, default (300, 2000)
+        Range of the oscillations' peak speeds [mm/min] (a sine of lower peak
+        spends most of its time below the paper's lowest feed of 100 mm/min).
     """
     low, high = geometry.window_mm[0] + margin_mm, geometry.window_mm[1] - margin_mm
+    dwell = (float(dwell_probability), float(dwell_s[0]), float(dwell_s[1]))
     speeds = (speeds_mm_min[0] * MM_MIN, speeds_mm_min[1] * MM_MIN)
+    sine_peaks = (sine_peak_mm_min[0] * MM_MIN, sine_peak_mm_min[1] * MM_MIN)
     profile = MotionProfile(geometry.window_centre_mm, limits)
     profile.hold(0.5)
     legs = oscillations = 0
@@ -145,27 +166,30 @@ def random_window_trajectory(geometry: AxisGeometry, rng: np.random.Generator, d
         if random_steps:
             block_end = min(profile.time_s + rng.uniform(15.0, 30.0), duration_s - 1.0)
             while profile.time_s < block_end:
-                legs += _random_leg(profile, rng, low, high, speeds)
+                legs += _random_leg(profile, rng, low, high, speeds, dwell)
         else:
-            _oscillation(profile, rng, low, high, speeds)
+            _oscillation(profile, rng, low, high, sine_peaks, dwell)
             oscillations += 1
         random_steps = not random_steps
-    profile.hold(0.5)
+    profile.hold(0.1)
     limits = profile.limits
     return Trajectory(profile, {
         "kind": "random velocity steps and sinusoidal movements",
         "window_mm": list(geometry.window_mm),
         "speeds_mm_min": list(speeds_mm_min),
+        "sine_peak_mm_min": list(sine_peak_mm_min),
         "duration_s": profile.duration_s,
         "moves": legs,
         "oscillations": oscillations,
+        "dwell_probability": dwell[0],
+        "dwell_s": [dwell[1], dwell[2]],
         "max_acceleration_mm_s2": limits.max_acceleration_mm_s2,
         "max_jerk_mm_s3": limits.max_jerk_mm_s3,
     })
 
 
 def constant_speed_trajectory(geometry: AxisGeometry, speeds_mm_min, limits: MotionLimits | None = None,
-                              dwell_s: float = 1.0) -> Trajectory:
+                              dwell_s: float = 0.2) -> Trajectory:
     """Once back and forth over the whole travel at each constant speed (datasets B, D).
 
     The axis starts at the upper end of the travel, moves to the lower end and
@@ -215,8 +239,8 @@ DATASETS = {
 #: Datasets of the paper's Table 1, generated by default.
 DEFAULT_DATASETS = ("A", "B", "C", "D")
 
-#: Shortest useful ``duration_s`` [s] of the datasets that take one. A and C rest 0.5 s at each end
-#: and move only while time < duration - 1 s (below 1.5 s they do not move at all; at 2 s they make
+#: Shortest useful ``duration_s`` [s] of the datasets that take one. A and C rest 0.5 s at the start
+#: and 0.1 s at the end and move only while time < duration - 1 s (below 1.5 s they do not move at all; at 2 s they make
 #: at least one move), ending at rest after the move that crosses that time, so their length is
 #: approximate. P runs whole periods of its 10 s rectangular envelope (the duration is rounded up to
 #: them). B and D take no duration: they cross the travel once back and forth per speed.
