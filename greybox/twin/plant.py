@@ -58,6 +58,8 @@ from .axes import axis_geometry
 __all__ = [
     "PlantParameters",
     "default_plant_parameters",
+    "position_factor_at",
+    "cogging_current_at",
     "stribeck_ratio",
     "lag_decay",
     "lagged_stribeck_ratio",
@@ -172,18 +174,24 @@ class PlantParameters:
                                  float(self.stribeck_shape))
         return ratio.reshape(velocity.shape)[()]
 
-    def position_factor(self, position_mm) -> np.ndarray:
-        """Position factor ``g(x)`` of the Maxwell-slip friction (dimensionless)."""
+    def _position_terms(self, position_mm):
         x = np.asarray(position_mm, dtype=float)
-        low, high = self.travel_mm
-        u = (2.0 * x - low - high) / (high - low)
-        lead = np.sin(2.0 * np.pi * x / self.lead_mm + self.lead_phase_rad)
-        return 1.0 + self.preload_gain * u**4 + self.tilt_gain * u + self.lead_gain * lead
+        factor, cogging = _position_term_arrays(np.ascontiguousarray(x.ravel()), *self._position_head())
+        return factor.reshape(x.shape)[()], cogging.reshape(x.shape)[()]
+
+    def _position_head(self) -> tuple:
+        """``(x_lo, x_hi, c_pre, c_tilt, lead, c_lead, phi, a_cog, lambda_cog, phi_cog)`` as floats."""
+        return (float(self.travel_mm[0]), float(self.travel_mm[1]), float(self.preload_gain), float(self.tilt_gain),
+                float(self.lead_mm), float(self.lead_gain), float(self.lead_phase_rad), float(self.cogging_A),
+                float(self.cogging_period_mm), float(self.cogging_phase_rad))
+
+    def position_factor(self, position_mm) -> np.ndarray:
+        """Position factor ``g(x)`` of the Maxwell-slip friction (dimensionless; :func:`position_factor_at`)."""
+        return self._position_terms(position_mm)[0]
 
     def cogging_current(self, position_mm) -> np.ndarray:
-        """Current [A] balancing the motor's cogging torque, ``a_cog sin(2 pi x / lambda_cog + phi_cog)``."""
-        x = np.asarray(position_mm, dtype=float)
-        return self.cogging_A * np.sin(2.0 * np.pi * x / self.cogging_period_mm + self.cogging_phase_rad)
+        """Current [A] balancing the motor's cogging torque (:func:`cogging_current_at`)."""
+        return self._position_terms(position_mm)[1]
 
     def steady_friction(self, velocity_mm_s, position_mm) -> np.ndarray:
         """Friction current [A] in steady sliding at constant velocity [mm/s] and position [mm]."""
@@ -272,6 +280,44 @@ def stribeck_ratio(velocity_mm_s, coulomb_ratio, stribeck_velocity_mm_s, stribec
     """
     return coulomb_ratio + (1.0 - coulomb_ratio) * math.exp(
         -((abs(velocity_mm_s) / stribeck_velocity_mm_s) ** stribeck_shape))
+
+
+@njit(cache=True)
+def position_factor_at(position_mm, low_mm, high_mm, preload_gain, tilt_gain, lead_mm, lead_gain, lead_phase_rad):
+    """Position factor ``g(x) = 1 + c_pre u^4 + c_tilt u + c_lead sin(2 pi x / lead + phi)`` of the twin.
+
+    Parameters
+    ----------
+    position_mm : float
+        Position ``x`` [mm].
+    low_mm, high_mm : float
+        Ends of the travel [mm]; ``u = (2x - x_lo - x_hi) / (x_hi - x_lo)``.
+    preload_gain, tilt_gain : float
+        ``c_pre`` and ``c_tilt``.
+    lead_mm, lead_gain, lead_phase_rad : float
+        Screw lead [mm], ``c_lead`` and ``phi`` [rad].
+    """
+    u = (2.0 * position_mm - low_mm - high_mm) / (high_mm - low_mm)
+    return 1.0 + preload_gain * u ** 4 + tilt_gain * u + lead_gain * math.sin(
+        2.0 * math.pi * position_mm / lead_mm + lead_phase_rad)
+
+
+@njit(cache=True)
+def cogging_current_at(position_mm, cogging_A, cogging_period_mm, cogging_phase_rad):
+    """Cogging current ``R(x) = a_cog sin(2 pi x / lambda_cog + phi_cog)`` [A] at ``position_mm`` [mm]."""
+    return cogging_A * math.sin(2.0 * math.pi * position_mm / cogging_period_mm + cogging_phase_rad)
+
+
+@njit(cache=True)
+def _position_term_arrays(position_mm, low_mm, high_mm, preload_gain, tilt_gain, lead_mm, lead_gain, lead_phase_rad,
+                           cogging_A, cogging_period_mm, cogging_phase_rad):
+    factor = np.empty(position_mm.shape[0])
+    cogging = np.empty(position_mm.shape[0])
+    for i in range(position_mm.shape[0]):
+        factor[i] = position_factor_at(position_mm[i], low_mm, high_mm, preload_gain, tilt_gain, lead_mm,
+                                       lead_gain, lead_phase_rad)
+        cogging[i] = cogging_current_at(position_mm[i], cogging_A, cogging_period_mm, cogging_phase_rad)
+    return factor, cogging
 
 
 @njit(cache=True)
@@ -455,8 +501,9 @@ def simulate_plant(params: PlantParameters, motion, n_samples: int, sample_time_
 
 
 # ------------------------------------------------------------------ the plant of a position loop
-#: Length of the head of the plant law's parameters: r_c, v_s, delta, tau, sigma_v, x_lo, x_hi, c_pre,
-#: lead, c_lead, phi, c_tilt, a_cog, lambda_cog, phi_cog (then k_1..m, D_1..m).
+#: Length of the head of the plant law's parameters: r_c, v_s, delta, tau, sigma_v, then the ten position
+#: terms of :meth:`PlantParameters._position_head` (x_lo, x_hi, c_pre, c_tilt, lead, c_lead, phi, a_cog,
+#: lambda_cog, phi_cog); then k_1..m, D_1..m.
 _TWIN_HEAD = 15
 
 
@@ -466,11 +513,9 @@ def twin_plant_friction(parameters, state, position_mm, velocity_mm_s):
 
     Layout of ``parameters`` and ``state`` in :func:`twin_plant_law`.
     """
-    low, high = parameters[5], parameters[6]
-    u = (2.0 * position_mm - low - high) / (high - low)
-    factor = 1.0 + parameters[7] * u ** 4 + parameters[11] * u + parameters[9] * math.sin(
-        2.0 * math.pi * position_mm / parameters[8] + parameters[10])
-    cogging = parameters[12] * math.sin(2.0 * math.pi * position_mm / parameters[13] + parameters[14])
+    factor = position_factor_at(position_mm, parameters[5], parameters[6], parameters[7], parameters[8],
+                                parameters[9], parameters[10], parameters[11])
+    cogging = cogging_current_at(position_mm, parameters[12], parameters[13], parameters[14])
     return factor * state[1] + parameters[4] * velocity_mm_s + cogging
 
 
@@ -492,7 +537,7 @@ def twin_plant_advance(parameters, state, velocity_mm_s, step_s):
 def twin_plant_law(params: PlantParameters, *, friction: bool = True) -> PlantLaw:
     """The truth plant as the plant of a position loop, at rest (relaxed elements, ratio 1).
 
-    ``parameters = (r_c, v_s, delta, tau, sigma_v, x_lo, x_hi, c_pre, lead, c_lead, phi, c_tilt,
+    ``parameters = (r_c, v_s, delta, tau, sigma_v, x_lo, x_hi, c_pre, c_tilt, lead, c_lead, phi,
     a_cog, lambda_cog, phi_cog, k_1..m, D_1..m)``, ``state = (r, sum_i k_i d_i, d_1..m)``; the
     friction is ``g(x) sum_i k_i d_i + sigma_v v``, plus the cogging current (see the module doc).
 
@@ -512,10 +557,8 @@ def twin_plant_law(params: PlantParameters, *, friction: bool = True) -> PlantLa
     """
     scale = 1.0 if friction else 0.0
     head = [float(params.coulomb_ratio), float(params.stribeck_velocity_mm_s), float(params.stribeck_shape),
-            float(params.lag_time_s), float(params.viscous_A_s_mm) * scale, float(params.travel_mm[0]),
-            float(params.travel_mm[1]), float(params.preload_gain), float(params.lead_mm), float(params.lead_gain),
-            float(params.lead_phase_rad), float(params.tilt_gain), float(params.cogging_A) * scale,
-            float(params.cogging_period_mm), float(params.cogging_phase_rad)]
+            float(params.lag_time_s), float(params.viscous_A_s_mm) * scale, *params._position_head()]
+    head[12] *= scale  # a_cog
     parameters = np.concatenate((head, np.asarray(params.stiffness_A_mm, float) * scale,
                                  np.asarray(params.breakaway_deflection_mm, float)))
     state = np.zeros(2 + len(params.breakaway_A))
