@@ -114,6 +114,10 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
                      "--jobs", "1", "--no-models"]) == 0
     captured = capsys.readouterr()
     assert "axis Y, experiment 2: gmssvr (GMS on A, SVR on B)" in captured.err  # progress display
+    # one axis: the four per-axis checks of the paper's pattern, flagged as a quick run
+    pattern = [line for line in captured.out.splitlines() if line.startswith("  met ") or "not met" in line]
+    assert len(pattern) == 4 and "checks met (--quick: small search budgets" in captured.out
+    assert "The paper's pattern on the synthetic axes" in (out / "tables.md").read_text()
     records = json.loads((out / "metrics.json").read_text())
     assert {(r["experiment"], r["model"]) for r in records} == {
         (1, m) for m in ("coulomb", "stribeck", "lugre", "gms", "svr", "gmssvr", "noise_floor")} | {

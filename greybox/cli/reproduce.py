@@ -91,7 +91,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"  {len(result.files['figures'])} figures, {len(result.files['models'])} model files in {out_dir}")
     checks = paper_pattern(result.records)
     if checks:
-        print(f"the paper's pattern: {sum(c['met'] for c in checks)} of {len(checks)} checks met")
+        caveat = " (--quick: small search budgets, not the figures of a full run)" if args.quick else ""
+        print(f"the paper's pattern: {sum(c['met'] for c in checks)} of {len(checks)} checks met{caveat}")
         for c in checks:
             print(f"  {'met    ' if c['met'] else 'not met'} {c['check']} ({c['axis']}): {c['ours']} "
                   f"(target {c['target']}, paper {c['paper']})")

@@ -21,7 +21,7 @@ def add_parser(subparsers) -> None:
         help="write synthetic axis logs (datasets A-D, P) of the twin machine",
         description=(
             "Simulate the synthetic feed axis (24-element Maxwell-slip friction, position-dependent, "
-            "inertia, AR(1) current noise) along the trajectories of Rüppel et al. (2024, Table 1) and "
+            "motor cogging, inertia, AR(1) current noise) along the trajectories of Rüppel et al. (2024, Table 1) and "
             "write one MCAP file per dataset, DIR/<axis>_<dataset>.mcap. Datasets: "
             + "; ".join(f"{k}: {v}" for k, v in DATASETS.items()) + "."
         ),

@@ -9,7 +9,8 @@ records of ``greybox reproduce``, the relations the paper's real axes show:
   (0.08-0.16 A);
 * Table 4 (train A + B, test C + D): the sole SVR's test RE at least three
   times its training RE (the paper's overfitting), GMS+SVR the lowest test RE
-  on each axis, and the position effect larger on Y than on X (test RE of
+  of the paper's four models (Stribeck, SVR, GMS, GMS+SVR; variants such as
+  ``gmssvr_eq8`` are not compared) on each axis, and the position effect larger on Y than on X (test RE of
   Stribeck and of GMS on Y at least 1.8 times that on X).
 
 Each check is computed the same way on the paper's figures
