@@ -175,6 +175,7 @@ class PlantParameters:
         return ratio.reshape(velocity.shape)[()]
 
     def _position_terms(self, position_mm):
+        """Position factor ``g(x)`` and cogging current [A] at ``position_mm`` [mm], in one pass."""
         x = np.asarray(position_mm, dtype=float)
         factor, cogging = _position_term_arrays(np.ascontiguousarray(x.ravel()), *self._position_head())
         return factor.reshape(x.shape)[()], cogging.reshape(x.shape)[()]
@@ -495,9 +496,9 @@ def simulate_plant(params: PlantParameters, motion, n_samples: int, sample_time_
         np.asarray(params.breakaway_deflection_mm, float), params.coulomb_ratio,
         params.stribeck_velocity_mm_s, params.stribeck_shape, params.lag_time_s)
     x_log, v_log, a_log = x[::stride], v[::stride], a[::stride]
-    friction = params.position_factor(x_log) * maxwell + params.viscous_A_s_mm * v_log
-    return PlantResponse(x_log, v_log, a_log, friction, params.inertia_A_s2_mm * a_log,
-                         params.cogging_current(x_log))
+    factor, cogging = params._position_terms(x_log)
+    friction = factor * maxwell + params.viscous_A_s_mm * v_log
+    return PlantResponse(x_log, v_log, a_log, friction, params.inertia_A_s2_mm * a_log, cogging)
 
 
 # ------------------------------------------------------------------ the plant of a position loop
