@@ -8,7 +8,10 @@ rules (DESIGN.md, "Layout"):
 - no import cycle between modules;
 - only ``greybox.twin`` itself, ``greybox.control``, ``greybox.studies`` and
   ``greybox.cli`` import the synthetic twin;
-- ``greybox.base`` (the model protocol) imports nothing of greybox;
+- ``greybox.base`` (the model protocol) and ``greybox.twin.laws.base`` (the
+  truth laws' base class) import nothing of greybox, and the twin imports no
+  model (``greybox.friction``, ``greybox.models``): a truth plant built from
+  the models it tests would flatter them;
 - the physical and current models (``greybox.friction``, ``greybox.models``)
   import nothing of the layers above them: ``evaluate``, ``discover``,
   ``studies``, ``control``, ``cli``.
@@ -224,6 +227,15 @@ def test_the_model_protocol_imports_nothing_of_greybox(graph):
     assert "greybox.base" in graph
     found = forbidden(graph, lambda m: m == "greybox.base", lambda t: True)
     assert not found, "greybox/base.py must import nothing of greybox:\n" + "\n".join(found)
+
+
+def test_the_truth_laws_base_imports_nothing_of_greybox_and_no_truth_law_uses_a_model(graph):
+    assert "greybox.twin.laws.base" in graph
+    found = forbidden(graph, lambda m: m == "greybox.twin.laws.base", lambda t: True)
+    assert not found, "greybox/twin/laws/base.py must import nothing of greybox:\n" + "\n".join(found)
+    found = forbidden(graph, lambda m: _within(m, "greybox.twin"),
+                      lambda t: _within(t, "greybox.friction") or _within(t, "greybox.models"))
+    assert not found, "the truth plants must not be built from the models they test:\n" + "\n".join(found)
 
 
 def test_the_models_import_nothing_of_the_layers_above_them(graph):

@@ -9,6 +9,7 @@ from greybox.cli import main
 from greybox.data.io import read_log
 from greybox.errors import GreyboxError
 from greybox.twin import ESSENTIAL_TRUTH_CHANNELS, make_dataset, synthesize
+from greybox.twin.family import draw_member, member_dataset
 
 
 def test_synth_writes_one_file_per_dataset(tmp_path, capsys):
@@ -55,6 +56,11 @@ def test_synth_refuses_to_overwrite_without_force(tmp_path, capsys):
     (["--axis", "X", "--effect", "thermal_drift", "--effect-param", "time_constant_s=fast"], "not a number"),
     (["--axis", "X", "--seed", "-2"], "argument --seed: must be an integer from 0 to 4294967295, got -2"),
     (["--axis", "X", "--duration", "0"], "argument --duration: must be a positive number of seconds, got 0"),
+    ([], "give the axes to simulate (--axis X, Y or both) or --family N"),
+    (["--family", "2", "--axis", "X"], "--family draws each axis, its noise and sensors; --axis does not apply"),
+    (["--family", "2", "--noise-std", "0.2"], "--noise-std does not apply"),
+    (["--family", "0"], "argument --family: must be a positive integer, got 0"),
+    (["--family", "1", "--datasets", "A", "--duration", "1"], "dataset A needs at least"),
 ])
 def test_synth_errors_are_one_line_messages(tmp_path, capsys, args, message):
     argv = ["synth", "--out", str(tmp_path / "o"), "--seed", "0", *args]
@@ -75,3 +81,19 @@ def test_synthesize_keeps_only_the_requested_truth_channels(tmp_path):
     with pytest.raises(GreyboxError, match="unknown truth channel"):
         synthesize("X", 5, tmp_path / "b", ["D"], truth_channels=["truth_speed_A"])
     assert not (tmp_path / "b").exists()
+
+
+def test_synth_family_writes_each_member_with_its_own_law_and_a_catalogue(tmp_path, capsys):
+    out = tmp_path / "family"
+    assert main(["synth", "--family", "4", "--seed", "9", "--out", str(out), "--datasets", "C", "--duration", "4",
+                 "--cutting", "--truth", "essential"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert [line.split(":")[0] for line in lines[:4]] == [f"member_{i:03d}" for i in range(4)]
+    assert "family.json" in lines[-1]
+    for index in range(4):
+        member = draw_member(index, 9)
+        log = read_log(out / member.name / f"{member.axis}_C.mcap")
+        assert log.attrs["family_member"]["law"] == member.law
+        expected = member_dataset(member, "C", duration_s=4.0, cutting=True)
+        np.testing.assert_array_equal(log.current, expected.current)
+        assert set(log.extras) == {"truth_current_A", "truth_process_A"}

@@ -10,6 +10,8 @@ from ..errors import GreyboxError
 from ..twin.cutting import CuttingSpec
 from ..twin.datasets import ESSENTIAL_TRUTH_CHANNELS, SAMPLE_TIME_S, dataset_motion, synthesize
 from ..twin.effects import EFFECTS, effect_parameters
+from ..twin.family import synthesize_family
+from ..twin.laws import TRUTH_LAWS
 from ..twin.noise import CurrentNoise
 from ..twin.trajectories import DATASETS, DEFAULT_DATASETS, MIN_DURATION_S
 from ._types import FINITE, MAX_SEED, NON_NEGATIVE, POSITIVE, POSITIVE_INT, SEED, positive
@@ -23,10 +25,16 @@ def add_parser(subparsers) -> None:
             "Simulate the synthetic feed axis (24-element Maxwell-slip friction, position-dependent, "
             "motor cogging, inertia, AR(1) current noise) along the trajectories of Rüppel et al. (2024, Table 1) and "
             "write one MCAP file per dataset, DIR/<axis>_<dataset>.mcap. Datasets: "
-            + "; ".join(f"{k}: {v}" for k, v in DATASETS.items()) + "."
+            + "; ".join(f"{k}: {v}" for k, v in DATASETS.items()) + ". With --family N: N axes of the family of "
+            "truth axes instead (friction laws " + ", ".join(TRUTH_LAWS) + " in turn, random parameters, "
+            "position- and load-dependent friction, cogging, noise and quantisation drawn from documented ranges), "
+            "written as DIR/member_NNN/<axis>_<dataset>.mcap with DIR/family.json describing every member."
         ),
     )
-    parser.add_argument("--axis", required=True, nargs="+", metavar="AXIS", help="axes: X, Y or both (X Y)")
+    parser.add_argument("--axis", nargs="+", metavar="AXIS", help="axes: X, Y or both (X Y); required without --family")
+    parser.add_argument("--family", type=POSITIVE_INT, metavar="N",
+                        help="write N random axes of the family of truth axes (each draws its own axis, noise "
+                             "and sensors; --seed is the family seed)")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="output directory (created if missing; a non-empty one only with --force)")
     parser.add_argument("--seed", required=True, type=SEED, metavar="N",
@@ -158,17 +166,48 @@ def _check_duration(args: argparse.Namespace, axes, datasets) -> None:
               file=sys.stderr)
 
 
+def _run_family(args: argparse.Namespace, datasets, cutting) -> int:
+    given = [flag for flag, value in (("--axis", args.axis), ("--effect", args.effect),
+                                      ("--strength", args.strength), ("--effect-param", args.effect_param))
+             if value]
+    if args.noise_std != CurrentNoise.std_A:
+        given.append("--noise-std")
+    if given:
+        raise GreyboxError(f"--family draws each axis, its noise and sensors; {', '.join(given)} does not apply")
+    _check_out_dir(args)
+    for key in datasets:
+        minimum = MIN_DURATION_S.get(key)
+        if args.duration is not None and minimum is not None and args.duration < minimum:
+            raise GreyboxError(f"--duration {args.duration:g}: dataset {key} needs at least {minimum:g} s "
+                               f"({_MINIMUM_REASONS[key]})")
+    options = {"cutting": cutting} if cutting is not None else {}
+    synthesize_family(args.family, args.seed, args.out, datasets, force=args.force,
+                      truth_channels=ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None,
+                      progress=print, duration_s=args.duration, **options)
+    print(f"family of {args.family} axes (seed {args.seed}) -> {args.out}; members described in "
+          f"{Path(args.out) / 'family.json'}")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
-    axes = list(dict.fromkeys(a.strip().upper() for a in args.axis if a.strip()))
     datasets = list(dict.fromkeys(d.strip().upper() for d in args.datasets if d.strip()))
+    cutting = None
+    if args.cutting:
+        cutting = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm, teeth=args.teeth)
+    if args.family is not None:
+        if not datasets:
+            raise GreyboxError("give at least one dataset (--datasets)")
+        return _run_family(args, datasets, cutting)
+    if not args.axis:
+        raise GreyboxError("give the axes to simulate (--axis X, Y or both) or --family N")
+    axes = list(dict.fromkeys(a.strip().upper() for a in args.axis if a.strip()))
     if not axes or not datasets:
         raise GreyboxError("give at least one axis (--axis) and one dataset (--datasets)")
     options = _effect_options(args)
     _check_out_dir(args)
     _check_duration(args, axes, datasets)
-    if args.cutting:
-        options["cutting"] = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm,
-                                         teeth=args.teeth)
+    if cutting is not None:
+        options["cutting"] = cutting
     synthesize(
         axes, args.seed, args.out, datasets,
         force=args.force,

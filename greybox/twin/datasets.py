@@ -18,7 +18,7 @@ from .axes import axis_geometry
 from .cutting import CuttingSpec, cut_segments, cutting_current
 from .effects import EffectInputs, effect_current, effect_parameters
 from .noise import CurrentNoise
-from .plant import PlantParameters, default_plant_parameters, simulate_plant
+from .plant import PlantParameters, default_plant_parameters
 from .sensors import Sensors, quantise
 from .trajectories import DATASETS, DEFAULT_DATASETS, Trajectory, dataset_trajectory
 
@@ -125,8 +125,10 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         Inject a cutting-force current (``True``: default :class:`CuttingSpec`).
     duration_s : float, optional
         Length [s] of the datasets A, C (default 120 s) and P (default 60 s).
-    plant : PlantParameters, optional
-        Truth plant; default :func:`default_plant_parameters` of the axis.
+    plant : PlantParameters or FamilyPlant, optional
+        Truth plant (anything with ``simulate(motion, n_samples, sample_time_s)`` and ``to_dict()``); default
+        :func:`default_plant_parameters` of the axis. With cutting, the process current is added to the
+        screw's axial load (:meth:`~greybox.twin.plant.PlantResponse.under_load`).
     noise : CurrentNoise, optional
         Current noise; default ``CurrentNoise()`` (0.09 A, lag-1 correlation 0.7).
     sensors : Sensors, optional
@@ -157,7 +159,12 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
 
     n = int(np.floor(trajectory.duration_s / SAMPLE_TIME_S + 1e-9)) + 1
     time = np.round(np.arange(n) * SAMPLE_TIME_S, 9)
-    response = simulate_plant(plant, trajectory.motion, n, SAMPLE_TIME_S)
+    response = plant.simulate(trajectory.motion, n, SAMPLE_TIME_S)
+    process = None
+    if cutting:
+        spec = cutting if isinstance(cutting, CuttingSpec) else CuttingSpec()
+        process = cutting_current(spec, time, response.position_mm, response.velocity_mm_s)
+        response = response.under_load(process)
     truth = {"truth_friction_A": response.friction_A, "truth_inertia_A": response.inertia_A,
              "truth_cogging_A": response.cogging_A}
     attrs = {
@@ -178,9 +185,7 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         truth["truth_effect_A"] = effect_current(effect, inputs, effect_strength, **params)
         attrs["effect"] = {"name": effect, "strength_A": float(effect_strength),
                            **effect_parameters(effect), **params}
-    if cutting:
-        spec = cutting if isinstance(cutting, CuttingSpec) else CuttingSpec()
-        process = cutting_current(spec, time, response.position_mm, response.velocity_mm_s)
+    if process is not None:
         truth["truth_process_A"] = process
         attrs["cutting"] = {**spec.to_dict(), "workpiece_mm": list(spec.workpiece(response.position_mm)),
                             "cut_segments": len(cut_segments(process))}

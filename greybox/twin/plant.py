@@ -200,6 +200,10 @@ class PlantParameters:
         coulomb = self.static_friction_A * self.stribeck_ratio(v) * np.sign(v)
         return self.position_factor(position_mm) * coulomb + self.viscous_A_s_mm * v
 
+    def simulate(self, motion, n_samples: int, sample_time_s: float = 0.002) -> "PlantResponse":
+        """Motion and current at the log samples along ``motion`` (:func:`simulate_plant`)."""
+        return simulate_plant(self, motion, n_samples, sample_time_s)
+
     def to_dict(self) -> dict:
         """JSON-serialisable parameter dictionary."""
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}
@@ -449,6 +453,12 @@ class PlantResponse:
         True motion [mm, mm/s, mm/s^2].
     friction_A, inertia_A, cogging_A : ndarray
         Friction, inertia and cogging current [A].
+    load_gain : float, default 0.0
+        Friction current per ampere of axial load (``1 - efficiency`` of the screw); 0: friction independent
+        of the load.
+    friction_direction : ndarray, optional
+        Friction over its largest magnitude, in [-1, 1]: the direction in which a load-dependent friction acts
+        (needed when ``load_gain`` is not 0).
     """
 
     position_mm: np.ndarray
@@ -457,11 +467,24 @@ class PlantResponse:
     friction_A: np.ndarray
     inertia_A: np.ndarray
     cogging_A: np.ndarray
+    load_gain: float = 0.0
+    friction_direction: np.ndarray | None = None
 
     @property
     def current_A(self) -> np.ndarray:
         """Inertia plus friction plus cogging current [A]."""
         return self.friction_A + self.inertia_A + self.cogging_A
+
+    def under_load(self, process_A) -> "PlantResponse":
+        """The response with a process current [A] added to the axial load of the screw.
+
+        The friction grows by ``load_gain (|I_inertia + I_process| - |I_inertia|)`` in the friction's
+        direction; the process current itself is not included (the caller adds it).
+        """
+        if self.load_gain == 0.0:
+            return self
+        extra = self.load_gain * (np.abs(self.inertia_A + process_A) - np.abs(self.inertia_A))
+        return replace(self, friction_A=self.friction_A + extra * self.friction_direction)
 
 
 def fine_steps_per_sample(params: PlantParameters, sample_time_s: float) -> int:
