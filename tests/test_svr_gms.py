@@ -120,37 +120,19 @@ def _lowest_corner(objective, intervals, n_calls, random_state, progress=None):
     return point, [{**point, "objective": objective(point)}]
 
 
-def test_residual_target_searches_local_kernels_only(fitted):
-    """With the residual target gamma stays in RESIDUAL_GAMMA_BOUNDS (the search really runs here)."""
-    from greybox.models.gmssvr import RESIDUAL_GAMMA_BOUNDS
-
-    model, train = fitted
-    residual = GMSSVRModel(C=3.0, epsilon=0.01, n_subset=200, n_calls=5, cv_folds=2, cv_blocks=4)
-    residual.fit_svr(train, gms=model.gms_)
-    tried = [trial["gamma"] for trial in residual.search_history_]
-    low, high = RESIDUAL_GAMMA_BOUNDS
-    assert len(tried) == 5 and all(low <= gamma <= high for gamma in tried) and low <= residual.gamma_ <= high
-
-
-def test_gamma_floor_of_the_residual_target_is_a_prior_not_a_warning(fitted, monkeypatch):
-    import warnings
-
+def test_both_targets_search_the_default_intervals_and_ending_at_an_end_warns(fitted, monkeypatch):
+    """No prior narrows the residual target's search (chosen on the family's training runs, docs/svr.md)."""
     from greybox.models import svr
-    from greybox.models.gmssvr import RESIDUAL_GAMMA_BOUNDS
 
     monkeypatch.setattr(svr, "minimize_log_uniform", _lowest_corner)
     model, train = fitted
     search = dict(C=3.0, epsilon=0.01, n_subset=200, n_calls=1, cv_folds=2, cv_blocks=4)
-    residual = GMSSVRModel(**search)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        residual.fit_svr(train, gms=model.gms_)
-    assert residual.gamma_ == RESIDUAL_GAMMA_BOUNDS[0] and residual.at_bounds_ == ["gamma"]
-    # The user's interval replaces the prior, and ending at its end is then worth a warning.
-    widened = GMSSVRModel(**search, bounds={"gamma": (0.01, 100.0)})
-    with pytest.warns(UserWarning, match="gamma = 0.01 ended at the end"):
-        widened.fit_svr(train, gms=model.gms_)
-    # The paper's form searches the default interval, which reaches below the floor.
-    current = GMSSVRModel(**search, target="current")
-    with pytest.warns(UserWarning, match="gamma = 0.01 ended at the end"):
-        current.fit_svr(train, gms=model.gms_)
+    for target in ("residual", "current"):
+        fitted_model = GMSSVRModel(**search, target=target)
+        with pytest.warns(UserWarning, match="gamma = 0.01 ended at the end"):
+            fitted_model.fit_svr(train, gms=model.gms_)
+        assert fitted_model.gamma_ == svr.default_bounds(1.0)["gamma"][0] and fitted_model.at_bounds_ == ["gamma"]
+    narrowed = GMSSVRModel(**search, bounds={"gamma": (2.0, 50.0)})
+    with pytest.warns(UserWarning, match="gamma = 2 ended at the end"):
+        narrowed.fit_svr(train, gms=model.gms_)
+    assert narrowed.gamma_ == 2.0

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Callable, Collection, Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
@@ -164,7 +164,6 @@ def fit_svr_expansion(
     random_state: int,
     progress: Callable[[ProgressEvent], None] | None = None,
     stage: str = "SVR hyperparameters",
-    floors: Collection[str] = (),
 ) -> SVRExpansion:
     """Standardise, choose hyperparameters, train on a covering subset.
 
@@ -200,10 +199,6 @@ def fit_svr_expansion(
         evaluation; its cost is the CV mean squared error over ``var(y)``.
     stage : str
         Stage name in the progress events.
-    floors : collection of str, optional
-        Hyperparameters whose lower search bound is a deliberate floor, a
-        prior of the model rather than a limit of the search: ending there
-        raises no warning (the name is still listed in ``at_bounds``).
 
     Returns
     -------
@@ -276,11 +271,9 @@ def fit_svr_expansion(
         history = [{**{k: v for k, v in t.items() if k != "objective"}, "cv_rmse": t["objective"]} for t in trials]
         cv_rmse = min(t["objective"] for t in trials)
         at_bounds = [name for name in free if _near_bound(hyper[name], search[name])]
-        surprising = [name for name in at_bounds
-                      if not (name in floors and _near_bound(hyper[name], search[name], end="low"))]
-        if surprising:
+        if at_bounds:
             warnings.warn(
-                f"{stage}: {', '.join(f'{n} = {hyper[n]:.3g}' for n in surprising)} ended at the end of "
+                f"{stage}: {', '.join(f'{n} = {hyper[n]:.3g}' for n in at_bounds)} ended at the end of "
                 "its search interval; the optimum may lie outside (widen it with bounds=)",
                 UserWarning, stacklevel=3)
     else:
@@ -313,15 +306,11 @@ def _check_bounds(bounds) -> None:
             raise ParameterError(f"bounds of {name!r} must satisfy 0 < low < high < inf, got {interval!r}")
 
 
-def _near_bound(value: float, interval: tuple[float, float], fraction: float = 0.01, end: str = "either") -> bool:
-    """True if ``value`` lies within ``fraction`` of the log-width of ``interval`` from an end.
-
-    ``end`` is ``"low"``, ``"high"`` or ``"either"``.
-    """
+def _near_bound(value: float, interval: tuple[float, float], fraction: float = 0.01) -> bool:
+    """True if ``value`` lies within ``fraction`` of the log-width of ``interval`` from either end."""
     low, high = np.log(interval[0]), np.log(interval[1])
     margin = fraction * (high - low)
-    at_low, at_high = bool(np.log(value) <= low + margin), bool(np.log(value) >= high - margin)
-    return {"low": at_low, "high": at_high, "either": at_low or at_high}[end]
+    return bool(np.log(value) <= low + margin or np.log(value) >= high - margin)
 
 
 def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) -> tuple[float, float]:
@@ -396,22 +385,15 @@ class KernelRegressionModel(CurrentModel):
         _check_bounds(self.bounds)
 
     def _fit_kernel(self, X, y, coverage, run_lengths: Sequence[int],
-                    progress: Callable[[ProgressEvent], None] | None, *, stage: str = "SVR hyperparameters",
-                    prior_bounds: Mapping[str, tuple[float, float]] | None = None) -> None:
-        """Fit :func:`fit_svr_expansion` with this model's SVR settings and keep it as learned attributes.
-
-        ``prior_bounds`` are search intervals the model class sets by design;
-        the model's own ``bounds`` override them, and their lower ends are
-        floors (see :func:`fit_svr_expansion`) unless overridden.
-        """
-        bounds = {**(prior_bounds or {}), **(self.bounds or {})}
-        floors = [name for name in (prior_bounds or {}) if name not in (self.bounds or {})]
+                    progress: Callable[[ProgressEvent], None] | None, *,
+                    stage: str = "SVR hyperparameters") -> None:
+        """Fit :func:`fit_svr_expansion` with this model's SVR settings and keep it as learned attributes."""
         fit = fit_svr_expansion(
             X, y, coverage, run_lengths,
             fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
             n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
-            cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=bounds or None,
-            random_state=self.random_state, progress=progress, stage=stage, floors=floors)
+            cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=self.bounds,
+            random_state=self.random_state, progress=progress, stage=stage)
         self.input_mean_ = fit.input_mean
         self.input_scale_ = fit.input_scale
         self.support_vectors_ = fit.support_vectors

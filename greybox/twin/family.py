@@ -36,7 +36,7 @@ from .datasets import _check_seed, _for_storage, _kept_truth_channels, dataset_p
 from .laws import TRUTH_LAWS, TruthLaw
 from .laws.base import log_uniform
 from .noise import CurrentNoise
-from .plant import PlantResponse, _position_term_arrays, fine_steps_per_sample
+from .plant import PlantResponse, _position_term_arrays, fine_motion
 from .sensors import Sensors
 from .trajectories import DATASETS, DEFAULT_DATASETS
 
@@ -135,9 +135,7 @@ class FamilyPlant:
         sample_time_s : float, default 0.002
             Log sample time [s].
         """
-        stride = fine_steps_per_sample(self, sample_time_s)
-        fine_time = np.arange((n_samples - 1) * stride + 1) * self.internal_step_s
-        x, v, a = motion.evaluate(fine_time)
+        stride, x, v, a = fine_motion(self, motion, n_samples, sample_time_s)
         law = self.law.respond(x, v, a, self.internal_step_s, stride, self.inertia_A_s2_mm)
         x_log, v_log, a_log = x[::stride], v[::stride], a[::stride]
         factor, cogging = self.position_terms(x_log)
@@ -204,8 +202,9 @@ def ranges_markdown() -> str:
     """The documented ranges of the family (:data:`FAMILY_RANGES` and every law's ``RANGES``) as Markdown tables."""
     def table(title, ranges):
         rows = [f"**{title}**", "", "| parameter | low | high | unit | drawn |", "|---|---|---|---|---|"]
-        rows += [f"| `{name}` | {low:g} | {high:g} | {unit} | {how} |" if not isinstance(low, str)
-                 else f"| `{name}` | {low} | {high} | {unit} | {how} |" for name, (low, high, unit, how) in ranges.items()]
+        for name, (low, high, unit, how) in ranges.items():
+            ends = (low, high) if isinstance(low, str) else (f"{low:g}", f"{high:g}")
+            rows.append(f"| `{name}` | {ends[0]} | {ends[1]} | {unit} | {how} |")
         return "\n".join(rows)
 
     parts = [table("every member", FAMILY_RANGES)]

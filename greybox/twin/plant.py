@@ -70,6 +70,7 @@ __all__ = [
     "twin_plant_advance",
     "PlantResponse",
     "fine_steps_per_sample",
+    "fine_motion",
     "simulate_plant",
 ]
 
@@ -487,7 +488,7 @@ class PlantResponse:
         return replace(self, friction_A=self.friction_A + extra * self.friction_direction)
 
 
-def fine_steps_per_sample(params: PlantParameters, sample_time_s: float) -> int:
+def fine_steps_per_sample(params, sample_time_s: float) -> int:
     """Number of internal steps per log sample; raises if the step does not divide the sample time."""
     ratio = sample_time_s / params.internal_step_s
     stride = int(round(ratio))
@@ -495,6 +496,25 @@ def fine_steps_per_sample(params: PlantParameters, sample_time_s: float) -> int:
         raise GreyboxError(
             f"plant: internal step {params.internal_step_s} s must divide the sample time {sample_time_s} s")
     return stride
+
+
+def fine_motion(plant, motion, n_samples: int, sample_time_s: float):
+    """The motion on a plant's fine grid up to the last log sample: ``(stride, x_mm, v_mm_s, a_mm_s2)``.
+
+    Parameters
+    ----------
+    plant : object
+        Has ``internal_step_s`` [s], which must divide ``sample_time_s``.
+    motion : object
+        Has ``evaluate(time_s) -> (x_mm, v_mm_s, a_mm_s2)``.
+    n_samples : int
+        Number of log samples.
+    sample_time_s : float
+        Log sample time [s]; the log samples are every ``stride``-th fine point.
+    """
+    stride = fine_steps_per_sample(plant, sample_time_s)
+    x, v, a = motion.evaluate(np.arange((n_samples - 1) * stride + 1) * plant.internal_step_s)
+    return stride, x, v, a
 
 
 def simulate_plant(params: PlantParameters, motion, n_samples: int, sample_time_s: float = 0.002) -> PlantResponse:
@@ -511,9 +531,7 @@ def simulate_plant(params: PlantParameters, motion, n_samples: int, sample_time_
     sample_time_s : float, default 0.002
         Log sample time [s].
     """
-    stride = fine_steps_per_sample(params, sample_time_s)
-    fine_time = np.arange((n_samples - 1) * stride + 1) * params.internal_step_s
-    x, v, a = motion.evaluate(fine_time)
+    stride, x, v, a = fine_motion(params, motion, n_samples, sample_time_s)
     maxwell = maxwell_slip_kernel(
         x, v, params.internal_step_s, stride, params.stiffness_A_mm,
         np.asarray(params.breakaway_deflection_mm, float), params.coulomb_ratio,
