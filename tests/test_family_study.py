@@ -13,7 +13,8 @@ from greybox.studies.robustness import TARGETS, robustness_markdown, run_member,
 def _row(index, law, ratios, process=30.0, mean=-2.0):
     return {"index": index, "law": law, "axis": "X", "noise_std_A": 0.08, "floor_re": 7.0, "cut_samples": 100,
             "process_floor_pct": 20.0,
-            "models": {name: {"re": 7.0 * r, "rmse_A": 0.1, "ratio": r, "process_rmse_A": 0.1,
+            "models": {name: {"re": 7.0 * r, "rmse_A": 0.1, "ratio": r, "ratio_cogging_floor": 0.8 * r,
+                              "process_rmse_A": 0.1,
                               "process_error_pct": process * r, "mean_force_error_pct": mean * r}
                        for name, r in ratios.items()}}
 
@@ -30,7 +31,8 @@ def test_summary_takes_median_and_90th_percentile_per_model_and_law_and_judges_t
     assert summary["laws"]["dahl"]["gmssvr"]["median"] == pytest.approx(np.median(gmssvr[1::2]))
     assert summary["models"]["gms"]["mean_force_error_pct"]["median"] == pytest.approx(np.median(4 * np.array(gmssvr)))
     text = robustness_markdown({"family_seed": 1, "first": 0, "members": 10, "workers": 2}, summary, 60.0)
-    assert "| GMS+SVR | 1.45 | 1.92 |" in text and "not met" in text
+    assert summary["models"]["gmssvr"]["ratio_cogging_floor"]["median"] == pytest.approx(0.8 * np.median(gmssvr))
+    assert "| GMS+SVR | 1.45 | 1.92 | 1.16 | 1.54 |" in text and "not met" in text
 
 
 def test_a_member_runs_every_model_and_no_model_beats_the_noise():
@@ -39,6 +41,7 @@ def test_a_member_runs_every_model_and_no_model_beats_the_noise():
     assert set(row["models"]) == {"coulomb", "stribeck", "lugre", "gms", "svr", "gmssvr"}
     for name, cell in row["models"].items():
         assert cell["ratio"] > 0.97, name
+        assert cell["ratio_cogging_floor"] < cell["ratio"] or row["cogging_A"] == 0.0, name
         assert cell["process_error_pct"] > 0.95 * row["process_floor_pct"], name
     assert row["models"]["gms"]["ratio"] < row["models"]["coulomb"]["ratio"]
 
@@ -52,3 +55,24 @@ def test_priors_keep_the_default_when_it_is_within_one_per_cent_of_the_best():
     assert close["best"] == others[0] and close["chosen"] == priors.DEFAULT
     far = priors._choice(summary({priors.DEFAULT: 1.05, others[0]: 1.0}))
     assert far["chosen"] == others[0] and far["equivalent"] == [others[0]]
+
+
+def _square(job):
+    return {"index": job, "value": job * job}
+
+
+def test_members_run_in_order_and_the_json_holds_every_row(tmp_path):
+    import json
+
+    from greybox.studies.members import run_members
+
+    lines = []
+    path = tmp_path / "study.json"
+    summary, seconds = run_members(_square, [3, 1, 2], json_path=path, settings={"what": "squares"},
+                                   summarise=lambda rows: {"total": sum(r["value"] for r in rows)},
+                                   describe=lambda row: f"{row['index']} -> {row['value']}", workers=2,
+                                   progress=lines.append)
+    assert summary == {"total": 14} and seconds >= 0 and lines == ["3 -> 9", "1 -> 1", "2 -> 4"]
+    saved = json.loads(path.read_text())
+    assert saved["settings"] == {"what": "squares"} and [r["index"] for r in saved["members"]] == [3, 1, 2]
+    assert saved["summary"] == summary
