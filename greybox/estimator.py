@@ -27,6 +27,9 @@ from .metrics import rmse
 
 __all__ = ["CurrentModel", "check_runs"]
 
+#: Learned attributes that record the training region: name -> channel of the runs (range [mm] or [mm/s]).
+_REGION_CHANNELS = {"position_range_mm_": "position", "velocity_range_mm_s_": "velocity"}
+
 
 def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
     """Return ``logs`` as a list of prepared runs, or raise :class:`LogError`.
@@ -324,6 +327,41 @@ class CurrentModel(ModelProtocol):
         self.effort_unit_ = runs[0].effort_unit
         self.sample_time_ = float(np.median([run.sample_time for run in runs]))
         self.n_samples_fit_ = int(sum(len(run) for run in runs))
+        for name, channel in _REGION_CHANNELS.items():
+            values = np.concatenate([getattr(run, channel) for run in runs])
+            setattr(self, name, [float(np.min(values)), float(np.max(values))])
+
+    def _widen_region(self, other: "CurrentModel") -> None:
+        """Widen the training region to cover the one of ``other`` (a fitted stage this model contains)."""
+        for name in _REGION_CHANNELS:
+            theirs = getattr(other, name, None)  # None: a stage loaded from a file that predates the record
+            if theirs is not None:
+                ours = getattr(self, name)
+                setattr(self, name, [min(ours[0], theirs[0]), max(ours[1], theirs[1])])
+
+    def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
+        """Samples of one prepared run outside the region the training runs covered.
+
+        Parameters
+        ----------
+        log : AxisLog
+            One prepared run.
+
+        Returns
+        -------
+        dict of str to ndarray of bool
+            ``{"position": ..., "velocity": ...}``: True where the position [mm] or the velocity [mm/s]
+            lies outside the range of the training runs (kernel models add ``"inputs"``, their input
+            space). Empty for a model loaded from a file that predates the record of the ranges.
+        """
+        check_is_fitted(self)
+        out = {}
+        for name, channel in _REGION_CHANNELS.items():
+            bounds = getattr(self, name, None)
+            if bounds is not None:
+                values = getattr(log, channel)
+                out[channel] = (values < bounds[0]) | (values > bounds[1])
+        return out
 
     def _check_predict_runs(self, logs) -> list[AxisLog]:
         check_is_fitted(self)

@@ -28,7 +28,7 @@ from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
 PROCESS_COLUMNS = ["time_s", "current_measured_A", "current_model_A", "current_process_A", "position_mm",
-                   "velocity_mm_s"]
+                   "velocity_mm_s", "outside_training"]
 
 
 @pytest.fixture(scope="module")

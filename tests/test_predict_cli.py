@@ -18,7 +18,8 @@ from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
-FORCE_PER_AMP = 1.35 * 2 * math.pi * 0.9 / 0.010  # examples/axis_x.toml [N/A]
+FORCE_PER_AMP = 1.35 * 2 * math.pi * 0.9 / 0.010  # examples/axis_x.toml, driving [N/A]
+FORCE_PER_AMP_BACKDRIVEN = 1.35 * 2 * math.pi / 0.85 / 0.010  # the same file, back-driven [N/A]
 
 
 @pytest.fixture(autouse=True)
@@ -83,7 +84,7 @@ def test_outputs_hold_measured_model_process_and_force(files, tmp_path, capsys, 
     status, stdout, stderr = _predict(capsys, files["model_path"], files["log_path"], "--out", out,
                                       "--axis-config", EXAMPLE, "--chunk-s", "1.3")
     assert status == 0, stderr
-    assert f"wrote {out}" in stdout and "763.407 N/A" in stdout
+    assert f"wrote {out}" in stdout and "763.407 N/A driving, 997.918 N/A back-driven" in stdout
     assert f"{_n_chunks(files, 1.3)} chunk(s) of 1.3 s" in stdout
     table = _read_table(out)
     for name in ("time_s", "current_measured_A", "current_model_A", "current_process_A", "force_process_N"):
@@ -96,7 +97,9 @@ def test_outputs_hold_measured_model_process_and_force(files, tmp_path, capsys, 
     np.testing.assert_array_equal(table["current_measured_A"], log.current)
     np.testing.assert_allclose(table["current_model_A"], model_current, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(table["current_process_A"], table["current_measured_A"] - table["current_model_A"])
-    np.testing.assert_allclose(table["force_process_N"], FORCE_PER_AMP * table["current_process_A"], rtol=1e-12)
+    back = table["current_process_A"] * table["velocity_mm_s"] < 0
+    factor = np.where(back, FORCE_PER_AMP_BACKDRIVEN, FORCE_PER_AMP)
+    np.testing.assert_allclose(table["force_process_N"], factor * table["current_process_A"], rtol=1e-12)
 
 
 def test_mcap_output_is_one_topic_with_one_message_per_sample(files, tmp_path, capsys):
@@ -113,7 +116,7 @@ def test_mcap_output_is_one_topic_with_one_message_per_sample(files, tmp_path, c
     assert schema.name == "greybox.ProcessSample" and schema.encoding == "jsonschema"
     first = json.loads(messages[1][2].data)
     assert set(first) == {"current_measured_A", "current_model_A", "current_process_A", "position_mm",
-                          "velocity_mm_s"}
+                          "velocity_mm_s", "outside_training"}
     assert len(messages) == len(_expected(files)[0])
 
 

@@ -11,7 +11,7 @@ import pytest
 from greybox.data.axis_config import AxisConfig, parse_axis_config, read_axis_config
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.evaluate.process import force_constant_N_per_A, predict_process, process_force
+from greybox.evaluate.process import predict_process
 from greybox.friction import CoulombModel
 from greybox.twin import make_dataset
 
@@ -33,37 +33,69 @@ def _write(tmp_path, text: str, name: str = "axis.toml") -> Path:
 
 
 def test_force_constant_against_a_hand_calculation(tmp_path):
-    # 2 Nm/A * 3 motor rev per screw rev * 2 pi * 0.8 / 0.005 m = 6031.857894892403 N/A
+    # 2 Nm/A * 3 motor rev per screw rev * 2 pi * 0.8 / 0.005 m = 6031.857894892403 N/A driving,
+    # 2 * 3 * 2 pi / (0.8 * 0.005 m) = 9424.777960769379 N/A back-driven
     config = read_axis_config(_write(tmp_path, VALID))
-    assert force_constant_N_per_A(config) == pytest.approx(6031.857894892403, rel=1e-12)
-    np.testing.assert_allclose(process_force([0.5, -1.0, 0.0], config), [3015.9289474462, -6031.857894892403, 0.0])
+    assert config.force_constants_N_per_A == pytest.approx((6031.857894892403, 9424.777960769379), rel=1e-12)
+    np.testing.assert_allclose(config.process_force_N([0.5, -1.0, 0.0], 1.0),
+                               [3015.9289474462, -9424.777960769379, 0.0])
+    np.testing.assert_allclose(config.process_force_N([0.5, -1.0], -1.0), [4712.38898038469, -6031.857894892403])
 
 
-def test_force_from_the_power_balance():
-    """F v = eta T omega with v = omega h / (2 pi i): the power reaching the table, one operating point."""
-    config = AxisConfig(torque_constant_Nm_per_A=0.7, screw_lead_mm=16.0, gear_ratio=2.5, efficiency=0.85)
-    current_A, omega = 3.0, 150.0  # A, rad/s of the motor
+@pytest.mark.parametrize("current_A, omega", [(3.0, 150.0), (-3.0, -150.0), (3.0, -150.0), (-3.0, 150.0)])
+def test_force_from_the_power_balance_in_either_direction_of_power_flow(current_A, omega):
+    """Driving: F v = eta_d T omega; back-driven (I and v of opposite signs): T omega = eta_b F v."""
+    config = AxisConfig(torque_constant_Nm_per_A=0.7, screw_lead_mm=16.0, gear_ratio=2.5,
+                        efficiency_driving=0.85, efficiency_backdriven=0.7)
     table_speed_m_s = omega / (2 * math.pi) / config.gear_ratio * config.screw_lead_mm / 1000.0
-    power_to_table_W = config.efficiency * config.torque_constant_Nm_per_A * current_A * omega
-    assert process_force(current_A, config) == pytest.approx(power_to_table_W / table_speed_m_s, rel=1e-12)
+    motor_power_W = config.torque_constant_Nm_per_A * current_A * omega
+    if motor_power_W > 0:
+        table_power_W = config.efficiency_driving * motor_power_W
+    else:
+        table_power_W = motor_power_W / config.efficiency_backdriven
+    force = config.process_force_N(current_A, table_speed_m_s * 1000.0)
+    assert force == pytest.approx(table_power_W / table_speed_m_s, rel=1e-12)
+
+
+def test_back_driven_current_is_divided_by_the_efficiency_and_rest_counts_as_driving():
+    """With one efficiency eta a back-driven force read as driving would come out eta^2 too small."""
+    config = AxisConfig(torque_constant_Nm_per_A=1.0, screw_lead_mm=10.0, gear_ratio=1.0, efficiency_driving=0.85)
+    lossless = config.lossless_force_constant_N_per_A
+    assert config.process_force_N(-1.0, 5.0) == pytest.approx(-lossless / 0.85)
+    assert config.process_force_N(1.0, -5.0) == pytest.approx(lossless / 0.85)
+    assert config.process_force_N(1.0, 5.0) == pytest.approx(lossless * 0.85)
+    assert config.process_force_N(1.0, 0.0) == pytest.approx(lossless * 0.85)
 
 
 def test_force_scales_as_expected():
-    base = AxisConfig(torque_constant_Nm_per_A=1.0, screw_lead_mm=10.0, gear_ratio=1.0, efficiency=1.0)
-    k = force_constant_N_per_A(base)
+    base = AxisConfig(torque_constant_Nm_per_A=1.0, screw_lead_mm=10.0, gear_ratio=1.0, efficiency_driving=1.0)
+    k = base.lossless_force_constant_N_per_A
     assert k == pytest.approx(2 * math.pi * 100.0)  # 1 Nm per A over a 10 mm lead: 628.3 N/A
-    for change, factor in (({"screw_lead_mm": 20.0}, 0.5), ({"gear_ratio": 4.0}, 4.0), ({"efficiency": 0.5}, 0.5),
-                           ({"torque_constant_Nm_per_A": 3.0}, 3.0)):
+    assert base.force_constants_N_per_A == (k, k)
+    for change, factors in (({"screw_lead_mm": 20.0}, (0.5, 0.5)), ({"gear_ratio": 4.0}, (4.0, 4.0)),
+                            ({"efficiency_driving": 0.5}, (0.5, 2.0)),
+                            ({"efficiency_driving": 0.9, "efficiency_backdriven": 0.8}, (0.9, 1.25)),
+                            ({"torque_constant_Nm_per_A": 3.0}, (3.0, 3.0))):
         other = AxisConfig(**{**{"torque_constant_Nm_per_A": 1.0, "screw_lead_mm": 10.0, "gear_ratio": 1.0,
-                                 "efficiency": 1.0}, **change})
-        assert force_constant_N_per_A(other) == pytest.approx(factor * k)
+                                 "efficiency_driving": 1.0}, **change})
+        assert other.force_constants_N_per_A == pytest.approx((factors[0] * k, factors[1] * k))
 
 
 def test_example_file_parses_and_gives_the_documented_factor():
     config = read_axis_config(EXAMPLE)
     assert config.name == "X" and config.channels == {}
-    assert force_constant_N_per_A(config) == pytest.approx(1.35 * 2 * math.pi * 0.9 / 0.010)
-    assert f"{force_constant_N_per_A(config):.1f}" == "763.4"
+    driving, backdriven = config.force_constants_N_per_A
+    assert driving == pytest.approx(1.35 * 2 * math.pi * 0.9 / 0.010)
+    assert backdriven == pytest.approx(1.35 * 2 * math.pi / 0.85 / 0.010)
+    assert f"{driving:.1f} {backdriven:.1f}" == "763.4 997.9"  # the figures the example file's comment states
+
+
+def test_old_files_with_one_efficiency_still_load_and_mean_it_for_both_directions(tmp_path):
+    config = read_axis_config(_write(tmp_path, VALID))
+    assert config.efficiency_driving == config.efficiency_backdriven == 0.8
+    both = VALID.replace("efficiency = 0.8", "efficiency_driving = 0.8\nefficiency_backdriven = 0.6")
+    config = read_axis_config(_write(tmp_path, both, "both.toml"))
+    assert (config.efficiency_driving, config.efficiency_backdriven) == (0.8, 0.6)
 
 
 def test_channels_table(tmp_path):
@@ -82,6 +114,10 @@ def test_channels_table(tmp_path):
     (VALID.replace("screw_lead_mm = 5.0", 'screw_lead_mm = "5 mm"'), "must be a number .* got the text '5 mm'"),
     (VALID.replace("efficiency = 0.8", "efficiency = 90"), "90 looks like a percentage, write 0.9"),
     (VALID.replace("efficiency = 0.8", "efficiency = 0"), "efficiency must be a positive number"),
+    (VALID + "efficiency_backdriven = 0.7\n", "give either 'efficiency' .* not 'efficiency' and efficiency_backdriven"),
+    (VALID.replace("efficiency = 0.8", "efficiency_driving = 0.8"), "missing efficiency_backdriven"),
+    (VALID.replace("efficiency = 0.8", "efficiency_driving = 0.8\nefficiency_backdriven = 85"),
+     "efficiency_backdriven must be a fraction .* 85 looks like a percentage, write 0.85"),
     (VALID.replace("screw_lead_mm = 5.0", "screw_lead_mm = 0.005"), "was it written in metres"),
     (VALID.replace("gear_ratio = 3.0", "gear_ratio = -3.0"), "gear_ratio must be a positive number"),
     (VALID.replace("gear_ratio = 3.0", "gear_ratio = true"), "gear_ratio must be a number"),
@@ -111,9 +147,9 @@ def test_missing_and_binary_files(tmp_path):
 
 def test_parse_without_a_file_and_invalid_dataclass():
     config = parse_axis_config({"torque_constant_Nm_per_A": 1, "screw_lead_mm": 10, "gear_ratio": 1, "efficiency": 1})
-    assert config.efficiency == 1.0 and isinstance(config.gear_ratio, float)
-    with pytest.raises(GreyboxError, match="efficiency must be a fraction"):
-        AxisConfig(torque_constant_Nm_per_A=1.0, screw_lead_mm=10.0, gear_ratio=1.0, efficiency=1.5)
+    assert config.efficiency_driving == config.efficiency_backdriven == 1.0 and isinstance(config.gear_ratio, float)
+    with pytest.raises(GreyboxError, match="efficiency_driving must be a fraction"):
+        AxisConfig(torque_constant_Nm_per_A=1.0, screw_lead_mm=10.0, gear_ratio=1.0, efficiency_driving=1.5)
 
 
 def test_process_force_of_a_cutting_log_is_the_scaled_process_current():
@@ -124,8 +160,11 @@ def test_process_force_of_a_cutting_log_is_the_scaled_process_current():
     config = read_axis_config(EXAMPLE)
     result = predict_process(model, cut, axis_config=config, chunk_s=1.0)
     np.testing.assert_array_equal(result.process, cut.current - model.predict(cut))
-    np.testing.assert_allclose(result.force, force_constant_N_per_A(config) * result.process, rtol=1e-15)
-    assert result.force_constant_N_per_A == pytest.approx(763.4070148223198)
+    driving, backdriven = config.force_constants_N_per_A
+    back = result.process * cut.velocity < 0
+    assert back.any() and (~back).any()
+    np.testing.assert_allclose(result.force, np.where(back, backdriven, driving) * result.process, rtol=1e-15)
+    assert result.force_constants_N_per_A == pytest.approx((763.4070148223198, 997.9176664344051))
     columns = result.columns()
     assert list(columns)[:5] == ["time_s", "current_measured_A", "current_model_A", "current_process_A",
                                  "force_process_N"]
@@ -143,3 +182,11 @@ def test_force_logs_need_no_axis_metadata():
     np.testing.assert_array_equal(result.force, result.process)
     with pytest.raises(GreyboxError, match="carries force in N already"):
         predict_process(model, cut, axis_config=read_axis_config(EXAMPLE))
+
+
+def test_an_axis_file_written_by_to_toml_reads_back_equal(tmp_path):
+    config = AxisConfig(torque_constant_Nm_per_A=1.35, screw_lead_mm=16.0, gear_ratio=1.5, efficiency_driving=0.93,
+                        efficiency_backdriven=1 - 0.0712345678901, name='Z "rear"', channels={"current_A": "I Z"})
+    again = read_axis_config(_write(tmp_path, config.to_toml()))
+    assert again.to_dict() == config.to_dict()
+    assert again.force_constants_N_per_A == config.force_constants_N_per_A

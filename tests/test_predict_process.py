@@ -42,7 +42,8 @@ def test_thinned_picture_keeps_single_sample_peaks():
     measured = np.zeros(n)
     measured[4321] = 5.0
     result = ProcessResult(time=time, position=np.zeros(n), velocity=np.zeros(n), measured=measured,
-                           model=np.zeros(n), force=763.4 * measured, force_constant_N_per_A=763.4)
+                           model=np.zeros(n), force=763.4 * measured,
+                           force_constants_N_per_A=(763.4, 763.4))
     assert envelope_indices(n, 20_000).size == n
     figure = plot_process(result, max_points=500)
     process_axes = figure.axes[2]

@@ -165,7 +165,7 @@ def test_member_log_components_add_up_and_carry_the_member():
     e = log.extras
     np.testing.assert_allclose(e["truth_current_A"],
                                e["truth_friction_A"] + e["truth_inertia_A"] + e["truth_cogging_A"], atol=1e-12)
-    assert log.attrs["family_member"] == {"index": 3, "family_seed": 0, "law": "backlash_screw"}
+    assert log.attrs["family_member"] == {"index": 3, "family_seed": 0, "law": "backlash_screw", "repeat": 0}
     assert log.attrs["plant"]["law"]["law"] == "backlash_screw"
     step = member.sensors.position_resolution_mm
     assert np.allclose(np.round(log.position / step) * step, log.position, atol=1e-9)

@@ -77,7 +77,7 @@ def test_synth_errors_are_one_line_messages(tmp_path, capsys, args, message):
 def test_synthesize_keeps_only_the_requested_truth_channels(tmp_path):
     paths = synthesize("X", 5, tmp_path, ["D"], truth_channels=ESSENTIAL_TRUTH_CHANNELS, cutting=True)
     log = read_log(paths[0])
-    assert set(log.extras) == {"truth_current_A", "truth_process_A"}
+    assert set(log.extras) == {"truth_current_A", "truth_process_A", "truth_process_force_N"}
     with pytest.raises(GreyboxError, match="unknown truth channel"):
         synthesize("X", 5, tmp_path / "b", ["D"], truth_channels=["truth_speed_A"])
     assert not (tmp_path / "b").exists()
@@ -96,4 +96,4 @@ def test_synth_family_writes_each_member_with_its_own_law_and_a_catalogue(tmp_pa
         assert log.attrs["family_member"]["law"] == member.law
         expected = member_dataset(member, "C", duration_s=4.0, cutting=True)
         np.testing.assert_array_equal(log.current, expected.current)
-        assert set(log.extras) == {"truth_current_A", "truth_process_A"}
+        assert set(log.extras) == {"truth_current_A", "truth_process_A", "truth_process_force_N"}

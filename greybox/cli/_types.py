@@ -135,6 +135,8 @@ POSITIVE = NumberRange(float, low=0, low_open=True)
 NON_NEGATIVE = NumberRange(float, low=0)
 #: A number in (0, 1), both bounds excluded.
 FRACTION = NumberRange(float, low=0, high=1, low_open=True, high_open=True, description="a fraction in (0, 1)")
+#: A number in [-1, 1], both bounds included (a relative force of either sign).
+SIGNED_FRACTION = NumberRange(float, low=-1, high=1, description="a number in [-1, 1]")
 #: An integer >= 1.
 POSITIVE_INT = NumberRange(int, low=1)
 #: An integer >= 0.

@@ -11,8 +11,11 @@ import numpy as np
 
 from ..errors import GreyboxError
 from ._options import add_log_arguments
-from ._types import non_negative, positive
+from ._types import FRACTION, non_negative, positive
 from ._window import add_window_argument, check_window
+
+#: Nominal coverage of the bounds when --calibration is given without --interval.
+DEFAULT_COVERAGE = 0.95
 
 #: Output extensions accepted for the table and for the picture.
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
@@ -35,8 +38,16 @@ def add_parser(subparsers) -> None:
                         help="table to write: .csv, .parquet or .mcap (CSV: plain, header first, metadata in "
                         "OUT.json beside it; MCAP: one message per sample, topic /process/<axis>)")
     parser.add_argument("--axis-config", metavar="TOML",
-                        help="axis metadata (torque constant, screw lead, gear ratio, efficiency, channel "
-                        "names); adds force_process_N (see examples/axis_x.toml)")
+                        help="axis metadata (torque constant, screw lead, gear ratio, efficiency driving and "
+                        "back-driven, channel names); adds force_process_N, converted by the direction of the "
+                        "power flow (see examples/axis_x.toml)")
+    parser.add_argument("--calibration", nargs="+", metavar="AIRCUT",
+                        help="air-cut logs the model was NOT trained on: its residuals there calibrate lower and "
+                        "upper bounds of the process current (and force), split-conformal per regime (reversal, "
+                        "acceleration, constant feed, other)")
+    parser.add_argument("--interval", type=FRACTION, metavar="C",
+                        help=f"nominal coverage of the bounds, a fraction in (0, 1) (default {DEFAULT_COVERAGE:g}; "
+                        "needs --calibration)")
     parser.add_argument("--plot", metavar="PNG", help="also draw measured, model and process current (and force)")
     parser.add_argument("--plot-mean-s", type=non_negative("seconds"), default=0.1, metavar="S",
                         help="window of the moving mean drawn over the process current, in seconds (default "
@@ -50,15 +61,15 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(run=run)
 
 
-def _read_log(args: argparse.Namespace, channels: dict):
-    """Read and prepare the log; column mapping from the axis metadata, overridden by --columns."""
+def _read_log(args: argparse.Namespace, channels: dict, path=None):
+    """Read and prepare a log (the cutting log by default); column mapping from the axis metadata, then --columns."""
     from ..data.io import parse_column_mapping, read_log
     from ..data.prepare import prepare
 
     columns = dict(channels)
     if args.columns:
         columns.update(parse_column_mapping(args.columns))
-    log = read_log(args.log, columns=columns or None, topic=args.topic, sample_time=args.sample_time,
+    log = read_log(path or args.log, columns=columns or None, topic=args.topic, sample_time=args.sample_time,
                    time_tolerance=args.time_tolerance)
     (prepared,) = prepare([log], cutoff_hz=args.cutoff_hz, sample_time=args.resample)
     return prepared
@@ -98,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
     from ..models.chunked import chunk_slices, samples_per_chunk
     from ..persistence import load_model
 
-    inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else [])
+    inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else []) + list(args.calibration or [])
     out = Path(args.out)
     for target in output_paths(out):  # the table, and for CSV its metadata sidecar
         check_output_path(target, overwrite=args.force, protect=inputs)
@@ -111,13 +122,23 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(plot, overwrite=args.force, protect=inputs)
     elif args.plot_window is not None:
         raise GreyboxError("--plot-window needs --plot PNG")
+    if args.calibration is None and args.interval is not None:
+        raise GreyboxError("--interval needs --calibration AIRCUT... (air-cut logs the model was not trained on)")
     config = read_axis_config(args.axis_config) if args.axis_config else None
     model = load_model(args.model)
     log = _read_log(args, config.channels if config else {})
     window = check_window(args.plot_window, log.time, "--plot-window", Path(args.log).name)
+    interval = None
+    if args.calibration:
+        from ..evaluate.interval import calibrate_interval
+
+        interval = calibrate_interval(model, [_read_log(args, config.channels if config else {}, path)
+                                              for path in args.calibration],
+                                      coverage=DEFAULT_COVERAGE if args.interval is None else args.interval,
+                                      chunk_s=args.chunk_s)
 
     started = time.perf_counter()
-    result = predict_process(model, log, axis_config=config, chunk_s=args.chunk_s,
+    result = predict_process(model, log, axis_config=config, interval=interval, chunk_s=args.chunk_s,
                              progress=_progress(float(log.time[-1]), args.quiet))
     elapsed = time.perf_counter() - started
     result.attrs.update({"model_file": str(args.model), "log_file": str(args.log)})
@@ -131,9 +152,18 @@ def run(args: argparse.Namespace) -> int:
     print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} {unit}, "
           f"process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")
     if unit == "A" and result.force is not None:
+        driving, backdriven = result.force_constants_N_per_A
+        factors = (f"{driving:.6g} N/A" if driving == backdriven
+                   else f"{driving:.6g} N/A driving, {backdriven:.6g} N/A back-driven")
         print(f"  force    rms process {_rms(result.force):.4g} N, "
               f"largest |process| {np.max(np.abs(result.force)):.4g} N "
-              f"({result.force_constant_N_per_A:.6g} N/A from {Path(args.axis_config).name})")
+              f"({factors} from {Path(args.axis_config).name})")
+    _report_extrapolation(result.attrs["extrapolation"], Path(args.log).name)
+    if interval is not None:
+        widths = ", ".join(f"{name.replace('_', ' ')} {value:.3g}" for name, value in interval.half_width_A.items())
+        print(f"  interval {100 * interval.coverage:g} % (split conformal per regime on "
+              f"{sum(interval.samples.values())} air-cut samples of {len(args.calibration)} log(s)): "
+              f"half-width [{unit}] {widths}; mean {np.mean(result.half_width):.3g} {unit}")
     write_process(result, out, overwrite=args.force, protect=inputs)
     for target in output_paths(out):
         print(f"wrote {target}")
@@ -144,6 +174,20 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {args.plot}")
     print(f"done in {time.perf_counter() - run_started:.2f} s wall (model {elapsed:.2f} s)")
     return 0
+
+
+def _report_extrapolation(summary: dict, log_name: str) -> None:
+    """One line on the share of samples outside the training region; a note on stderr above the limit."""
+    if summary["share"] is None:
+        print(f"  outside the training region: not known ({summary['reason']})")
+        return
+    parts = ", ".join(f"{name} {100 * share:.1f} %" for name, share in summary["by"].items())
+    print(f"  outside the training region: {100 * summary['share']:.1f} % of the samples ({parts})")
+    if summary["share"] > summary["warn_above"]:
+        print(f"note: {log_name}: {100 * summary['share']:.1f} % of the samples lie outside the positions, speeds "
+              f"or inputs the model was trained on (more than {100 * summary['warn_above']:g} %): the model "
+              "extrapolates there (column outside_training); train on air cuts that cover the cutting programme",
+              file=sys.stderr)
 
 
 def _rms(values: np.ndarray) -> float:

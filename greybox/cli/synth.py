@@ -14,7 +14,7 @@ from ..twin.family import synthesize_family
 from ..twin.laws import TRUTH_LAWS
 from ..twin.noise import CurrentNoise
 from ..twin.trajectories import DATASETS, DEFAULT_DATASETS, MIN_DURATION_S
-from ._types import FINITE, MAX_SEED, NON_NEGATIVE, POSITIVE, POSITIVE_INT, SEED, positive
+from ._types import FINITE, MAX_SEED, NON_NEGATIVE, POSITIVE, POSITIVE_INT, SEED, SIGNED_FRACTION, positive
 
 
 def add_parser(subparsers) -> None:
@@ -48,9 +48,15 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--effect-param", action="append", default=[], metavar="KEY=VALUE",
                         help="further effect parameter, e.g. period_mm=5 (repeatable)")
     parser.add_argument("--cutting", action="store_true",
-                        help="inject a milling-like cutting load, kept as truth_process_A")
+                        help="inject a milling-like cutting load, kept as truth_process_A and as the force on the "
+                        "table truth_process_force_N (with --family, each member's axis file is written beside "
+                        "its logs as axis.toml)")
     parser.add_argument("--cutting-strength", type=NON_NEGATIVE, default=CuttingSpec.strength_A, metavar="A",
                         help="mean process current [A] at 1000 mm/min feed (default %(default)s)")
+    parser.add_argument("--cutting-return-pass", type=SIGNED_FRACTION, default=CuttingSpec.return_pass, metavar="R",
+                        help="process force on the return stroke relative to the cutting stroke's, in [-1, 1]: 0 an "
+                        "air cut (default), > 0 opposing the motion too, < 0 pushing the table along it (climb "
+                        "milling; the screw is back-driven)")
     parser.add_argument("--spindle-rpm", type=POSITIVE, default=CuttingSpec.spindle_rpm, metavar="RPM",
                         help="spindle speed [1/min] of the tooth-passing ripple (default %(default)s)")
     parser.add_argument("--teeth", type=POSITIVE_INT, default=CuttingSpec.teeth, metavar="Z",
@@ -193,7 +199,8 @@ def run(args: argparse.Namespace) -> int:
     datasets = list(dict.fromkeys(d.strip().upper() for d in args.datasets if d.strip()))
     cutting = None
     if args.cutting:
-        cutting = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm, teeth=args.teeth)
+        cutting = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm, teeth=args.teeth,
+                              return_pass=args.cutting_return_pass)
     if args.family is not None:
         if not datasets:
             raise GreyboxError("give at least one dataset (--datasets)")

@@ -6,7 +6,8 @@ One small TOML file per axis (see ``examples/axis_x.toml``)::
     torque_constant_Nm_per_A = 1.35   # motor torque constant k_t [Nm/A]
     screw_lead_mm = 10.0              # table travel per screw revolution h [mm]
     gear_ratio = 1.0                  # motor revolutions per screw revolution i [-]
-    efficiency = 0.9                  # efficiency of motor shaft -> table, 0 < eta <= 1 [-]
+    efficiency_driving = 0.92         # motor drives the table against the load, 0 < eta <= 1 [-]
+    efficiency_backdriven = 0.88      # the load drives the table along, the motor brakes [-]
 
     [channels]                        # optional: columns of the log if not named by convention
     position_mm = "X1_ActualPosition"
@@ -15,7 +16,8 @@ One small TOML file per axis (see ``examples/axis_x.toml``)::
 Every quantity carries its unit in its key; only these units are accepted, and
 a key naming another unit (``screw_lead_m``, ``torque_constant_mNm_per_A``) is
 an error asking for the conversion rather than a silent factor of 1000. The
-``[channels]`` table is the column mapping of ``greybox.data.io.read_log``
+``efficiency = 0.9`` alone (the form of older files) gives both directions the
+same efficiency. The ``[channels]`` table is the column mapping of ``greybox.data.io.read_log``
 (``{canonical_name: name_in_file}``; the canonical name may carry any supported
 unit, e.g. ``position_um``).
 
@@ -24,11 +26,14 @@ The force these constants give is derived in :mod:`greybox.evaluate.process`.
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import tomllib
 from dataclasses import dataclass, field
 from typing import Mapping
+
+import numpy as np
 
 from ..errors import GreyboxError
 from .units import CANONICAL_NAMES, UNIT_FACTORS, parse_column_name
@@ -41,12 +46,19 @@ QUANTITIES = {
     "screw_lead_mm": ("screw lead h", "mm", "table travel per screw revolution"),
     "gear_ratio": ("gear ratio i", "motor revolutions per screw revolution",
                    "1.0 for a motor coupled directly to the screw"),
-    "efficiency": ("efficiency eta", "fraction, 0 < eta <= 1", "about 0.9 for a ball screw"),
+    "efficiency_driving": ("efficiency eta_d while the motor drives the table against the load",
+                           "fraction, 0 < eta <= 1", "about 0.9 for a ball screw"),
+    "efficiency_backdriven": ("efficiency eta_b while the load drives the table and the motor brakes",
+                              "fraction, 0 < eta <= 1", "about 0.85 for a ball screw, below eta_d"),
 }
+
+#: One efficiency for both directions (older axis files): stands for both keys above.
+SHARED_EFFICIENCY = "efficiency"
+_EFFICIENCIES = ("efficiency_driving", "efficiency_backdriven")
 
 #: Stems of the keys above: a key starting with one of these but naming another unit is a unit error.
 _STEMS = {"torque_constant": "torque_constant_Nm_per_A", "screw_lead": "screw_lead_mm", "lead": "screw_lead_mm",
-          "gear_ratio": "gear_ratio", "efficiency": "efficiency"}
+          "gear_ratio": "gear_ratio", "efficiency": "efficiency_driving"}
 
 #: Optional keys besides the quantities.
 _OPTIONAL = ("name",)
@@ -69,9 +81,14 @@ class AxisConfig:
     gear_ratio : float
         ``i`` = motor revolutions per screw revolution [-] (1 for a direct
         coupling, 2 for a belt that halves the speed).
-    efficiency : float
-        ``eta`` [-], 0 < eta <= 1: share of the motor's mechanical power that
-        reaches the table (gear and screw together).
+    efficiency_driving : float
+        ``eta_d`` [-], 0 < eta <= 1: share of the motor's mechanical power that
+        reaches the table (gear and screw together) while the motor drives the
+        table against the load (power flows from the motor to the table).
+    efficiency_backdriven : float, optional
+        ``eta_b`` [-], 0 < eta <= 1: share of the table's mechanical power that
+        reaches the motor while the load drives the table along its motion and
+        the motor brakes (a back-driven screw); default ``efficiency_driving``.
     name : str, default ""
         Axis name.
     channels : mapping of str to str, optional
@@ -83,35 +100,97 @@ class AxisConfig:
     torque_constant_Nm_per_A: float
     screw_lead_mm: float
     gear_ratio: float
-    efficiency: float
+    efficiency_driving: float
+    efficiency_backdriven: float | None = None
     name: str = ""
     channels: Mapping[str, str] = field(default_factory=dict)
     source: str = ""
 
     def __post_init__(self):
+        if self.efficiency_backdriven is None:
+            object.__setattr__(self, "efficiency_backdriven", self.efficiency_driving)
         values = {key: getattr(self, key) for key in QUANTITIES}
         _check_values(values, self.source or "<axis config>")
         object.__setattr__(self, "channels", dict(self.channels))
+
+    @property
+    def lossless_force_constant_N_per_A(self) -> float:
+        """Force on the table per ampere through a lossless drive train, ``K_0 = k_t i 2 pi / h`` [N/A] (h in m)."""
+        return self.torque_constant_Nm_per_A * self.gear_ratio * 2.0 * math.pi / (self.screw_lead_mm * 1e-3)
+
+    @property
+    def force_constants_N_per_A(self) -> tuple[float, float]:
+        """Force on the table per ampere, driving (``eta_d K_0``) and back-driven (``K_0 / eta_b``) [N/A].
+
+        Driving: the motor pushes the table against the load and the share
+        ``eta_d`` of its power reaches the table. Back-driven: the load pushes
+        the table along and the share ``eta_b`` of the table's power reaches
+        the motor (:mod:`greybox.evaluate.process` derives both).
+        """
+        lossless = self.lossless_force_constant_N_per_A
+        return lossless * self.efficiency_driving, lossless / self.efficiency_backdriven
+
+    def process_force_N(self, process_current_A, velocity_mm_s):
+        """Force [N] the drive exerts on the table for a process current [A], by the direction of power flow.
+
+        Parameters
+        ----------
+        process_current_A : array_like
+            Process share of the motor current [A].
+        velocity_mm_s : array_like
+            Axis velocity [mm/s], broadcast against the current; its sign
+            against the current's tells driving (``I v >= 0``; at rest no power
+            flows and the driving constant is used) from back-driven (``I v < 0``).
+
+        Returns
+        -------
+        ndarray
+            ``eta_d K_0 I`` where driving, ``K_0 I / eta_b`` where back-driven [N].
+        """
+        current = np.asarray(process_current_A, dtype=float)
+        velocity = np.asarray(velocity_mm_s, dtype=float)
+        driving, backdriven = self.force_constants_N_per_A
+        return np.where(current * velocity < 0.0, backdriven * current, driving * current)
+
+    def to_dict(self) -> dict:
+        """The constants (and name and channels) as a JSON-able dict, the keys of an axis file."""
+        return {"name": self.name, **{key: float(getattr(self, key)) for key in QUANTITIES},
+                "channels": dict(self.channels)}
+
+    def to_toml(self) -> str:
+        """The axis file's text (TOML), which :func:`read_axis_config` reads back to an equal configuration."""
+        lines = [f"name = {json.dumps(self.name)}"] if self.name else []
+        lines += [f"{key} = {float(getattr(self, key))!r}  # {QUANTITIES[key][0]} [{QUANTITIES[key][1]}]"
+                  for key in QUANTITIES]
+        if self.channels:
+            lines += ["", "[channels]"] + [f"{key} = {json.dumps(value)}" for key, value in self.channels.items()]
+        return "\n".join(lines) + "\n"
 
 
 def _fail(where: str, problem: str):
     raise GreyboxError(f"{where}: {problem}")
 
 
-def _check_values(values: Mapping[str, object], where: str) -> None:
-    """Raise unless every quantity is a finite number in its plausible range."""
+def _check_values(values: Mapping[str, object], where: str, names: Mapping[str, str] | None = None) -> None:
+    """Raise unless every quantity is a finite number in its plausible range.
+
+    ``names`` maps a quantity to the key the user wrote, if another (the shared ``efficiency``).
+    """
+    names = names or {}
     for key, value in values.items():
         words, unit, _ = QUANTITIES[key]
+        written = names.get(key, key)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             shown = f"the text {value!r}" if isinstance(value, str) else f"a {type(value).__name__}"
-            _fail(where, f"{key} must be a number ({words} in {unit}), got {shown}; write the number only, "
+            _fail(where, f"{written} must be a number ({words} in {unit}), got {shown}; write the number only, "
                          "the unit is in the key")
         if not math.isfinite(value) or value <= 0:
-            _fail(where, f"{key} must be a positive number ({words} in {unit}), got {value}")
-    efficiency = values["efficiency"]
-    if efficiency > 1.0:
-        hint = f"; {efficiency:g} looks like a percentage, write {efficiency / 100:g}" if efficiency <= 100 else ""
-        _fail(where, f"efficiency must be a fraction 0 < eta <= 1, got {efficiency:g}{hint}")
+            _fail(where, f"{written} must be a positive number ({words} in {unit}), got {value}")
+    for key in _EFFICIENCIES:
+        efficiency = values[key]
+        if efficiency > 1.0:
+            hint = f"; {efficiency:g} looks like a percentage, write {efficiency / 100:g}" if efficiency <= 100 else ""
+            _fail(where, f"{names.get(key, key)} must be a fraction 0 < eta <= 1, got {efficiency:g}{hint}")
     lead = values["screw_lead_mm"]
     if lead < MIN_LEAD_MM:
         _fail(where, f"screw_lead_mm = {lead:g} mm is implausibly small (below {MIN_LEAD_MM:g} mm); "
@@ -160,9 +239,16 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
     """
     where = source or "<axis config>"
     values: dict[str, object] = {}
+    shared = document.get(SHARED_EFFICIENCY)
+    given = [key for key in _EFFICIENCIES if key in document]
+    if shared is not None and given:
+        _fail(where, f"give either '{SHARED_EFFICIENCY}' (both directions) or {' and '.join(_EFFICIENCIES)}, "
+                     f"not '{SHARED_EFFICIENCY}' and {' and '.join(given)}")
     for key, value in document.items():
         if key in QUANTITIES:
             values[key] = value
+        elif key == SHARED_EFFICIENCY:
+            values.update({name: value for name in _EFFICIENCIES})
         elif key == "channels":
             continue
         elif key in _OPTIONAL:
@@ -175,14 +261,19 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
                 words, unit, _ = QUANTITIES[accepted]
                 problem = "no unit in the key" if key == stem else "unit not accepted"
                 _fail(where, f"'{key}': {problem}; give the {words} as '{accepted}' (in {unit})")
-            expected = ", ".join(list(QUANTITIES) + list(_OPTIONAL) + ["[channels]"])
+            expected = ", ".join(list(QUANTITIES) + [SHARED_EFFICIENCY] + list(_OPTIONAL) + ["[channels]"])
             _fail(where, f"unknown key '{key}'; expected {expected}")
     missing = [key for key in QUANTITIES if key not in values]
+    if any(key in missing for key in _EFFICIENCIES) and not given:
+        missing = [key for key in missing if key not in _EFFICIENCIES]
+        _fail(where, "missing efficiency (the share of the motor's power reaching the table, about 0.9 for a ball "
+                     "screw): give 'efficiency' for both directions, or efficiency_driving and efficiency_backdriven"
+                     + (f"; also missing {', '.join(missing)}" if missing else ""))
     if missing:
         lines = "; ".join(f"{key} ({QUANTITIES[key][0]} in {QUANTITIES[key][1]}: {QUANTITIES[key][2]})"
                           for key in missing)
         _fail(where, f"missing {lines}")
-    _check_values(values, where)
+    _check_values(values, where, {key: SHARED_EFFICIENCY for key in _EFFICIENCIES} if shared is not None else None)
     channels = _check_channels(document.get("channels", {}), where)
     return AxisConfig(**{key: float(values[key]) for key in QUANTITIES}, name=str(document.get("name", "")),
                       channels=channels, source=source)

@@ -51,6 +51,31 @@ def envelope_indices(n_samples: int, max_points: int) -> np.ndarray:
     return np.arange(0, n_samples, size)
 
 
+def band_envelope(time, lower, upper, max_points: int = ENVELOPE_POINTS
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A band thinned for drawing: per bin of samples (:func:`envelope_indices`) the lowest lower and highest upper.
+
+    Parameters
+    ----------
+    time : array_like
+        Time [s], increasing.
+    lower, upper : array_like
+        Bounds of the band, same length (any unit).
+    max_points : int, default :data:`ENVELOPE_POINTS`
+        Upper bound of points returned; bands this short are returned whole.
+
+    Returns
+    -------
+    (ndarray, ndarray, ndarray)
+        Times [s] (each bin's first), lower and upper bounds to fill between.
+    """
+    time, lower, upper = (np.asarray(a, dtype=float) for a in (time, lower, upper))
+    starts = envelope_indices(lower.size, max_points)
+    if starts.size == lower.size:
+        return time, lower, upper
+    return time[starts], np.minimum.reduceat(lower, starts), np.maximum.reduceat(upper, starts)
+
+
 def envelope(time, values, max_points: int = ENVELOPE_POINTS) -> tuple[np.ndarray, np.ndarray]:
     """Points that draw a signal as its envelope: per bin of samples its minimum and its maximum, in time order.
 

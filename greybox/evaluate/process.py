@@ -15,25 +15,35 @@ The motor turns the current into a torque ``T = k_t I`` [Nm]. A gear of ratio
 ``i`` (motor revolutions per screw revolution) and a screw of lead ``h`` [m]
 (table travel per screw revolution) move the table by ``h / i`` per motor
 revolution, so ``v = omega h / (2 pi i)`` for a motor speed ``omega`` [rad/s].
-Of the motor's mechanical power ``T omega`` the share ``eta`` reaches the
-table, ``F v = eta T omega``, hence
+A lossless drive train would pass ``F v = T omega``, that is
+``F = K_0 I`` with ``K_0 = k_t i 2 pi / h``. The screw, nut, bearings and
+gear lose a share of the power that grows with the load, and which way the
+power flows decides the conversion:
 
-    F = T * i * 2 pi * eta / h = k_t * I * i * 2 pi * eta / (h_mm / 1000)   [N].
+* driving (the drive pushes the table against the load, ``I v > 0``): of the
+  motor's power the share ``eta_d`` reaches the table, ``F v = eta_d T omega``,
 
-Example: ``k_t = 1.35 Nm/A``, ``h = 10 mm``, ``i = 1``, ``eta = 0.9`` give
-``0.9 * 1.35 * 2 pi / 0.010 m = 763.4 N/A``.
+      F = eta_d K_0 I;
 
-Conventions. ``eta`` covers the losses that grow with the load (screw, nut,
-support bearings, gear); the load-independent friction is already in the
-model and removed with it. ``eta`` is applied for power flowing from the motor
-to the table, which is the case while the drive feeds against a cutting
-force; a process that pushes the table along (climb milling pulling the
-table) would need ``1 / eta`` instead, a difference of ``eta^2``. The force
-has the sign of the current: the current models are fitted with a
+* back-driven (the load pushes the table along its motion and the motor
+  brakes, ``I v < 0``, e.g. climb milling pulling the table): of the table's
+  power the share ``eta_b`` reaches the motor, ``T omega = eta_b F v``,
+
+      F = K_0 I / eta_b.
+
+At rest (``v = 0``) no power flows and ``eta_d`` is used. With one efficiency
+for both directions the back-driven force comes out ``eta^2`` too small.
+
+Example: ``k_t = 1.35 Nm/A``, ``h = 10 mm``, ``i = 1``, ``eta_d = 0.9`` give
+``0.9 * 1.35 * 2 pi / 0.010 m = 763.4 N/A`` while driving.
+
+Conventions. The efficiencies cover the losses that grow with the load; the
+load-independent friction is already in the model and removed with it. The
+force has the sign of the current: the current models are fitted with a
 non-negative inertia ``J``, so a positive current accelerates the axis
 towards positive positions, and ``force_process_N > 0`` is a force the drive
-exerts on the table towards positive positions. The cutting force along the
-axis is its opposite.
+exerts on the table towards positive positions. The process force on the
+table (e.g. the cutting force along the axis) is its opposite.
 """
 
 from __future__ import annotations
@@ -48,44 +58,9 @@ from ..data.log import AxisLog, as_log_list
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, iter_chunks, samples_per_chunk
 from ..registry import model_kind
+from .interval import ProcessInterval
 
-__all__ = ["force_constant_N_per_A", "process_force", "ProcessResult", "predict_process"]
-
-
-def force_constant_N_per_A(config: AxisConfig) -> float:
-    """Force on the table per ampere of motor current [N/A].
-
-    ``k_t * i * 2 pi * eta / h`` with the lead ``h`` in metres (see the module notes).
-
-    Parameters
-    ----------
-    config : AxisConfig
-        Torque constant [Nm/A], screw lead [mm], gear ratio, efficiency.
-
-    Returns
-    -------
-    float
-    """
-    lead_m = config.screw_lead_mm * 1e-3
-    return config.torque_constant_Nm_per_A * config.gear_ratio * 2.0 * np.pi * config.efficiency / lead_m
-
-
-def process_force(process_current_A, config: AxisConfig) -> np.ndarray:
-    """Force [N] the drive exerts on the table for a process current [A].
-
-    Parameters
-    ----------
-    process_current_A : array_like
-        Process share of the motor current [A].
-    config : AxisConfig
-        Drive-train constants of the axis.
-
-    Returns
-    -------
-    ndarray
-        ``force_constant_N_per_A(config) * process_current_A`` [N].
-    """
-    return force_constant_N_per_A(config) * np.asarray(process_current_A, dtype=float)
+__all__ = ["EXTRAPOLATION_WARNING_SHARE", "ProcessResult", "extrapolation_summary", "predict_process"]
 
 
 @dataclass(frozen=True)
@@ -110,8 +85,9 @@ class ProcessResult:
         without axis metadata.
     effort_unit : str
         "A" or "N".
-    force_constant_N_per_A : float or None
-        Factor from process current to force [N/A] (None without axis metadata).
+    force_constants_N_per_A : (float, float) or None
+        Factors from process current to force [N/A], driving and back-driven
+        (:attr:`~greybox.data.axis_config.AxisConfig.force_constants_N_per_A`; None without axis metadata).
     axis : str
         Axis name.
     source : str
@@ -119,7 +95,17 @@ class ProcessResult:
     dataset : str
         Dataset id of the log (:attr:`greybox.data.log.AxisLog.dataset`), "" if it has none.
     attrs : dict
-        JSON-able description (model kind and file, chunk length, axis constants).
+        JSON-able description (model kind and file, chunk length, axis constants, interval).
+    half_width : ndarray or None
+        Half-width of the calibrated interval of the process current per sample [A] (or [N]),
+        :class:`~greybox.evaluate.interval.ProcessInterval`; None without calibration.
+    force_bounds : (ndarray, ndarray) or None
+        Lower and upper bound of the process force [N] of a current log, the current's bounds
+        converted like the current; None without calibration or without axis metadata.
+    outside : ndarray of bool or None
+        True where the log leaves the region the model's training runs covered
+        (:meth:`~greybox.estimator.CurrentModel.outside_training`); None for a model file that
+        predates the record of that region.
     """
 
     time: np.ndarray
@@ -129,34 +115,55 @@ class ProcessResult:
     model: np.ndarray
     force: np.ndarray | None
     effort_unit: str = "A"
-    force_constant_N_per_A: float | None = None
+    force_constants_N_per_A: tuple[float, float] | None = None
     axis: str = ""
     source: str = ""
     attrs: dict = field(default_factory=dict)
     dataset: str = ""
+    half_width: np.ndarray | None = None
+    force_bounds: tuple | None = None
+    outside: np.ndarray | None = None
 
     @property
     def process(self) -> np.ndarray:
         """Process share ``measured - model`` [A] (or [N])."""
         return self.measured - self.model
 
+    @property
+    def process_bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Lower and upper bound of the process share [A] (or [N]); None without calibration."""
+        if self.half_width is None:
+            return None
+        return self.process - self.half_width, self.process + self.half_width
+
     def columns(self) -> dict[str, np.ndarray]:
         """The output columns, in order.
 
         For a current log: ``time_s``, ``current_measured_A``,
-        ``current_model_A``, ``current_process_A``, ``force_process_N`` (with
-        axis metadata), ``position_mm``, ``velocity_mm_s``. For a force log
-        the three effort columns are ``force_measured_N``, ``force_model_N``,
-        ``force_process_N``.
+        ``current_model_A``, ``current_process_A`` (with an interval also
+        ``current_process_lower_A`` and ``current_process_upper_A``),
+        ``force_process_N`` (with axis metadata; with an interval also
+        ``force_process_lower_N`` and ``force_process_upper_N``),
+        ``position_mm``, ``velocity_mm_s`` and ``outside_training`` (1 where
+        the log leaves the training region, else 0; absent for a model file
+        that predates the record). For a force log the effort columns are
+        ``force_measured_N``, ``force_model_N``, ``force_process_N`` (and its
+        bounds).
         """
         quantity = "current" if self.effort_unit == "A" else "force"
         unit = self.effort_unit
         out = {"time_s": self.time, f"{quantity}_measured_{unit}": self.measured,
                f"{quantity}_model_{unit}": self.model, f"{quantity}_process_{unit}": self.process}
-        if self.force is not None:
+        if self.half_width is not None:
+            out[f"{quantity}_process_lower_{unit}"], out[f"{quantity}_process_upper_{unit}"] = self.process_bounds
+        if self.force is not None and unit == "A":
             out["force_process_N"] = self.force
+            if self.force_bounds is not None:
+                out["force_process_lower_N"], out["force_process_upper_N"] = self.force_bounds
         out["position_mm"] = self.position
         out["velocity_mm_s"] = self.velocity
+        if self.outside is not None:
+            out["outside_training"] = self.outside.astype(np.float64)
         return out
 
     def to_frame(self):
@@ -166,8 +173,37 @@ class ProcessResult:
         return pd.DataFrame(self.columns())
 
 
+#: Share of samples outside the training region above which ``greybox predict`` warns.
+EXTRAPOLATION_WARNING_SHARE = 0.05
+
+
+def extrapolation_summary(regions: dict, n_samples: int) -> dict:
+    """JSON-able shares of samples outside the training region, overall and per quantity.
+
+    Parameters
+    ----------
+    regions : dict of str to ndarray of bool
+        :meth:`~greybox.estimator.CurrentModel.outside_training` of the log.
+    n_samples : int
+        Samples of the log.
+
+    Returns
+    -------
+    dict
+        ``{"share": float or None, "by": {quantity: share}, "warn_above": float}``; ``share`` is None
+        (with a ``"reason"``) when the model carries no training region.
+    """
+    if not regions:
+        return {"share": None, "by": {}, "warn_above": EXTRAPOLATION_WARNING_SHARE,
+                "reason": "the model file predates the record of its training region; retrain to get one"}
+    outside = np.logical_or.reduce(list(regions.values()))
+    return {"share": float(np.count_nonzero(outside)) / n_samples,
+            "by": {name: float(np.count_nonzero(mask)) / n_samples for name, mask in regions.items()},
+            "warn_above": EXTRAPOLATION_WARNING_SHARE}
+
+
 def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = None,
-                    chunk_s: float = DEFAULT_CHUNK_S,
+                    interval: ProcessInterval | None = None, chunk_s: float = DEFAULT_CHUNK_S,
                     progress: Callable[[int, int, float], None] | None = None) -> ProcessResult:
     """Process share of the current of a cutting log, and its force.
 
@@ -179,6 +215,9 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
         One prepared run recorded while cutting.
     axis_config : AxisConfig, optional
         Drive-train constants; gives ``force`` for a current log.
+    interval : ProcessInterval, optional
+        Calibrated half-widths (:func:`~greybox.evaluate.interval.calibrate_interval`); gives the bounds
+        of the process current and force.
     chunk_s : float, default 60.0
         The model runs over chunks of this length [s], carrying its state
         (see :mod:`greybox.models.chunked`).
@@ -207,7 +246,7 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
         if progress is not None:
             progress(done, n_chunks, float(run.time[samples.stop - 1]))
     force = None
-    factor = None
+    factors = None
     attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s)}
     if run.effort_unit == "N":
         if axis_config is not None:
@@ -215,15 +254,29 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
                                "axis metadata convert a current and do not apply")
         force = run.effort - predicted
     elif axis_config is not None:
-        force = process_force(run.effort - predicted, axis_config)
-        factor = force_constant_N_per_A(axis_config)
+        force = axis_config.process_force_N(run.effort - predicted, run.velocity)
+        factors = axis_config.force_constants_N_per_A
         attrs["axis_config"] = {"source": axis_config.source,
                                 "torque_constant_Nm_per_A": axis_config.torque_constant_Nm_per_A,
                                 "screw_lead_mm": axis_config.screw_lead_mm, "gear_ratio": axis_config.gear_ratio,
-                                "efficiency": axis_config.efficiency,
-                                "force_constant_N_per_A": factor}
+                                "efficiency_driving": axis_config.efficiency_driving,
+                                "efficiency_backdriven": axis_config.efficiency_backdriven,
+                                "force_constant_driving_N_per_A": factors[0],
+                                "force_constant_backdriven_N_per_A": factors[1]}
+    regions = model.outside_training(run)
+    outside = np.logical_or.reduce(list(regions.values())) if regions else None
+    attrs["extrapolation"] = extrapolation_summary(regions, len(run))
+    half_width = force_bounds = None
+    if interval is not None:
+        half_width = interval.half_widths(run)
+        attrs["interval"] = interval.to_dict()
+        if factors is not None:
+            process = run.effort - predicted
+            force_bounds = (axis_config.process_force_N(process - half_width, run.velocity),
+                            axis_config.process_force_N(process + half_width, run.velocity))
     return ProcessResult(time=run.time, position=run.position, velocity=run.velocity, measured=run.effort,
                          model=predicted, force=force, effort_unit=run.effort_unit,
-                         force_constant_N_per_A=factor,
+                         force_constants_N_per_A=factors,
                          axis=run.axis or (axis_config.name if axis_config is not None else ""),
-                         source=run.source, attrs=attrs, dataset=run.dataset or "")
+                         source=run.source, attrs=attrs, dataset=run.dataset or "", half_width=half_width,
+                         force_bounds=force_bounds, outside=outside)

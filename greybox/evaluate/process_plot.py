@@ -7,7 +7,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .plots import ENVELOPE_POINTS, envelope, envelope_indices, finish_figure, import_pyplot, window_title
+from .plots import (
+    ENVELOPE_POINTS,
+    band_envelope,
+    envelope,
+    envelope_indices,
+    finish_figure,
+    import_pyplot,
+    window_title,
+)
 from .process import ProcessResult
 
 __all__ = ["envelope_indices", "moving_mean", "plot_process"]
@@ -37,6 +45,15 @@ def moving_mean(values, window: int) -> np.ndarray:
     start = np.clip(index - window // 2, 0, values.size)
     stop = np.clip(index - window // 2 + window, 0, values.size)
     return (sums[stop] - sums[start]) / (stop - start)
+
+
+def _mark_outside(ax, time, outside, max_points: int, label: str) -> None:
+    """Shade the time spans (thinned to bins, :func:`envelope_indices`) where the log leaves the training region."""
+    starts = envelope_indices(outside.size, max_points)
+    flags = np.logical_or.reduceat(outside, starts) if starts.size < outside.size else outside
+    ax.fill_between(time[starts], 0, 1, where=flags, step="post", transform=ax.get_xaxis_transform(),
+                    color="tab:orange", alpha=0.15, lw=0, label=label)
+    ax.legend(loc="upper right", fontsize="small")
 
 
 def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *,
@@ -89,28 +106,50 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     def line(ax, values, **style):
         ax.plot(*envelope(result.time[shown], values[shown], max_points), **style)
 
-    figure, (ax_v, ax_i, ax_p) = plt.subplots(3, 1, sharex=True, figsize=(11, 8), layout="constrained",
-                                              height_ratios=(1, 2, 2))
+    factors = result.force_constants_N_per_A
+    force_panel = unit == "A" and factors is not None and factors[0] != factors[1]
+    figure, axes = plt.subplots(4 if force_panel else 3, 1, sharex=True, figsize=(11, 10 if force_panel else 8),
+                                layout="constrained", height_ratios=(1, 2, 2, 2) if force_panel else (1, 2, 2))
+    ax_v, ax_i, ax_p = axes[:3]
     line(ax_v, result.velocity, lw=0.8, color="tab:gray")
     ax_v.set_ylabel("velocity [mm/s]")
     line(ax_i, result.measured, lw=0.5, color="tab:gray", label=f"measured {noun}")
     line(ax_i, result.model, lw=0.8, color="tab:blue", label=f"model {noun} (inertia + friction)")
     ax_i.set_ylabel(f"{noun} [{unit}]")
     ax_i.legend(loc="upper right", fontsize="small")
-    line(ax_p, result.process, lw=0.6, color="tab:red", label=f"process {noun} = measured - model")
-    if mean_s > 0 and result.time.size > 1:
-        mean_samples = max(1, int(round(mean_s / float(np.median(np.diff(result.time))))))
-        line(ax_p, moving_mean(result.process, mean_samples), lw=1.2, color="darkred",
-             label=f"moving mean over {mean_s:g} s")
-    ax_p.axhline(0.0, color="black", lw=0.5)
+    coverage = result.attrs.get("interval", {}).get("coverage")
+    band_label = f"{100 * coverage:g} % interval" if coverage else "interval"
+    mean_samples = (max(1, int(round(mean_s / float(np.median(np.diff(result.time))))))
+                    if mean_s > 0 and result.time.size > 1 else 0)
+
+    def process_panel(ax, values, bounds, what, color, dark):
+        if bounds is not None:
+            ax.fill_between(*band_envelope(result.time[shown], bounds[0][shown], bounds[1][shown], max_points),
+                            color=color, alpha=0.25, lw=0, step="post", label=band_label)
+        line(ax, values, lw=0.6, color=color, label=what)
+        if mean_samples:
+            line(ax, moving_mean(values, mean_samples), lw=1.2, color=dark, label=f"moving mean over {mean_s:g} s")
+        ax.axhline(0.0, color="black", lw=0.5)
+        ax.legend(loc="upper right", fontsize="small")
+
+    process_panel(ax_p, result.process, result.process_bounds, f"process {noun} = measured - model",
+                  "tab:red", "darkred")
     ax_p.set_ylabel(f"process {noun} [{unit}]")
-    ax_p.set_xlabel("time [s]")
-    ax_p.legend(loc="upper right", fontsize="small")
-    factor = result.force_constant_N_per_A
-    if unit == "A" and factor:
+    if unit == "A" and factors and not force_panel:
+        factor = factors[0]
         right = ax_p.secondary_yaxis("right", functions=(lambda i: i * factor, lambda f: f / factor))
         right.set_ylabel("process force [N]")
-    for ax in (ax_v, ax_i, ax_p):
+    if force_panel:  # two efficiencies: no single scale, the force gets a panel of its own
+        process_panel(axes[3], result.force, result.force_bounds,
+                      "process force (driving: eta_d K_0 I, back-driven: K_0 I / eta_b)", "tab:green", "darkgreen")
+        axes[3].set_ylabel("process force [N]")
+    if result.outside is not None and np.any(result.outside[shown]):
+        share = 100.0 * float(np.mean(result.outside))
+        for ax in axes[2:]:
+            _mark_outside(ax, result.time[shown], result.outside[shown], max_points,
+                          f"outside the training region ({share:.1f} % of the log)")
+    axes[-1].set_xlabel("time [s]")
+    for ax in axes:
         ax.grid(True, alpha=0.3)
     title = " / ".join(part for part in (result.axis and f"axis {result.axis}",
                                          result.dataset and f"dataset {result.dataset}") if part) or "axis log"

@@ -259,6 +259,7 @@ class GMSSVRModel(KernelRegressionModel):
                 raise LogError(run.source or None, f"log carries effort in {run.effort_unit}, "
                                                    f"the GMS stage was fitted on {self.gms_.effort_unit_}")
         self._set_fit_info(runs)
+        self._widen_region(self.gms_)
         self.J_ = float(self.gms_.J_)
         self.offset_ = float(self.gms_.offset_)
 
@@ -286,6 +287,9 @@ class GMSSVRModel(KernelRegressionModel):
         """
         gms_current, z, _, end = self.gms_.trajectory(run, state, sample_time=sample_time)
         return np.column_stack((run.position, gms_current, z)), end
+
+    def _run_inputs(self, run: AxisLog) -> np.ndarray:
+        return self._inputs(run, self.initial_state(), run.sample_time)[0]
 
     def initial_state(self):
         """State of the frozen GMS stage at the start of a run (all elements at rest)."""

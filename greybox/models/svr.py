@@ -364,8 +364,10 @@ class KernelRegressionModel(CurrentModel):
     checks them, fits the expansion (:func:`fit_svr_expansion`) into the
     learned attributes ``input_mean_``, ``input_scale_``, ``support_vectors_``,
     ``dual_coef_``, ``intercept_``, ``epsilon_``, ``C_``, ``gamma_``,
-    ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_`` and
-    ``n_train_``, and evaluates it.
+    ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_``,
+    ``n_train_`` and ``input_range_`` (the lowest and highest value of each
+    input over the training data, shape (2, n_features)), and evaluates it.
+    A subclass gives its inputs of a whole run by ``_run_inputs(run)``.
     """
 
     def _check_params(self) -> None:
@@ -407,6 +409,21 @@ class KernelRegressionModel(CurrentModel):
         self.search_history_ = list(fit.history)
         self.at_bounds_ = list(fit.at_bounds)
         self.n_train_ = fit.n_train
+        self.input_range_ = np.vstack((np.min(X, axis=0), np.max(X, axis=0)))
+
+    def _run_inputs(self, run: AxisLog) -> np.ndarray:  # pragma: no cover - abstract
+        """Raw SVR inputs of one whole run, shape (n, n_features)."""
+        raise NotImplementedError
+
+    def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
+        """As :meth:`CurrentModel.outside_training <greybox.estimator.CurrentModel.outside_training>`, with
+        ``"inputs"``: True where any SVR input lies outside its range over the training data."""
+        out = super().outside_training(log)
+        ranges = getattr(self, "input_range_", None)  # None: a file that predates the record
+        if ranges is not None:
+            X = self._run_inputs(log)
+            out["inputs"] = np.any((X < ranges[0]) | (X > ranges[1]), axis=1)
+        return out
 
     def _kernel_predict(self, X) -> np.ndarray:
         """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
@@ -540,6 +557,8 @@ class SVRCurrentModel(KernelRegressionModel):
 
     def _inputs(self, run: AxisLog) -> np.ndarray:
         return np.column_stack((run.position, run.velocity))
+
+    _run_inputs = _inputs
 
     def _fit_runs(self, runs, progress) -> None:
         self.J_, self.offset_ = inertia_offset_proxy(runs, self.inertia)

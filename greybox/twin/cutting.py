@@ -6,8 +6,10 @@ current in the direction of motion:
 
     I_p = sgn(v) * c(v) * e(x) * I_c * (|v| / v_ref)^p * (1 + q (pi/2 |sin(pi f_z t)| - 1))
 
-* ``c(v)`` is 1 while moving in the cutting direction, else 0 (the return
-  stroke is an air cut);
+* ``c(v)`` is 1 while moving in the cutting direction and ``r`` on the return
+  stroke: 0 (default) makes it an air cut, ``r > 0`` a cut whose force opposes
+  the motion as well, ``r < 0`` one whose force pushes the table along its
+  motion (climb milling pulling the table), so that the screw is back-driven;
 * ``e(x)`` is the engagement, rising from 0 to 1 with a ``sin^2`` ramp over the
   entry length at the workpiece edges (entry and exit ramps);
 * ``(|v| / v_ref)^p`` scales the force with the chip thickness (feed per tooth);
@@ -53,6 +55,10 @@ class CuttingSpec:
         Share of the covered positions taken by the default workpiece.
     cutting_direction : {-1, 1}, default -1
         Feed direction in which the tool cuts.
+    return_pass : float, default 0.0
+        Process force on the return stroke relative to the cutting stroke's
+        at the same feed, ``r`` in [-1, 1]: 0 an air cut, positive opposing
+        the motion, negative pushing the table along (back-driving the screw).
     """
 
     strength_A: float = 0.5
@@ -65,10 +71,13 @@ class CuttingSpec:
     workpiece_mm: tuple | None = None
     workpiece_fraction: float = 0.6
     cutting_direction: int = -1
+    return_pass: float = 0.0
 
     def __post_init__(self):
         if self.cutting_direction not in (-1, 1):
             raise GreyboxError(f"cutting: direction must be -1 or 1, got {self.cutting_direction}")
+        if not -1.0 <= self.return_pass <= 1.0:
+            raise GreyboxError(f"cutting: return pass must be in [-1, 1], got {self.return_pass}")
         if not 0.0 <= self.ripple <= 1.0:
             raise GreyboxError(f"cutting: ripple depth must be in [0, 1], got {self.ripple}")
         if self.spindle_rpm <= 0 or self.teeth < 1 or self.reference_feed_mm_min <= 0 or self.entry_length_mm <= 0:
@@ -108,12 +117,12 @@ def _engagement(position_mm, workpiece, entry_length_mm):
 def cutting_current(spec: CuttingSpec, time_s, position_mm, velocity_mm_s) -> np.ndarray:
     """Process current [A] of the cutting load along a motion (zero outside the cut segments)."""
     v = np.asarray(velocity_mm_s, dtype=float)
-    cutting = (v * spec.cutting_direction) > 0.0
+    share = np.where(v * spec.cutting_direction > 0.0, 1.0, np.where(v != 0.0, spec.return_pass, 0.0))
     engagement = _engagement(position_mm, spec.workpiece(position_mm), spec.entry_length_mm)
     feed = (np.abs(v) / (spec.reference_feed_mm_min / 60.0)) ** spec.feed_exponent
     tooth = np.abs(np.sin(np.pi * spec.tooth_frequency_hz * np.asarray(time_s, dtype=float)))
     ripple = 1.0 + spec.ripple * (0.5 * np.pi * tooth - 1.0)
-    return np.where(cutting, np.sign(v) * engagement * feed * spec.strength_A * ripple, 0.0)
+    return np.where(share != 0.0, np.sign(v) * share * engagement * feed * spec.strength_A * ripple, 0.0)
 
 
 def cut_segments(process_current_A) -> list[tuple[int, int]]:

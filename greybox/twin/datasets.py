@@ -38,11 +38,11 @@ SAMPLE_TIME_S = 0.002
 
 #: Truth channels a synthetic log carries (the last two only with an effect or cutting).
 TRUTH_CHANNELS = ("truth_current_A", "truth_friction_A", "truth_inertia_A", "truth_cogging_A", "truth_noise_A",
-                  "truth_effect_A", "truth_process_A")
+                  "truth_effect_A", "truth_process_A", "truth_process_force_N")
 
 #: Truth channels kept in compact files: the noise-free current (for the noise
 #: floor) and the injected components.
-ESSENTIAL_TRUTH_CHANNELS = ("truth_current_A", "truth_effect_A", "truth_process_A")
+ESSENTIAL_TRUTH_CHANNELS = ("truth_current_A", "truth_effect_A", "truth_process_A", "truth_process_force_N")
 
 #: Resolution [A] to which truth channels are rounded when written to files.
 TRUTH_STORAGE_RESOLUTION_A = 1e-6
@@ -141,7 +141,10 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         [mm/s], noisy quantised current [A]; acceleration is not logged.
         Extras: ``truth_current_A`` (noise-free current), ``truth_friction_A``,
         ``truth_inertia_A``, ``truth_cogging_A``, ``truth_noise_A`` (logged minus noise-free current),
-        and ``truth_effect_A`` / ``truth_process_A`` when injected.
+        and ``truth_effect_A`` / ``truth_process_A`` when injected; with cutting also
+        ``truth_process_force_N``, the process force on the table [N] behind ``truth_process_A``
+        (:mod:`greybox.twin.drive`; the axis file that converts one into the other is in
+        ``attrs["cutting"]["axis_config"]``).
         ``attrs`` holds the seed, plant, trajectory, noise, sensors, effect and cutting settings.
 
     Raises
@@ -194,6 +197,9 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
     current = sensors.current(noise_free + noise.sample(n, noise_rng))
     position = sensors.position(response.position_mm)
     extras = {"truth_current_A": noise_free, **truth, "truth_noise_A": current - noise_free}
+    if process is not None:
+        extras["truth_process_force_N"] = plant.process_force_N(process, response.velocity_mm_s)
+        attrs["cutting"]["axis_config"] = plant.axis_config(geometry.name).to_dict()
     return AxisLog(
         time=time,
         position=position,

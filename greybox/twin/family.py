@@ -30,9 +30,11 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ..atomic import write_text_atomic
+from ..data.axis_config import AxisConfig
 from ..errors import GreyboxError
 from .axes import axis_geometry
 from .datasets import _check_seed, _for_storage, _kept_truth_channels, dataset_path, make_dataset
+from .drive import drive_config, load_gain_efficiencies
 from .laws import TRUTH_LAWS, TruthLaw
 from .laws.base import log_uniform
 from .noise import CurrentNoise
@@ -40,8 +42,8 @@ from .plant import PlantResponse, _position_term_arrays, fine_motion
 from .sensors import Sensors
 from .trajectories import DATASETS, DEFAULT_DATASETS
 
-__all__ = ["FAMILY_RANGES", "FamilyPlant", "FamilyMember", "ranges_markdown", "draw_member", "member_dataset",
-           "synthesize_family"]
+__all__ = ["FAMILY_RANGES", "AXIS_FILE", "FamilyPlant", "FamilyMember", "ranges_markdown", "draw_member",
+           "member_dataset", "synthesize_family"]
 
 #: ``{parameter: (low, high, unit, how drawn)}`` of the effects every member has.
 FAMILY_RANGES = {
@@ -61,6 +63,9 @@ FAMILY_RANGES = {
     "position_resolution_mm": (5e-5, 1e-3, "mm", "one of 0.05, 0.1, 0.5, 1 um"),
     "current_resolution_A": (1e-3, 5e-3, "A", "one of 1, 2, 5 mA"),
 }
+
+#: Name of each member's axis file (``greybox predict --axis-config``) beside its logs.
+AXIS_FILE = "axis.toml"
 
 _LEADS_MM = (5.0, 10.0, 16.0, 20.0)
 _POSITION_RESOLUTIONS_MM = (5e-5, 1e-4, 5e-4, 1e-3)
@@ -143,6 +148,14 @@ class FamilyPlant:
                     + self.load_gain * np.abs(law.inertia_A) * law.direction)
         return PlantResponse(x_log, v_log, a_log, friction, law.inertia_A, cogging, load_gain=float(self.load_gain),
                              friction_direction=law.direction)
+
+    def axis_config(self, name: str = "") -> AxisConfig:
+        """The axis file of this member: the twin's motor, this screw lead, the efficiencies of its load friction."""
+        return drive_config(self.lead_mm, load_gain_efficiencies(self.load_gain), name)
+
+    def process_force_N(self, process_A, velocity_mm_s) -> np.ndarray:
+        """Process force [N] on the table behind a process current [A] (losses booked in the friction)."""
+        return self.axis_config().lossless_force_constant_N_per_A * np.asarray(process_A, dtype=float)
 
     def to_dict(self) -> dict:
         """JSON-serialisable parameters, the law's under ``"law"``."""
@@ -259,14 +272,18 @@ def draw_member(index: int, family_seed: int) -> FamilyMember:
     return FamilyMember(int(index), int(family_seed), axis, plant, noise, sensors, dataset_seed)
 
 
-def member_dataset(member: FamilyMember, dataset: str, **options):
+def member_dataset(member: FamilyMember, dataset: str, *, repeat: int = 0, **options):
     """One log of a family member (:func:`~greybox.twin.datasets.make_dataset` with the member's plant,
     noise, sensors and seed); ``options`` are the other arguments of ``make_dataset`` (cutting, duration_s,
-    effect ...). The log's ``attrs`` carry the member under ``"family_member"``."""
-    log = make_dataset(member.axis, dataset, member.dataset_seed, plant=member.plant, noise=member.noise,
+    effect ...). ``repeat`` > 0 runs the dataset again on the same axis with other draws of its noise and of
+    the random parts of its trajectory (the seed ``dataset_seed + repeat``). The log's ``attrs`` carry the
+    member under ``"family_member"``."""
+    seed = (member.dataset_seed + int(repeat)) % 2**32
+    log = make_dataset(member.axis, dataset, seed, plant=member.plant, noise=member.noise,
                        sensors=member.sensors, **options)
     attrs = dict(log.attrs)
-    attrs["family_member"] = {"index": member.index, "family_seed": member.family_seed, "law": member.law}
+    attrs["family_member"] = {"index": member.index, "family_seed": member.family_seed, "law": member.law,
+                              "repeat": int(repeat)}
     return log.replace(attrs=attrs)
 
 
@@ -274,6 +291,9 @@ def synthesize_family(count: int, family_seed: int, out_dir, datasets: Sequence[
                       first: int = 0, force: bool = False, truth_channels: Sequence[str] | None = None,
                       progress: Callable[[str], None] | None = None, **options) -> list[Path]:
     """Write ``count`` family members as ``out_dir/member_NNN/<axis>_<dataset>.mcap`` plus ``out_dir/family.json``.
+
+    Beside each member's logs, ``member_NNN/axis.toml`` is its axis file (:data:`AXIS_FILE`): the drive-train
+    constants and the efficiencies its load-dependent friction implies, for ``greybox predict --axis-config``.
 
     Parameters
     ----------
@@ -326,6 +346,7 @@ def synthesize_family(count: int, family_seed: int, out_dir, datasets: Sequence[
             if m is member:
                 write_log(_for_storage(member_dataset(member, key, **options), keep), path)
                 written.append(path)
+        write_text_atomic(out / member.name / AXIS_FILE, member.plant.axis_config(member.axis).to_toml())
         if progress is not None:
             progress(f"{member.name}: {member.law}, axis {member.axis}, noise {member.noise.std_A:.3f} A -> "
                      f"{out / member.name} ({len(ids)} logs, {clock.perf_counter() - start:.1f} s)")

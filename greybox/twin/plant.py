@@ -52,8 +52,10 @@ import numpy as np
 from numba import njit
 
 from ..base import PlantLaw
+from ..data.axis_config import AxisConfig
 from ..errors import GreyboxError
 from .axes import axis_geometry
+from .drive import AXIS_EFFICIENCIES, drive_config
 
 __all__ = [
     "PlantParameters",
@@ -186,6 +188,14 @@ class PlantParameters:
         return (float(self.travel_mm[0]), float(self.travel_mm[1]), float(self.preload_gain), float(self.tilt_gain),
                 float(self.lead_mm), float(self.lead_gain), float(self.lead_phase_rad), float(self.cogging_A),
                 float(self.cogging_period_mm), float(self.cogging_phase_rad))
+
+    def axis_config(self, name: str = "") -> AxisConfig:
+        """The axis file of this axis: the twin's motor, this screw lead, the X and Y axes' efficiencies."""
+        return drive_config(self.lead_mm, AXIS_EFFICIENCIES, name)
+
+    def process_force_N(self, process_A, velocity_mm_s) -> np.ndarray:
+        """Process force [N] on the table behind a process current [A] (losses booked in the current)."""
+        return self.axis_config().process_force_N(process_A, velocity_mm_s)
 
     def position_factor(self, position_mm) -> np.ndarray:
         """Position factor ``g(x)`` of the Maxwell-slip friction (dimensionless; :func:`position_factor_at`)."""

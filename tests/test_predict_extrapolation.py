@@ -1,0 +1,107 @@
+"""Where the model extrapolates: samples outside the region its training runs covered."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+import pytest
+
+import greybox.cli as cli
+from greybox.data.io import read_log, write_log
+from greybox.data.prepare import prepare
+from greybox.evaluate.process import EXTRAPOLATION_WARNING_SHARE, predict_process
+from greybox.friction import GMSModel, StribeckModel
+from greybox.models.gmssvr import GMSSVRModel
+from greybox.persistence import load_model, save_model
+from greybox.twin import make_dataset
+
+SMALL_SVR = dict(n_subset=200, n_calls=3, cv_folds=2, cv_blocks=4)
+
+
+@pytest.fixture(scope="module")
+def logs():
+    """Air cut A in the 50 mm window (training), C in the same window, D over the whole travel."""
+    return dict(zip("ACD", prepare([make_dataset("X", "A", seed=31, duration_s=20),
+                                    make_dataset("X", "C", seed=32, duration_s=20),
+                                    make_dataset("X", "D", seed=33)])))
+
+
+def test_the_region_is_the_range_of_the_training_runs_and_the_flags_follow_it(logs):
+    model = StribeckModel().fit(logs["A"])
+    assert model.position_range_mm_ == [logs["A"].position.min(), logs["A"].position.max()]
+    assert model.velocity_range_mm_s_ == [logs["A"].velocity.min(), logs["A"].velocity.max()]
+    inside = model.outside_training(logs["A"])
+    assert set(inside) == {"position", "velocity"} and not any(mask.any() for mask in inside.values())
+    far = model.outside_training(logs["D"])
+    low, high = model.position_range_mm_
+    np.testing.assert_array_equal(far["position"], (logs["D"].position < low) | (logs["D"].position > high))
+    assert far["position"].mean() > 0.8
+
+
+def test_gms_svr_adds_its_input_space_and_covers_both_stages(logs):
+    model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=60), **SMALL_SVR).fit_staged(logs["A"], logs["C"])
+    both = np.concatenate([logs["A"].position, logs["C"].position])
+    assert model.position_range_mm_ == [both.min(), both.max()]
+    assert model.input_range_.shape == (2, 2 + len(model.gms_.alpha_))
+    flags = model.outside_training(logs["D"])
+    assert set(flags) == {"position", "velocity", "inputs"}
+    assert np.all(flags["inputs"][flags["position"]])  # position is one of the inputs
+    again = model.outside_training(logs["C"])
+    assert not again["position"].any() and not again["inputs"].any()
+
+
+def test_predict_reports_records_and_marks_the_samples_outside(logs, tmp_path, capsys):
+    model = StribeckModel().fit(logs["A"])
+    save_model(model, tmp_path / "m.gbm")
+    write_log(make_dataset("X", "D", seed=34, duration_s=None, cutting=True), tmp_path / "cut.mcap")
+    out = tmp_path / "p.csv"
+    status = cli.main(["predict", str(tmp_path / "m.gbm"), str(tmp_path / "cut.mcap"), "--out", str(out),
+                       "--plot", str(tmp_path / "p.png"), "--quiet"])
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    meta = json.loads(Path(str(out) + ".json").read_text())["attrs"]["extrapolation"]
+    assert meta["share"] > EXTRAPOLATION_WARNING_SHARE and set(meta["by"]) == {"position", "velocity"}
+    assert f"outside the training region: {100 * meta['share']:.1f} % of the samples" in captured.out
+    note = [line for line in captured.err.splitlines() if line.startswith("note: cut.mcap:")]
+    assert len(note) == 1 and "the model extrapolates there (column outside_training)" in note[0]
+    import pandas as pd
+
+    table = pd.read_csv(out)
+    assert table["outside_training"].mean() == pytest.approx(meta["share"])
+
+    matplotlib.use("Agg")
+    from greybox.evaluate.process_plot import plot_process
+
+    result = predict_process(model, prepare([make_dataset("X", "D", seed=34)])[0])
+    figure = plot_process(result)
+    labels = [text.get_text() for text in figure.axes[2].get_legend().get_texts()]
+    assert any(label.startswith("outside the training region") for label in labels)
+    matplotlib.pyplot.close(figure)
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".mcap"])
+def test_inside_the_window_there_is_no_note_and_every_format_carries_the_column(logs, tmp_path, capsys, suffix):
+    model = StribeckModel().fit([logs["A"], logs["C"]])
+    save_model(model, tmp_path / "m.gbm")
+    write_log(make_dataset("X", "C", seed=32, duration_s=20, cutting=True), tmp_path / "cut.mcap")
+    out = tmp_path / f"p{suffix}"
+    status = cli.main(["predict", str(tmp_path / "m.gbm"), str(tmp_path / "cut.mcap"), "--out", str(out), "--quiet"])
+    captured = capsys.readouterr()
+    assert status == 0 and "note:" not in captured.err
+    assert "outside the training region: 0.0 % of the samples" in captured.out
+    flags = read_log(out, columns={"current_A": "current_measured_A"}).extras["outside_training"]
+    assert flags.size > 1000 and np.all(flags == 0.0)
+
+
+def test_a_model_file_without_a_region_still_predicts_and_says_so(logs, tmp_path, capsys):
+    model = StribeckModel().fit(logs["A"])
+    del model.position_range_mm_, model.velocity_range_mm_s_  # as a file written before the record
+    save_model(model, tmp_path / "old.gbm")
+    loaded = load_model(tmp_path / "old.gbm")
+    assert loaded.outside_training(logs["D"]) == {}
+    result = predict_process(loaded, logs["D"])
+    assert result.outside is None and result.attrs["extrapolation"]["share"] is None
+    assert "outside_training" not in result.columns()
