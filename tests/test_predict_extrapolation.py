@@ -105,3 +105,12 @@ def test_a_model_file_without_a_region_still_predicts_and_says_so(logs, tmp_path
     result = predict_process(loaded, logs["D"])
     assert result.outside is None and result.attrs["extrapolation"]["share"] is None
     assert "outside_training" not in result.columns()
+
+
+def test_gms_svr_reads_its_inputs_in_chunks_equal_to_the_whole_run(logs):
+    model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=60), **SMALL_SVR).fit(logs["A"])
+    long_log = prepare([make_dataset("X", "C", seed=35, duration_s=130)])[0]
+    chunks = list(model._input_chunks(long_log))
+    assert len(chunks) >= 2  # the GMS state is carried across a chunk boundary
+    whole = model._inputs(long_log, model.initial_state(), long_log.sample_time)[0]
+    np.testing.assert_array_equal(np.concatenate(chunks), whole)

@@ -53,6 +53,7 @@ from ..errors import LogError, ParameterError
 from ..estimator import check_runs
 from ..friction.gms import GMSModel
 from ..identify.progress import make_progress
+from .chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from .svr import KernelRegressionModel
 
 __all__ = ["GMSSVRModel", "TARGETS"]
@@ -288,8 +289,12 @@ class GMSSVRModel(KernelRegressionModel):
         gms_current, z, _, end = self.gms_.trajectory(run, state, sample_time=sample_time)
         return np.column_stack((run.position, gms_current, z)), end
 
-    def _run_inputs(self, run: AxisLog) -> np.ndarray:
-        return self._inputs(run, self.initial_state(), run.sample_time)[0]
+    def _input_chunks(self, run: AxisLog):
+        """The inputs chunk by chunk (the GMS state carried across), so that memory stays bounded."""
+        state = self.initial_state()
+        for samples in chunk_slices(len(run), samples_per_chunk(run.sample_time, DEFAULT_CHUNK_S)):
+            X, state = self._inputs(run.select(samples), state, run.sample_time)
+            yield X
 
     def initial_state(self):
         """State of the frozen GMS stage at the start of a run (all elements at rest)."""

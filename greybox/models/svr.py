@@ -367,7 +367,7 @@ class KernelRegressionModel(CurrentModel):
     ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_``,
     ``n_train_`` and ``input_range_`` (the lowest and highest value of each
     input over the training data, shape (2, n_features)), and evaluates it.
-    A subclass gives its inputs of a whole run by ``_run_inputs(run)``.
+    A subclass gives the inputs of a whole run by ``_input_chunks(run)``.
     """
 
     def _check_params(self) -> None:
@@ -411,8 +411,8 @@ class KernelRegressionModel(CurrentModel):
         self.n_train_ = fit.n_train
         self.input_range_ = np.vstack((np.min(X, axis=0), np.max(X, axis=0)))
 
-    def _run_inputs(self, run: AxisLog) -> np.ndarray:  # pragma: no cover - abstract
-        """Raw SVR inputs of one whole run, shape (n, n_features)."""
+    def _input_chunks(self, run: AxisLog):  # pragma: no cover - abstract
+        """Raw SVR inputs of one whole run, in consecutive chunks of shape (n_chunk, n_features)."""
         raise NotImplementedError
 
     def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
@@ -421,8 +421,8 @@ class KernelRegressionModel(CurrentModel):
         out = super().outside_training(log)
         ranges = getattr(self, "input_range_", None)  # None: a file that predates the record
         if ranges is not None:
-            X = self._run_inputs(log)
-            out["inputs"] = np.any((X < ranges[0]) | (X > ranges[1]), axis=1)
+            out["inputs"] = np.concatenate([np.any((X < ranges[0]) | (X > ranges[1]), axis=1)
+                                            for X in self._input_chunks(log)])
         return out
 
     def _kernel_predict(self, X) -> np.ndarray:
@@ -558,7 +558,8 @@ class SVRCurrentModel(KernelRegressionModel):
     def _inputs(self, run: AxisLog) -> np.ndarray:
         return np.column_stack((run.position, run.velocity))
 
-    _run_inputs = _inputs
+    def _input_chunks(self, run: AxisLog):
+        yield self._inputs(run)
 
     def _fit_runs(self, runs, progress) -> None:
         self.J_, self.offset_ = inertia_offset_proxy(runs, self.inertia)
