@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 from ..data.log import AxisLog
-from ._types import FRACTION, POSITIVE, positive
+from ..data.prepare import MAX_GAP_STEPS
+from ._types import FRACTION, GAP_STEPS, POSITIVE, positive
 
-__all__ = ["add_log_arguments", "read_logs"]
+__all__ = ["add_log_arguments", "read_logs", "read_named_runs", "read_runs"]
 
 
 def add_log_arguments(parser: argparse.ArgumentParser, *, prepare: bool = True) -> None:
@@ -53,7 +56,16 @@ def add_log_arguments(parser: argparse.ArgumentParser, *, prepare: bool = True) 
             "--resample",
             type=positive("seconds"),
             metavar="S",
-            help="resample every log to a uniform step of S seconds before use",
+            help="resample every log to a uniform step of S seconds before use (linear interpolation): time "
+            "stamps may then be irregular, and a log is split into runs at gaps longer than --max-gap steps",
+        )
+        group.add_argument(
+            "--max-gap",
+            type=GAP_STEPS,
+            default=MAX_GAP_STEPS,
+            metavar="STEPS",
+            help=f"with --resample: the longest time step, in median steps of the log, that is interpolated "
+            f"over; a longer one splits the log into runs (default {MAX_GAP_STEPS:g})",
         )
 
 
@@ -74,20 +86,76 @@ def read_logs(args: argparse.Namespace, paths, *, prepare: bool = True) -> list[
     list of AxisLog
         One log per file, in the order given.
     """
-    from ..data.io import parse_column_mapping, read_log
-    from ..data.prepare import prepare as prepare_logs
+    from ..data.io import parse_column_mapping
 
     columns = parse_column_mapping(args.columns) if args.columns else None
-    logs = [
-        read_log(
-            path,
-            columns=columns,
-            topic=args.topic,
-            sample_time=args.sample_time,
-            time_tolerance=args.time_tolerance,
-        )
-        for path in paths
-    ]
+    return [run for path in paths for run in read_runs(args, path, columns=columns, prepare=prepare)]
+
+
+def read_named_runs(args: argparse.Namespace, paths, names, *, prepare: bool = True
+                    ) -> tuple[list[AxisLog], list[str]]:
+    """Like :func:`read_logs`, with a name per run: the file's ``names`` entry, plus ``run k/n`` where split.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed options added by :func:`add_log_arguments`.
+    paths : iterable of str
+        Log files.
+    names : iterable of str
+        A display name per file.
+    prepare : bool, default True
+        Derive velocity and acceleration (and resample when asked).
+
+    Returns
+    -------
+    (list of AxisLog, list of str)
+        The runs in file order and a name for each.
+    """
+    from ..data.io import parse_column_mapping
+
+    columns = parse_column_mapping(args.columns) if args.columns else None
+    runs, labels = [], []
+    for path, name in zip(paths, names):
+        pieces = read_runs(args, path, columns=columns, prepare=prepare)
+        runs += pieces
+        labels += [name] if len(pieces) == 1 else [f"{name} run {k}/{len(pieces)}" for k in
+                                                    range(1, len(pieces) + 1)]
+    return runs, labels
+
+
+def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = True) -> list[AxisLog]:
+    """Read one file and prepare it as the options say: one run, or several when --resample splits it at gaps.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed options added by :func:`add_log_arguments`.
+    path : str
+        Log file.
+    columns : dict, optional
+        Column mapping (``{canonical_name: name_in_file}``).
+    prepare : bool, default True
+        Derive velocity and acceleration (and resample when asked).
+
+    Returns
+    -------
+    list of AxisLog
+        The runs of the file, in time order; a note on stderr names the gaps where it was split.
+    """
+    from ..data.io import read_log
+    from ..data.prepare import prepare as prepare_logs
+
+    resample = getattr(args, "resample", None) if prepare else None
+    log = read_log(path, columns=columns, topic=args.topic, sample_time=args.sample_time,
+                   time_tolerance=None if resample else args.time_tolerance)
     if not prepare:
-        return logs
-    return prepare_logs(logs, cutoff_hz=getattr(args, "cutoff_hz", None), sample_time=getattr(args, "resample", None))
+        return [log]
+    runs = prepare_logs([log], cutoff_hz=getattr(args, "cutoff_hz", None), sample_time=resample,
+                        tolerance=args.time_tolerance, max_gap_steps=getattr(args, "max_gap", MAX_GAP_STEPS))
+    if len(runs) > 1:
+        starts = ", ".join(f"{run.attrs['split']['start_s']:.6g}" for run in runs[1:])
+        print(f"note: {Path(path).name}: split into {len(runs)} runs at gaps longer than "
+              f"{args.max_gap:g} steps (--max-gap); the runs after the first start at t = {starts} s",
+              file=sys.stderr)
+    return runs

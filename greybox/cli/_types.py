@@ -137,6 +137,8 @@ NON_NEGATIVE = NumberRange(float, low=0)
 FRACTION = NumberRange(float, low=0, high=1, low_open=True, high_open=True, description="a fraction in (0, 1)")
 #: A number in [-1, 1], both bounds included (a relative force of either sign).
 SIGNED_FRACTION = NumberRange(float, low=-1, high=1, description="a number in [-1, 1]")
+#: A number of time steps above 1 (--max-gap).
+GAP_STEPS = NumberRange(float, low=1, low_open=True, description="a number of steps above 1")
 #: An integer >= 1.
 POSITIVE_INT = NumberRange(int, low=1)
 #: An integer >= 0.

@@ -11,7 +11,7 @@ from ..evaluate.records import evaluate_models, write_evaluation_report
 from ..evaluate.regimes import REGIME_NAMES
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json
 from ..persistence import load_model
-from ._options import add_log_arguments, read_logs
+from ._options import add_log_arguments, read_named_runs
 
 
 def add_parser(subparsers) -> None:
@@ -82,8 +82,7 @@ def run(args: argparse.Namespace) -> int:
     _check_outputs(args)
     names = _model_names(args.models)
     models = dict(zip(names, (load_model(path) for path in args.models)))
-    runs = read_logs(args, args.test)
-    run_names = _model_names(args.test)
+    runs, run_names = read_named_runs(args, args.test, _model_names(args.test))
     units = dict.fromkeys(run.effort_unit for run in runs)
     if len(units) > 1:
         listed = ", ".join(f"{name} in {run.effort_unit}" for name, run in zip(run_names, runs))

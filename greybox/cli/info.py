@@ -9,7 +9,7 @@ from pathlib import PurePath
 import numpy as np
 
 from ..data.log import AxisLog
-from ._options import add_log_arguments, read_logs
+from ._options import add_log_arguments, read_named_runs
 
 
 def add_parser(subparsers) -> None:
@@ -90,12 +90,12 @@ def display_names(paths) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    summaries = [summarise(log) for log in read_logs(args, args.logs)]
+    runs, names = read_named_runs(args, args.logs, display_names(list(args.logs)))
+    summaries = [summarise(log) for log in runs]
     if args.json:
         for summary in summaries:
             print(json.dumps(summary))
         return 0
-    names = display_names([s["file"] or path for s, path in zip(summaries, args.logs)])
     width = max([28, *map(len, names)])
     header = f"{'file':<{width}} {'axis':>4} {'set':>4} {'samples':>9} {'dt ms':>6} {'dur s':>8} " \
              f"{'position mm':>19} {'vmax mm/min':>11} {'RMS effort':>12} {'noise':>8}"

@@ -45,9 +45,24 @@ def _check_out(args: argparse.Namespace) -> None:
     check_output_path(out, overwrite=args.force, protect=[args.log], inputs_name="the log to draw")
 
 
+def _run_to_draw(runs, window, name: str):
+    """The one run to draw: the log's only run, or, for a log split at gaps, the run where --window starts."""
+    if len(runs) == 1:
+        return runs[0]
+    starts = ", ".join(f"{run.time[0]:.6g}-{run.time[-1]:.6g}" for run in runs)
+    if window is None:
+        raise GreyboxError(f"{name}: split into {len(runs)} runs at gaps ({starts} s); plot draws one: give "
+                           "--window START END inside one of them, or a larger --max-gap")
+    for run in runs:
+        if run.time[0] <= window[0] <= run.time[-1]:
+            return run
+    raise GreyboxError(f"{name}: --window starts at {window[0]:g} s, in no run of the log ({starts} s)")
+
+
 def run(args: argparse.Namespace) -> int:
     _check_out(args)
-    (log,) = read_logs(args, [args.log], prepare=not args.raw)
+    runs = read_logs(args, [args.log], prepare=not args.raw)
+    log = _run_to_draw(runs, args.window, Path(args.log).name)
     window = check_window(args.window, log.time, name=Path(args.log).name)
     path = plot_log(log, args.out, window=window)
     print(f"wrote {path}")

@@ -61,18 +61,16 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(run=run)
 
 
-def _read_log(args: argparse.Namespace, channels: dict, path=None):
-    """Read and prepare a log (the cutting log by default); column mapping from the axis metadata, then --columns."""
-    from ..data.io import parse_column_mapping, read_log
-    from ..data.prepare import prepare
+def _read_runs(args: argparse.Namespace, channels: dict, path=None):
+    """Read and prepare a log (the cutting log by default) into its runs; column mapping from the axis
+    metadata, overridden by --columns."""
+    from ..data.io import parse_column_mapping
+    from ._options import read_runs
 
     columns = dict(channels)
     if args.columns:
         columns.update(parse_column_mapping(args.columns))
-    log = read_log(path or args.log, columns=columns or None, topic=args.topic, sample_time=args.sample_time,
-                   time_tolerance=args.time_tolerance)
-    (prepared,) = prepare([log], cutoff_hz=args.cutoff_hz, sample_time=args.resample)
-    return prepared
+    return read_runs(args, path or args.log, columns=columns or None)
 
 
 def _progress(total_s: float, quiet: bool):
@@ -126,28 +124,31 @@ def run(args: argparse.Namespace) -> int:
         raise GreyboxError("--interval needs --calibration AIRCUT... (air-cut logs the model was not trained on)")
     config = read_axis_config(args.axis_config) if args.axis_config else None
     model = load_model(args.model)
-    log = _read_log(args, config.channels if config else {})
-    window = check_window(args.plot_window, log.time, "--plot-window", Path(args.log).name)
+    runs = _read_runs(args, config.channels if config else {})
+    log_time = np.concatenate([run.time for run in runs])
+    window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
     interval = None
     if args.calibration:
         from ..evaluate.interval import calibrate_interval
 
-        interval = calibrate_interval(model, [_read_log(args, config.channels if config else {}, path)
-                                              for path in args.calibration],
+        interval = calibrate_interval(model, [run for path in args.calibration
+                                              for run in _read_runs(args, config.channels if config else {}, path)],
                                       coverage=DEFAULT_COVERAGE if args.interval is None else args.interval,
                                       chunk_s=args.chunk_s)
 
     started = time.perf_counter()
-    result = predict_process(model, log, axis_config=config, interval=interval, chunk_s=args.chunk_s,
-                             progress=_progress(float(log.time[-1]), args.quiet))
+    result = predict_process(model, runs, axis_config=config, interval=interval, chunk_s=args.chunk_s,
+                             progress=_progress(float(log_time[-1]), args.quiet))
     elapsed = time.perf_counter() - started
     result.attrs.update({"model_file": str(args.model), "log_file": str(args.log)})
-    n_chunks = len(chunk_slices(len(log), samples_per_chunk(log.sample_time, args.chunk_s)))
+    n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, args.chunk_s))) for run in runs)
+    duration = sum(run.duration for run in runs)
     unit = result.effort_unit
     noun = "current" if unit == "A" else "force"
     process = result.process
     print(f"predicted {Path(args.log).name} with the {result.attrs['model_kind']} model {Path(args.model).name}: "
-          f"{len(log)} samples, {log.duration:.1f} s, {n_chunks} chunk(s) of {args.chunk_s:g} s"
+          f"{len(result.time)} samples, {duration:.1f} s, {n_chunks} chunk(s) of {args.chunk_s:g} s"
+          + (f" in {len(runs)} runs" if len(runs) > 1 else "")
           + (f", dataset {result.dataset}" if result.dataset else ""))
     print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} {unit}, "
           f"process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")

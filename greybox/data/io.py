@@ -27,7 +27,7 @@ from ..errors import GreyboxError, LogError
 from .file_metadata import sidecar_path
 from .log import AxisLog
 from .units import CANONICAL_NAMES, UNIT_FACTORS, parse_column_name
-from .validate import check_finite, check_time
+from .validate import check_finite, check_increasing, check_time
 
 __all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS"]
 
@@ -74,7 +74,7 @@ def read_log(
     columns: Mapping[str, str] | None = None,
     topic: str | None = None,
     sample_time: float | None = None,
-    time_tolerance: float = 0.25,
+    time_tolerance: float | None = 0.25,
     fmt: str | None = None,
 ) -> AxisLog:
     """Read and validate one axis log.
@@ -93,8 +93,9 @@ def read_log(
     sample_time : float, optional
         Sample time [s] for CSV/Parquet files without a time column; time is
         then ``row_index * sample_time`` from 0 s.
-    time_tolerance : float, default 0.25
-        Allowed deviation of a time step from the nominal step (fraction).
+    time_tolerance : float or None, default 0.25
+        Allowed deviation of a time step from the nominal step (fraction); None accepts any strictly
+        increasing time (a log to be resampled, :func:`greybox.data.prepare.prepare`).
     fmt : {"csv", "parquet", "mcap", "emps"}, optional
         Format, overriding the extension.
 
@@ -128,7 +129,10 @@ def read_log(
         log = _handler(fmt, 1)(path, **options)
     except OSError as exc:
         raise LogError(path, f"cannot read the file ({exc.strerror or exc})") from None
-    check_time(log.time, source=path, tolerance=time_tolerance)
+    if time_tolerance is None:
+        check_increasing(log.time, source=path)
+    else:
+        check_time(log.time, source=path, tolerance=time_tolerance)
     check_finite(log)
     return log
 

@@ -28,9 +28,9 @@ import numpy as np
 
 from ..errors import LogError
 from .log import AxisLog, as_log_list
-from .validate import check_finite, check_time
+from .validate import check_finite, check_increasing, check_time, check_velocity_units
 
-__all__ = ["default_cutoff", "derive", "resample", "trim", "prepare"]
+__all__ = ["MAX_GAP_STEPS", "default_cutoff", "derive", "resample", "split_at_gaps", "trim", "prepare"]
 
 #: Default cut-off of the derivative filter for fast logs [Hz].
 DEFAULT_CUTOFF_HZ = 50.0
@@ -47,7 +47,7 @@ def _lowpass(values: np.ndarray, sos: np.ndarray) -> np.ndarray:
     return sosfiltfilt(sos, values)
 
 
-def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4) -> AxisLog:
+def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4, tolerance: float = 0.25) -> AxisLog:
     """Fill in velocity and acceleration where the log lacks them.
 
     Without logged velocity, the position is low-pass filtered (zero-phase
@@ -60,11 +60,13 @@ def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4) -> A
     Parameters
     ----------
     log : AxisLog
-        One run with a uniform time base.
+        One run with a uniform time base (the median step is taken as the sample time).
     cutoff_hz : float, optional
         Filter cut-off [Hz]; default :func:`default_cutoff` of the sample time.
     order : int, default 4
         Butterworth order (the forward-backward run doubles the attenuation).
+    tolerance : float, default 0.25
+        Time-step tolerance of the uniformity check (see :func:`check_time`).
 
     Returns
     -------
@@ -75,15 +77,15 @@ def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4) -> A
     Raises
     ------
     LogError
-        For a non-uniform time base, a cut-off not below the Nyquist
-        frequency, or a log too short for the filter.
+        For a time base that is not uniform within ``tolerance``, a cut-off
+        not below the Nyquist frequency, or a log too short for the filter.
     """
     if log.is_prepared:
         return log
     from scipy.signal import butter
 
     source = log.source or None
-    sample_time = check_time(log.time, source=source)
+    sample_time = check_time(log.time, source=source, tolerance=tolerance)
     nyquist = 0.5 / sample_time
     cutoff = default_cutoff(sample_time) if cutoff_hz is None else float(cutoff_hz)
     if not 0.0 < cutoff < nyquist:
@@ -171,14 +173,63 @@ def trim(log: AxisLog, start_s: float | None = None, stop_s: float | None = None
     return log.select(slice(index[0], index[-1] + 1))
 
 
+#: Default of ``max_gap_steps``: a step longer than this many nominal steps splits a resampled log into runs.
+MAX_GAP_STEPS = 5.0
+
+
+def split_at_gaps(log: AxisLog, max_gap_steps: float = MAX_GAP_STEPS) -> list[AxisLog]:
+    """Split one log into runs at every time step longer than ``max_gap_steps`` nominal (median) steps.
+
+    Parameters
+    ----------
+    log : AxisLog
+        One log with strictly increasing time (steps may vary).
+    max_gap_steps : float, default :data:`MAX_GAP_STEPS`
+        Longest step that stays inside a run, in nominal steps (> 1).
+
+    Returns
+    -------
+    list of AxisLog
+        The runs in time order; pieces of a single sample between two gaps are left out. Each run's
+        ``attrs["split"]`` says which piece of how many it is and from which time it starts [s].
+
+    Raises
+    ------
+    LogError
+        For time not strictly increasing, or when no piece keeps two samples.
+    """
+    if not max_gap_steps > 1.0:
+        raise ValueError(f"max_gap_steps must be larger than 1, got {max_gap_steps!r}")
+    source = log.source or None
+    steps = check_increasing(log.time, source=source)
+    cuts = np.flatnonzero(steps > max_gap_steps * float(np.median(steps))) + 1
+    if not cuts.size:
+        return [log]
+    edges = np.concatenate(([0], cuts, [len(log)]))
+    pieces = [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:]) if b - a >= 2]
+    if not pieces:
+        raise LogError(source, f"every stretch between the {cuts.size} gaps holds a single sample")
+    runs = []
+    for index, (a, b) in enumerate(pieces):
+        attrs = {**log.attrs, "split": {"run": index, "runs": len(pieces), "start_s": float(log.time[a]),
+                                        "max_gap_steps": float(max_gap_steps)}}
+        runs.append(log.select(slice(a, b)).replace(attrs=attrs))
+    return runs
+
+
 def prepare(
     logs: AxisLog | Iterable[AxisLog],
     *,
     cutoff_hz: float | None = None,
     sample_time: float | None = None,
     tolerance: float = 0.25,
+    max_gap_steps: float = MAX_GAP_STEPS,
 ) -> list[AxisLog]:
     """Validate, optionally resample, and derive velocity/acceleration, run by run.
+
+    A logged velocity is compared with d(position)/dt first: a factor of 1000 or 60 between them (metres
+    under a millimetre name, per minute under per second) is an error that names the probable unit slip
+    (:func:`~greybox.data.validate.check_velocity_units`).
 
     Parameters
     ----------
@@ -187,20 +238,28 @@ def prepare(
     cutoff_hz : float, optional
         Derivative-filter cut-off [Hz]; default :func:`default_cutoff`.
     sample_time : float, optional
-        Resample every run to this sample time [s] before deriving.
+        Resample to this sample time [s] before deriving: time stamps may then be irregular, and every
+        log is first split into runs at steps longer than ``max_gap_steps`` (:func:`split_at_gaps`).
+        Without it the time base must be uniform within ``tolerance``.
     tolerance : float, default 0.25
-        Time-step tolerance of the validation (see :func:`check_time`).
+        Time-step tolerance of the validation without resampling (see :func:`check_time`).
+    max_gap_steps : float, default :data:`MAX_GAP_STEPS`
+        With ``sample_time``: the longest step, in nominal steps, that is interpolated over.
 
     Returns
     -------
     list of AxisLog
-        Prepared runs (velocity and acceleration present), in input order.
+        Prepared runs (velocity and acceleration present), in input order; with ``sample_time`` a
+        log split at gaps gives several consecutive runs.
     """
     prepared = []
     for run in as_log_list(logs):
-        check_time(run.time, source=run.source or None, tolerance=tolerance)
         check_finite(run)
-        if sample_time is not None:
-            run = resample(run, sample_time)
-        prepared.append(derive(run, cutoff_hz=cutoff_hz))
+        check_velocity_units(run)
+        if sample_time is None:
+            check_time(run.time, source=run.source or None, tolerance=tolerance)
+            pieces = [run]
+        else:
+            pieces = [resample(piece, sample_time) for piece in split_at_gaps(run, max_gap_steps)]
+        prepared += [derive(piece, cutoff_hz=cutoff_hz, tolerance=tolerance) for piece in pieces]
     return prepared

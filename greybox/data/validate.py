@@ -7,7 +7,22 @@ import numpy as np
 from ..errors import LogError
 from .log import AxisLog
 
-__all__ = ["check_time", "check_finite"]
+__all__ = ["check_time", "check_increasing", "check_finite", "check_velocity_units", "UNIT_SLIPS"]
+
+#: Factors by which a logged velocity can disagree with d(position)/dt when one column's unit is wrong,
+#: and what the factor points to (the fix names the column's unit suffix, e.g. ``--columns position_m=NAME``).
+UNIT_SLIPS = {
+    1000.0: "the position is probably in m under a mm name (position_m=NAME), or the velocity in um/s",
+    1e-3: "the position is probably in um under a mm name (position_um=NAME), or the velocity in m/s "
+          "(velocity_m_s=NAME)",
+    60.0: "the velocity is probably in mm/min under a mm/s name (velocity_mm_min=NAME)",
+    1.0 / 60.0: "the velocity is probably in mm/s under a mm/min name (velocity_mm_s=NAME)",
+    1000.0 / 60.0: "the velocity is probably in mm/min while the position is in m, or in m/min mislabelled",
+    60.0 / 1000.0: "the velocity is probably in m/min under a mm/s name (velocity_m_min=NAME)",
+}
+
+#: Relative deviation of the factor from one of :data:`UNIT_SLIPS` that still counts as that slip.
+_SLIP_TOLERANCE = 0.15
 
 
 def check_time(time, *, source=None, tolerance: float = 0.25) -> float:
@@ -38,6 +53,48 @@ def check_time(time, *, source=None, tolerance: float = 0.25) -> float:
     if not 0.0 < tolerance < 1.0:
         raise ValueError(f"tolerance must lie in (0, 1), got {tolerance!r}")
     time = np.asarray(time, dtype=np.float64)
+    steps = check_increasing(time, source=source)
+    nominal = float(np.median(steps))
+    off = np.flatnonzero(np.abs(steps - nominal) > tolerance * nominal)
+    if off.size:
+        k = int(off[0])
+        if steps[k] > nominal:
+            raise LogError(
+                source,
+                f"gap of {steps[k] * 1e3:.6g} ms at t = {time[k]:.9g} s (nominal step {nominal * 1e3:.6g} ms, "
+                f"tolerance {tolerance:.0%}); --resample S splits the log into runs at gaps longer than "
+                "--max-gap steps and resamples the rest",
+            )
+        raise LogError(
+            source,
+            f"time step jitter: step of {steps[k] * 1e3:.6g} ms at t = {time[k]:.9g} s deviates from the "
+            f"nominal {nominal * 1e3:.6g} ms by more than {tolerance:.0%}; --resample S puts the log on a "
+            "uniform grid",
+        )
+    return nominal
+
+
+def check_increasing(time, *, source=None) -> np.ndarray:
+    """Check that there are at least 2 sample times, finite and strictly increasing; return the steps [s].
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Sample times [s].
+    source : str or path-like, optional
+        File the times came from, named in the error message.
+
+    Returns
+    -------
+    ndarray, shape (n - 1,)
+        Time steps [s], all positive.
+
+    Raises
+    ------
+    LogError
+        For fewer than 2 samples, non-finite times, time going backwards or repeating.
+    """
+    time = np.asarray(time, dtype=np.float64)
     n = time.shape[0]
     if n < 2:
         raise LogError(source, f"the log has {n} sample{'s' if n != 1 else ''}; at least 2 are needed")
@@ -52,22 +109,7 @@ def check_time(time, *, source=None, tolerance: float = 0.25) -> float:
         if steps[k - 1] == 0.0:
             raise LogError(source, f"time repeats at sample {k}: t = {time[k]:.9g} s twice")
         raise LogError(source, f"time goes backwards at sample {k}: t = {time[k]:.9g} s after {time[k - 1]:.9g} s")
-    nominal = float(np.median(steps))
-    off = np.flatnonzero(np.abs(steps - nominal) > tolerance * nominal)
-    if off.size:
-        k = int(off[0])
-        if steps[k] > nominal:
-            raise LogError(
-                source,
-                f"gap of {steps[k] * 1e3:.6g} ms at t = {time[k]:.9g} s (nominal step {nominal * 1e3:.6g} ms, "
-                f"tolerance {tolerance:.0%}); split the log into runs at the gap",
-            )
-        raise LogError(
-            source,
-            f"time step jitter: step of {steps[k] * 1e3:.6g} ms at t = {time[k]:.9g} s deviates from the "
-            f"nominal {nominal * 1e3:.6g} ms by more than {tolerance:.0%}; resample the log to a uniform grid",
-        )
-    return nominal
+    return steps
 
 
 def check_finite(log: AxisLog) -> None:
@@ -99,3 +141,43 @@ def check_finite(log: AxisLog) -> None:
                 f"channel '{name}' holds {values[k]} at t = {log.time[k]:.9g} s (sample {k}; "
                 f"{bad.size} non-finite value{'s' if bad.size != 1 else ''} in all)",
             )
+
+
+def check_velocity_units(log: AxisLog) -> float | None:
+    """Compare a logged velocity with d(position)/dt; name a probable unit error.
+
+    Parameters
+    ----------
+    log : AxisLog
+        One run, time strictly increasing (steps may vary); checked only when it carries a velocity.
+
+    Returns
+    -------
+    float or None
+        The factor ``k`` of the least-squares fit ``v_logged = k d(position)/dt`` over the samples in
+        motion; None when there is no logged velocity or too little motion to tell.
+
+    Raises
+    ------
+    LogError
+        When ``k`` lies within 15 % of a factor of :data:`UNIT_SLIPS` (a column in the wrong unit: the
+        message names the factor and the column name that fixes it) or near -1 (velocity of the
+        opposite sign).
+    """
+    if log.velocity is None or len(log) < 3:
+        return None
+    slope = np.gradient(log.position, log.time)
+    moving = np.abs(slope) > 0.1 * np.percentile(np.abs(slope), 99)
+    if np.count_nonzero(moving) < 50:
+        return None
+    d, v = slope[moving], log.velocity[moving]
+    k = float(v @ d / (d @ d))
+    source = log.source or None
+    if abs(k + 1.0) < _SLIP_TOLERANCE:
+        raise LogError(source, f"the logged velocity has the opposite sign of d(position)/dt (factor {k:.3g}); "
+                               "check the sign convention of the velocity column")
+    for factor, reason in UNIT_SLIPS.items():
+        if k > 0 and abs(np.log(k / factor)) < np.log1p(_SLIP_TOLERANCE):
+            raise LogError(source, f"the logged velocity is {k:.4g} x d(position)/dt: {reason}; give the column "
+                                   "its unit with --columns")
+    return k

@@ -49,7 +49,7 @@ table (e.g. the cutting force along the axis) is its opposite.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -202,7 +202,7 @@ def extrapolation_summary(regions: dict, n_samples: int) -> dict:
             "warn_above": EXTRAPOLATION_WARNING_SHARE}
 
 
-def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = None,
+def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: AxisConfig | None = None,
                     interval: ProcessInterval | None = None, chunk_s: float = DEFAULT_CHUNK_S,
                     progress: Callable[[int, int, float], None] | None = None) -> ProcessResult:
     """Process share of the current of a cutting log, and its force.
@@ -211,8 +211,10 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
     ----------
     model : CurrentModel
         A fitted model (trained on air cuts) of a registered kind.
-    log : AxisLog
-        One prepared run recorded while cutting.
+    log : AxisLog or sequence of AxisLog
+        One prepared run recorded while cutting, or the consecutive runs of one log split at gaps
+        (:func:`greybox.data.prepare.split_at_gaps`): each is predicted from the model's initial state,
+        and the result holds them one after the other.
     axis_config : AxisConfig, optional
         Drive-train constants; gives ``force`` for a current log.
     interval : ProcessInterval, optional
@@ -232,29 +234,43 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
     Raises
     ------
     GreyboxError
-        For several runs, or axis metadata given with a log that already
-        carries force.
+        For runs of different effort units, or axis metadata given with a log that already carries force.
     """
     runs = as_log_list(log)
-    if len(runs) != 1:
-        raise GreyboxError(f"predict_process takes one run, got {len(runs)}; call it once per log")
-    (run,) = runs
-    n_chunks = len(chunk_slices(len(run), samples_per_chunk(run.sample_time, chunk_s)))
-    predicted = np.empty(len(run))
-    for done, (samples, current) in enumerate(iter_chunks(model, run, chunk_s=chunk_s), start=1):
-        predicted[samples] = current
-        if progress is not None:
-            progress(done, n_chunks, float(run.time[samples.stop - 1]))
-    force = None
-    factors = None
+    unit = runs[0].effort_unit
+    for run in runs:
+        if run.effort_unit != unit:
+            raise GreyboxError(f"{run.source or '<in-memory log>'}: the runs mix effort units")
+    if unit == "N" and axis_config is not None:
+        raise GreyboxError(f"{runs[0].source or '<in-memory log>'}: the log carries force in N already; "
+                           "axis metadata convert a current and do not apply")
+    n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, chunk_s))) for run in runs)
+    done = 0
+    predicted = []
+    for run in runs:
+        out = np.empty(len(run))
+        for samples, current in iter_chunks(model, run, chunk_s=chunk_s):
+            out[samples] = current
+            done += 1
+            if progress is not None:
+                progress(done, n_chunks, float(run.time[samples.stop - 1]))
+        predicted.append(out)
+
+    def joined(values):
+        return np.concatenate(values)
+
+    time, position, velocity, effort = (joined([getattr(run, name) for run in runs])
+                                        for name in ("time", "position", "velocity", "effort"))
+    model_current = joined(predicted)
+    process = effort - model_current
+    force = factors = None
     attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s)}
-    if run.effort_unit == "N":
-        if axis_config is not None:
-            raise GreyboxError(f"{run.source or '<in-memory log>'}: the log carries force in N already; "
-                               "axis metadata convert a current and do not apply")
-        force = run.effort - predicted
+    if len(runs) > 1:
+        attrs["runs"] = [{"start_s": float(run.time[0]), "samples": len(run)} for run in runs]
+    if unit == "N":
+        force = process
     elif axis_config is not None:
-        force = axis_config.process_force_N(run.effort - predicted, run.velocity)
+        force = axis_config.process_force_N(process, velocity)
         factors = axis_config.force_constants_N_per_A
         attrs["axis_config"] = {"source": axis_config.source,
                                 "torque_constant_Nm_per_A": axis_config.torque_constant_Nm_per_A,
@@ -263,20 +279,21 @@ def predict_process(model, log: AxisLog, *, axis_config: AxisConfig | None = Non
                                 "efficiency_backdriven": axis_config.efficiency_backdriven,
                                 "force_constant_driving_N_per_A": factors[0],
                                 "force_constant_backdriven_N_per_A": factors[1]}
-    regions = model.outside_training(run)
+    per_run = [model.outside_training(run) for run in runs]
+    regions = {name: joined([flags[name] for flags in per_run]) for name in per_run[0]}
     outside = np.logical_or.reduce(list(regions.values())) if regions else None
-    attrs["extrapolation"] = extrapolation_summary(regions, len(run))
+    attrs["extrapolation"] = extrapolation_summary(regions, len(time))
     half_width = force_bounds = None
     if interval is not None:
-        half_width = interval.half_widths(run)
+        half_width = joined([interval.half_widths(run) for run in runs])
         attrs["interval"] = interval.to_dict()
         if factors is not None:
-            process = run.effort - predicted
-            force_bounds = (axis_config.process_force_N(process - half_width, run.velocity),
-                            axis_config.process_force_N(process + half_width, run.velocity))
-    return ProcessResult(time=run.time, position=run.position, velocity=run.velocity, measured=run.effort,
-                         model=predicted, force=force, effort_unit=run.effort_unit,
+            force_bounds = (axis_config.process_force_N(process - half_width, velocity),
+                            axis_config.process_force_N(process + half_width, velocity))
+    first = runs[0]
+    return ProcessResult(time=time, position=position, velocity=velocity, measured=effort,
+                         model=model_current, force=force, effort_unit=unit,
                          force_constants_N_per_A=factors,
-                         axis=run.axis or (axis_config.name if axis_config is not None else ""),
-                         source=run.source, attrs=attrs, dataset=run.dataset or "", half_width=half_width,
+                         axis=first.axis or (axis_config.name if axis_config is not None else ""),
+                         source=first.source, attrs=attrs, dataset=first.dataset or "", half_width=half_width,
                          force_bounds=force_bounds, outside=outside)
