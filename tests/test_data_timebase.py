@@ -145,3 +145,12 @@ def test_a_unit_slip_between_velocity_and_position_is_named(scale, column, messa
     assert cli.main(["info", str(path)]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and message in err and "--columns" in err or "opposite" in err
+
+
+def test_resampling_a_log_already_on_the_grid_changes_nothing(uniform):
+    raw, reference = uniform
+    logged = make_dataset("X", "C", seed=41, duration_s=20)  # with its logged velocity, ending at rest
+    (again,) = prepare([logged], sample_time=STEP)
+    (plain,) = prepare([logged])
+    np.testing.assert_array_equal(again.velocity, plain.velocity)
+    np.testing.assert_array_equal(again.time, plain.time)

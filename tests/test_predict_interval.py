@@ -129,3 +129,22 @@ def test_interval_without_calibration_is_refused(cli_files, capsys):
     status = cli.main(["predict", str(cli_files / "m.gbm"), str(cli_files / "cut.mcap"), "--out",
                        str(cli_files / "x.csv"), "--interval", "0.9"])
     assert status == 2 and "--interval needs --calibration" in capsys.readouterr().err
+
+
+def test_the_cutting_log_is_no_calibration_and_pooled_classes_are_said(cli_files, capsys):
+    model, log = cli_files / "m.gbm", cli_files / "cut.mcap"
+    status = cli.main(["predict", str(model), str(log), "--out", str(cli_files / "y.csv"), "--calibration", str(log)])
+    err = capsys.readouterr().err
+    assert status == 2 and "is the cutting log itself" in err
+    status = cli.main(["predict", str(model), str(log), "--out", str(cli_files / "z.csv"), "--calibration",
+                       str(cli_files / "air.mcap"), "--quiet"])
+    out = capsys.readouterr().out
+    assert status == 0
+    line = next(text for text in out.splitlines() if text.startswith("  interval"))
+    assert ("pooled" in line) == any(n < 200 for n in _samples(cli_files / "z.csv.json").values())
+
+
+def _samples(sidecar):
+    import json
+
+    return json.loads(Path(sidecar).read_text())["attrs"]["interval"]["calibration_samples"]

@@ -131,6 +131,11 @@ def run(args: argparse.Namespace) -> int:
     if args.calibration:
         from ..evaluate.interval import calibrate_interval
 
+        own = [path for path in args.calibration if Path(path).resolve() == Path(args.log).resolve()]
+        if own:
+            raise GreyboxError(f"--calibration: {own[0]} is the cutting log itself; calibrate on air cuts the "
+                               "model was not trained on")
+
         interval = calibrate_interval(model, [run for path in args.calibration
                                               for run in _read_runs(args, config.channels if config else {}, path)],
                                       coverage=DEFAULT_COVERAGE if args.interval is None else args.interval,
@@ -161,7 +166,12 @@ def run(args: argparse.Namespace) -> int:
               f"({factors} from {Path(args.axis_config).name})")
     _report_extrapolation(result.attrs["extrapolation"], Path(args.log).name)
     if interval is not None:
-        widths = ", ".join(f"{name.replace('_', ' ')} {value:.3g}" for name, value in interval.half_width_A.items())
+        from ..evaluate.interval import MIN_CLASS_SAMPLES
+
+        widths = ", ".join(f"{name.replace('_', ' ')} {value:.3g}"
+                           + ("" if interval.samples[name] >= MIN_CLASS_SAMPLES
+                              else f" (pooled: {interval.samples[name]} samples)")
+                           for name, value in interval.half_width_A.items())
         print(f"  interval {100 * interval.coverage:g} % (split conformal per regime on "
               f"{sum(interval.samples.values())} air-cut samples of {len(args.calibration)} log(s)): "
               f"half-width [{unit}] {widths}; mean {np.mean(result.half_width):.3g} {unit}")
@@ -187,7 +197,8 @@ def _report_extrapolation(summary: dict, log_name: str) -> None:
     if summary["share"] > summary["warn_above"]:
         print(f"note: {log_name}: {100 * summary['share']:.1f} % of the samples lie outside the positions, speeds "
               f"or inputs the model was trained on (more than {100 * summary['warn_above']:g} %): the model "
-              "extrapolates there (column outside_training); train on air cuts that cover the cutting programme",
+              "extrapolates there (column outside_training); train on air cuts that cover the cutting programme, "
+              "or check the units of position and velocity (--columns)",
               file=sys.stderr)
 
 

@@ -54,9 +54,9 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--cutting-strength", type=NON_NEGATIVE, default=CuttingSpec.strength_A, metavar="A",
                         help="mean process current [A] at 1000 mm/min feed (default %(default)s)")
     parser.add_argument("--cutting-return-pass", type=SIGNED_FRACTION, default=CuttingSpec.return_pass, metavar="R",
-                        help="process force on the return stroke relative to the cutting stroke's, in [-1, 1]: 0 an "
-                        "air cut (default), > 0 opposing the motion too, < 0 pushing the table along it (climb "
-                        "milling; the screw is back-driven)")
+                        help="process current on the return stroke relative to the cutting stroke's at the same feed, "
+                        "in [-1, 1]: 0 an air cut (default), > 0 a force opposing the motion too, < 0 one pushing "
+                        "the table along it (climb milling; the screw is back-driven)")
     parser.add_argument("--spindle-rpm", type=POSITIVE, default=CuttingSpec.spindle_rpm, metavar="RPM",
                         help="spindle speed [1/min] of the tooth-passing ripple (default %(default)s)")
     parser.add_argument("--teeth", type=POSITIVE_INT, default=CuttingSpec.teeth, metavar="Z",

@@ -46,10 +46,10 @@ QUANTITIES = {
     "screw_lead_mm": ("screw lead h", "mm", "table travel per screw revolution"),
     "gear_ratio": ("gear ratio i", "motor revolutions per screw revolution",
                    "1.0 for a motor coupled directly to the screw"),
-    "efficiency_driving": ("efficiency eta_d while the motor drives the table against the load",
-                           "fraction, 0 < eta <= 1", "about 0.9 for a ball screw"),
-    "efficiency_backdriven": ("efficiency eta_b while the load drives the table and the motor brakes",
-                              "fraction, 0 < eta <= 1", "about 0.85 for a ball screw, below eta_d"),
+    "efficiency_driving": ("driving efficiency eta_d", "a fraction, 0 < eta <= 1",
+                           "the motor pushes the table against the load; about 0.9 for a ball screw"),
+    "efficiency_backdriven": ("back-driven efficiency eta_b", "a fraction, 0 < eta <= 1",
+                              "the load pushes the table along, the motor brakes; about 0.85, below eta_d"),
 }
 
 #: One efficiency for both directions (older axis files): stands for both keys above.

@@ -140,6 +140,8 @@ def resample(log: AxisLog, sample_time: float) -> AxisLog:
                                "cannot resample")
     count = int(np.floor((log.time[-1] - log.time[0]) / sample_time * (1 + 1e-12))) + 1
     grid = log.time[0] + np.arange(count) * sample_time
+    if count == len(log) and np.allclose(log.time, grid, rtol=0.0, atol=1e-9 * sample_time):
+        return log  # already on the grid: rounding of the time stamps must not interpolate every channel
 
     def interp(values):
         return None if values is None else np.interp(grid, log.time, values)

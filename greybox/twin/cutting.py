@@ -56,9 +56,11 @@ class CuttingSpec:
     cutting_direction : {-1, 1}, default -1
         Feed direction in which the tool cuts.
     return_pass : float, default 0.0
-        Process force on the return stroke relative to the cutting stroke's
-        at the same feed, ``r`` in [-1, 1]: 0 an air cut, positive opposing
-        the motion, negative pushing the table along (back-driving the screw).
+        Process current on the return stroke relative to the cutting
+        stroke's at the same feed, ``r`` in [-1, 1]: 0 an air cut, positive a
+        force opposing the motion, negative one pushing the table along
+        (back-driving the screw; the force behind the current then differs
+        by the efficiencies, :mod:`greybox.twin.drive`).
     """
 
     strength_A: float = 0.5
