@@ -40,7 +40,7 @@ def test_format_override_and_inapplicable_options(tmp_path, make_log):
     write_log(make_log(n=50), path, fmt="csv")
     assert len(read_log(path, fmt="csv")) == 50
     assert_read_fails(path, "option 'topic' does not apply to csv files", fmt="csv", topic="/axis/X")
-    assert format_of("a.PQ") == "parquet" and format_of("b.mat") == "emps"
+    assert format_of("a.PQ") == "parquet" and format_of("b.mat") == "mat"
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet", ".mcap"])

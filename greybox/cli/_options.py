@@ -77,7 +77,7 @@ def read_logs(args: argparse.Namespace, paths, *, prepare: bool = True) -> list[
     args : argparse.Namespace
         Parsed options added by :func:`add_log_arguments`.
     paths : iterable of str
-        Log files (CSV, Parquet, MCAP, EMPS ``.mat``).
+        Log files (CSV, Parquet, MCAP, MATLAB ``.mat``).
     prepare : bool, default True
         Derive velocity and acceleration (and resample when asked).
 

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import LogError
 from .log import AxisLog
 
-__all__ = ["read_emps", "EMPS_VARIABLES"]
+__all__ = ["read_emps", "emps_log", "EMPS_VARIABLES"]
 
 #: Variables every EMPS file must hold.
 EMPS_VARIABLES = ("t", "qm", "vir", "gtau")
@@ -44,13 +44,30 @@ def read_emps(path) -> AxisLog:
     LogError
         For a file that is not a MATLAB file or lacks a required variable.
     """
-    from scipy.io import loadmat
-    from scipy.io.matlab import MatReadError
+    from .mat_io import load_mat_variables
 
-    try:
-        variables = loadmat(path)
-    except (MatReadError, ValueError, TypeError, NotImplementedError, OSError, EOFError) as exc:
-        raise LogError(path, f"not a readable MATLAB .mat file ({exc})") from None
+    return emps_log(load_mat_variables(path), path)
+
+
+def emps_log(variables, path) -> AxisLog:
+    """The EMPS log of a ``.mat`` file's variables (see :func:`read_emps`).
+
+    Parameters
+    ----------
+    variables : mapping of str to ndarray
+        The file's variables (:func:`greybox.data.mat_io.load_mat_variables`).
+    path : str or path-like
+        The file, for the log's source and error messages.
+
+    Returns
+    -------
+    AxisLog
+
+    Raises
+    ------
+    LogError
+        For a missing variable, or one of the wrong shape.
+    """
     missing = [name for name in EMPS_VARIABLES if name not in variables]
     if missing:
         found = sorted(name for name in variables if not name.startswith("__"))

@@ -6,7 +6,8 @@ format      extensions            reader options
 ``csv``     ``.csv``              ``columns``, ``sample_time``
 ``parquet`` ``.parquet``, ``.pq`` ``columns``, ``sample_time``
 ``mcap``    ``.mcap``             ``columns``, ``topic``
-``emps``    ``.mat``              none (EMPS benchmark files; read only)
+``mat``     ``.mat``              ``columns``, ``sample_time`` (MATLAB 4, 5 or 7.3; read only;
+                                  EMPS benchmark files read as such)
 =========== ===================== ===========================================
 
 :func:`read_log` validates what it reads (uniform time base, finite values),
@@ -32,14 +33,14 @@ from .validate import check_finite, check_increasing, check_time
 __all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS"]
 
 #: File extensions of each format.
-FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",), "emps": (".mat",)}
+FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",), "mat": (".mat",)}
 
 # format -> (module, reader, writer or None, reader options)
 _HANDLERS = {
     "csv": ("csv_io", "read_csv", "write_csv", ("columns", "sample_time")),
     "parquet": ("parquet_io", "read_parquet", "write_parquet", ("columns", "sample_time")),
     "mcap": ("mcap_io", "read_mcap", "write_mcap", ("columns", "topic")),
-    "emps": ("emps", "read_emps", None, ()),
+    "mat": ("matlab", "read_mat", None, ("columns", "sample_time")),
 }
 
 
@@ -96,7 +97,7 @@ def read_log(
     time_tolerance : float or None, default 0.25
         Allowed deviation of a time step from the nominal step (fraction); None accepts any strictly
         increasing time (a log to be resampled, :func:`greybox.data.prepare.prepare`).
-    fmt : {"csv", "parquet", "mcap", "emps"}, optional
+    fmt : {"csv", "parquet", "mcap", "mat"}, optional
         Format, overriding the extension.
 
     Returns
