@@ -30,7 +30,7 @@ def add_log_arguments(parser: argparse.ArgumentParser, *, prepare: bool = True) 
         help="column mapping for exports with other headers, e.g. "
         "'position_mm=X1_ActualPosition,current_A=X1_CurrentFeedback' (CSV, Parquet, MCAP fields)",
     )
-    group.add_argument("--topic", help="MCAP topic (channel) to read when a file holds several axes")
+    group.add_argument("--topic", help="MCAP topic (channel) or TDMS group to read when a file holds several axes")
     group.add_argument(
         "--sample-time",
         type=positive("seconds"),
@@ -77,7 +77,7 @@ def read_logs(args: argparse.Namespace, paths, *, prepare: bool = True) -> list[
     args : argparse.Namespace
         Parsed options added by :func:`add_log_arguments`.
     paths : iterable of str
-        Log files (CSV, Parquet, MCAP, MATLAB ``.mat``).
+        Log files (CSV, Parquet, MCAP, TDMS, MATLAB ``.mat``).
     prepare : bool, default True
         Derive velocity and acceleration (and resample when asked).
 

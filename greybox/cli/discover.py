@@ -36,7 +36,7 @@ def add_parser(subparsers) -> None:
                         help="kind of the base model: " + ", ".join(sorted(MODEL_CLASSES)) + " (its linear "
                         "parameters are refitted with the effects; svr and gmssvr have none and refit slowly)")
     parser.add_argument("--train", required=True, nargs="+", metavar="LOG",
-                        help="training logs (CSV, Parquet, MCAP or MATLAB .mat), each a separate run")
+                        help="training logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat), each a separate run")
     parser.add_argument("--test", required=True, nargs="+", metavar="LOG", help="test logs, each a separate run")
     parser.add_argument("--json", required=True, metavar="OUT", help="JSON file of the findings to write")
     parser.add_argument("--out", metavar="DIR", help="also write a report into DIR: the JSON and residual plots")

@@ -24,7 +24,7 @@ def add_parser(subparsers) -> None:
     )
     parser.add_argument("models", nargs="+", metavar="MODEL", help="model files written by 'greybox train'")
     parser.add_argument("--test", required=True, nargs="+", metavar="LOG",
-                        help="test logs (CSV, Parquet, MCAP or MATLAB .mat); their errors are pooled")
+                        help="test logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat); their errors are pooled")
     parser.add_argument("--out", metavar="DIR", help="write a report (tables, figures, HTML page) into DIR")
     parser.add_argument("--json", metavar="FILE", help="write the metric records (with regimes) to FILE")
     parser.add_argument("--force", action="store_true",

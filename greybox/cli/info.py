@@ -18,7 +18,7 @@ def add_parser(subparsers) -> None:
         help="summarise logs",
         description="Print one line per log: samples, step, duration, position, velocity and effort ranges.",
     )
-    parser.add_argument("logs", nargs="+", metavar="LOG", help="log files (CSV, Parquet, MCAP or MATLAB .mat)")
+    parser.add_argument("logs", nargs="+", metavar="LOG", help="log files (CSV, Parquet, MCAP, TDMS or MATLAB .mat)")
     parser.add_argument("--json", action="store_true", help="print one JSON object per log instead of a table")
     add_log_arguments(parser)
     parser.set_defaults(run=run)

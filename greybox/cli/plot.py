@@ -19,7 +19,7 @@ def add_parser(subparsers) -> None:
         description="Draw position, velocity and current over time, and current over velocity. A long log is "
         "drawn as its envelope (minimum and maximum of each pixel column); --window draws a stretch of it.",
     )
-    parser.add_argument("log", metavar="LOG", help="log file (CSV, Parquet, MCAP or MATLAB .mat)")
+    parser.add_argument("log", metavar="LOG", help="log file (CSV, Parquet, MCAP, TDMS or MATLAB .mat)")
     parser.add_argument("--out", required=True, metavar="PNG",
                         help="picture to write (.png, .svg or .pdf); an existing file is kept unless --force")
     parser.add_argument("--force", action="store_true", help="overwrite PNG if it exists")

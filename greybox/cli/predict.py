@@ -33,7 +33,7 @@ def add_parser(subparsers) -> None:
         "of --chunk-s seconds carrying its state, so long logs need little working memory.",
     )
     parser.add_argument("model", metavar="MODEL", help="model file written by 'greybox train' (.gbm)")
-    parser.add_argument("log", metavar="LOG", help="cutting log (CSV, Parquet, MCAP or MATLAB .mat)")
+    parser.add_argument("log", metavar="LOG", help="cutting log (CSV, Parquet, MCAP, TDMS or MATLAB .mat)")
     parser.add_argument("--out", required=True, metavar="OUT",
                         help="table to write: .csv, .parquet or .mcap (CSV: plain, header first, metadata in "
                         "OUT.json beside it; MCAP: one message per sample, topic /process/<axis>)")

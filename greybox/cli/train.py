@@ -26,7 +26,8 @@ def add_parser(subparsers) -> None:
     )
     parser.add_argument("--model", required=True, choices=sorted(MODEL_CLASSES), help="model kind")
     parser.add_argument(
-        "--train", required=True, nargs="+", metavar="LOG", help="training logs (CSV, Parquet, MCAP or MATLAB .mat)"
+        "--train", required=True, nargs="+", metavar="LOG",
+        help="training logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat)"
     )
     parser.add_argument(
         "--stage2",

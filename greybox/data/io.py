@@ -8,6 +8,7 @@ format      extensions            reader options
 ``mcap``    ``.mcap``             ``columns``, ``topic``
 ``mat``     ``.mat``              ``columns``, ``sample_time`` (MATLAB 4, 5 or 7.3; read only;
                                   EMPS benchmark files read as such)
+``tdms``    ``.tdms``             ``columns``, ``topic`` (the group), ``sample_time`` (read only)
 =========== ===================== ===========================================
 
 :func:`read_log` validates what it reads (uniform time base, finite values),
@@ -33,7 +34,7 @@ from .validate import check_finite, check_increasing, check_time
 __all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS"]
 
 #: File extensions of each format.
-FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",), "mat": (".mat",)}
+FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",), "mat": (".mat",), "tdms": (".tdms",)}
 
 # format -> (module, reader, writer or None, reader options)
 _HANDLERS = {
@@ -41,6 +42,7 @@ _HANDLERS = {
     "parquet": ("parquet_io", "read_parquet", "write_parquet", ("columns", "sample_time")),
     "mcap": ("mcap_io", "read_mcap", "write_mcap", ("columns", "topic")),
     "mat": ("matlab", "read_mat", None, ("columns", "sample_time")),
+    "tdms": ("tdms_io", "read_tdms", None, ("columns", "topic", "sample_time")),
 }
 
 
@@ -97,7 +99,7 @@ def read_log(
     time_tolerance : float or None, default 0.25
         Allowed deviation of a time step from the nominal step (fraction); None accepts any strictly
         increasing time (a log to be resampled, :func:`greybox.data.prepare.prepare`).
-    fmt : {"csv", "parquet", "mcap", "mat"}, optional
+    fmt : {"csv", "parquet", "mcap", "mat", "tdms"}, optional
         Format, overriding the extension.
 
     Returns

@@ -1,0 +1,92 @@
+"""TDMS axis logs (National Instruments, e.g. a CompactRIO recording a SINUMERIK axis data stream), via npTDMS.
+
+A TDMS file holds groups of channels. One group is one log: the group named
+by ``topic`` (``--topic``), or the file's only group. Its channels are the
+columns, named like CSV columns (``position_mm``, ``current_A``, any supported
+unit suffix) or mapped with ``columns`` (``--columns
+position_mm=X1_Pos,current_A=X1_Iq``). Time comes from a time channel
+(``time_s`` or mapped), else from the channels' waveform properties
+(``wf_start_offset`` and ``wf_increment``, as LabVIEW writes waveforms), else
+from ``sample_time``. Only numeric channels of the group's common length are
+columns.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from ..errors import LogError
+from .log import AxisLog
+from .units import log_from_columns, parse_column_name
+
+__all__ = ["read_tdms"]
+
+
+def _group(tdms, path, topic: str | None):
+    groups = tdms.groups()
+    names = [group.name for group in groups]
+    if topic is not None:
+        for group in groups:
+            if group.name == topic:
+                return group
+        raise LogError(path, f"no TDMS group '{topic}'; the file holds {', '.join(names) or 'none'}")
+    if len(groups) != 1:
+        listed = ", ".join(names) or "none"
+        raise LogError(path, f"the file holds {len(groups)} TDMS groups ({listed}); choose one with --topic GROUP")
+    return groups[0]
+
+
+def _has_time_column(names, columns: Mapping[str, str] | None) -> bool:
+    mapped = {parse_column_name(key)[0] for key in (columns or {}) if parse_column_name(key)}
+    conventional = any((parse_column_name(name) or (None,))[0] == "time" for name in names)
+    return "time" in mapped or conventional
+
+
+def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | None = None,
+              sample_time: float | None = None) -> AxisLog:
+    """Read one group of a TDMS file as an axis log.
+
+    Parameters
+    ----------
+    path : str or path-like
+        TDMS file.
+    columns : mapping of str to str, optional
+        ``{canonical_name: channel}`` for channels not named by the convention.
+    topic : str, optional
+        Group to read; required when the file holds several.
+    sample_time : float, optional
+        Sample time [s] for a group with neither a time channel nor waveform properties.
+
+    Returns
+    -------
+    AxisLog
+        Not yet validated; :func:`greybox.data.io.read_log` validates.
+
+    Raises
+    ------
+    LogError
+        For a file that is not TDMS, a missing or ambiguous group, or missing channels.
+    """
+    from nptdms import TdmsFile
+
+    try:
+        tdms = TdmsFile.read(path)
+    except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on corrupt files
+        raise LogError(path, f"not a readable TDMS file ({type(exc).__name__}: {exc})") from None
+    group = _group(tdms, path, topic)
+    channels = [channel for channel in group.channels() if np.asarray(channel[:]).dtype.kind in "biuf"]
+    if not channels:
+        raise LogError(path, f"TDMS group '{group.name}' holds no numeric channel")
+    lengths = [len(channel) for channel in channels]
+    common = max(set(lengths), key=lengths.count)
+    table = {channel.name: np.asarray(channel[:], dtype=np.float64) for channel in channels if len(channel) == common}
+    time = None
+    if not _has_time_column(table, columns) and sample_time is None:
+        first = next(channel for channel in channels if len(channel) == common)
+        if "wf_increment" in first.properties:
+            time = np.asarray(first.time_track(), dtype=np.float64)
+    return log_from_columns(table, source=str(path), columns=columns, time=time, sample_time=sample_time,
+                            dataset=Path(path).stem, axis=group.name if topic is not None else "")
