@@ -40,9 +40,8 @@ def _group(tdms, path, topic: str | None):
 
 
 def _has_time_column(names, columns: Mapping[str, str] | None) -> bool:
-    mapped = {parse_column_name(key)[0] for key in (columns or {}) if parse_column_name(key)}
-    conventional = any((parse_column_name(name) or (None,))[0] == "time" for name in names)
-    return "time" in mapped or conventional
+    """True if a channel name, or a key of the mapping, names the time."""
+    return any((parse_column_name(name) or (None,))[0] == "time" for name in [*names, *(columns or {})])
 
 
 def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | None = None,
@@ -77,16 +76,16 @@ def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | No
     except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on corrupt files
         raise LogError(path, f"not a readable TDMS file ({type(exc).__name__}: {exc})") from None
     group = _group(tdms, path, topic)
-    channels = [channel for channel in group.channels() if np.asarray(channel[:]).dtype.kind in "biuf"]
-    if not channels:
+    numeric = [(channel, data) for channel, data in ((channel, np.asarray(channel[:])) for channel in group.channels())
+               if data.dtype.kind in "biuf"]
+    if not numeric:
         raise LogError(path, f"TDMS group '{group.name}' holds no numeric channel")
-    lengths = [len(channel) for channel in channels]
+    lengths = [data.size for _, data in numeric]
     common = max(set(lengths), key=lengths.count)
-    table = {channel.name: np.asarray(channel[:], dtype=np.float64) for channel in channels if len(channel) == common}
+    kept = [(channel, data) for channel, data in numeric if data.size == common]
+    table = {channel.name: data.astype(np.float64) for channel, data in kept}
     time = None
-    if not _has_time_column(table, columns) and sample_time is None:
-        first = next(channel for channel in channels if len(channel) == common)
-        if "wf_increment" in first.properties:
-            time = np.asarray(first.time_track(), dtype=np.float64)
+    if not _has_time_column(table, columns) and sample_time is None and "wf_increment" in kept[0][0].properties:
+        time = np.asarray(kept[0][0].time_track(), dtype=np.float64)
     return log_from_columns(table, source=str(path), columns=columns, time=time, sample_time=sample_time,
                             dataset=Path(path).stem, axis=group.name if topic is not None else "")

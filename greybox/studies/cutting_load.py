@@ -56,6 +56,7 @@ from ..data.prepare import prepare
 from ..evaluate.interval import calibrate_interval
 from ..evaluate.process import predict_process
 from ..evaluate.report import MODEL_LABELS
+from ..metrics import rmse
 from ..twin.cutting import CuttingSpec
 from ..twin.family import draw_member, member_dataset
 from .experiments import EXPERIMENTS, MODEL_SETTINGS, Experiment, run_experiments
@@ -86,11 +87,6 @@ EXPERIMENT = replace(EXPERIMENTS[1], models=tuple(m for m in EXPERIMENTS[1].mode
                                                   if m.name in ("stribeck", "gms", "gmssvr")), test=("D",))
 
 
-def _rms(values) -> float:
-    values = np.asarray(values, float)
-    return float(np.sqrt(np.mean(values * values))) if values.size else float("nan")
-
-
 def _pass_errors(estimate, truth, velocity) -> dict:
     """Mean force error [%] per pass direction and RMS error [%] over the cut."""
     in_cut = truth != 0.0
@@ -101,7 +97,7 @@ def _pass_errors(estimate, truth, velocity) -> dict:
         out[name] = {"true_mean_N": true_mean, "estimated_mean_N": float(np.mean(estimate[chosen])),
                      "mean_error_pct": 100.0 * (float(np.mean(estimate[chosen])) - true_mean) / abs(true_mean),
                      "samples": int(np.count_nonzero(chosen))}
-    out["rms_error_pct"] = 100.0 * _rms((estimate - truth)[in_cut]) / _rms(truth[in_cut])
+    out["rms_error_pct"] = 100.0 * rmse(truth[in_cut], estimate[in_cut]) / rmse(truth[in_cut], 0.0 * truth[in_cut])
     return out
 
 
