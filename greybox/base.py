@@ -41,10 +41,13 @@ from dataclasses import dataclass
 import numpy as np
 from sklearn.base import BaseEstimator
 
-__all__ = ["EFFORT", "LinearPart", "ModelProtocol", "Parameter", "PlantLaw"]
+__all__ = ["EFFORT", "LENGTH", "LinearPart", "ModelProtocol", "Parameter", "PlantLaw"]
 
 #: Placeholder for the effort unit ("A" or "N") in the units of :class:`Parameter`.
 EFFORT = "{E}"
+
+#: Placeholder for the length unit ("mm", or "deg" for a rotary axis) in the units of :class:`Parameter`.
+LENGTH = "{L}"
 
 
 @dataclass(frozen=True)

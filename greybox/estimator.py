@@ -19,8 +19,9 @@ from typing import Iterable
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from .base import EFFORT, ModelProtocol, Parameter
+from .base import EFFORT, LENGTH, ModelProtocol, Parameter
 from .data.log import AxisLog, as_log_list
+from .data.quantities import MOTIONS, Motion
 from .errors import LogError, ParameterError
 from .identify.progress import make_progress
 from .metrics import rmse
@@ -44,10 +45,10 @@ def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
     LogError
         If a run has no velocity or acceleration (not prepared), too few
         samples (fewer than 2), non-finite motion or effort values, or the runs mix effort
-        units. The message names the run's source file.
+        units or linear and rotary axes. The message names the run's source file.
     """
     runs = as_log_list(logs)
-    unit = runs[0].effort_unit
+    unit, motion = runs[0].effort_unit, runs[0].motion
     for run in runs:
         source = run.source or None
         if not run.is_prepared:
@@ -66,6 +67,8 @@ def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
             raise LogError(source, "time is not increasing: no positive sample time")
         if run.effort_unit != unit:
             raise LogError(source, f"runs mix effort units: {unit} and {run.effort_unit}")
+        if run.motion != motion:
+            raise LogError(source, f"runs mix a {motion} and a {run.motion} axis")
     return runs
 
 
@@ -86,9 +89,12 @@ class CurrentModel(ModelProtocol):
 
     and the methods of :class:`~greybox.base.ModelProtocol` that apply to them.
 
-    Learned attributes set here: ``effort_unit_`` ("A" or "N"),
-    ``sample_time_`` (median step of the fitted runs [s]) and
-    ``n_samples_fit_``.
+    Learned attributes set here: ``effort_unit_`` ("A", "N" or "Nm"),
+    ``motion_`` ("linear" or "rotary": the units of position and velocity,
+    mm or deg), ``sample_time_`` (median step of the fitted runs [s]),
+    ``n_samples_fit_`` and the training region ``position_range_mm_``,
+    ``velocity_range_mm_s_`` (in the motion's units: [deg], [deg/s] for a
+    rotary axis).
     """
 
     def fit(self, logs: AxisLog | Iterable[AxisLog], progress=None) -> "CurrentModel":
@@ -250,15 +256,23 @@ class CurrentModel(ModelProtocol):
         Returns
         -------
         list of Parameter
-            Units carry the effort unit the model was fitted on (A or N).
+            Units carry the effort unit the model was fitted on (A, N or Nm) and the
+            length unit of its motion (mm, or deg for a rotary axis).
         """
         check_is_fitted(self)
         rows = self._own_parameters() + [
-            Parameter("J", self.J_, f"{EFFORT} s^2/mm", "inertia (x 1000 = kg for force logs)"),
+            Parameter("J", self.J_, f"{EFFORT} s^2/{LENGTH}", "inertia (x 1000 = kg for force logs)"),
             Parameter("offset", self.offset_, EFFORT, "constant effort"),
         ]
-        unit = self.effort_unit_
-        return [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit), p.description) for p in rows]
+        unit, length = self.effort_unit_, self.units_.length
+        return [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit).replace(LENGTH, length), p.description)
+                for p in rows]
+
+    @property
+    def units_(self) -> Motion:
+        """Units of the axis the model was fitted on (a model file without the record: a linear axis)."""
+        check_is_fitted(self)
+        return MOTIONS[getattr(self, "motion_", "linear")]
 
     def validate_fitted(self) -> None:
         """Check that the learned state is complete and usable, as a model read from a file must be.
@@ -276,15 +290,19 @@ class CurrentModel(ModelProtocol):
         self._check_params()
         try:
             check_is_fitted(self)
+            motion = getattr(self, "motion_", "linear")
+            if motion not in MOTIONS:
+                raise ParameterError(f"motion_ must be one of {', '.join(MOTIONS)}, got {motion!r}")
+            if self.effort_unit_ not in MOTIONS[motion].effort_units:
+                raise ParameterError(f"effort_unit_ of a {motion} axis must be one of "
+                                     f"{MOTIONS[motion].effort_units}, got {self.effort_unit_!r}")
             for row in self.parameter_table():
                 if not np.all(np.isfinite(np.asarray(row.value, dtype=float))):
                     raise ParameterError(f"parameter {row.name} is not finite: {row.value!r}")
-            if self.effort_unit_ not in ("A", "N"):
-                raise ParameterError(f"effort_unit_ must be 'A' or 'N', got {self.effort_unit_!r}")
             step = float(self.sample_time_)
             if not (np.isfinite(step) and step > 0.0):
                 raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")
-            probe = _probe_run(step, self.effort_unit_)
+            probe = _probe_run(step, self.effort_unit_, motion)
             whole = self.predict(probe)
             first, state = self.predict_chunk(probe.select(slice(0, 50)), sample_time=step)
             second, _ = self.predict_chunk(probe.select(slice(50, None)), state, sample_time=step)
@@ -325,6 +343,7 @@ class CurrentModel(ModelProtocol):
 
     def _set_fit_info(self, runs: list[AxisLog]) -> None:
         self.effort_unit_ = runs[0].effort_unit
+        self.motion_ = runs[0].motion
         self.sample_time_ = float(np.median([run.sample_time for run in runs]))
         self.n_samples_fit_ = int(sum(len(run) for run in runs))
         for name, channel in _REGION_CHANNELS.items():
@@ -370,6 +389,9 @@ class CurrentModel(ModelProtocol):
             if run.effort_unit != self.effort_unit_:
                 raise LogError(run.source or None,
                                f"log carries effort in {run.effort_unit}, the model was fitted on {self.effort_unit_}")
+            if run.motion != self.units_.name:
+                raise LogError(run.source or None, f"log is of a {run.motion} axis ({run.units.length}), the model "
+                                                   f"was fitted on a {self.units_.name} axis ({self.units_.length})")
         return runs
 
     def _check_flags(self, *names: str) -> None:
@@ -399,7 +421,7 @@ class CurrentModel(ModelProtocol):
         return {}
 
 
-def _probe_run(sample_time: float, effort_unit: str) -> AxisLog:
+def _probe_run(sample_time: float, effort_unit: str, motion: str) -> AxisLog:
     """A short prepared run with a reversal and a dwell: 200 samples at ``sample_time`` [s]."""
     n = 200
     time = np.arange(n) * sample_time
@@ -409,4 +431,4 @@ def _probe_run(sample_time: float, effort_unit: str) -> AxisLog:
     position = np.concatenate(([0.0], np.cumsum(velocity[:-1] * sample_time)))
     acceleration = np.gradient(velocity, sample_time)
     return AxisLog(time=time, position=position, effort=np.zeros(n), velocity=velocity,
-                   acceleration=acceleration, effort_unit=effort_unit)
+                   acceleration=acceleration, effort_unit=effort_unit, motion=motion)

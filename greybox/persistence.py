@@ -283,6 +283,10 @@ def load_model(path: str | PathLike):
         version, of a model kind this greybox does not know, or damaged.
     """
     path = Path(path)
+    if path.is_dir():
+        hint = (" holding a machine model (one model file per axis): give one axis's file, e.g. "
+                f"{path / '<axis>.gbm'}, and the log's axis with --axis" if (path / "machine.json").is_file() else "")
+        raise ModelFileError(f"{path}: is a directory{hint}; expected a model file")
     if not path.is_file():
         raise ModelFileError(f"{path}: no such model file")
     try:

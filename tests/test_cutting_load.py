@@ -57,8 +57,8 @@ def test_a_perfect_air_cut_model_with_the_member_axis_file_recovers_the_force_of
     assert (config.efficiency_driving, config.efficiency_backdriven) == pytest.approx((1 / (1 + gain), 1 - gain))
     process = cut.effort - air.effort  # what a perfect model of the air cut leaves: the same noise cancels
     truth = cut.extras["truth_process_force_N"]
-    estimated = config.process_force_N(process, cut.velocity)
-    blind = config.force_constants_N_per_A[0] * process
+    estimated = config.process_load(process, cut.velocity)
+    blind = config.load_constants[0] * process
     for sign in (1.0, -1.0):
         chosen = (truth != 0) & (truth * cut.velocity * sign > 0)
         error = abs(np.mean(estimated[chosen]) / np.mean(truth[chosen]) - 1)

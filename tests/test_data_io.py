@@ -79,8 +79,10 @@ def test_refuses_to_overwrite_its_input(tmp_path, make_log):
 def test_write_errors(tmp_path, make_log):
     with pytest.raises(LogError, match="can be read but not written"):
         write_log(make_log(), tmp_path / "out.mat")
-    with pytest.raises(LogError, match="holds one log"):
-        write_log([make_log(), make_log(axis="Y")], tmp_path / "out.csv")
+    with pytest.raises(LogError, match="axis name '' cannot prefix columns"):
+        write_log([make_log(axis=""), make_log(axis="Y")], tmp_path / "out.csv")
+    with pytest.raises(LogError, match="several logs of axis X"):
+        write_log([make_log(), make_log()], tmp_path / "out.parquet")
 
 
 def test_parse_column_mapping():

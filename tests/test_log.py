@@ -28,8 +28,14 @@ def test_channel_of_wrong_length_names_the_source_and_channel():
 
 
 def test_unknown_effort_unit_is_rejected():
-    with pytest.raises(LogError, match="unknown effort unit 'V'"):
+    with pytest.raises(LogError, match="effort unit 'V' does not fit a linear axis"):
         make_log(effort_unit="V")
+    with pytest.raises(LogError, match="effort unit 'Nm' does not fit a linear axis"):
+        make_log(effort_unit="Nm")
+    with pytest.raises(LogError, match="effort unit 'N' does not fit a rotary axis"):
+        make_log(effort_unit="N", motion="rotary")
+    with pytest.raises(LogError, match="unknown motion 'angular'"):
+        make_log(motion="angular")
 
 
 def test_current_requires_ampere_effort():

@@ -36,10 +36,10 @@ def test_force_constant_against_a_hand_calculation(tmp_path):
     # 2 Nm/A * 3 motor rev per screw rev * 2 pi * 0.8 / 0.005 m = 6031.857894892403 N/A driving,
     # 2 * 3 * 2 pi / (0.8 * 0.005 m) = 9424.777960769379 N/A back-driven
     config = read_axis_config(_write(tmp_path, VALID))
-    assert config.force_constants_N_per_A == pytest.approx((6031.857894892403, 9424.777960769379), rel=1e-12)
-    np.testing.assert_allclose(config.process_force_N([0.5, -1.0, 0.0], 1.0),
+    assert config.load_constants == pytest.approx((6031.857894892403, 9424.777960769379), rel=1e-12)
+    np.testing.assert_allclose(config.process_load([0.5, -1.0, 0.0], 1.0),
                                [3015.9289474462, -9424.777960769379, 0.0])
-    np.testing.assert_allclose(config.process_force_N([0.5, -1.0], -1.0), [4712.38898038469, -6031.857894892403])
+    np.testing.assert_allclose(config.process_load([0.5, -1.0], -1.0), [4712.38898038469, -6031.857894892403])
 
 
 @pytest.mark.parametrize("current_A, omega", [(3.0, 150.0), (-3.0, -150.0), (3.0, -150.0), (-3.0, 150.0)])
@@ -53,38 +53,38 @@ def test_force_from_the_power_balance_in_either_direction_of_power_flow(current_
         table_power_W = config.efficiency_driving * motor_power_W
     else:
         table_power_W = motor_power_W / config.efficiency_backdriven
-    force = config.process_force_N(current_A, table_speed_m_s * 1000.0)
+    force = config.process_load(current_A, table_speed_m_s * 1000.0)
     assert force == pytest.approx(table_power_W / table_speed_m_s, rel=1e-12)
 
 
 def test_back_driven_current_is_divided_by_the_efficiency_and_rest_counts_as_driving():
     """With one efficiency eta a back-driven force read as driving would come out eta^2 too small."""
     config = AxisConfig(torque_constant_Nm_per_A=1.0, screw_lead_mm=10.0, gear_ratio=1.0, efficiency_driving=0.85)
-    lossless = config.lossless_force_constant_N_per_A
-    assert config.process_force_N(-1.0, 5.0) == pytest.approx(-lossless / 0.85)
-    assert config.process_force_N(1.0, -5.0) == pytest.approx(lossless / 0.85)
-    assert config.process_force_N(1.0, 5.0) == pytest.approx(lossless * 0.85)
-    assert config.process_force_N(1.0, 0.0) == pytest.approx(lossless * 0.85)
+    lossless = config.lossless_load_constant
+    assert config.process_load(-1.0, 5.0) == pytest.approx(-lossless / 0.85)
+    assert config.process_load(1.0, -5.0) == pytest.approx(lossless / 0.85)
+    assert config.process_load(1.0, 5.0) == pytest.approx(lossless * 0.85)
+    assert config.process_load(1.0, 0.0) == pytest.approx(lossless * 0.85)
 
 
 def test_force_scales_as_expected():
     base = AxisConfig(torque_constant_Nm_per_A=1.0, screw_lead_mm=10.0, gear_ratio=1.0, efficiency_driving=1.0)
-    k = base.lossless_force_constant_N_per_A
+    k = base.lossless_load_constant
     assert k == pytest.approx(2 * math.pi * 100.0)  # 1 Nm per A over a 10 mm lead: 628.3 N/A
-    assert base.force_constants_N_per_A == (k, k)
+    assert base.load_constants == (k, k)
     for change, factors in (({"screw_lead_mm": 20.0}, (0.5, 0.5)), ({"gear_ratio": 4.0}, (4.0, 4.0)),
                             ({"efficiency_driving": 0.5}, (0.5, 2.0)),
                             ({"efficiency_driving": 0.9, "efficiency_backdriven": 0.8}, (0.9, 1.25)),
                             ({"torque_constant_Nm_per_A": 3.0}, (3.0, 3.0))):
         other = AxisConfig(**{**{"torque_constant_Nm_per_A": 1.0, "screw_lead_mm": 10.0, "gear_ratio": 1.0,
                                  "efficiency_driving": 1.0}, **change})
-        assert other.force_constants_N_per_A == pytest.approx((factors[0] * k, factors[1] * k))
+        assert other.load_constants == pytest.approx((factors[0] * k, factors[1] * k))
 
 
 def test_example_file_parses_and_gives_the_documented_factor():
     config = read_axis_config(EXAMPLE)
     assert config.name == "X" and config.channels == {}
-    driving, backdriven = config.force_constants_N_per_A
+    driving, backdriven = config.load_constants
     assert driving == pytest.approx(1.35 * 2 * math.pi * 0.9 / 0.010)
     assert backdriven == pytest.approx(1.35 * 2 * math.pi / 0.85 / 0.010)
     assert f"{driving:.1f} {backdriven:.1f}" == "763.4 997.9"  # the figures the example file's comment states
@@ -160,11 +160,11 @@ def test_process_force_of_a_cutting_log_is_the_scaled_process_current():
     config = read_axis_config(EXAMPLE)
     result = predict_process(model, cut, axis_config=config, chunk_s=1.0)
     np.testing.assert_array_equal(result.process, cut.current - model.predict(cut))
-    driving, backdriven = config.force_constants_N_per_A
+    driving, backdriven = config.load_constants
     back = result.process * cut.velocity < 0
     assert back.any() and (~back).any()
-    np.testing.assert_allclose(result.force, np.where(back, backdriven, driving) * result.process, rtol=1e-15)
-    assert result.force_constants_N_per_A == pytest.approx((763.4070148223198, 997.9176664344051))
+    np.testing.assert_allclose(result.load, np.where(back, backdriven, driving) * result.process, rtol=1e-15)
+    assert result.load_constants == pytest.approx((763.4070148223198, 997.9176664344051))
     columns = result.columns()
     assert list(columns)[:5] == ["time_s", "current_measured_A", "current_model_A", "current_process_A",
                                  "force_process_N"]
@@ -179,7 +179,7 @@ def test_force_logs_need_no_axis_metadata():
     cut = cut.replace(effort=cut.effort * to_force, effort_unit="N")
     result = predict_process(model, cut)
     assert list(result.columns())[1:4] == ["force_measured_N", "force_model_N", "force_process_N"]
-    np.testing.assert_array_equal(result.force, result.process)
+    np.testing.assert_array_equal(result.load, result.process)
     with pytest.raises(GreyboxError, match="carries force in N already"):
         predict_process(model, cut, axis_config=read_axis_config(EXAMPLE))
 
@@ -189,4 +189,4 @@ def test_an_axis_file_written_by_to_toml_reads_back_equal(tmp_path):
                         efficiency_backdriven=1 - 0.0712345678901, name='Z "rear"', channels={"current_A": "I Z"})
     again = read_axis_config(_write(tmp_path, config.to_toml()))
     assert again.to_dict() == config.to_dict()
-    assert again.force_constants_N_per_A == config.force_constants_N_per_A
+    assert again.load_constants == config.load_constants

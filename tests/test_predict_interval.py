@@ -78,9 +78,9 @@ def test_bounds_of_force_follow_the_conversion_and_hold_the_estimate(fitted):
     result = predict_process(model, cut, axis_config=config, interval=interval)
     lower, upper = result.process_bounds
     np.testing.assert_allclose(upper - lower, 2 * interval.half_widths(cut))
-    force_low, force_high = result.force_bounds
-    assert np.all(force_low <= result.force) and np.all(result.force <= force_high)
-    np.testing.assert_array_equal(force_low, config.process_force_N(lower, cut.velocity))
+    force_low, force_high = result.load_bounds
+    assert np.all(force_low <= result.load) and np.all(result.load <= force_high)
+    np.testing.assert_array_equal(force_low, config.process_load(lower, cut.velocity))
     truth = cut.extras["truth_process_force_N"]
     covered = np.mean((force_low <= truth) & (truth <= force_high))
     assert 0.9 < covered <= 1.0

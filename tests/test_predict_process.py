@@ -42,8 +42,8 @@ def test_thinned_picture_keeps_single_sample_peaks():
     measured = np.zeros(n)
     measured[4321] = 5.0
     result = ProcessResult(time=time, position=np.zeros(n), velocity=np.zeros(n), measured=measured,
-                           model=np.zeros(n), force=763.4 * measured,
-                           force_constants_N_per_A=(763.4, 763.4))
+                           model=np.zeros(n), load=763.4 * measured,
+                           load_constants=(763.4, 763.4))
     assert envelope_indices(n, 20_000).size == n
     figure = plot_process(result, max_points=500)
     process_axes = figure.axes[2]
@@ -78,7 +78,7 @@ def test_process_panel_draws_the_moving_mean():
     time = np.arange(n) * 0.002
     measured = np.where(time > 2.0, -0.4, 0.0) + 0.3 * np.sin(2 * np.pi * 100.0 * time)
     result = ProcessResult(time=time, position=np.zeros(n), velocity=np.zeros(n), measured=measured,
-                           model=np.zeros(n), force=None)
+                           model=np.zeros(n), load=None)
     figure = plot_process(result, mean_s=0.1)
     mean_line = figure.axes[2].lines[1]
     assert "0.1 s" in mean_line.get_label()

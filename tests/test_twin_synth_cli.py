@@ -56,7 +56,7 @@ def test_synth_refuses_to_overwrite_without_force(tmp_path, capsys):
     (["--axis", "X", "--effect", "thermal_drift", "--effect-param", "time_constant_s=fast"], "not a number"),
     (["--axis", "X", "--seed", "-2"], "argument --seed: must be an integer from 0 to 4294967295, got -2"),
     (["--axis", "X", "--duration", "0"], "argument --duration: must be a positive number of seconds, got 0"),
-    ([], "give the axes to simulate (--axis X, Y or both) or --family N"),
+    ([], "give the axes to simulate (--axis X, Y, C or several) or --family N"),
     (["--family", "2", "--axis", "X"], "--family draws each axis, its noise and sensors; --axis does not apply"),
     (["--family", "2", "--noise-std", "0.2"], "--noise-std does not apply"),
     (["--family", "0"], "argument --family: must be a positive integer, got 0"),

@@ -31,6 +31,10 @@ def add_log_arguments(parser: argparse.ArgumentParser, *, prepare: bool = True) 
         "'position_mm=X1_ActualPosition,current_A=X1_CurrentFeedback' (CSV, Parquet, MCAP fields)",
     )
     group.add_argument("--topic", help="MCAP topic (channel) or TDMS group to read when a file holds several axes")
+    group.add_argument("--axis", metavar="NAME",
+                       help="the axis to read from a log of several axes: its columns named NAME_position_mm, "
+                       "NAME_current_A, ... (CSV, Parquet, MATLAB, TDMS channels), the MCAP channel /axis/NAME or "
+                       "the TDMS group NAME")
     group.add_argument(
         "--sample-time",
         type=positive("seconds"),
@@ -124,7 +128,8 @@ def read_named_runs(args: argparse.Namespace, paths, names, *, prepare: bool = T
     return runs, labels
 
 
-def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = True) -> list[AxisLog]:
+def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = True,
+              axis: str | None = None) -> list[AxisLog]:
     """Read one file and prepare it as the options say: one run, or several when --resample splits it at gaps.
 
     Parameters
@@ -137,6 +142,8 @@ def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = T
         Column mapping (``{canonical_name: name_in_file}``).
     prepare : bool, default True
         Derive velocity and acceleration (and resample when asked).
+    axis : str, optional
+        The axis to read from a log of several (default: ``--axis``).
 
     Returns
     -------
@@ -148,7 +155,8 @@ def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = T
 
     resample = getattr(args, "resample", None) if prepare else None
     log = read_log(path, columns=columns, topic=args.topic, sample_time=args.sample_time,
-                   time_tolerance=None if resample else args.time_tolerance)
+                   time_tolerance=None if resample else args.time_tolerance,
+                   axis=axis if axis is not None else getattr(args, "axis", None))
     if not prepare:
         return [log]
     runs = prepare_logs([log], cutoff_hz=getattr(args, "cutoff_hz", None), sample_time=resample,

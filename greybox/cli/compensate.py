@@ -93,6 +93,13 @@ def _load(path: str):
     return load_model(path)
 
 
+def _linear_only(source, motion: str) -> None:
+    """Refuse a model or log of a rotary axis: the loop study's references, gains and report are in mm."""
+    if motion != "linear":
+        raise GreyboxError(f"{source}: a {motion} axis (deg); the position-loop study of greybox compensate "
+                           "simulates linear feed axes in mm only")
+
+
 def _plant(args):
     from ..control.plants import ModelPlant, TwinPlant
 
@@ -106,6 +113,7 @@ def _plant(args):
         raise GreyboxError(f"{args.plant}: no such model file; the plant is twin-X, twin-Y or a gms/lugre model "
                            "file (--plant)")
     model = _load(args.plant)  # its errors name the file already
+    _linear_only(args.plant, model.units_.name)
     try:
         return ModelPlant(model, name=Path(args.plant).stem)
     except GreyboxError as error:
@@ -133,7 +141,10 @@ def _training_runs(args, plant):
     from ._options import read_logs
 
     if args.train:
-        return read_logs(args, args.train)
+        runs = read_logs(args, args.train)
+        for run in runs:
+            _linear_only(run.source or "--train", run.motion)
+        return runs
     if not isinstance(plant, TwinPlant) or plant.axis is None:
         raise GreyboxError("--model with a model plant needs training logs: give --train LOG ...")
     _say(args, f"synthesising training data: axis {plant.axis}, datasets A and P, {args.train_duration:g} s each, "
@@ -148,6 +159,7 @@ def _models(args, plant) -> dict:
     entries = []
     for path in args.model_files:
         model = _load(path)
+        _linear_only(path, model.units_.name)
         entries.append((model_kind(model), Path(path).stem, model))
     kinds = _fit_kinds(args)
     if kinds:
@@ -192,7 +204,9 @@ def _references(args) -> list:
             continue
         if not os.path.isfile(value):
             raise GreyboxError(f"{value}: no such log; --reference takes low, high or log files")
-        references += read_logs(args, [value])
+        for run in read_logs(args, [value]):
+            _linear_only(value, run.motion)
+            references.append(run)
     return references
 
 

@@ -102,11 +102,11 @@ def _format_parameters(parameters: dict) -> str:
 
 
 def _print_summary(result) -> None:
-    unit = result.unit
+    unit, relabel = result.unit, result.units.relabel
     print(f"verdict: {result.verdict}")
     for index, entry in enumerate(result.effects, 1):
         evidence = entry["evidence"]
-        print(f"  {index}. {entry['name']}: {_format_parameters(entry['parameters'])}")
+        print(f"  {index}. {entry['name']}: {relabel(_format_parameters(entry['parameters']))}")
         print(f"     explains {100 * evidence['explained_fraction']:.2f} % of the residual at step "
               f"{evidence['step']} (passes beyond {100 * (evidence['threshold_fraction'] or np.inf):.3f} %, "
               f"p = {evidence['p_value']:.3f}); the joint refit {100 * evidence['refit_explained_fraction']:.2f} %")
@@ -123,7 +123,7 @@ def _print_summary(result) -> None:
             held = entry["held_out"]
             print(f"  base misfit: {name} ({effect(name).summary}) removes {100 * held['gain']:.2f} +- "
                   f"{100 * held['uncertainty']:.2f} % of the held-out residual and is kept "
-                  f"({_format_parameters(entry['parameters'])})")
+                  f"({relabel(_format_parameters(entry['parameters']))})")
         if not kept:
             print("  base misfit: the structure left lies along the velocity or the time since the motion changed "
                   "(or does not hold on held-out blocks): the base model's own friction law misfits")

@@ -35,10 +35,13 @@ def summarise(log: AxisLog) -> dict:
     Returns
     -------
     dict
-        Samples, sample time [ms], duration [s], position range [mm], peak
-        speed [mm/min], effort RMS and range (in the log's unit) and, for
-        synthetic logs, the RMS of the known noise (the noise floor).
+        Samples, sample time [ms], duration [s], kind of axis (``motion``),
+        position range [mm] and peak speed [mm/min] (keys ``position_min_mm``,
+        ``speed_max_mm_min``; ``..._deg``, ``..._deg_min`` for a rotary axis),
+        effort RMS and range (in the log's unit) and, for synthetic logs, the
+        RMS of the known noise (the noise floor).
     """
+    length = log.units.length
     summary = {
         "file": log.source,
         "axis": log.axis,
@@ -46,9 +49,10 @@ def summarise(log: AxisLog) -> dict:
         "samples": len(log),
         "sample_time_ms": 1e3 * log.sample_time,
         "duration_s": log.duration,
-        "position_min_mm": float(log.position.min()),
-        "position_max_mm": float(log.position.max()),
-        "speed_max_mm_min": float(60.0 * np.abs(log.velocity).max()) if log.velocity is not None else None,
+        "motion": log.motion,
+        f"position_min_{length}": float(log.position.min()),
+        f"position_max_{length}": float(log.position.max()),
+        f"speed_max_{length}_min": float(60.0 * np.abs(log.velocity).max()) if log.velocity is not None else None,
         "effort_unit": log.effort_unit,
         "effort_rms": float(np.sqrt(np.mean(log.effort**2))),
         "effort_min": float(log.effort.min()),
@@ -97,15 +101,19 @@ def run(args: argparse.Namespace) -> int:
             print(json.dumps(summary))
         return 0
     width = max([28, *map(len, names)])
+    lengths = {log.units.length for log in runs}
+    length = lengths.pop() if len(lengths) == 1 else "mm|deg"
     header = f"{'file':<{width}} {'axis':>4} {'set':>4} {'samples':>9} {'dt ms':>6} {'dur s':>8} " \
-             f"{'position mm':>19} {'vmax mm/min':>11} {'RMS effort':>12} {'noise':>8}"
+             f"{'position ' + length:>19} {'vmax ' + length + '/min':>12} {'RMS effort':>12} {'noise':>8}"
     print(header)
-    for name, s in zip(names, summaries):
+    for name, s, log in zip(names, summaries, runs):
+        unit = log.units.length
         noise = f"{s['noise_floor_rmse_A']:.4f}" if "noise_floor_rmse_A" in s else "-"
-        vmax = f"{s['speed_max_mm_min']:.0f}" if s["speed_max_mm_min"] is not None else "-"
+        vmax = s[f"speed_max_{unit}_min"]
+        vmax = f"{vmax:.0f}" if vmax is not None else "-"
         print(
             f"{name:<{width}} {s['axis']:>4} {s['dataset']:>4} {s['samples']:>9d} {s['sample_time_ms']:>6.2f} "
-            f"{s['duration_s']:>8.1f} {s['position_min_mm']:>9.2f}..{s['position_max_mm']:<8.2f} {vmax:>11} "
-            f"{s['effort_rms']:>10.4f} {s['effort_unit']} {noise:>8}"
+            f"{s['duration_s']:>8.1f} {s[f'position_min_{unit}']:>9.2f}..{s[f'position_max_{unit}']:<8.2f} "
+            f"{vmax:>12} {s['effort_rms']:>10.4f} {s['effort_unit']:<2} {noise:>8}"
         )
     return 0

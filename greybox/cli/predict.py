@@ -29,18 +29,25 @@ def add_parser(subparsers) -> None:
         help="process current (and force) of a cutting log from a model trained on air cuts",
         description="Run a model trained on air cuts over a log recorded while cutting and write, per "
         "sample, the measured current, the model current (inertia + friction) and the process current "
-        "= measured - model; with --axis-config also the process force in N. The model runs over chunks "
+        "= measured - model; with --axis-config also the process force in N (torque in Nm for a rotary "
+        "axis). The model runs over chunks "
         "of --chunk-s seconds carrying its state, so long logs need little working memory.",
     )
-    parser.add_argument("model", metavar="MODEL", help="model file written by 'greybox train' (.gbm)")
+    parser.add_argument("model", metavar="MODEL",
+                        help="model file written by 'greybox train' (.gbm), or a machine model directory "
+                        "('greybox train --axes')")
     parser.add_argument("log", metavar="LOG", help="cutting log (CSV, Parquet, MCAP, TDMS or MATLAB .mat)")
     parser.add_argument("--out", required=True, metavar="OUT",
                         help="table to write: .csv, .parquet or .mcap (CSV: plain, header first, metadata in "
                         "OUT.json beside it; MCAP: one message per sample, topic /process/<axis>)")
     parser.add_argument("--axis-config", metavar="TOML",
                         help="axis metadata (torque constant, screw lead, gear ratio, efficiency driving and "
-                        "back-driven, channel names); adds force_process_N, converted by the direction of the "
-                        "power flow (see examples/axis_x.toml)")
+                        "back-driven, channel names); adds force_process_N (torque_process_Nm for a rotary axis), "
+                        "converted by the direction of the power flow (see examples/axis_x.toml, axis_c.toml)")
+    parser.add_argument("--machine", metavar="TOML",
+                        help="with a machine model (a directory written by 'greybox train --axes'): the machine "
+                        "file with each axis's channels and mechanics (see examples/machine.toml); adds each "
+                        "axis's force or torque and the resultant force of the linear axes")
     parser.add_argument("--calibration", nargs="+", metavar="AIRCUT",
                         help="air-cut logs the model was NOT trained on: its residuals there calibrate lower and "
                         "upper bounds of the process current (and force), split-conformal per regime (reversal, "
@@ -99,15 +106,10 @@ def _progress(total_s: float, quiet: bool):
     return show
 
 
-def run(args: argparse.Namespace) -> int:
-    run_started = time.perf_counter()
-    from ..data.axis_config import read_axis_config
-    from ..evaluate.process import predict_process
-    from ..evaluate.process_io import check_output_path, output_paths, write_process
-    from ..models.chunked import chunk_slices, samples_per_chunk
-    from ..persistence import load_model
+def _check_outputs(args: argparse.Namespace, inputs: list) -> tuple[Path, object]:
+    """Refuse, before any work, outputs that must not or cannot be written; return the table path and window."""
+    from ..evaluate.process_io import check_output_path, output_paths
 
-    inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else []) + list(args.calibration or [])
     out = Path(args.out)
     for target in output_paths(out):  # the table, and for CSV its metadata sidecar
         check_output_path(target, overwrite=args.force, protect=inputs)
@@ -122,48 +124,40 @@ def run(args: argparse.Namespace) -> int:
         raise GreyboxError("--plot-window needs --plot PNG")
     if args.calibration is None and args.interval is not None:
         raise GreyboxError("--interval needs --calibration AIRCUT... (air-cut logs the model was not trained on)")
-    config = read_axis_config(args.axis_config) if args.axis_config else None
-    model = load_model(args.model)
-    runs = _read_runs(args, config.channels if config else {})
-    log_time = np.concatenate([run.time for run in runs])
-    window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
-    interval = None
-    if args.calibration:
-        from ..evaluate.interval import calibrate_interval
+    own = [path for path in args.calibration or () if Path(path).resolve() == Path(args.log).resolve()]
+    if own:
+        raise GreyboxError(f"--calibration: {own[0]} is the cutting log itself; calibrate on air cuts the "
+                           "model was not trained on")
+    return out
 
-        own = [path for path in args.calibration if Path(path).resolve() == Path(args.log).resolve()]
-        if own:
-            raise GreyboxError(f"--calibration: {own[0]} is the cutting log itself; calibrate on air cuts the "
-                               "model was not trained on")
 
-        interval = calibrate_interval(model, [run for path in args.calibration
-                                              for run in _read_runs(args, config.channels if config else {}, path)],
-                                      coverage=DEFAULT_COVERAGE if args.interval is None else args.interval,
-                                      chunk_s=args.chunk_s)
+def _interval(args: argparse.Namespace, model, read):
+    """The calibrated interval of ``model`` from the --calibration logs (``read(path)`` gives their runs)."""
+    if not args.calibration:
+        return None
+    from ..evaluate.interval import calibrate_interval
 
-    started = time.perf_counter()
-    result = predict_process(model, runs, axis_config=config, interval=interval, chunk_s=args.chunk_s,
-                             progress=_progress(float(log_time[-1]), args.quiet))
-    elapsed = time.perf_counter() - started
-    result.attrs.update({"model_file": str(args.model), "log_file": str(args.log)})
-    n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, args.chunk_s))) for run in runs)
-    duration = sum(run.duration for run in runs)
+    return calibrate_interval(model, [run for path in args.calibration for run in read(path)],
+                              coverage=DEFAULT_COVERAGE if args.interval is None else args.interval,
+                              chunk_s=args.chunk_s)
+
+
+def _print_result(result, args: argparse.Namespace, interval, axis_file: str | None) -> None:
+    """The console lines of one axis's result: effort, load, extrapolation and interval."""
     unit = result.effort_unit
-    noun = "current" if unit == "A" else "force"
+    units = result.units
+    noun = "current" if unit == "A" else units.load
     process = result.process
-    print(f"predicted {Path(args.log).name} with the {result.attrs['model_kind']} model {Path(args.model).name}: "
-          f"{len(result.time)} samples, {duration:.1f} s, {n_chunks} chunk(s) of {args.chunk_s:g} s"
-          + (f" in {len(runs)} runs" if len(runs) > 1 else "")
-          + (f", dataset {result.dataset}" if result.dataset else ""))
-    print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} {unit}, "
-          f"process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")
-    if unit == "A" and result.force is not None:
-        driving, backdriven = result.force_constants_N_per_A
-        factors = (f"{driving:.6g} N/A" if driving == backdriven
-                   else f"{driving:.6g} N/A driving, {backdriven:.6g} N/A back-driven")
-        print(f"  force    rms process {_rms(result.force):.4g} N, "
-              f"largest |process| {np.max(np.abs(result.force)):.4g} N "
-              f"({factors} from {Path(args.axis_config).name})")
+    print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} "
+          f"{unit}, process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")
+    if unit == "A" and result.load is not None:
+        driving, backdriven = result.load_constants
+        per_ampere = f"{units.load_unit}/A"
+        factors = (f"{driving:.6g} {per_ampere}" if driving == backdriven
+                   else f"{driving:.6g} {per_ampere} driving, {backdriven:.6g} {per_ampere} back-driven")
+        print(f"  {units.load:<8} rms process {_rms(result.load):.4g} {units.load_unit}, "
+              f"largest |process| {np.max(np.abs(result.load)):.4g} {units.load_unit} "
+              f"({factors} from {axis_file})")
     _report_extrapolation(result.attrs["extrapolation"], Path(args.log).name)
     if interval is not None:
         from ..evaluate.interval import MIN_CLASS_SAMPLES
@@ -175,14 +169,113 @@ def run(args: argparse.Namespace) -> int:
         print(f"  interval {100 * interval.coverage:g} % (split conformal per regime on "
               f"{sum(interval.samples.values())} air-cut samples of {len(args.calibration)} log(s)): "
               f"half-width [{unit}] {widths}; mean {np.mean(result.half_width):.3g} {unit}")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..machine_model import is_machine_model
+
+    if is_machine_model(args.model):
+        return _run_machine(args)
+    run_started = time.perf_counter()
+    from ..data.axis_config import read_axis_config
+    from ..evaluate.process import predict_process
+    from ..models.chunked import chunk_slices, samples_per_chunk
+    from ..persistence import load_model
+
+    if args.machine:
+        raise GreyboxError("--machine applies to a machine model (a directory written by 'greybox train --axes'); "
+                           "give one axis's mechanics with --axis-config")
+    inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else []) + list(args.calibration or [])
+    out = _check_outputs(args, inputs)
+    config = read_axis_config(args.axis_config) if args.axis_config else None
+    model = load_model(args.model)
+    runs = _read_runs(args, config.channels if config else {})
+    log_time = np.concatenate([run.time for run in runs])
+    window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
+    interval = _interval(args, model, lambda path: _read_runs(args, config.channels if config else {}, path))
+    started = time.perf_counter()
+    result = predict_process(model, runs, axis_config=config, interval=interval, chunk_s=args.chunk_s,
+                             progress=_progress(float(log_time[-1]), args.quiet))
+    elapsed = time.perf_counter() - started
+    result.attrs.update({"model_file": str(args.model), "log_file": str(args.log)})
+    n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, args.chunk_s))) for run in runs)
+    duration = sum(run.duration for run in runs)
+    print(f"predicted {Path(args.log).name} with the {result.attrs['model_kind']} model {Path(args.model).name}: "
+          f"{len(result.time)} samples, {duration:.1f} s, {n_chunks} chunk(s) of {args.chunk_s:g} s"
+          + (f" in {len(runs)} runs" if len(runs) > 1 else "")
+          + (f", dataset {result.dataset}" if result.dataset else ""))
+    _print_result(result, args, interval, Path(args.axis_config).name if args.axis_config else None)
+    from ..evaluate.process_plot import plot_process
+
+    _write_outputs(args, result, out, inputs, window, plot_process)
+    print(f"done in {time.perf_counter() - run_started:.2f} s wall (model {elapsed:.2f} s)")
+    return 0
+
+
+def _write_outputs(args: argparse.Namespace, result, out: Path, inputs: list, window, draw) -> None:
+    """Write the table (atomically) and, with --plot, the picture ``draw`` makes of ``result``."""
+    from ..evaluate.process_io import output_paths, write_process
+
     write_process(result, out, overwrite=args.force, protect=inputs)
     for target in output_paths(out):
         print(f"wrote {target}")
     if args.plot:
-        from ..evaluate.process_plot import plot_process
-
-        plot_process(result, args.plot, mean_s=args.plot_mean_s, window=window)
+        draw(result, args.plot, mean_s=args.plot_mean_s, window=window)
         print(f"wrote {args.plot}")
+
+
+def _run_machine(args: argparse.Namespace) -> int:
+    """``greybox predict`` with a machine model: every axis of the log, and the resultant force."""
+    run_started = time.perf_counter()
+    from ..data.machine_config import read_machine_config
+    from ..evaluate.machine_process import RESULTANT_COLUMN, predict_machine
+    from ..machine_model import load_machine
+    from ._options import read_runs
+
+    for option, value in (("--axis-config", args.axis_config), ("--columns", args.columns), ("--axis", args.axis)):
+        if value:
+            raise GreyboxError(f"{option} does not apply to a machine model ({args.model}): it predicts every axis "
+                               "of the log; give the axes' channels and mechanics with --machine TOML")
+    inputs = [args.model, args.log] + ([args.machine] if args.machine else []) + list(args.calibration or [])
+    out = _check_outputs(args, inputs)
+    machine = load_machine(args.model)
+    config = read_machine_config(args.machine) if args.machine else None
+    described = {name: config.axis(name) for name in machine.axes} if config else {}
+
+    def read(path, name):
+        channels = dict(described[name].channels) if name in described else {}
+        return read_runs(args, path, columns=channels or None, axis=name)
+
+    runs = {name: read(args.log, name) for name in machine.axes}
+    log_time = np.concatenate([run.time for run in runs[machine.axes[0]]])
+    window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
+    intervals = {name: _interval(args, machine.models[name], lambda path, name=name: read(path, name))
+                 for name in machine.axes}
+    started = time.perf_counter()
+    result = predict_machine(machine.models, runs,
+                             axis_configs={name: axis.config for name, axis in described.items()},
+                             intervals=intervals, name=machine.name, chunk_s=args.chunk_s,
+                             progress=None if args.quiet else
+                             (lambda name: _progress(float(runs[name][-1].time[-1]), False)))
+    elapsed = time.perf_counter() - started
+    result.attrs.update({"model_dir": str(args.model), "log_file": str(args.log)})
+    kinds = ", ".join(f"{name}: {axis_result.attrs['model_kind']}" for name, axis_result in result.results.items())
+    print(f"predicted {Path(args.log).name} with the machine model {Path(args.model).name} ({kinds}): "
+          f"{len(result.time)} samples" + (f", dataset {result.dataset}" if result.dataset else ""))
+    for name, axis_result in result.results.items():
+        print(f"axis {name}:")
+        _print_result(axis_result, args, intervals[name],
+                      Path(args.machine).name if name in described and described[name].config else None)
+    if result.attrs["interpolated_axes"]:
+        print(f"  axes {', '.join(result.attrs['interpolated_axes'])} interpolated onto the time stamps of axis "
+              f"{result.attrs['time_of']}")
+    resultant = result.resultant()
+    if resultant is not None:
+        print(f"resultant process force of axes {', '.join(result.forces())}: rms {_rms(resultant):.4g} N, "
+              f"largest {np.max(resultant):.4g} N (column {RESULTANT_COLUMN})")
+    from ..evaluate.process_plot import plot_machine_process
+
+    _write_outputs(args, result, out, inputs, window, plot_machine_process)
     print(f"done in {time.perf_counter() - run_started:.2f} s wall (model {elapsed:.2f} s)")
     return 0
 

@@ -31,7 +31,9 @@ def add_parser(subparsers) -> None:
             "written as DIR/member_NNN/<axis>_<dataset>.mcap with DIR/family.json describing every member."
         ),
     )
-    parser.add_argument("--axis", nargs="+", metavar="AXIS", help="axes: X, Y or both (X Y); required without --family")
+    parser.add_argument("--axis", nargs="+", metavar="AXIS",
+                        help="axes: X, Y (feed axes, mm), C (rotary table, deg) or several (X Y C); required "
+                        "without --family")
     parser.add_argument("--family", type=POSITIVE_INT, metavar="N",
                         help="write N random axes of the family of truth axes (each draws its own axis, noise "
                              "and sensors; --seed is the family seed)")
@@ -71,6 +73,10 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--truth", choices=("all", "essential"), default="all",
                         help="truth channels to write: all, or only noise-free current and injected "
                              "components (compact files; default %(default)s)")
+    parser.add_argument("--one-file", choices=("csv", "parquet", "mcap"), metavar="FORMAT",
+                        help="write each dataset of all axes to one file DIR/<dataset>.FORMAT (csv, parquet or "
+                        "mcap), as a machine logs its axes together (columns X_position_mm, Y_current_A, ...; "
+                        "MCAP: a channel per axis), every axis cut to the shortest")
     parser.add_argument("--force", action="store_true",
                         help="write into a non-empty DIR, overwriting files of the same name")
     parser.set_defaults(run=run)
@@ -206,7 +212,7 @@ def run(args: argparse.Namespace) -> int:
             raise GreyboxError("give at least one dataset (--datasets)")
         return _run_family(args, datasets, cutting)
     if not args.axis:
-        raise GreyboxError("give the axes to simulate (--axis X, Y or both) or --family N")
+        raise GreyboxError("give the axes to simulate (--axis X, Y, C or several) or --family N")
     axes = list(dict.fromkeys(a.strip().upper() for a in args.axis if a.strip()))
     if not axes or not datasets:
         raise GreyboxError("give at least one axis (--axis) and one dataset (--datasets)")
@@ -220,6 +226,7 @@ def run(args: argparse.Namespace) -> int:
         force=args.force,
         truth_channels=ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None,
         progress=print,
+        one_file=args.one_file,
         duration_s=args.duration,
         noise=CurrentNoise(std_A=args.noise_std),
         **options,

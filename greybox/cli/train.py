@@ -14,7 +14,7 @@ from ..metrics import metrics_table
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model
-from ._options import add_log_arguments, read_logs
+from ._options import add_log_arguments, read_named_runs
 
 
 def add_parser(subparsers) -> None:
@@ -22,7 +22,9 @@ def add_parser(subparsers) -> None:
         "train",
         help="fit a current model to logs and save it",
         description="Read and prepare every training log as a separate run, fit the model to all runs, "
-        "print the training error and the identified parameters, and save the model file.",
+        "print the training error and the identified parameters, and save the model file. With --axes (or "
+        "--machine), fit one model per axis of logs that hold several axes and write a machine model: a "
+        "directory with one model file per axis and a manifest machine.json.",
     )
     parser.add_argument("--model", required=True, choices=sorted(MODEL_CLASSES), help="model kind")
     parser.add_argument(
@@ -35,8 +37,16 @@ def add_parser(subparsers) -> None:
         metavar="LOG",
         help="gmssvr only: logs for the SVR stage; the GMS stage is then fitted on --train alone",
     )
-    parser.add_argument("--out", required=True, metavar="MODEL", help="model file to write (.gbm)")
-    parser.add_argument("--force", action="store_true", help="overwrite MODEL if it exists")
+    parser.add_argument("--out", required=True, metavar="MODEL",
+                        help="model file to write (.gbm); with --axes or --machine, the machine model's directory")
+    parser.add_argument("--axes", metavar="A,B,...",
+                        help="axes to fit, comma-separated (e.g. X,Y,Z): one model each, from the logs' columns "
+                        "X_position_mm, X_current_A, ... (MCAP channels /axis/X, TDMS groups X; default with "
+                        "--machine: all its axes)")
+    parser.add_argument("--machine", metavar="TOML",
+                        help="machine file: the axes, their channels in the logs and mechanics (see "
+                        "examples/machine.toml)")
+    parser.add_argument("--force", action="store_true", help="overwrite MODEL (the machine model) if it exists")
     add_model_arguments(parser, backlash=True)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
     add_log_arguments(parser)
@@ -65,34 +75,64 @@ def describe_parameters(model) -> list[str]:
             for row in model.parameter_table()]
 
 
-def _fit(model, args: argparse.Namespace):
-    """Fit ``model`` as the options say; return the paths and runs it was fitted on."""
+def _read(args: argparse.Namespace, paths, axis=None) -> tuple[list[str], list]:
+    """The runs of ``paths`` (of one axis of a machine: its channels from the machine file) and a name per run."""
+    if axis is None:
+        runs, names = read_named_runs(args, paths, list(paths))
+        return names, runs
+    from ._options import read_runs
+
+    columns = dict(axis.channels) or None
+    runs, names = [], []
+    for path in paths:
+        pieces = read_runs(args, path, columns=columns, axis=axis.name)
+        runs += pieces
+        names += [path] * len(pieces)
+    return names, runs
+
+
+def _fit(model, args: argparse.Namespace, axis=None):
+    """Fit ``model`` as the options say (to one axis of a machine); return the names and runs it was fitted on."""
     progress = None if args.quiet else True
     if args.stage2 and model.first_stage() is None:
         raise GreyboxError(f"option --stage2 does not apply to the {args.model} model: it has one stage")
-    runs = read_logs(args, args.train)
+    names, runs = _read(args, args.train, axis)
     if not args.stage2:
         model.fit(runs, progress=progress)
-        return list(args.train), runs
-    second = read_logs(args, args.stage2)
+        return names, runs
+    second_names, second = _read(args, args.stage2, axis)
     model.fit_staged(runs, second, progress=progress)
-    return list(args.train) + list(args.stage2), runs + second
+    return names + second_names, runs + second
 
 
-def run(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    check_output_path(out, overwrite=args.force, protect=list(args.train) + list(args.stage2 or ()),
-                      error=ModelFileError, inputs_name="one of the training logs")
-    model = build_model(args.model, args)
-    started = time.perf_counter()
-    paths, runs = _fit(model, args)
-    elapsed = time.perf_counter() - started
+def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
+    """The machine's name and the axes to fit (:class:`~greybox.data.machine_config.MachineAxis`)."""
+    from ..data.machine_config import MachineAxis, read_machine_config
+
+    if args.columns:
+        raise GreyboxError("--columns does not apply with --axes or --machine: an axis's columns are named "
+                           "X_position_mm, ... or mapped in the machine file's [axes.X.channels]")
+    if args.axis:
+        raise GreyboxError("give the axes to fit with --axes A,B,... (--axis reads one axis into one model file)")
+    machine = read_machine_config(args.machine) if args.machine else None
+    names = [name.strip() for name in (args.axes or "").split(",") if name.strip()]
+    if args.axes is not None and not names:
+        raise GreyboxError(f"--axes names no axis: {args.axes!r}")
+    if len(set(names)) != len(names):
+        raise GreyboxError(f"--axes names an axis twice: {args.axes}")
+    if machine is None:
+        return "", [MachineAxis(name, "linear") for name in names]
+    return machine.name, [machine.axis(name) for name in (names or list(machine.axes))]
+
+
+def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
+    """Print the training error per run and the parameters; return the predictions."""
     unit = runs[0].effort_unit
-    print(f"trained {args.model} on {len(runs)} run(s), {sum(len(r) for r in runs)} samples, "
+    print(f"trained {label} on {len(runs)} run(s), {sum(len(r) for r in runs)} samples, "
           f"effort in {unit}, in {elapsed:.1f} s")
     print(f"  {'run':<32} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7}")
     predictions = [model.predict(run) for run in runs]
-    for path, run, prediction in zip(paths, runs, predictions):
+    for path, run, prediction in zip(names, runs, predictions):
         table = metrics_table(run.effort, prediction)
         print(f"  {Path(path).name[-32:]:<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     if len(runs) > 1:
@@ -105,6 +145,47 @@ def run(args: argparse.Namespace) -> int:
     print("fit:")
     for name, value in model.fit_summary().items():
         print(f"  {name:<18} = {_format_value(value)}")
+    return predictions
+
+
+def _run_machine(args: argparse.Namespace) -> int:
+    from ..machine_model import MachineModel, check_machine_output, load_machine, save_machine
+
+    name, axes = _machine_axes(args)
+    check_machine_output(args.out, [axis.name for axis in axes], overwrite=args.force)
+    models = {}
+    predictions = {}
+    for axis in axes:
+        model = build_model(args.model, args)
+        started = time.perf_counter()
+        names, runs = _fit(model, args, axis)
+        predictions[axis.name] = (runs, _report_fit(model, names, runs, time.perf_counter() - started,
+                                                    f"{args.model} for axis {axis.name}"))
+        models[axis.name] = model
+    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force)
+    reloaded = load_machine(args.out)
+    for axis, (runs, expected) in predictions.items():
+        if not all(np.array_equal(reloaded.models[axis].predict(run), p) for run, p in zip(runs, expected)):
+            raise ModelFileError(f"{args.out}: the saved model of axis {axis} does not reproduce the fitted model")
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+def run(args: argparse.Namespace) -> int:
+    inputs = list(args.train) + list(args.stage2 or ())
+    if args.axes is not None or args.machine:
+        out = Path(args.out)
+        if any(out.resolve() == Path(path).resolve() for path in inputs):
+            raise ModelFileError(f"{out}: is one of the training logs; choose another output directory")
+        return _run_machine(args)
+    out = Path(args.out)
+    check_output_path(out, overwrite=args.force, protect=inputs, error=ModelFileError,
+                      inputs_name="one of the training logs")
+    model = build_model(args.model, args)
+    started = time.perf_counter()
+    names, runs = _fit(model, args)
+    predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
     save_model(model, out, overwrite=args.force)
     reloaded = load_model(out)
     if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):

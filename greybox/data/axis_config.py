@@ -1,6 +1,7 @@
 """Axis metadata: the drive-train constants that turn a motor current into a force on the table.
 
-One small TOML file per axis (see ``examples/axis_x.toml``)::
+One small TOML file per axis (see ``examples/axis_x.toml`` and, for a rotary
+axis, ``examples/axis_c.toml``)::
 
     name = "X"                        # optional: axis name
     torque_constant_Nm_per_A = 1.35   # motor torque constant k_t [Nm/A]
@@ -13,6 +14,13 @@ One small TOML file per axis (see ``examples/axis_x.toml``)::
     position_mm = "X1_ActualPosition"
     current_A = "X1_CurrentFeedback"
 
+A rotary axis (rotary table, swivel head) has no screw: its file says
+``motion = "rotary"``, gives ``gear_ratio`` as motor revolutions per
+revolution of the axis (e.g. 90 for a worm gear, 1 for a direct drive) and no
+``screw_lead_mm``; the constants then turn the current into a torque on the
+axis in Nm (``K_0 = k_t i``). Its ``[channels]`` name rotary columns
+(``position_deg = "C_Angle"``).
+
 Every quantity carries its unit in its key; only these units are accepted, and
 a key naming another unit (``screw_lead_m``, ``torque_constant_mNm_per_A``) is
 an error asking for the conversion rather than a silent factor of 1000. The
@@ -21,7 +29,7 @@ same efficiency. The ``[channels]`` table is the column mapping of ``greybox.dat
 (``{canonical_name: name_in_file}``; the canonical name may carry any supported
 unit, e.g. ``position_um``).
 
-The force these constants give is derived in :mod:`greybox.evaluate.process`.
+The load (force or torque) these constants give is derived in :mod:`greybox.evaluate.process`.
 """
 
 from __future__ import annotations
@@ -36,16 +44,17 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import GreyboxError
-from .units import CANONICAL_NAMES, UNIT_FACTORS, parse_column_name
+from .quantities import MOTIONS, Motion
+from .units import CANONICAL_NAMES, known_column, parse_column_name
 
-__all__ = ["AxisConfig", "read_axis_config", "parse_axis_config", "QUANTITIES"]
+__all__ = ["AxisConfig", "read_axis_config", "parse_axis_config", "check_channels", "read_toml", "QUANTITIES"]
 
 #: Accepted keys: key -> (quantity in words, unit, hint for the missing key).
 QUANTITIES = {
     "torque_constant_Nm_per_A": ("torque constant k_t", "Nm/A", "from the motor data sheet (k_T, torque per A)"),
     "screw_lead_mm": ("screw lead h", "mm", "table travel per screw revolution"),
-    "gear_ratio": ("gear ratio i", "motor revolutions per screw revolution",
-                   "1.0 for a motor coupled directly to the screw"),
+    "gear_ratio": ("gear ratio i", "motor revolutions per screw (rotary axis: axis) revolution",
+                   "1.0 for a motor coupled directly to the screw or the rotary axis"),
     "efficiency_driving": ("driving efficiency eta_d", "a fraction, 0 < eta <= 1",
                            "the motor pushes the table against the load; about 0.9 for a ball screw"),
     "efficiency_backdriven": ("back-driven efficiency eta_b", "a fraction, 0 < eta <= 1",
@@ -61,7 +70,10 @@ _STEMS = {"torque_constant": "torque_constant_Nm_per_A", "screw_lead": "screw_le
           "gear_ratio": "gear_ratio", "efficiency": "efficiency_driving"}
 
 #: Optional keys besides the quantities.
-_OPTIONAL = ("name",)
+_OPTIONAL = ("name", "motion")
+
+#: The quantity a linear axis needs and a rotary axis must not give.
+_SCREW = "screw_lead_mm"
 
 #: Smallest plausible screw lead [mm]; a smaller value was most likely written in metres.
 MIN_LEAD_MM = 0.1
@@ -69,18 +81,20 @@ MIN_LEAD_MM = 0.1
 
 @dataclass(frozen=True)
 class AxisConfig:
-    """Drive-train constants of one feed axis.
+    """Drive-train constants of one feed axis, linear or rotary.
 
     Parameters
     ----------
     torque_constant_Nm_per_A : float
         Motor torque constant ``k_t`` [Nm/A]: torque per ampere of the
         current the log records.
-    screw_lead_mm : float
-        Screw lead ``h`` [mm]: table travel per screw revolution.
+    screw_lead_mm : float or None
+        Screw lead ``h`` [mm]: table travel per screw revolution; ``None``
+        for a rotary axis.
     gear_ratio : float
         ``i`` = motor revolutions per screw revolution [-] (1 for a direct
-        coupling, 2 for a belt that halves the speed).
+        coupling, 2 for a belt that halves the speed); for a rotary axis motor
+        revolutions per revolution of the axis.
     efficiency_driving : float
         ``eta_d`` [-], 0 < eta <= 1: share of the motor's mechanical power that
         reaches the table (gear and screw together) while the motor drives the
@@ -91,6 +105,8 @@ class AxisConfig:
         the motor brakes (a back-driven screw); default ``efficiency_driving``.
     name : str, default ""
         Axis name.
+    motion : {"linear", "rotary"}, default "linear"
+        Kind of axis: a linear axis needs ``screw_lead_mm``, a rotary one must not have it.
     channels : mapping of str to str, optional
         Column mapping of the log, ``{canonical_name: name_in_file}``.
     source : str, default ""
@@ -98,70 +114,92 @@ class AxisConfig:
     """
 
     torque_constant_Nm_per_A: float
-    screw_lead_mm: float
+    screw_lead_mm: float | None
     gear_ratio: float
     efficiency_driving: float
     efficiency_backdriven: float | None = None
     name: str = ""
+    motion: str = "linear"
     channels: Mapping[str, str] = field(default_factory=dict)
     source: str = ""
 
     def __post_init__(self):
+        where = self.source or "<axis config>"
         if self.efficiency_backdriven is None:
             object.__setattr__(self, "efficiency_backdriven", self.efficiency_driving)
-        values = {key: getattr(self, key) for key in QUANTITIES}
-        _check_values(values, self.source or "<axis config>")
+        if self.motion not in MOTIONS:
+            _fail(where, f"motion must be one of {', '.join(MOTIONS)}, got {self.motion!r}")
+        rotary = self.motion == "rotary"
+        if rotary and self.screw_lead_mm is not None:
+            _fail(where, f"a rotary axis has no {_SCREW}; give gear_ratio as motor revolutions per axis revolution")
+        values = {key: getattr(self, key) for key in self.quantities}
+        _check_values(values, where)
         object.__setattr__(self, "channels", dict(self.channels))
 
     @property
-    def lossless_force_constant_N_per_A(self) -> float:
-        """Force on the table per ampere through a lossless drive train, ``K_0 = k_t i 2 pi / h`` [N/A] (h in m)."""
+    def quantities(self) -> tuple[str, ...]:
+        """The keys of :data:`QUANTITIES` this kind of axis needs (a rotary axis has no screw lead)."""
+        return tuple(key for key in QUANTITIES if key != _SCREW or self.motion == "linear")
+
+    @property
+    def units(self) -> Motion:
+        """Units of the axis: the load is a force [N] on a linear axis, a torque [Nm] on a rotary one."""
+        return MOTIONS[self.motion]
+
+    @property
+    def lossless_load_constant(self) -> float:
+        """Load per ampere through a lossless drive train: ``K_0 = k_t i 2 pi / h`` [N/A] (h in m) on a
+        linear axis, ``K_0 = k_t i`` [Nm/A] on a rotary one."""
+        if self.motion == "rotary":
+            return self.torque_constant_Nm_per_A * self.gear_ratio
         return self.torque_constant_Nm_per_A * self.gear_ratio * 2.0 * math.pi / (self.screw_lead_mm * 1e-3)
 
     @property
-    def force_constants_N_per_A(self) -> tuple[float, float]:
-        """Force on the table per ampere, driving (``eta_d K_0``) and back-driven (``K_0 / eta_b``) [N/A].
+    def load_constants(self) -> tuple[float, float]:
+        """Load per ampere, driving (``eta_d K_0``) and back-driven (``K_0 / eta_b``) [N/A, or Nm/A rotary].
 
         Driving: the motor pushes the table against the load and the share
         ``eta_d`` of its power reaches the table. Back-driven: the load pushes
         the table along and the share ``eta_b`` of the table's power reaches
         the motor (:mod:`greybox.evaluate.process` derives both).
         """
-        lossless = self.lossless_force_constant_N_per_A
+        lossless = self.lossless_load_constant
         return lossless * self.efficiency_driving, lossless / self.efficiency_backdriven
 
-    def process_force_N(self, process_current_A, velocity_mm_s):
-        """Force [N] the drive exerts on the table for a process current [A], by the direction of power flow.
+    def process_load(self, process_current_A, velocity):
+        """Load the drive exerts on the axis for a process current [A], by the direction of power flow.
 
         Parameters
         ----------
         process_current_A : array_like
             Process share of the motor current [A].
-        velocity_mm_s : array_like
-            Axis velocity [mm/s], broadcast against the current; its sign
+        velocity : array_like
+            Axis velocity [mm/s, or deg/s rotary], broadcast against the current; its sign
             against the current's tells driving (``I v >= 0``; at rest no power
             flows and the driving constant is used) from back-driven (``I v < 0``).
 
         Returns
         -------
         ndarray
-            ``eta_d K_0 I`` where driving, ``K_0 I / eta_b`` where back-driven [N].
+            ``eta_d K_0 I`` where driving, ``K_0 I / eta_b`` where back-driven: force on
+            the table [N], or torque on a rotary axis [Nm].
         """
         current = np.asarray(process_current_A, dtype=float)
-        velocity = np.asarray(velocity_mm_s, dtype=float)
-        driving, backdriven = self.force_constants_N_per_A
+        velocity = np.asarray(velocity, dtype=float)
+        driving, backdriven = self.load_constants
         return np.where(current * velocity < 0.0, backdriven * current, driving * current)
 
     def to_dict(self) -> dict:
-        """The constants (and name and channels) as a JSON-able dict, the keys of an axis file."""
-        return {"name": self.name, **{key: float(getattr(self, key)) for key in QUANTITIES},
-                "channels": dict(self.channels)}
+        """The constants (and name, motion and channels) as a JSON-able dict, the keys of an axis file."""
+        return {"name": self.name, "motion": self.motion,
+                **{key: float(getattr(self, key)) for key in self.quantities}, "channels": dict(self.channels)}
 
     def to_toml(self) -> str:
         """The axis file's text (TOML), which :func:`read_axis_config` reads back to an equal configuration."""
         lines = [f"name = {json.dumps(self.name)}"] if self.name else []
+        lines += [f"motion = {json.dumps(self.motion)}"] if self.motion != "linear" else []
         lines += [f"{key} = {float(getattr(self, key))!r}  # {QUANTITIES[key][0]} [{QUANTITIES[key][1]}]"
-                  for key in QUANTITIES]
+                  for key in self.quantities]
         if self.channels:
             lines += ["", "[channels]"] + [f"{key} = {json.dumps(value)}" for key, value in self.channels.items()]
         return "\n".join(lines) + "\n"
@@ -191,13 +229,21 @@ def _check_values(values: Mapping[str, object], where: str, names: Mapping[str, 
         if efficiency > 1.0:
             hint = f"; {efficiency:g} looks like a percentage, write {efficiency / 100:g}" if efficiency <= 100 else ""
             _fail(where, f"{names.get(key, key)} must be a fraction 0 < eta <= 1, got {efficiency:g}{hint}")
-    lead = values["screw_lead_mm"]
+    lead = values.get(_SCREW, MIN_LEAD_MM)
     if lead < MIN_LEAD_MM:
         _fail(where, f"screw_lead_mm = {lead:g} mm is implausibly small (below {MIN_LEAD_MM:g} mm); "
                      f"was it written in metres? {lead:g} m is {lead * 1000:g} mm")
 
 
-def _check_channels(table, where: str) -> dict[str, str]:
+def check_channels(table, where: str) -> dict[str, str]:
+    """A ``[channels]`` table checked: ``{canonical_name: name_in_log}``, each quantity mapped once.
+
+    Raises
+    ------
+    GreyboxError
+        For a table that is not one, a key that is not a quantity with a known unit, a name that is
+        not text, or a quantity mapped twice; the message names ``where``.
+    """
     if not isinstance(table, dict):
         _fail(where, "[channels] must be a table of canonical_name = \"name in the log\" pairs")
     known = ", ".join(CANONICAL_NAMES.values())
@@ -205,7 +251,7 @@ def _check_channels(table, where: str) -> dict[str, str]:
     quantities: dict[str, str] = {}
     for key, value in table.items():
         parsed = parse_column_name(key)
-        if parsed is None or parsed[1] is None or parsed[1] not in UNIT_FACTORS[parsed[0]]:
+        if not known_column(key):
             _fail(where, f"[channels]: '{key}' is not a quantity with a known unit; use e.g. {known}")
         if not isinstance(value, str) or not value.strip():
             _fail(where, f"[channels]: {key} must name a column of the log as text, got {value!r}")
@@ -239,6 +285,13 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
     """
     where = source or "<axis config>"
     values: dict[str, object] = {}
+    motion = document.get("motion", "linear")
+    if motion not in MOTIONS:
+        _fail(where, f"motion must be one of {', '.join(repr(name) for name in MOTIONS)}, got {motion!r}")
+    required = [key for key in QUANTITIES if key != _SCREW or motion == "linear"]
+    if motion == "rotary" and _SCREW in document:
+        _fail(where, f"a rotary axis (motion = \"rotary\") has no {_SCREW}; give gear_ratio as motor revolutions per "
+                     "revolution of the axis")
     shared = document.get(SHARED_EFFICIENCY)
     given = [key for key in _EFFICIENCIES if key in document]
     if shared is not None and given:
@@ -263,7 +316,7 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
                 _fail(where, f"'{key}': {problem}; give the {words} as '{accepted}' (in {unit})")
             expected = ", ".join(list(QUANTITIES) + [SHARED_EFFICIENCY] + list(_OPTIONAL) + ["[channels]"])
             _fail(where, f"unknown key '{key}'; expected {expected}")
-    missing = [key for key in QUANTITIES if key not in values]
+    missing = [key for key in required if key not in values]
     if any(key in missing for key in _EFFICIENCIES) and not given:
         missing = [key for key in missing if key not in _EFFICIENCIES]
         _fail(where, "missing efficiency (the share of the motor's power reaching the table, about 0.9 for a ball "
@@ -272,11 +325,46 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
     if missing:
         lines = "; ".join(f"{key} ({QUANTITIES[key][0]} in {QUANTITIES[key][1]}: {QUANTITIES[key][2]})"
                           for key in missing)
-        _fail(where, f"missing {lines}")
+        hint = (f" (for a rotary axis write motion = \"rotary\" instead of a {_SCREW})"
+                if missing == [_SCREW] and motion == "linear" else "")
+        _fail(where, f"missing {lines}{hint}")
     _check_values(values, where, {key: SHARED_EFFICIENCY for key in _EFFICIENCIES} if shared is not None else None)
-    channels = _check_channels(document.get("channels", {}), where)
-    return AxisConfig(**{key: float(values[key]) for key in QUANTITIES}, name=str(document.get("name", "")),
-                      channels=channels, source=source)
+    channels = check_channels(document.get("channels", {}), where)
+    constants = {_SCREW: None, **{key: float(values[key]) for key in required}}
+    return AxisConfig(**constants, name=str(document.get("name", "")), motion=motion, channels=channels,
+                      source=source)
+
+
+def read_toml(path, what: str = "axis configuration") -> dict:
+    """The parsed content of a TOML file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        TOML file.
+    what : str, default "axis configuration"
+        What the file is, for the messages ("machine file").
+
+    Raises
+    ------
+    GreyboxError
+        For a missing or unreadable file, a directory, text that is not UTF-8 or not valid TOML;
+        the message names the file.
+    """
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as stream:
+            return tomllib.load(stream)
+    except FileNotFoundError:
+        _fail(path, f"no such {what} file")
+    except IsADirectoryError:
+        _fail(path, f"is a directory; expected a TOML {what} file")
+    except OSError as exc:
+        _fail(path, f"cannot read the {what} file ({exc.strerror or exc})")
+    except UnicodeDecodeError:
+        _fail(path, "not a TOML file (not UTF-8 text)")
+    except tomllib.TOMLDecodeError as exc:
+        _fail(path, f"not valid TOML ({exc})")
 
 
 def read_axis_config(path) -> AxisConfig:
@@ -297,18 +385,4 @@ def read_axis_config(path) -> AxisConfig:
         For a missing or unreadable file, invalid TOML, or content that
         :func:`parse_axis_config` refuses; the message names the file.
     """
-    path = os.fspath(path)
-    try:
-        with open(path, "rb") as stream:
-            document = tomllib.load(stream)
-    except FileNotFoundError:
-        _fail(path, "no such axis configuration file")
-    except IsADirectoryError:
-        _fail(path, "is a directory, not an axis configuration file")
-    except OSError as exc:
-        _fail(path, f"cannot read the axis configuration ({exc.strerror or exc})")
-    except UnicodeDecodeError:
-        _fail(path, "not a TOML file (not UTF-8 text)")
-    except tomllib.TOMLDecodeError as exc:
-        _fail(path, f"not valid TOML ({exc})")
-    return parse_axis_config(document, source=path)
+    return parse_axis_config(read_toml(path), source=os.fspath(path))

@@ -26,14 +26,14 @@ from __future__ import annotations
 
 import csv
 import json
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import pandas as pd
 
 from ..errors import LogError
-from .file_metadata import log_metadata, metadata_fields, read_sidecar, sidecar_path, sidecar_text
+from .file_metadata import logs_metadata, metadata_fields, read_sidecar, sidecar_path, sidecar_text
 from .log import AxisLog
-from .units import log_from_columns
+from .units import log_from_columns, several_axes_table
 
 __all__ = ["read_csv", "write_csv"]
 
@@ -60,7 +60,8 @@ def _preamble(path) -> tuple[int, dict, str]:
     return comments, metadata, ""
 
 
-def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: float | None = None) -> AxisLog:
+def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: float | None = None,
+             axis: str | None = None) -> AxisLog:
     """Read a CSV axis log.
 
     Parameters
@@ -73,6 +74,9 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
         ``{canonical_name: header}`` for headers not named by the convention.
     sample_time : float, optional
         Sample time [s] for files without a time column.
+    axis : str, optional
+        Axis to read from a file holding several, its columns named ``<axis>_<quantity>_<unit>``
+        (``X_position_mm``; :func:`greybox.data.units.select_axis`).
 
     Returns
     -------
@@ -108,10 +112,11 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
     if frame.empty:
         raise LogError(path, "no data rows (the file holds only a header)")
     table = {str(name).strip(): frame[name].to_numpy() for name in frame.columns}
-    return log_from_columns(table, source=path, columns=columns, sample_time=sample_time, **metadata_fields(metadata))
+    return log_from_columns(table, source=path, columns=columns, sample_time=sample_time, select=axis,
+                            **metadata_fields(metadata, axis))
 
 
-def write_csv(log: AxisLog, path, *, metadata_path=None) -> None:
+def write_csv(log: AxisLog | Sequence[AxisLog], path, *, metadata_path=None) -> None:
     """Write an axis log as plain CSV with canonical headers, and its metadata as a JSON sidecar.
 
     Floats are written with the shortest text that reads back to the same
@@ -119,7 +124,9 @@ def write_csv(log: AxisLog, path, *, metadata_path=None) -> None:
 
     Parameters
     ----------
-    log : AxisLog
+    log : AxisLog or sequence of AxisLog
+        One log, or several axes on the same time stamps: one table with the columns
+        ``time_s, X_position_mm, ...`` (:func:`~greybox.data.units.several_axes_table`).
     path : str or path-like
         CSV file; its first line is the header. Written in place;
         :func:`greybox.data.io.write_log` makes it atomic.
@@ -129,8 +136,9 @@ def write_csv(log: AxisLog, path, *, metadata_path=None) -> None:
         :func:`greybox.data.io.write_log` passes a temporary file that then
         replaces the sidecar.
     """
+    logs = [log] if isinstance(log, AxisLog) else list(log)
     with open(path, "w", encoding="utf-8", newline="") as stream:
-        log.to_frame().to_csv(stream, index=False, lineterminator="\n")
+        pd.DataFrame(several_axes_table(logs, source=path)).to_csv(stream, index=False, lineterminator="\n")
     side = sidecar_path(path) if metadata_path is None else metadata_path
     with open(side, "w", encoding="utf-8", newline="\n") as stream:
-        stream.write(sidecar_text(log_metadata(log)))
+        stream.write(sidecar_text(logs_metadata(logs)))

@@ -19,7 +19,8 @@ from typing import Mapping
 from ..errors import LogError
 from .log import AxisLog
 
-__all__ = ["SIDECAR_SUFFIX", "log_metadata", "metadata_fields", "read_sidecar", "sidecar_path", "sidecar_text"]
+__all__ = ["SIDECAR_SUFFIX", "log_metadata", "logs_metadata", "metadata_fields", "read_sidecar", "sidecar_path",
+           "sidecar_text"]
 
 #: Appended to a CSV file's name to give its metadata file: ``x.csv`` -> ``x.csv.json``.
 SIDECAR_SUFFIX = ".json"
@@ -30,7 +31,15 @@ def log_metadata(log: AxisLog) -> dict[str, object]:
     return {"axis": log.axis, "dataset": log.dataset, "effort_unit": log.effort_unit, "attrs": log.attrs}
 
 
-def metadata_fields(metadata: Mapping[str, object]) -> dict[str, object]:
+def logs_metadata(logs) -> dict[str, object]:
+    """The metadata object written with one log, or with several axes in one table: ``{"axes": {axis: ...}}``."""
+    logs = list(logs)
+    if len(logs) == 1:
+        return log_metadata(logs[0])
+    return {"axes": {log.axis: log_metadata(log) for log in logs}}
+
+
+def metadata_fields(metadata: Mapping[str, object], axis: str | None = None) -> dict[str, object]:
     """Keyword arguments of :func:`greybox.data.units.log_from_columns` from a read metadata object.
 
     Parameters
@@ -38,7 +47,12 @@ def metadata_fields(metadata: Mapping[str, object]) -> dict[str, object]:
     metadata : mapping
         The decoded JSON object; missing keys give an unknown effort unit,
         empty axis and dataset names and no attrs.
+    axis : str, optional
+        The axis read from a table of several: its entry of ``metadata["axes"]``.
     """
+    if isinstance(metadata.get("axes"), dict):
+        entry = metadata["axes"].get(axis) if axis is not None else None
+        metadata = entry if isinstance(entry, dict) else {}
     return {
         "effort_unit": metadata.get("effort_unit"),
         "axis": str(metadata.get("axis", "")),

@@ -28,7 +28,7 @@ from ..atomic import atomic_output
 from ..errors import GreyboxError, LogError
 from .file_metadata import sidecar_path
 from .log import AxisLog
-from .units import CANONICAL_NAMES, UNIT_FACTORS, parse_column_name
+from .units import CANONICAL_NAMES, known_column
 from .validate import check_finite, check_increasing, check_time
 
 __all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS"]
@@ -38,11 +38,11 @@ FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",),
 
 # format -> (module, reader, writer or None, reader options)
 _HANDLERS = {
-    "csv": ("csv_io", "read_csv", "write_csv", ("columns", "sample_time")),
-    "parquet": ("parquet_io", "read_parquet", "write_parquet", ("columns", "sample_time")),
-    "mcap": ("mcap_io", "read_mcap", "write_mcap", ("columns", "topic")),
-    "mat": ("matlab", "read_mat", None, ("columns", "sample_time")),
-    "tdms": ("tdms_io", "read_tdms", None, ("columns", "topic", "sample_time")),
+    "csv": ("csv_io", "read_csv", "write_csv", ("columns", "sample_time", "axis")),
+    "parquet": ("parquet_io", "read_parquet", "write_parquet", ("columns", "sample_time", "axis")),
+    "mcap": ("mcap_io", "read_mcap", "write_mcap", ("columns", "topic", "axis")),
+    "mat": ("matlab", "read_mat", None, ("columns", "sample_time", "axis")),
+    "tdms": ("tdms_io", "read_tdms", None, ("columns", "topic", "sample_time", "axis")),
 }
 
 
@@ -79,6 +79,7 @@ def read_log(
     sample_time: float | None = None,
     time_tolerance: float | None = 0.25,
     fmt: str | None = None,
+    axis: str | None = None,
 ) -> AxisLog:
     """Read and validate one axis log.
 
@@ -101,6 +102,11 @@ def read_log(
         increasing time (a log to be resampled, :func:`greybox.data.prepare.prepare`).
     fmt : {"csv", "parquet", "mcap", "mat", "tdms"}, optional
         Format, overriding the extension.
+    axis : str, optional
+        One axis of a file holding several: columns (fields, vectors, channels) named
+        ``<axis>_<quantity>_<unit>`` (``X_position_mm``, ``X_current_A``; columns without a prefix,
+        such as ``time_s``, are shared), or the MCAP channel ``/axis/<axis>``, or the TDMS group
+        ``<axis>``.
 
     Returns
     -------
@@ -122,7 +128,7 @@ def read_log(
     fmt = format_of(path, fmt)
     if os.path.getsize(path) == 0:
         raise LogError(path, "empty file (0 bytes)")
-    given = {"columns": columns, "topic": topic, "sample_time": sample_time}
+    given = {"columns": columns, "topic": topic, "sample_time": sample_time, "axis": axis}
     accepted = _HANDLERS[fmt][3]
     for option, value in given.items():
         if value is not None and option not in accepted:
@@ -151,7 +157,8 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
     Parameters
     ----------
     log : AxisLog or sequence of AxisLog
-        The log; MCAP also takes several logs of different axes (one channel each).
+        The log; or several logs of different axes: one channel each in MCAP, one table with
+        columns ``X_position_mm, ...`` in CSV and Parquet (same time stamps needed).
     path : str or path-like
         Output file; the format follows from the extension.
     fmt : {"csv", "parquet", "mcap"}, optional
@@ -160,7 +167,7 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
     Raises
     ------
     LogError
-        For an unknown or read-only format, several logs for a one-log format,
+        For an unknown or read-only format, several logs that one table cannot hold,
         or a ``path`` that is the file a log was read from.
     """
     path = os.fspath(path)
@@ -170,8 +177,6 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
     logs = [log] if isinstance(log, AxisLog) else list(log)
     if not logs:
         raise LogError(path, "no log to write")
-    if fmt != "mcap" and len(logs) > 1:
-        raise LogError(path, f"a {fmt} file holds one log; write several axes to .mcap or to one file each")
     for item in logs:
         if item.source and os.path.exists(path) and os.path.exists(item.source) and os.path.samefile(path, item.source):
             raise LogError(path, "refusing to overwrite the file the log was read from; choose another output path")
@@ -179,10 +184,10 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
     if fmt == "csv":  # two files, each replaced in one step: the plain CSV and its metadata sidecar
         target = os.path.abspath(path)
         with atomic_output(target) as temporary, atomic_output(sidecar_path(target)) as side:
-            writer(logs[0], str(temporary), metadata_path=str(side))
+            writer(logs, str(temporary), metadata_path=str(side))
         return
     with atomic_output(os.path.abspath(path)) as temporary:
-        writer(logs if fmt == "mcap" else logs[0], str(temporary))
+        writer(logs, str(temporary))
 
 
 def parse_column_mapping(text: str) -> dict[str, str]:
@@ -216,8 +221,7 @@ def parse_column_mapping(text: str) -> dict[str, str]:
         key, value = (part.strip() for part in pair.split("=", 1))
         if not key or not value:
             raise GreyboxError(f"column mapping: empty name in '{pair.strip()}'")
-        parsed = parse_column_name(key)
-        if parsed is None or parsed[1] not in UNIT_FACTORS[parsed[0]]:
+        if not known_column(key):
             raise GreyboxError(f"column mapping: '{key}' is not a quantity with a known unit; use e.g. {known}")
         if key in mapping:
             raise GreyboxError(f"column mapping: '{key}' is given twice")

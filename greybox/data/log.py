@@ -14,20 +14,14 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 
 from ..errors import LogError
+from .quantities import MOTIONS, Motion
 
-__all__ = ["AxisLog", "as_log_list", "EFFORT_UNITS", "CANONICAL_COLUMNS"]
+__all__ = ["AxisLog", "as_log_list", "EFFORT_UNITS"]
 
 #: Units of the drive effort a log may carry: motor current [A] or, for drives
-#: that log force instead (e.g. the EMPS benchmark), force on the load side [N].
-EFFORT_UNITS = ("A", "N")
-
-#: Canonical column names of the base channels in tables (CSV, Parquet, frames).
-CANONICAL_COLUMNS = {
-    "time": "time_s",
-    "position": "position_mm",
-    "velocity": "velocity_mm_s",
-    "acceleration": "acceleration_mm_s2",
-}
+#: that log their load instead (e.g. the EMPS benchmark), force on the load side
+#: [N] of a linear axis or torque [Nm] of a rotary one.
+EFFORT_UNITS = ("A", "N", "Nm")
 
 
 def _as_channel(values, name: str, n: int | None, source) -> np.ndarray:
@@ -48,21 +42,25 @@ class AxisLog:
     time : array_like, shape (n,)
         Sample times [s], strictly increasing.
     position : array_like, shape (n,)
-        Axis position [mm].
+        Axis position [mm], or [deg] for a rotary axis.
     effort : array_like, shape (n,)
-        Drive effort: motor current [A], or force [N] when ``effort_unit == "N"``.
+        Drive effort: motor current [A], or the load in ``effort_unit``
+        (force [N] of a linear axis, torque [Nm] of a rotary one).
     velocity : array_like, shape (n,), optional
-        Axis velocity [mm/s]; ``None`` until derived by :func:`greybox.data.prepare`.
+        Axis velocity [mm/s or deg/s]; ``None`` until derived by :func:`greybox.data.prepare`.
     acceleration : array_like, shape (n,), optional
-        Axis acceleration [mm/s^2]; ``None`` until derived.
-    effort_unit : {"A", "N"}, default "A"
-        Unit of ``effort``.
+        Axis acceleration [mm/s^2 or deg/s^2]; ``None`` until derived.
+    effort_unit : {"A", "N", "Nm"}, default "A"
+        Unit of ``effort``; "N" for a linear axis only, "Nm" for a rotary one.
     axis : str, default ""
         Axis name, e.g. ``"X"``.
     dataset : str, default ""
         Dataset id, e.g. ``"A"``.
     source : str, default ""
         File the log was read from (empty for an in-memory log).
+    motion : {"linear", "rotary"}, default "linear"
+        Kind of axis (:mod:`greybox.data.quantities`): it sets the units of
+        position, velocity, acceleration and load.
     extras : mapping of str to array_like, optional
         Further channels of the same length, e.g. the truth components of a
         synthetic log (``"truth_friction_A"``). Names carry their unit suffix.
@@ -86,6 +84,7 @@ class AxisLog:
     axis: str = ""
     dataset: str = ""
     source: str = ""
+    motion: str = "linear"
     extras: Mapping[str, np.ndarray] = field(default_factory=dict)
     attrs: Mapping[str, object] = field(default_factory=dict)
 
@@ -100,8 +99,11 @@ class AxisLog:
             value = getattr(self, name)
             if value is not None:
                 object.__setattr__(self, name, _as_channel(value, name, n, src))
-        if self.effort_unit not in EFFORT_UNITS:
-            raise LogError(src, f"unknown effort unit {self.effort_unit!r}; expected one of {EFFORT_UNITS}")
+        if self.motion not in MOTIONS:
+            raise LogError(src, f"unknown motion {self.motion!r}; expected one of {', '.join(MOTIONS)}")
+        if self.effort_unit not in self.units.effort_units:
+            raise LogError(src, f"effort unit {self.effort_unit!r} does not fit a {self.motion} axis; expected one "
+                                f"of {self.units.effort_units}")
         extras = {str(k): _as_channel(v, str(k), n, src) for k, v in dict(self.extras).items()}
         object.__setattr__(self, "extras", extras)
         object.__setattr__(self, "attrs", dict(self.attrs))
@@ -126,9 +128,14 @@ class AxisLog:
         return self.effort
 
     @property
+    def units(self) -> Motion:
+        """Units and column names of the axis's motion (mm and N, or deg and Nm)."""
+        return MOTIONS[self.motion]
+
+    @property
     def effort_column(self) -> str:
-        """Canonical column name of the effort: ``current_A`` or ``force_N``."""
-        return "current_A" if self.effort_unit == "A" else "force_N"
+        """Canonical column name of the effort: ``current_A``, ``force_N`` or ``torque_Nm``."""
+        return self.units.effort_column(self.effort_unit)
 
     @property
     def sample_time(self) -> float:
@@ -176,14 +183,32 @@ class AxisLog:
         """Return the log as a :class:`pandas.DataFrame` with canonical column names."""
         import pandas as pd
 
-        columns = {CANONICAL_COLUMNS["time"]: self.time, CANONICAL_COLUMNS["position"]: self.position}
+        return pd.DataFrame(dict(self.named_channels(time=True)))
+
+    def named_channels(self, *, time: bool = False) -> list[tuple[str, np.ndarray]]:
+        """The channels under their canonical column names: base channels present, then the extras.
+
+        Parameters
+        ----------
+        time : bool, default False
+            Start with ``("time_s", time)``.
+
+        Returns
+        -------
+        list of (str, ndarray)
+            E.g. ``position_mm``, ``velocity_mm_s``, ``acceleration_mm_s2``, ``current_A``, extras
+            (``position_deg``, ``velocity_deg_s``, ... for a rotary axis).
+        """
+        units = self.units
+        columns = [("time_s", self.time)] if time else []
+        columns.append((units.position_column, self.position))
         if self.velocity is not None:
-            columns[CANONICAL_COLUMNS["velocity"]] = self.velocity
+            columns.append((units.velocity_column, self.velocity))
         if self.acceleration is not None:
-            columns[CANONICAL_COLUMNS["acceleration"]] = self.acceleration
-        columns[self.effort_column] = self.effort
-        columns.update(self.extras)
-        return pd.DataFrame(columns)
+            columns.append((units.acceleration_column, self.acceleration))
+        columns.append((self.effort_column, self.effort))
+        columns += list(self.extras.items())
+        return columns
 
 
 def as_log_list(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:

@@ -92,7 +92,7 @@ def _columns(variables: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
 
 
 def log_from_vectors(variables: Mapping[str, np.ndarray], path, *, columns: Mapping[str, str] | None = None,
-                     sample_time: float | None = None) -> AxisLog:
+                     sample_time: float | None = None, axis: str | None = None) -> AxisLog:
     """An axis log from a ``.mat`` file's variables, its vectors taken as named columns.
 
     Parameters
@@ -105,6 +105,9 @@ def log_from_vectors(variables: Mapping[str, np.ndarray], path, *, columns: Mapp
         ``{canonical_name: variable}`` for variables not named by the convention.
     sample_time : float, optional
         Sample time [s] for files without a time vector.
+    axis : str, optional
+        Axis to read from a file holding several, its vectors named ``<axis>_<quantity>_<unit>``
+        (``X_position_mm``; :func:`greybox.data.units.select_axis`).
 
     Returns
     -------
@@ -133,4 +136,4 @@ def log_from_vectors(variables: Mapping[str, np.ndarray], path, *, columns: Mapp
     if odd:
         raise LogError(path, f"variable '{odd[0]}' has {lengths[odd[0]]} samples, the other channels {common}")
     return log_from_columns(table, source=str(path), columns=columns, sample_time=sample_time,
-                            dataset=Path(path).stem)
+                            dataset=Path(path).stem, select=axis)

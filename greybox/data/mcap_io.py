@@ -31,7 +31,7 @@ from numba import njit
 
 from ..errors import LogError
 from .log import AxisLog
-from .units import CANONICAL_NAMES, log_from_columns
+from .units import log_from_columns
 
 __all__ = ["AXIS_SAMPLE_SCHEMA", "SCHEMA_NAME", "read_mcap", "write_mcap", "topic_for"]
 
@@ -42,17 +42,24 @@ SCHEMA_NAME = "greybox.AxisSample"
 AXIS_SAMPLE_SCHEMA = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": SCHEMA_NAME,
-    "description": "One sample of one machine-tool feed axis. The sample time is the message log_time in ns.",
+    "description": "One sample of one machine-tool axis, linear (mm, N) or rotary (deg, Nm). "
+                   "The sample time is the message log_time in ns.",
     "type": "object",
     "properties": {
-        "position_mm": {"type": "number", "description": "axis position [mm]"},
+        "position_mm": {"type": "number", "description": "position of a linear axis [mm]"},
+        "position_deg": {"type": "number", "description": "angle of a rotary axis [deg]"},
         "current_A": {"type": "number", "description": "motor current [A]"},
-        "force_N": {"type": "number", "description": "drive force [N], for logs without current"},
+        "force_N": {"type": "number", "description": "drive force [N], for linear-axis logs without current"},
+        "torque_Nm": {"type": "number", "description": "drive torque [Nm], for rotary-axis logs without current"},
         "velocity_mm_s": {"type": "number", "description": "axis velocity [mm/s]"},
+        "velocity_deg_s": {"type": "number", "description": "axis angular velocity [deg/s]"},
         "acceleration_mm_s2": {"type": "number", "description": "axis acceleration [mm/s^2]"},
+        "acceleration_deg_s2": {"type": "number", "description": "axis angular acceleration [deg/s^2]"},
     },
-    "required": ["position_mm"],
-    "anyOf": [{"required": ["current_A"]}, {"required": ["force_N"]}],
+    "allOf": [
+        {"anyOf": [{"required": ["position_mm"]}, {"required": ["position_deg"]}]},
+        {"anyOf": [{"required": ["current_A"]}, {"required": ["force_N"]}, {"required": ["torque_Nm"]}]},
+    ],
     "additionalProperties": {"type": "number", "description": "extra channel; the name ends in its unit"},
 }
 
@@ -69,18 +76,8 @@ def topic_for(axis: str) -> str:
 
 
 # ---------------------------------------------------------------------- write
-def _sample_fields(log: AxisLog) -> list[tuple[str, np.ndarray]]:
-    fields = [(CANONICAL_NAMES["position"], log.position), (log.effort_column, log.effort)]
-    if log.velocity is not None:
-        fields.append((CANONICAL_NAMES["velocity"], log.velocity))
-    if log.acceleration is not None:
-        fields.append((CANONICAL_NAMES["acceleration"], log.acceleration))
-    fields.extend(log.extras.items())
-    return fields
-
-
 def _check_encodable(log: AxisLog, path) -> None:
-    for name, values in [("time_s", log.time)] + _sample_fields(log):
+    for name, values in log.named_channels(time=True):
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise LogError(path, f"channel '{name}' holds {values[bad[0]]} at sample {bad[0]}; "
@@ -91,7 +88,7 @@ def _check_encodable(log: AxisLog, path) -> None:
 
 def _encode_messages(log: AxisLog) -> Iterator[bytes]:
     """One JSON object per sample; floats as their shortest exact text (``repr``)."""
-    fields = _sample_fields(log)
+    fields = log.named_channels()
     template = "{" + ",".join(json.dumps(name).replace("%", "%%") + ":%r" for name, _ in fields) + "}"
     columns = [values.tolist() for _, values in fields]
     return ((template % row).encode() for row in zip(*columns))
@@ -457,6 +454,7 @@ def read_mcap(
     *,
     topic: str | None = None,
     columns: Mapping[str, str] | None = None,
+    axis: str | None = None,
 ) -> AxisLog:
     """Read one axis channel of an MCAP file with JSON messages.
 
@@ -470,6 +468,10 @@ def read_mcap(
     columns : mapping of str to str, optional
         ``{canonical_name: message_field}`` for fields not named by the
         greybox convention, e.g. ``{"position_mm": "pos", "current_A": "iq"}``.
+    axis : str, optional
+        Axis to read from a file holding several: the channel ``/axis/<axis>`` if there is one
+        (and no ``topic``), else the fields named ``<axis>_<quantity>_<unit>`` of the one channel
+        (:func:`greybox.data.units.select_axis`).
 
     Returns
     -------
@@ -485,7 +487,15 @@ def read_mcap(
         For a file that is not MCAP, truncated or corrupt, an ambiguous or
         unknown topic, non-JSON messages, or missing fields.
     """
-    channels, collector = _collect(path, topic)
+    select = None
+    if axis is not None and topic is None:
+        topic = topic_for(axis)
+        channels, collector = _collect(path, topic)
+        if not any(channel.topic == topic for channel in channels.values()):
+            topic, select = None, axis
+            channels, collector = _collect(path, None)
+    else:
+        channels, collector = _collect(path, topic)
     channel = _choose(channels, topic, path)
     if channel.message_encoding != "json":
         raise LogError(
@@ -509,4 +519,5 @@ def read_mcap(
         axis=metadata.get("axis", channel.topic.rstrip("/").rsplit("/", 1)[-1]),
         dataset=metadata.get("dataset", ""),
         attrs=attrs if isinstance(attrs, dict) else {"attrs": attrs},
+        select=select,
     )

@@ -12,19 +12,22 @@ mapping); the metadata is optional.
 from __future__ import annotations
 
 import json
-from typing import Mapping
+from typing import Mapping, Sequence
+
+import numpy as np
 
 from ..errors import LogError
-from .file_metadata import log_metadata, metadata_fields
+from .file_metadata import logs_metadata, metadata_fields
 from .log import AxisLog
-from .units import log_from_columns
+from .units import log_from_columns, several_axes_table
 
 __all__ = ["read_parquet", "write_parquet"]
 
 _METADATA_KEY = b"greybox"
 
 
-def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time: float | None = None) -> AxisLog:
+def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time: float | None = None,
+                 axis: str | None = None) -> AxisLog:
     """Read a Parquet axis log.
 
     Parameters
@@ -34,6 +37,9 @@ def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time:
         ``{canonical_name: column}`` for columns not named by the convention.
     sample_time : float, optional
         Sample time [s] for files without a time column.
+    axis : str, optional
+        Axis to read from a file holding several, its columns named ``<axis>_<quantity>_<unit>``
+        (``X_position_mm``; :func:`greybox.data.units.select_axis`).
 
     Returns
     -------
@@ -65,24 +71,27 @@ def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time:
         kind = column.type
         numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
         arrays[name] = column.to_numpy() if numeric else column.to_numpy(zero_copy_only=False).astype(object)
-    return log_from_columns(arrays, source=path, columns=columns, sample_time=sample_time, **metadata_fields(metadata))
+    return log_from_columns(arrays, source=path, columns=columns, sample_time=sample_time, select=axis,
+                            **metadata_fields(metadata, axis))
 
 
-def write_parquet(log: AxisLog, path) -> None:
+def write_parquet(log: AxisLog | Sequence[AxisLog], path) -> None:
     """Write an axis log as Parquet (float64 columns, zstd, metadata in the schema).
 
     Parameters
     ----------
-    log : AxisLog
+    log : AxisLog or sequence of AxisLog
+        One log, or several axes on the same time stamps: one table with the columns
+        ``time_s, X_position_mm, ...`` (:func:`~greybox.data.units.several_axes_table`).
     path : str or path-like
         Written in place; :func:`greybox.data.io.write_log` makes it atomic.
     """
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    frame = log.to_frame()
+    logs = [log] if isinstance(log, AxisLog) else list(log)
     table = pa.table(
-        {name: frame[name].to_numpy() for name in frame.columns},
-        metadata={_METADATA_KEY: json.dumps(log_metadata(log)).encode()},
+        {name: np.asarray(values, dtype=np.float64) for name, values in several_axes_table(logs, source=path).items()},
+        metadata={_METADATA_KEY: json.dumps(logs_metadata(logs)).encode()},
     )
     pq.write_table(table, path, compression="zstd")

@@ -45,7 +45,7 @@ def _has_time_column(names, columns: Mapping[str, str] | None) -> bool:
 
 
 def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | None = None,
-              sample_time: float | None = None) -> AxisLog:
+              sample_time: float | None = None, axis: str | None = None) -> AxisLog:
     """Read one group of a TDMS file as an axis log.
 
     Parameters
@@ -58,6 +58,10 @@ def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | No
         Group to read; required when the file holds several.
     sample_time : float, optional
         Sample time [s] for a group with neither a time channel nor waveform properties.
+    axis : str, optional
+        Axis to read from a file holding several: the group of that name if there is one (and no
+        ``topic``), else the group's channels named ``<axis>_<quantity>_<unit>``
+        (:func:`greybox.data.units.select_axis`).
 
     Returns
     -------
@@ -75,6 +79,9 @@ def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | No
         tdms = TdmsFile.read(path)
     except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on corrupt files
         raise LogError(path, f"not a readable TDMS file ({type(exc).__name__}: {exc})") from None
+    select = axis
+    if axis is not None and topic is None and any(group.name == axis for group in tdms.groups()):
+        topic, select = axis, None
     group = _group(tdms, path, topic)
     numeric = [(channel, data) for channel, data in ((channel, np.asarray(channel[:])) for channel in group.channels())
                if data.dtype.kind in "biuf"]
@@ -88,4 +95,4 @@ def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | No
     if not _has_time_column(table, columns) and sample_time is None and "wf_increment" in kept[0][0].properties:
         time = np.asarray(kept[0][0].time_track(), dtype=np.float64)
     return log_from_columns(table, source=str(path), columns=columns, time=time, sample_time=sample_time,
-                            dataset=Path(path).stem, axis=group.name if topic is not None else "")
+                            dataset=Path(path).stem, axis=group.name if topic is not None else "", select=select)

@@ -1,56 +1,83 @@
 """Units of logged quantities and the mapping of named columns to an :class:`AxisLog`.
 
-Every reader (CSV, Parquet, MCAP) ends in :func:`log_from_columns`: the file
-gives named numeric columns, this module finds the base channels among them by
-their name and unit suffix, converts them to the canonical units (s, mm, mm/s,
-mm/s^2, A or N) and keeps every other numeric column as an extra channel.
+Every reader (CSV, Parquet, MCAP, MATLAB, TDMS) ends in :func:`log_from_columns`:
+the file gives named numeric columns, this module finds the base channels among
+them by their name and unit suffix, converts them to the canonical units and
+keeps every other numeric column as an extra channel.
 
 A column name is ``<quantity>_<unit>``, e.g. ``position_um`` or
 ``velocity_mm_min``. The quantities and the unit suffixes understood are listed
 in :data:`UNIT_FACTORS`; the factor converts a value in that unit to the
-canonical unit (the first entry of each quantity). A column whose quantity is
-known but whose suffix looks like an unsupported unit (``position_inch``) is an
-error rather than a silently ignored channel; a suffix made of other words
-(``position_setpoint_mm``) makes the column an ordinary extra.
+canonical unit of its motion. The units also tell the kind of axis
+(:mod:`greybox.data.quantities`): mm, m, um, N are a linear axis (canonical s,
+mm, mm/s, mm/s^2, A or N); deg, rad, rev, rpm, Nm a rotary one (canonical s,
+deg, deg/s, deg/s^2, A or Nm). A log mixing the two is an error. A column whose
+quantity is known but whose suffix looks like an unsupported unit
+(``position_inch``) is an error rather than a silently ignored channel; a
+suffix made of other words (``position_setpoint_mm``) makes the column an
+ordinary extra.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Mapping
 
 import numpy as np
 
 from ..errors import LogError
 from .log import AxisLog
+from .quantities import LINEAR, ROTARY
 
 __all__ = [
     "UNIT_FACTORS",
+    "ROTARY_UNITS",
     "CANONICAL_NAMES",
+    "EFFORT_QUANTITIES",
     "parse_column_name",
+    "known_column",
     "resolve_columns",
+    "axes_in_columns",
+    "select_axis",
+    "several_axes_table",
     "log_from_columns",
 ]
 
-#: Conversion factors to the canonical unit, per quantity and unit suffix.
-#: The first suffix of each quantity is the canonical one.
+_DEG_PER_RAD = 180.0 / math.pi
+
+#: Conversion factors to the canonical unit of the motion, per quantity and unit suffix.
+#: The first suffix of each quantity is the linear axis's canonical one.
 UNIT_FACTORS: dict[str, dict[str, float]] = {
     "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9},
-    "position": {"mm": 1.0, "m": 1e3, "um": 1e-3, "µm": 1e-3},
-    "velocity": {"mm_s": 1.0, "m_s": 1e3, "mm_min": 1.0 / 60.0, "m_min": 1e3 / 60.0},
-    "acceleration": {"mm_s2": 1.0, "m_s2": 1e3},
+    "position": {"mm": 1.0, "m": 1e3, "um": 1e-3, "µm": 1e-3, "deg": 1.0, "rad": _DEG_PER_RAD, "rev": 360.0},
+    "velocity": {"mm_s": 1.0, "m_s": 1e3, "mm_min": 1.0 / 60.0, "m_min": 1e3 / 60.0,
+                 "deg_s": 1.0, "rad_s": _DEG_PER_RAD, "rpm": 6.0, "deg_min": 1.0 / 60.0, "rev_s": 360.0},
+    "acceleration": {"mm_s2": 1.0, "m_s2": 1e3, "deg_s2": 1.0, "rad_s2": _DEG_PER_RAD},
     "current": {"A": 1.0, "mA": 1e-3},
     "force": {"N": 1.0, "kN": 1e3},
+    "torque": {"Nm": 1.0, "mNm": 1e-3, "kNm": 1e3},
 }
 
-#: Canonical column name of each quantity, e.g. ``"velocity" -> "velocity_mm_s"``.
+#: Units (per quantity) that make a log a rotary axis's; the other position, velocity,
+#: acceleration and force units are a linear axis's, time and current units fit both.
+ROTARY_UNITS = {"position": {"deg", "rad", "rev"}, "velocity": {"deg_s", "rad_s", "rpm", "deg_min", "rev_s"},
+                "acceleration": {"deg_s2", "rad_s2"}, "torque": set(UNIT_FACTORS["torque"])}
+
+#: Canonical column name of each quantity (a linear axis's; torque for a rotary axis's load).
 CANONICAL_NAMES = {quantity: f"{quantity}_{next(iter(units))}" for quantity, units in UNIT_FACTORS.items()}
+
+#: Quantities that can be the drive effort of a log: the motor current or the load.
+EFFORT_QUANTITIES = ("current", "force", "torque")
+
+_EFFORT_UNIT = {"current": "A", "force": LINEAR.load_unit, "torque": ROTARY.load_unit}
+_MOTION_QUANTITIES = ("position", "velocity", "acceleration", "force", "torque")
 
 # Words that make up unit suffixes, supported or not. A multi-word suffix made
 # only of these is taken as a unit (and rejected when unsupported); any other
 # word makes the column an extra channel (``position_setpoint_mm``).
 _UNIT_WORDS = frozenset(
     "m mm um µm cm dm km nm in inch inches ft mil s ms us ns sec min h hr s2 sec2 "
-    "A mA kA uA N kN mN lbf deg rad rev rpm per".split()
+    "A mA kA uA N kN mN lbf Nm mNm kNm Nmm deg rad rev rpm grad per".split()
 )
 
 
@@ -83,6 +110,12 @@ def parse_column_name(name: str) -> tuple[str, str | None] | None:
     return None
 
 
+def known_column(name: str) -> bool:
+    """True when ``name`` is a quantity with a supported unit, e.g. ``"position_deg"`` (a valid mapping key)."""
+    parsed = parse_column_name(name)
+    return parsed is not None and parsed[1] in UNIT_FACTORS[parsed[0]]
+
+
 def _unit_factor(quantity: str, unit: str | None, column: str, source) -> float:
     units = UNIT_FACTORS[quantity]
     if unit is None:
@@ -101,6 +134,18 @@ def _unit_factor(quantity: str, unit: str | None, column: str, source) -> float:
     return units[unit]
 
 
+def _motion(units: Mapping[str, tuple[str, str]], source) -> str:
+    """The motion ("linear" or "rotary") the units of the found channels agree on; error if they disagree."""
+    kinds = {quantity: ("rotary" if unit in ROTARY_UNITS.get(quantity, ()) else "linear", column)
+             for quantity, (column, unit) in units.items() if quantity in _MOTION_QUANTITIES}
+    if len({kind for kind, _ in kinds.values()}) > 1:
+        listed = ", ".join(f"'{column}' ({kind})" for kind, column in kinds.values())
+        raise LogError(source, f"the columns mix a linear and a rotary axis: {listed}; a linear axis logs mm, mm/s "
+                               "and N, a rotary one deg (or rad, rev), deg/s (or rad/s, rpm) and Nm: give every "
+                               "column its unit with columns=")
+    return next(iter(kinds.values()))[0] if kinds else "linear"
+
+
 def resolve_columns(
     names,
     *,
@@ -108,8 +153,8 @@ def resolve_columns(
     columns: Mapping[str, str] | None = None,
     with_time: bool = True,
     effort_unit: str | None = None,
-) -> dict[str, tuple[str, float]]:
-    """Find the base channels among named columns.
+) -> tuple[dict[str, tuple[str, float]], str]:
+    """Find the base channels among named columns, and the kind of axis their units tell.
 
     Parameters
     ----------
@@ -120,29 +165,33 @@ def resolve_columns(
     columns : mapping of str to str, optional
         Explicit ``{canonical_name: name_in_file}`` pairs, e.g.
         ``{"position_mm": "X1_ActualPosition"}``. The key may carry any supported
-        unit suffix (``{"position_um": "Pos"}`` reads ``Pos`` as micrometres).
+        unit suffix (``{"position_um": "Pos"}`` reads ``Pos`` as micrometres,
+        ``{"position_rad": "C_angle"}`` as radians of a rotary axis).
     with_time : bool, default True
         Look for a time column; ``False`` when the format carries time itself (MCAP).
-    effort_unit : {"A", "N"}, optional
+    effort_unit : {"A", "N", "Nm"}, optional
         Effort unit recorded in the file's metadata; it decides between a
-        current and a force column when both are present.
+        current and a load column when both are present.
 
     Returns
     -------
-    dict
+    found : dict
         ``{quantity: (column_name, factor_to_canonical_unit)}`` for the
         quantities found, among ``time``, ``position``, ``velocity``,
-        ``acceleration`` and one of ``current`` / ``force``.
+        ``acceleration`` and one of ``current`` / ``force`` / ``torque``.
+    motion : {"linear", "rotary"}
+        The kind of axis the units tell (linear when no unit tells).
 
     Raises
     ------
     LogError
         For a mapped column that is missing, an unknown quantity or unit,
-        an ambiguous or missing required channel.
+        an ambiguous or missing required channel, units of a linear and a rotary axis together.
     """
     names = list(names)
     present = set(names)
     found: dict[str, tuple[str, float]] = {}
+    units: dict[str, tuple[str, str]] = {}
     for key, column in dict(columns or {}).items():
         parsed = parse_column_name(key)
         if parsed is None or parsed[1] is None:
@@ -157,6 +206,7 @@ def resolve_columns(
             raise LogError(source, f"column '{column}' (mapped to {key}) not found; "
                                    f"columns in the file: {_listing(names)}")
         found[quantity] = (column, _unit_factor(quantity, unit, key, source))
+        units[quantity] = (column, unit)
 
     candidates: dict[str, list[tuple[str, str | None]]] = {}
     for name in names:
@@ -175,35 +225,160 @@ def resolve_columns(
             )
         name, unit = hits[0]
         found[quantity] = (name, _unit_factor(quantity, unit, name, source))
+        units[quantity] = (name, unit)
 
-    if "current" in found and "force" in found:
-        mapped = {parse_column_name(key)[0] for key in dict(columns or {})} & {"current", "force"}
-        if len(mapped) == 2:
-            raise LogError(source, "columns: map either a current or a force column as the effort, not both")
-        if mapped:
-            chosen = mapped.pop()
-        elif effort_unit in ("A", "N"):
-            chosen = "current" if effort_unit == "A" else "force"
-        else:
-            raise LogError(
-                source,
-                f"both a current column ('{found['current'][0]}') and a force column ('{found['force'][0]}'); "
-                "choose the effort with columns={'current_A': ...} or columns={'force_N': ...}",
-            )
-        del found["force" if chosen == "current" else "current"]
+    efforts = [quantity for quantity in EFFORT_QUANTITIES if quantity in found]
+    if len(efforts) > 1:
+        mapped = [quantity for quantity in efforts
+                  if quantity in {parse_column_name(key)[0] for key in dict(columns or {})}]
+        by_unit = [quantity for quantity in efforts if _EFFORT_UNIT[quantity] == effort_unit]
+        if len(mapped) > 1:
+            raise LogError(source, "columns: map one effort column (current, force or torque), not several")
+        chosen = (mapped or by_unit or [None])[0]
+        if chosen is None:
+            listed = [f"a {quantity} column ('{found[quantity][0]}')" for quantity in efforts]
+            listed = ", ".join(listed[:-1]) + " and " + listed[-1]
+            raise LogError(source, f"both {listed}; choose the effort with columns={{'current_A': ...}} or "
+                                   f"columns={{'{CANONICAL_NAMES[efforts[-1]]}': ...}}")
+        for quantity in efforts:
+            if quantity != chosen:
+                del found[quantity], units[quantity]
+    axes = axes_in_columns(names)
+    if "position" not in found and axes:
+        raise LogError(source, f"the file holds several axes ({', '.join(axes)}); choose one with axis= "
+                               f"(--axis {axes[0]} on the command line)")
     if "position" not in found:
         raise LogError(
             source,
-            f"missing required column 'position_mm' (axis position; or position_m/position_um, "
-            f"or map one with columns=); columns in the file: {_listing(names)}",
+            f"missing required column 'position_mm' (axis position; or position_m/position_um, position_deg/"
+            f"position_rad for a rotary axis, or map one with columns=); columns in the file: {_listing(names)}",
         )
-    if "current" not in found and "force" not in found:
+    if not any(quantity in found for quantity in EFFORT_QUANTITIES):
         raise LogError(
             source,
-            f"missing required column 'current_A' (motor current; or force_N for force logs, "
+            f"missing required column 'current_A' (motor current; or force_N / torque_Nm for logs of the load, "
             f"or map one with columns=); columns in the file: {_listing(names)}",
         )
-    return found
+    return found, _motion(units, source)
+
+
+def _axis_prefix(name: str) -> tuple[str, str] | None:
+    """``("X", "position_mm")`` for a column ``X_position_mm``: an axis name, then a base channel with its unit."""
+    head, _, rest = str(name).partition("_")
+    if not head or not rest or not head[0].isalpha() or not head.isalnum():
+        return None
+    parsed = parse_column_name(rest)
+    return (head, rest) if parsed is not None and parsed[1] is not None and parsed[0] != "time" else None
+
+
+def axes_in_columns(names) -> list[str]:
+    """The axes of a several-axis table: prefixes of base channels named ``<axis>_<quantity>_<unit>``.
+
+    Parameters
+    ----------
+    names : iterable of str
+        Column names, e.g. ``time_s, X_position_mm, X_current_A, Y_position_mm, Y_current_A``.
+
+    Returns
+    -------
+    list of str
+        The axis names in the order of their first column (``["X", "Y"]``); empty for a one-axis table.
+    """
+    found = [prefixed[0] for prefixed in map(_axis_prefix, names) if prefixed is not None]
+    return list(dict.fromkeys(found))
+
+
+def select_axis(table: Mapping[str, np.ndarray], axis: str, *, source,
+                columns: Mapping[str, str] | None = None) -> dict[str, np.ndarray]:
+    """The columns of one axis of a several-axis table, under their names without the axis prefix.
+
+    A column ``<axis>_<rest>`` becomes ``<rest>`` (``X_position_mm`` -> ``position_mm``, and
+    ``X_truth_friction_A`` -> ``truth_friction_A``); columns of the other axes are left out;
+    columns without an axis prefix (``time_s``) are shared by all axes and kept, as are columns
+    ``columns=`` maps by their name in the file.
+
+    Parameters
+    ----------
+    table : mapping of str to array_like
+        Columns of the file.
+    axis : str
+        Axis to take, e.g. ``"X"``.
+    source : str or path-like
+        File name for error messages.
+    columns : mapping of str to str, optional
+        Explicit mapping (its values are names in the file, kept as they are).
+
+    Returns
+    -------
+    dict of str to array_like
+
+    Raises
+    ------
+    LogError
+        When no column carries the axis prefix and ``columns`` maps nothing either; the message
+        lists the axes the file holds.
+    """
+    axes = axes_in_columns(table)
+    mapped = set((columns or {}).values())
+    if axis not in axes and not mapped:
+        held = f"the axes in the file: {', '.join(axes)}" if axes else \
+            "the file holds one axis (no column named <axis>_<quantity>_<unit>, e.g. X_position_mm)"
+        raise LogError(source, f"no columns of axis '{axis}' (named {axis}_position_mm, {axis}_current_A, ...); "
+                               f"{held}")
+    selected: dict[str, np.ndarray] = {}
+    for name, values in table.items():
+        head, _, rest = str(name).partition("_")
+        if name in mapped:
+            selected[name] = values
+        elif head == axis and rest:
+            selected[rest] = values
+        elif head not in axes or not rest:
+            selected[name] = values
+    return selected
+
+
+def several_axes_table(logs, *, source) -> dict[str, np.ndarray]:
+    """The columns of one table holding one log, or several axes on the same time stamps.
+
+    Parameters
+    ----------
+    logs : sequence of AxisLog
+        One log (its canonical columns, :meth:`AxisLog.named_channels`), or several logs of
+        different axes with equal time stamps: ``time_s`` once, then each log's columns prefixed
+        with its axis name (``X_position_mm``, ``X_current_A``, ``X_truth_friction_A``, ...), which
+        :func:`select_axis` reads back.
+    source : str or path-like
+        File to be written, for error messages.
+
+    Returns
+    -------
+    dict of str to ndarray
+
+    Raises
+    ------
+    LogError
+        For several logs with an axis name that is not letters and digits, a repeated name, or
+        time stamps that differ (write them to MCAP, a channel per axis, instead).
+    """
+    logs = list(logs)
+    if len(logs) == 1:
+        return dict(logs[0].named_channels(time=True))
+    names = [log.axis for log in logs]
+    bad = [name for name in names if not (name[:1].isalpha() and name.isalnum())]
+    if bad:
+        raise LogError(source, f"axis name {bad[0]!r} cannot prefix columns; several axes in one table need names "
+                               "of letters and digits (X, Y, C, A1)")
+    if len(set(names)) != len(names):
+        raise LogError(source, f"several logs of axis {names[0]}; one table holds each axis once")
+    time = logs[0].time
+    for log in logs[1:]:
+        if log.time.shape != time.shape or not np.array_equal(log.time, time):
+            raise LogError(source, f"axes {logs[0].axis} and {log.axis} have different time stamps; one table holds "
+                                   "axes sampled together (write them to .mcap, a channel per axis)")
+    table = {"time_s": time}
+    for log in logs:
+        table.update({f"{log.axis}_{name}": values for name, values in log.named_channels()})
+    return table
 
 
 def _listing(names, limit: int = 12) -> str:
@@ -229,6 +404,7 @@ def log_from_columns(
     axis: str = "",
     dataset: str = "",
     attrs: Mapping[str, object] | None = None,
+    select: str | None = None,
 ) -> AxisLog:
     """Build an :class:`AxisLog` from named columns in their file units.
 
@@ -249,21 +425,27 @@ def log_from_columns(
     sample_time : float, optional
         Sample time [s] for files without any time column: the time is then
         ``row_index * sample_time``, starting at 0 s.
-    effort_unit : {"A", "N"}, optional
-        Effort unit from the file's metadata (decides between current and force).
+    effort_unit : {"A", "N", "Nm"}, optional
+        Effort unit from the file's metadata (decides between current and load).
     axis, dataset : str
         Names stored in the log.
     attrs : mapping, optional
         Free-form metadata stored in the log.
+    select : str, optional
+        Take one axis of a several-axis table, its columns named ``<select>_<quantity>_<unit>``
+        (:func:`select_axis`); the log's axis name is then ``select``.
 
     Returns
     -------
     AxisLog
-        Base channels in canonical units (s, mm, mm/s, mm/s^2, A or N); every
-        other numeric column, name unchanged, in ``extras``.
+        Base channels in canonical units (s, mm, mm/s, mm/s^2, A or N; for a rotary
+        axis s, deg, deg/s, deg/s^2, A or Nm); every other numeric column, name
+        unchanged, in ``extras``.
     """
+    if select is not None:
+        table, axis = select_axis(table, select, source=source, columns=columns), select
     names = [n for n in table if n and not str(n).startswith("Unnamed: ")]
-    found = resolve_columns(
+    found, motion = resolve_columns(
         names, source=source, columns=columns, with_time=time is None, effort_unit=effort_unit
     )
     used = {column for column, _ in found.values()}
@@ -301,7 +483,7 @@ def log_from_columns(
             "for logs without time stamps give the sample time (sample_time=, --sample-time)",
         )
 
-    unit = "A" if "current" in found else "N"
+    effort = next(quantity for quantity in EFFORT_QUANTITIES if quantity in found)
     extras = {}
     for name in names:
         if name in used:
@@ -312,10 +494,11 @@ def log_from_columns(
     return AxisLog(
         time=time_s,
         position=channel("position"),
-        effort=channel("current" if unit == "A" else "force"),
+        effort=channel(effort),
         velocity=channel("velocity"),
         acceleration=channel("acceleration"),
-        effort_unit=unit,
+        effort_unit=_EFFORT_UNIT[effort],
+        motion=motion,
         axis=axis,
         dataset=dataset,
         source=str(source),

@@ -10,8 +10,9 @@ from .log import AxisLog
 __all__ = ["check_time", "check_increasing", "check_finite", "check_velocity_units", "UNIT_SLIPS"]
 
 #: Factors by which a logged velocity can disagree with d(position)/dt when one column's unit is wrong,
-#: and what the factor points to (the fix names the column's unit suffix, e.g. ``--columns position_m=NAME``).
-UNIT_SLIPS = {
+#: and what the factor points to (the fix names the column's unit suffix, e.g. ``--columns position_m=NAME``),
+#: per kind of axis.
+_LINEAR_SLIPS = {
     1000.0: "the position is probably in m under a mm name (position_m=NAME), or the velocity in um/s",
     1e-3: "the position is probably in um under a mm name (position_um=NAME), or the velocity in m/s "
           "(velocity_m_s=NAME)",
@@ -20,6 +21,18 @@ UNIT_SLIPS = {
     1000.0 / 60.0: "the velocity is probably in mm/min while the position is in m, or in m/min mislabelled",
     60.0 / 1000.0: "the velocity is probably in m/min under a mm/s name (velocity_m_min=NAME)",
 }
+_ROTARY_SLIPS = {
+    180.0 / np.pi: "the position is probably in rad under a deg name (position_rad=NAME), or the velocity "
+                   "in deg/s under a rad/s name (velocity_deg_s=NAME)",
+    np.pi / 180.0: "the velocity is probably in rad/s under a deg/s name (velocity_rad_s=NAME), or the "
+                   "position in deg under a rad name (position_deg=NAME)",
+    60.0: "the velocity is probably in deg/min under a deg/s name (velocity_deg_min=NAME)",
+    1.0 / 60.0: "the velocity is probably in deg/s under a deg/min name (velocity_deg_s=NAME)",
+    1.0 / 6.0: "the velocity is probably in rpm under a deg/s name (velocity_rpm=NAME)",
+    6.0: "the velocity is probably in deg/s under an rpm name (velocity_deg_s=NAME)",
+    360.0: "the position is probably in revolutions under a deg name (position_rev=NAME)",
+}
+UNIT_SLIPS = {"linear": _LINEAR_SLIPS, "rotary": _ROTARY_SLIPS}
 
 #: Relative deviation of the factor from one of :data:`UNIT_SLIPS` that still counts as that slip.
 _SLIP_TOLERANCE = 0.15
@@ -126,13 +139,7 @@ def check_finite(log: AxisLog) -> None:
         Naming the first channel with a NaN or infinite value and the time of
         its first bad sample.
     """
-    channels = {"position_mm": log.position, log.effort_column: log.effort}
-    if log.velocity is not None:
-        channels["velocity_mm_s"] = log.velocity
-    if log.acceleration is not None:
-        channels["acceleration_mm_s2"] = log.acceleration
-    channels.update(log.extras)
-    for name, values in channels.items():
+    for name, values in log.named_channels():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             k = int(bad[0])
@@ -160,7 +167,8 @@ def check_velocity_units(log: AxisLog) -> float | None:
     Raises
     ------
     LogError
-        When ``k`` lies within 15 % of a factor of :data:`UNIT_SLIPS` (a column in the wrong unit: the
+        When ``k`` lies within 15 % of a factor of :data:`UNIT_SLIPS` for the log's kind of axis (a column
+        in the wrong unit; the nearest such factor is taken: the
         message names the factor and the column name that fixes it) or near -1 (velocity of the
         opposite sign).
     """
@@ -176,8 +184,9 @@ def check_velocity_units(log: AxisLog) -> float | None:
     if abs(k + 1.0) < _SLIP_TOLERANCE:
         raise LogError(source, f"the logged velocity has the opposite sign of d(position)/dt (factor {k:.3g}); "
                                "check the sign convention of the velocity column")
-    for factor, reason in UNIT_SLIPS.items():
-        if k > 0 and abs(np.log(k / factor)) < np.log1p(_SLIP_TOLERANCE):
+    if k > 0:  # the nearest slip within the tolerance (rad vs deg, 57.3, lies close to per minute, 60)
+        distance, reason = min((abs(np.log(k / factor)), reason) for factor, reason in UNIT_SLIPS[log.motion].items())
+        if distance < np.log1p(_SLIP_TOLERANCE):
             raise LogError(source, f"the logged velocity is {k:.4g} x d(position)/dt: {reason}; give the column "
                                    "its unit with --columns")
     return k

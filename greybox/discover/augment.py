@@ -383,7 +383,8 @@ class AugmentedModel(CurrentModel):
     def _own_parameters(self) -> list[Parameter]:
         base = [Parameter(f"base.{p.name}", p.value, p.unit, f"base model: {p.description}")
                 for p in self.base_.parameter_table()]
-        terms = [Parameter(f"{i + 1}:{e['name']}.{name}", value, "(in the name)", f"added effect {e['name']}")
+        relabel = self.units_.relabel  # names end in their unit, written in mm: deg for a rotary axis
+        terms = [Parameter(f"{i + 1}:{e['name']}.{relabel(name)}", value, "(in the name)", f"added effect {e['name']}")
                  for i, e in enumerate(self.effects_) for name, value in e["parameters"].items()]
         level = getattr(self, "friction_level_", None)
         if level is not None:

@@ -96,11 +96,12 @@ def plot_residuals(result: DiscoveryResult, which: str, path) -> Path:
             ax.plot(profile["centre"][keep], profile["mean"][keep], style, color=colour, lw=1.0,
                     label=f"{label}, {name.split('_')[1]} motion")
     ax.axhline(0.0, color="k", lw=0.5)
-    ax.set_xlabel("position [mm]")
+    ax.set_xlabel(result.units.relabel("position [mm]"))
     ax.set_title("mean residual along the position", fontsize=10)
     ax.legend(fontsize=7)
     ax.grid(True, alpha=0.3)
-    _profile(axes[0, 2], before["velocity"], after["velocity"], "velocity [mm/s]", "mean residual over velocity")
+    _profile(axes[0, 2], before["velocity"], after["velocity"], result.units.relabel("velocity [mm/s]"),
+             "mean residual over velocity")
     _profile(axes[1, 0], before["time"], after["time"], "time since the start of the run [s]",
              "mean residual over time")
     _profile(axes[1, 1], before["after_reversal"], after["after_reversal"],
@@ -154,7 +155,7 @@ def plot_evidence(result: DiscoveryResult, path) -> Path:
             line, = ax.plot(score.scan["shape"], score.scan["explained_fraction"], lw=0.8, label=score.name)
             ax.axhline(score.threshold_fraction, color=line.get_color(), ls="--", lw=0.8)
     ax.set_xscale("log")
-    ax.set_xlabel("period [mm]")
+    ax.set_xlabel(result.units.relabel("period [mm]"))
     ax.set_ylabel("explained fraction of the residual")
     ax.set_title(f"step {shown + 1}: period scans (dashed: pass level)", fontsize=10)
     ax.legend(fontsize=7)

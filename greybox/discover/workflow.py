@@ -46,6 +46,7 @@ import numpy as np
 from sklearn.base import clone
 
 from ..data.log import AxisLog
+from ..data.quantities import MOTIONS
 from ..errors import GreyboxError
 from ..estimator import check_runs
 from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
@@ -104,7 +105,10 @@ class DiscoveryResult:
     seconds : float
         Wall time of the workflow [s].
     unit : str
-        Effort unit, "A" or "N".
+        Effort unit, "A", "N" or "Nm".
+    motion : str
+        Kind of axis of the runs, "linear" or "rotary": lengths are in mm or deg (names of effect
+        parameters keep their ``_mm`` in the document; ``length_unit`` tells the unit).
     residuals : dict
         ``"train"`` and ``"test"``: ``time`` [s, running on across runs],
         residual ``before`` and ``after`` and their binned
@@ -122,8 +126,14 @@ class DiscoveryResult:
     settings: dict
     seconds: float
     unit: str = "A"
+    motion: str = "linear"
     base_misfit: dict | None = None
     residuals: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def units(self):
+        """Units of the runs' axis (:class:`greybox.data.quantities.Motion`)."""
+        return MOTIONS[self.motion]
 
     def to_dict(self) -> dict:
         """The JSON document of ``greybox discover --json``."""
@@ -132,6 +142,8 @@ class DiscoveryResult:
             "verdict": self.verdict,
             "effects": self.effects,
             "effort_unit": self.unit,
+            "motion": self.motion,
+            "length_unit": MOTIONS[self.motion].length,
             "test_rmse_before": self.test.get("rmse_before"),
             "test_rmse_after": self.test.get("rmse_after"),
             "test_re_before": self.test.get("re_before"),
@@ -397,7 +409,7 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
     return DiscoveryResult(verdict=verdict, effects=named, base_model=base_model, model=model, steps=steps,
                            rejected=rejected, train=train_gap, test=test_gap, settings=settings,
                            seconds=time.perf_counter() - started, unit=train[0].effort_unit,
-                           residuals=residuals, base_misfit=base_misfit)
+                           motion=train[0].motion, residuals=residuals, base_misfit=base_misfit)
 
 
 def _jsonable(value):

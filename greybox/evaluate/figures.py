@@ -47,7 +47,7 @@ def _color(model: str, k: int) -> str:
 
 
 def effort_name(runs: Sequence[AxisLog]) -> tuple[str, str]:
-    """What the runs' effort is and its unit: ``("current", "A")`` or ``("force", "N")``.
+    """What the runs' effort is and its unit: ``("current", "A")``, ``("force", "N")`` or ``("torque", "Nm")``.
 
     Raises
     ------
@@ -57,7 +57,7 @@ def effort_name(runs: Sequence[AxisLog]) -> tuple[str, str]:
     units = sorted({run.effort_unit for run in runs})
     if len(units) != 1:
         raise ValueError(f"the runs carry effort in different units ({', '.join(units)}); draw them apart")
-    return ("current" if units[0] == "A" else "force"), units[0]
+    return ("current" if units[0] == "A" else runs[0].units.load), units[0]
 
 
 def split_runs(runs: Sequence[AxisLog], prediction) -> list[np.ndarray]:
@@ -202,7 +202,7 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
     Parameters
     ----------
     runs : sequence of AxisLog
-        Prepared runs (position [mm], velocity [mm/s], measured current [A] or force [N]).
+        Prepared runs (position [mm or deg], velocity, measured current [A] or load [N or Nm]).
     predictions : dict
         ``{model: prediction}`` (concatenated or per run) [A] (or [N]).
     path : path-like
@@ -244,7 +244,7 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
         ax.set_title(MODEL_LABELS.get(model, model))
         ax.grid(True, alpha=0.3)
     for ax in axes[-1]:
-        ax.set_xlabel("position [mm]")
+        ax.set_xlabel(f"position [{runs[0].units.length}]")
     for ax in axes[:, 0]:
         ax.set_ylabel(f"measured - model [{unit}]")
     for ax in axes.ravel()[n:]:

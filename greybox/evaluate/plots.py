@@ -209,7 +209,8 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
     plt = import_pyplot(path)
     stride = max(1, int(np.ceil(len(log) / max_map_points)))
     effort = log.effort[::stride]
-    effort_label = "motor current [A]" if log.effort_unit == "A" else "force [N]"
+    units = log.units
+    effort_label = units.effort_label(log.effort_unit)
     has_velocity = log.velocity is not None
 
     figure = plt.figure(figsize=(11, 8), layout="constrained")
@@ -220,12 +221,12 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
     ax_map = figure.add_subplot(grid[:, 1])
 
     ax_pos.plot(*envelope(log.time, log.position, max_points), lw=0.8)
-    ax_pos.set_ylabel("position [mm]")
+    ax_pos.set_ylabel(f"position [{units.length}]")
     if has_velocity:
         ax_vel.plot(*envelope(log.time, log.velocity, max_points), lw=0.8)
     else:
         ax_vel.text(0.5, 0.5, "velocity not logged", ha="center", va="center", transform=ax_vel.transAxes)
-    ax_vel.set_ylabel("velocity [mm/s]")
+    ax_vel.set_ylabel(f"velocity [{units.velocity_unit}]")
     ax_eff.plot(*envelope(log.time, log.effort, max_points), lw=0.5)
     ax_eff.set_ylabel(effort_label)
     ax_eff.set_xlabel("time [s]")
@@ -234,7 +235,7 @@ def plot_log(log: AxisLog, path: str | os.PathLike | None = None, *, max_points:
 
     if has_velocity:
         ax_map.plot(log.velocity[::stride], effort, ".", ms=1, alpha=0.3)
-        ax_map.set_xlabel("velocity [mm/s]")
+        ax_map.set_xlabel(f"velocity [{units.velocity_unit}]")
     else:
         ax_map.text(0.5, 0.5, "velocity not logged", ha="center", va="center", transform=ax_map.transAxes)
     ax_map.set_ylabel(effort_label)

@@ -1,4 +1,4 @@
-"""The process share of the motor current, and the force behind it.
+"""The process share of the motor current, and the force (or torque) behind it.
 
 A model trained on air cuts predicts what the drive needs to move the axis
 without a process: inertia and friction. On a log recorded while cutting, the
@@ -37,6 +37,12 @@ for both directions the back-driven force comes out ``eta^2`` too small.
 Example: ``k_t = 1.35 Nm/A``, ``h = 10 mm``, ``i = 1``, ``eta_d = 0.9`` give
 ``0.9 * 1.35 * 2 pi / 0.010 m = 763.4 N/A`` while driving.
 
+A rotary axis has no screw: a gear of ratio ``i`` (motor revolutions per
+revolution of the axis) gives the torque on the axis ``M = K_0 I`` with
+``K_0 = k_t i`` [Nm/A], and the efficiencies apply the same way
+(``M = eta_d K_0 I`` driving, ``M = K_0 I / eta_b`` back-driven); the output
+is ``torque_process_Nm``.
+
 Conventions. The efficiencies cover the losses that grow with the load; the
 load-independent friction is already in the model and removed with it. The
 force has the sign of the current: the current models are fitted with a
@@ -55,6 +61,7 @@ import numpy as np
 
 from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog, as_log_list
+from ..data.quantities import MOTIONS, Motion
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, iter_chunks, samples_per_chunk
 from ..registry import model_kind
@@ -72,22 +79,24 @@ class ProcessResult:
     time : ndarray
         Time [s].
     position : ndarray
-        Axis position [mm].
+        Axis position [mm], or [deg] for a rotary axis.
     velocity : ndarray
-        Axis velocity [mm/s].
+        Axis velocity [mm/s], or [deg/s].
     measured : ndarray
-        Measured effort [A] (or [N] for a force log).
+        Measured effort [A] (or [N] / [Nm] for a log of the load).
     model : ndarray
-        Model prediction, inertia + friction [A] (or [N]).
-    force : ndarray or None
-        Process force [N]: from the axis metadata for a current log, the
-        process effort itself for a force log; None for a current log
-        without axis metadata.
+        Model prediction, inertia + friction [A] (or [N] / [Nm]).
+    load : ndarray or None
+        Process force [N] (torque [Nm] on a rotary axis): from the axis
+        metadata for a current log, the process effort itself for a log of
+        the load; None for a current log without axis metadata.
     effort_unit : str
-        "A" or "N".
-    force_constants_N_per_A : (float, float) or None
-        Factors from process current to force [N/A], driving and back-driven
-        (:attr:`~greybox.data.axis_config.AxisConfig.force_constants_N_per_A`; None without axis metadata).
+        "A", "N" or "Nm".
+    motion : str
+        "linear" or "rotary" (:mod:`greybox.data.quantities`).
+    load_constants : (float, float) or None
+        Factors from process current to load [N/A, or Nm/A], driving and back-driven
+        (:attr:`~greybox.data.axis_config.AxisConfig.load_constants`; None without axis metadata).
     axis : str
         Axis name.
     source : str
@@ -97,11 +106,11 @@ class ProcessResult:
     attrs : dict
         JSON-able description (model kind and file, chunk length, axis constants, interval).
     half_width : ndarray or None
-        Half-width of the calibrated interval of the process current per sample [A] (or [N]),
+        Half-width of the calibrated interval of the process current per sample [A] (or [N], [Nm]),
         :class:`~greybox.evaluate.interval.ProcessInterval`; None without calibration.
-    force_bounds : (ndarray, ndarray) or None
-        Lower and upper bound of the process force [N] of a current log, the current's bounds
-        converted like the current; None without calibration or without axis metadata.
+    load_bounds : (ndarray, ndarray) or None
+        Lower and upper bound of the process force [N] (torque [Nm]) of a current log, the current's
+        bounds converted like the current; None without calibration or without axis metadata.
     outside : ndarray of bool or None
         True where the log leaves the region the model's training runs covered
         (:meth:`~greybox.estimator.CurrentModel.outside_training`); None for a model file that
@@ -113,15 +122,16 @@ class ProcessResult:
     velocity: np.ndarray
     measured: np.ndarray
     model: np.ndarray
-    force: np.ndarray | None
+    load: np.ndarray | None
     effort_unit: str = "A"
-    force_constants_N_per_A: tuple[float, float] | None = None
+    motion: str = "linear"
+    load_constants: tuple[float, float] | None = None
     axis: str = ""
     source: str = ""
     attrs: dict = field(default_factory=dict)
     dataset: str = ""
     half_width: np.ndarray | None = None
-    force_bounds: tuple | None = None
+    load_bounds: tuple | None = None
     outside: np.ndarray | None = None
 
     @property
@@ -136,6 +146,11 @@ class ProcessResult:
             return None
         return self.process - self.half_width, self.process + self.half_width
 
+    @property
+    def units(self) -> Motion:
+        """Units of the axis: mm and N, or deg and Nm."""
+        return MOTIONS[self.motion]
+
     def columns(self) -> dict[str, np.ndarray]:
         """The output columns, in order.
 
@@ -148,20 +163,23 @@ class ProcessResult:
         the log leaves the training region, else 0; absent for a model file
         that predates the record). For a force log the effort columns are
         ``force_measured_N``, ``force_model_N``, ``force_process_N`` (and its
-        bounds).
+        bounds). A rotary axis writes ``torque_..._Nm``, ``position_deg`` and
+        ``velocity_deg_s`` instead.
         """
-        quantity = "current" if self.effort_unit == "A" else "force"
+        units = self.units
+        quantity = "current" if self.effort_unit == "A" else units.load
         unit = self.effort_unit
         out = {"time_s": self.time, f"{quantity}_measured_{unit}": self.measured,
                f"{quantity}_model_{unit}": self.model, f"{quantity}_process_{unit}": self.process}
         if self.half_width is not None:
             out[f"{quantity}_process_lower_{unit}"], out[f"{quantity}_process_upper_{unit}"] = self.process_bounds
-        if self.force is not None and unit == "A":
-            out["force_process_N"] = self.force
-            if self.force_bounds is not None:
-                out["force_process_lower_N"], out["force_process_upper_N"] = self.force_bounds
-        out["position_mm"] = self.position
-        out["velocity_mm_s"] = self.velocity
+        if self.load is not None and unit == "A":
+            load, load_unit = units.load, units.load_unit
+            out[f"{load}_process_{load_unit}"] = self.load
+            if self.load_bounds is not None:
+                out[f"{load}_process_lower_{load_unit}"], out[f"{load}_process_upper_{load_unit}"] = self.load_bounds
+        out[units.position_column] = self.position
+        out[units.velocity_column] = self.velocity
         if self.outside is not None:
             out["outside_training"] = self.outside.astype(np.float64)
         return out
@@ -205,7 +223,7 @@ def extrapolation_summary(regions: dict, n_samples: int) -> dict:
 def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: AxisConfig | None = None,
                     interval: ProcessInterval | None = None, chunk_s: float = DEFAULT_CHUNK_S,
                     progress: Callable[[int, int, float], None] | None = None) -> ProcessResult:
-    """Process share of the current of a cutting log, and its force.
+    """Process share of the current of a cutting log, and its force (torque on a rotary axis).
 
     Parameters
     ----------
@@ -216,7 +234,7 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
         (:func:`greybox.data.prepare.split_at_gaps`): each is predicted from the model's initial state,
         and the result holds them one after the other.
     axis_config : AxisConfig, optional
-        Drive-train constants; gives ``force`` for a current log.
+        Drive-train constants; gives ``load`` for a current log. Its kind of axis must be the log's.
     interval : ProcessInterval, optional
         Calibrated half-widths (:func:`~greybox.evaluate.interval.calibrate_interval`); gives the bounds
         of the process current and force.
@@ -234,16 +252,22 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
     Raises
     ------
     GreyboxError
-        For runs of different effort units, or axis metadata given with a log that already carries force.
+        For runs of different effort units, axis metadata given with a log that already carries its load,
+        or axis metadata of a linear axis with a rotary log (or the other way round).
     """
     runs = as_log_list(log)
     unit = runs[0].effort_unit
+    units = runs[0].units
+    name = runs[0].source or "<in-memory log>"
     for run in runs:
         if run.effort_unit != unit:
             raise GreyboxError(f"{run.source or '<in-memory log>'}: the runs mix effort units")
-    if unit == "N" and axis_config is not None:
-        raise GreyboxError(f"{runs[0].source or '<in-memory log>'}: the log carries force in N already; "
+    if unit != "A" and axis_config is not None:
+        raise GreyboxError(f"{name}: the log carries {units.load} in {unit} already; "
                            "axis metadata convert a current and do not apply")
+    if axis_config is not None and axis_config.motion != runs[0].motion:
+        raise GreyboxError(f"{name}: the log is of a {runs[0].motion} axis ({units.length}), the axis file "
+                           f"{axis_config.source or '(in memory)'} describes a {axis_config.motion} one")
     n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, chunk_s))) for run in runs)
     done = 0
     predicted = []
@@ -263,37 +287,35 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
                                         for name in ("time", "position", "velocity", "effort"))
     model_current = joined(predicted)
     process = effort - model_current
-    force = factors = None
+    load = factors = None
     attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s)}
     if len(runs) > 1:
         attrs["runs"] = [{"start_s": float(run.time[0]), "samples": len(run)} for run in runs]
-    if unit == "N":
-        force = process
+    if unit != "A":
+        load = process
     elif axis_config is not None:
-        force = axis_config.process_force_N(process, velocity)
-        factors = axis_config.force_constants_N_per_A
-        attrs["axis_config"] = {"source": axis_config.source,
-                                "torque_constant_Nm_per_A": axis_config.torque_constant_Nm_per_A,
-                                "screw_lead_mm": axis_config.screw_lead_mm, "gear_ratio": axis_config.gear_ratio,
-                                "efficiency_driving": axis_config.efficiency_driving,
-                                "efficiency_backdriven": axis_config.efficiency_backdriven,
-                                "force_constant_driving_N_per_A": factors[0],
-                                "force_constant_backdriven_N_per_A": factors[1]}
+        load = axis_config.process_load(process, velocity)
+        factors = axis_config.load_constants
+        per_ampere = f"{units.load_unit}_per_A"
+        constants = {key: value for key, value in axis_config.to_dict().items() if key not in ("name", "channels")}
+        attrs["axis_config"] = {"source": axis_config.source, **constants,
+                                f"{units.load}_constant_driving_{per_ampere}": factors[0],
+                                f"{units.load}_constant_backdriven_{per_ampere}": factors[1]}
     per_run = [model.outside_training(run) for run in runs]
     regions = {name: joined([flags[name] for flags in per_run]) for name in per_run[0]}
     outside = np.logical_or.reduce(list(regions.values())) if regions else None
     attrs["extrapolation"] = extrapolation_summary(regions, len(time))
-    half_width = force_bounds = None
+    half_width = load_bounds = None
     if interval is not None:
         half_width = joined([interval.half_widths(run) for run in runs])
         attrs["interval"] = interval.to_dict()
         if factors is not None:
-            force_bounds = (axis_config.process_force_N(process - half_width, velocity),
-                            axis_config.process_force_N(process + half_width, velocity))
+            load_bounds = (axis_config.process_load(process - half_width, velocity),
+                            axis_config.process_load(process + half_width, velocity))
     first = runs[0]
     return ProcessResult(time=time, position=position, velocity=velocity, measured=effort,
-                         model=model_current, force=force, effort_unit=unit,
-                         force_constants_N_per_A=factors,
+                         model=model_current, load=load, effort_unit=unit, motion=runs[0].motion,
+                         load_constants=factors,
                          axis=first.axis or (axis_config.name if axis_config is not None else ""),
                          source=first.source, attrs=attrs, dataset=first.dataset or "", half_width=half_width,
-                         force_bounds=force_bounds, outside=outside)
+                         load_bounds=load_bounds, outside=outside)

@@ -2,7 +2,8 @@
 
 The columns are those of :meth:`greybox.evaluate.process.ProcessResult.columns`
 (``time_s``, ``current_measured_A``, ``current_model_A``, ``current_process_A``,
-``force_process_N`` with axis metadata, ``position_mm``, ``velocity_mm_s``).
+``force_process_N`` with axis metadata, ``position_mm``, ``velocity_mm_s``; for a rotary
+axis ``torque_process_Nm``, ``position_deg``, ``velocity_deg_s``).
 
 * CSV: plain, the header row first, then one row per sample, floats as their
   shortest exact text (``pandas.read_csv``, spreadsheets and MATLAB's
@@ -51,8 +52,13 @@ _DESCRIPTIONS = {
     "force_measured_N": "measured drive force [N]",
     "force_model_N": "model force: inertia + friction, trained on air cuts [N]",
     "force_process_N": "process force the drive exerts on the table [N]",
+    "torque_measured_Nm": "measured drive torque [Nm]",
+    "torque_model_Nm": "model torque: inertia + friction, trained on air cuts [Nm]",
+    "torque_process_Nm": "process torque the drive exerts on the rotary axis [Nm]",
     "position_mm": "axis position [mm]",
     "velocity_mm_s": "axis velocity [mm/s]",
+    "position_deg": "rotary axis angle [deg]",
+    "velocity_deg_s": "rotary axis angular velocity [deg/s]",
 }
 
 
@@ -109,7 +115,7 @@ def _schema(fields) -> dict:
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": PROCESS_SCHEMA_NAME,
-        "description": "Measured, modelled and process current of one sample of one feed axis "
+        "description": "Measured, modelled and process current of one sample of one machine axis "
                        "(greybox predict). The sample time is the message log_time in ns.",
         "type": "object",
         "properties": {name: {"type": "number", "description": _DESCRIPTIONS.get(name, name)} for name in fields},

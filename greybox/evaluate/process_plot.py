@@ -18,7 +18,7 @@ from .plots import (
 )
 from .process import ProcessResult
 
-__all__ = ["envelope_indices", "moving_mean", "plot_process"]
+__all__ = ["envelope_indices", "moving_mean", "plot_machine_process", "plot_process"]
 
 
 def moving_mean(values, window: int) -> np.ndarray:
@@ -61,8 +61,9 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
                  window: tuple[float, float] | None = None):
     """Draw velocity, measured and model current, and the process current over time.
 
-    The process panel has a second scale in N when the force is known (the
-    force is proportional to the process current), and draws the moving mean
+    The process panel has a second scale in N (Nm for a rotary axis) when the
+    load is known and proportional to the process current (one efficiency), a
+    panel of its own when the two efficiencies differ, and draws the moving mean
     of the process current over ``mean_s`` on top of the sample values: the
     level of the cutting force, without the tooth-passing ripple and the
     current noise.
@@ -101,18 +102,20 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
         shown = slice(first, stop)
     plt = import_pyplot(path)
     unit = result.effort_unit
-    noun = "current" if unit == "A" else "force"
+    units = result.units
+    noun = "current" if unit == "A" else units.load
+    load_label = f"process {units.load} [{units.load_unit}]"
 
     def line(ax, values, **style):
         ax.plot(*envelope(result.time[shown], values[shown], max_points), **style)
 
-    factors = result.force_constants_N_per_A
+    factors = result.load_constants
     force_panel = unit == "A" and factors is not None and factors[0] != factors[1]
     figure, axes = plt.subplots(4 if force_panel else 3, 1, sharex=True, figsize=(11, 10 if force_panel else 8),
                                 layout="constrained", height_ratios=(1, 2, 2, 2) if force_panel else (1, 2, 2))
     ax_v, ax_i, ax_p = axes[:3]
     line(ax_v, result.velocity, lw=0.8, color="tab:gray")
-    ax_v.set_ylabel("velocity [mm/s]")
+    ax_v.set_ylabel(f"velocity [{units.velocity_unit}]")
     line(ax_i, result.measured, lw=0.5, color="tab:gray", label=f"measured {noun}")
     line(ax_i, result.model, lw=0.8, color="tab:blue", label=f"model {noun} (inertia + friction)")
     ax_i.set_ylabel(f"{noun} [{unit}]")
@@ -138,11 +141,12 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     if unit == "A" and factors and not force_panel:
         factor = factors[0]
         right = ax_p.secondary_yaxis("right", functions=(lambda i: i * factor, lambda f: f / factor))
-        right.set_ylabel("process force [N]")
-    if force_panel:  # two efficiencies: no single scale, the force gets a panel of its own
-        process_panel(axes[3], result.force, result.force_bounds,
-                      "process force (driving: eta_d K_0 I, back-driven: K_0 I / eta_b)", "tab:green", "darkgreen")
-        axes[3].set_ylabel("process force [N]")
+        right.set_ylabel(load_label)
+    if force_panel:  # two efficiencies: no single scale, the load gets a panel of its own
+        process_panel(axes[3], result.load, result.load_bounds,
+                      f"process {units.load} (driving: eta_d K_0 I, back-driven: K_0 I / eta_b)", "tab:green",
+                      "darkgreen")
+        axes[3].set_ylabel(load_label)
     if result.outside is not None and np.any(result.outside[shown]):
         share = 100.0 * float(np.mean(result.outside))
         for ax in axes[2:]:
@@ -160,4 +164,75 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     if model:
         title += f", {model} model"
     figure.suptitle(title)
+    return finish_figure(figure, path)
+
+
+def plot_machine_process(result, path: str | os.PathLike | None = None, *,
+                         max_points: int = ENVELOPE_POINTS, mean_s: float = 0.1,
+                         window: tuple[float, float] | None = None):
+    """Draw the process load of every axis of a machine, and the resultant force of its linear axes.
+
+    One panel per axis: its process force [N] or torque [Nm] where the machine file gives the
+    axis's mechanics, else its process current [A], with the moving mean over ``mean_s``; a last
+    panel with the resultant process force when two or more linear axes have force.
+
+    Parameters
+    ----------
+    result : MachineProcessResult
+        Output of :func:`greybox.evaluate.machine_process.predict_machine`.
+    path : path-like, optional
+        Write the figure there (PNG, SVG or PDF by extension) and close it.
+    max_points : int, default :data:`~greybox.evaluate.plots.ENVELOPE_POINTS`
+        Longer logs are drawn as their envelope.
+    mean_s : float, default 0.1
+        Window [s] of the moving means; 0 draws none.
+    window : (float, float), optional
+        Draw only the samples with ``start <= time <= stop`` [s].
+
+    Returns
+    -------
+    matplotlib.figure.Figure or pathlib.Path
+        The figure, or the written file when ``path`` is given.
+
+    Raises
+    ------
+    ValueError
+        If no sample lies in ``window``.
+    """
+    time = result.time
+    shown = slice(None)
+    if window is not None:
+        shown = slice(np.searchsorted(time, window[0], "left"), np.searchsorted(time, window[1], "right"))
+        if shown.start >= shown.stop:
+            raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
+    columns = result.columns()
+    panels = []
+    for axis, axis_result in result.results.items():
+        units = axis_result.units
+        if axis_result.load is not None:
+            column, what, unit = f"{axis}_{units.load}_process_{units.load_unit}", units.load, units.load_unit
+        else:
+            column, what, unit = f"{axis}_current_process_{axis_result.effort_unit}", "current", \
+                axis_result.effort_unit
+        panels.append((columns[column], f"axis {axis}: process {what} [{unit}]"))
+    resultant = result.resultant()
+    if resultant is not None:
+        panels.append((resultant, f"resultant process force |F| of {', '.join(result.forces())} [N]"))
+    plt = import_pyplot(path)
+    figure, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(11, 2.4 * len(panels) + 1),
+                                layout="constrained", squeeze=False)
+    step = float(np.median(np.diff(time))) if time.size > 1 else 0.0
+    mean_samples = max(1, int(round(mean_s / step))) if mean_s > 0 and step > 0 else 0
+    for ax, (values, label) in zip(axes[:, 0], panels):
+        ax.plot(*envelope(time[shown], values[shown], max_points), lw=0.6, color="tab:red", label="per sample")
+        if mean_samples:
+            ax.plot(*envelope(time[shown], moving_mean(values, mean_samples)[shown], max_points), lw=1.2,
+                    color="darkred", label=f"moving mean over {mean_s:g} s")
+        ax.axhline(0.0, color="black", lw=0.5)
+        ax.set_ylabel(label, fontsize="small")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize="small")
+    axes[-1, 0].set_xlabel("time [s]")
+    title = (f"machine {result.name}" if result.name else "machine") + f": axes {', '.join(result.results)}"
+    figure.suptitle(title + window_title(window))
     return finish_figure(figure, path)

@@ -38,7 +38,7 @@ from scipy.optimize import minimize_scalar
 from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 
-from ..base import EFFORT, Parameter
+from ..base import EFFORT, LENGTH, Parameter
 from ..data.log import AxisLog
 from ..errors import ParameterError
 from ..estimator import CurrentModel
@@ -237,7 +237,7 @@ class BacklashModel(CurrentModel):
 
     def _own_parameters(self) -> list[Parameter]:
         check_is_fitted(self, "base_")
-        own = [Parameter("width", self.width_, "mm", "backlash: motor travel across the gap"),
+        own = [Parameter("width", self.width_, LENGTH, "backlash: motor travel across the gap"),
                Parameter("threshold", self.threshold_, EFFORT, "force that counts as a load through the gap")]
         return own + [Parameter(f"base.{p.name}", p.value, p.unit, f"base model: {p.description}")
                       for p in self.base_.parameter_table() if p.name not in ("J", "offset")]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import EFFORT, LinearPart, Parameter
+from ..base import EFFORT, LENGTH, LinearPart, Parameter
 from ..errors import ParameterError
 from ..estimator import CurrentModel
 from ..identify.initial import check_motion, samples_at_speed
@@ -98,8 +98,8 @@ class CoulombModel(CurrentModel):
         return [
             Parameter("coulomb_pos", self.coulomb_pos_, EFFORT, "Coulomb level, positive motion"),
             Parameter("coulomb_neg", self.coulomb_neg_, EFFORT, "Coulomb level magnitude, negative motion"),
-            Parameter("viscous_pos", self.viscous_pos_, f"{EFFORT} s/mm", "viscous coefficient, positive motion"),
-            Parameter("viscous_neg", self.viscous_neg_, f"{EFFORT} s/mm", "viscous coefficient, negative motion"),
+            Parameter("viscous_pos", self.viscous_pos_, f"{EFFORT} s/{LENGTH}", "viscous coefficient, positive motion"),
+            Parameter("viscous_neg", self.viscous_neg_, f"{EFFORT} s/{LENGTH}", "viscous coefficient, negative motion"),
         ]
 
     # ---------------------------------------------------------------- linear part

@@ -23,7 +23,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..base import EFFORT, LinearPart, Parameter
+from ..base import EFFORT, LENGTH, LinearPart, Parameter
 from ..errors import ParameterError
 from ..estimator import CurrentModel
 from ..identify.initial import (
@@ -553,14 +553,14 @@ class GMSModel(CurrentModel):
     def _own_parameters(self) -> list[Parameter]:
         shared = [
             Parameter("alpha", self.alpha_, "-", "element fractions (sum 1)"),
-            Parameter("k", self.k_, f"{EFFORT}/mm", "element stiffnesses"),
-            Parameter("slip_rate", self.slip_rate_, "mm/s", "slip rate constant C"),
-            Parameter("sigma", self.sigma_, f"{EFFORT} s/mm", "micro-damping"),
+            Parameter("k", self.k_, f"{EFFORT}/{LENGTH}", "element stiffnesses"),
+            Parameter("slip_rate", self.slip_rate_, f"{LENGTH}/s", "slip rate constant C"),
+            Parameter("sigma", self.sigma_, f"{EFFORT} s/{LENGTH}", "micro-damping"),
         ]
-        curve = [("viscous", f"{EFFORT} s/mm", "viscous coefficient mu", self.viscous_),
-                 ("s_0", "mm", "break-away deflection at rest", self.s_0_),
-                 ("s_inf", "mm", "break-away deflection at high speed", self.s_inf_),
-                 ("v_s", "mm/s", "Stribeck velocity", self.v_s_)]
+        curve = [("viscous", f"{EFFORT} s/{LENGTH}", "viscous coefficient mu", self.viscous_),
+                 ("s_0", LENGTH, "break-away deflection at rest", self.s_0_),
+                 ("s_inf", LENGTH, "break-away deflection at high speed", self.s_inf_),
+                 ("v_s", f"{LENGTH}/s", "Stribeck velocity", self.v_s_)]
         if not self.asymmetric:
             return shared + [Parameter(name, value, unit, text) for name, unit, text, value in curve]
         negative = (self.viscous_neg_, self.s_0_neg_, self.s_inf_neg_, self.v_s_neg_)

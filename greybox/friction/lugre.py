@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import EFFORT, LinearPart, Parameter
+from ..base import EFFORT, LENGTH, LinearPart, Parameter
 from ..errors import LogError, ParameterError
 from ..estimator import CurrentModel
 from ..identify.initial import (
@@ -356,13 +356,13 @@ class LuGreModel(CurrentModel):
 
     def _own_parameters(self) -> list[Parameter]:
         bristle = [
-            Parameter("sigma0", self.sigma0_, f"{EFFORT}/mm", "bristle stiffness"),
-            Parameter("sigma1", self.sigma1_, f"{EFFORT} s/mm", "bristle damping"),
+            Parameter("sigma0", self.sigma0_, f"{EFFORT}/{LENGTH}", "bristle stiffness"),
+            Parameter("sigma1", self.sigma1_, f"{EFFORT} s/{LENGTH}", "bristle damping"),
         ]
-        curve = [("viscous", f"{EFFORT} s/mm", "viscous coefficient sigma2", self.viscous_),
+        curve = [("viscous", f"{EFFORT} s/{LENGTH}", "viscous coefficient sigma2", self.viscous_),
                  ("coulomb", EFFORT, "Coulomb level F_c", self.coulomb_),
                  ("static", EFFORT, "static level F_s", self.static_),
-                 ("v_s", "mm/s", "Stribeck velocity", self.v_s_)]
+                 ("v_s", f"{LENGTH}/s", "Stribeck velocity", self.v_s_)]
         if not self.asymmetric:
             return bristle + [Parameter(name, value, unit, text) for name, unit, text, value in curve]
         negative = (self.viscous_neg_, self.coulomb_neg_, self.static_neg_, self.v_s_neg_)

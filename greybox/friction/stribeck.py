@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import EFFORT, LinearPart, Parameter
+from ..base import EFFORT, LENGTH, LinearPart, Parameter
 from ..curves import stribeck_curve
 from ..errors import ParameterError
 from ..estimator import CurrentModel
@@ -121,8 +121,8 @@ class StribeckModel(CurrentModel):
             return [
                 Parameter("coulomb", self.coulomb_, EFFORT, "Coulomb level F_c"),
                 Parameter("static", self.static_, EFFORT, "static level F_s (just above zero speed)"),
-                Parameter("v_s", self.v_s_, "mm/s", "Stribeck velocity"),
-                Parameter("viscous", self.viscous_, f"{EFFORT} s/mm", "viscous coefficient"),
+                Parameter("v_s", self.v_s_, f"{LENGTH}/s", "Stribeck velocity"),
+                Parameter("viscous", self.viscous_, f"{EFFORT} s/{LENGTH}", "viscous coefficient"),
             ]
         return [
             Parameter("coulomb", self.coulomb_, EFFORT, "Coulomb level F_c+, positive motion"),
@@ -130,10 +130,10 @@ class StribeckModel(CurrentModel):
             Parameter("static", self.static_, EFFORT, "static level F_s+ (just above zero speed), positive motion"),
             Parameter("static_neg", self.static_neg_, EFFORT,
                       "static level magnitude F_s- (just above zero speed), negative motion"),
-            Parameter("v_s", self.v_s_, "mm/s", "Stribeck velocity, positive motion"),
-            Parameter("v_s_neg", self.v_s_neg_, "mm/s", "Stribeck velocity, negative motion"),
-            Parameter("viscous", self.viscous_, f"{EFFORT} s/mm", "viscous coefficient, positive motion"),
-            Parameter("viscous_neg", self.viscous_neg_, f"{EFFORT} s/mm", "viscous coefficient, negative motion"),
+            Parameter("v_s", self.v_s_, f"{LENGTH}/s", "Stribeck velocity, positive motion"),
+            Parameter("v_s_neg", self.v_s_neg_, f"{LENGTH}/s", "Stribeck velocity, negative motion"),
+            Parameter("viscous", self.viscous_, f"{EFFORT} s/{LENGTH}", "viscous coefficient, positive motion"),
+            Parameter("viscous_neg", self.viscous_neg_, f"{EFFORT} s/{LENGTH}", "viscous coefficient, negative motion"),
         ]
 
     # ---------------------------------------------------------------- linear part

@@ -114,7 +114,7 @@ class CuttingCase:
 def evaluate_model(kind: str, model, case: CuttingCase, config, detail_strength: float, target: float,
                    chunk_s: float) -> tuple[dict, object]:
     """All figures of one fitted model on one cutting case, and its result at the detailed strength."""
-    factor = config.force_constants_N_per_A[0]  # the cuts oppose the motion: driving
+    factor = config.load_constants[0]  # the cuts oppose the motion: driving
     air_residual = case.air.current - predict_chunked(model, case.air, chunk_s=chunk_s)
     air_test = rmse(case.shipped.current, predict_chunked(model, case.shipped, chunk_s=chunk_s))
     identity = 0.0
@@ -306,7 +306,7 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
     if plot_dir and Path(plot_dir).is_dir() and any(Path(plot_dir).iterdir()) and not force:
         raise GreyboxError(f"{plot_dir}: directory is not empty; nothing was written (pass --force to write into it)")
     config = read_axis_config(axis_config)
-    factor = config.force_constants_N_per_A[0]  # the cuts oppose the motion: driving
+    factor = config.load_constants[0]  # the cuts oppose the motion: driving
     train = prepare([read_log(data / name) for name in TRAIN_FILES])
     cases = {case.name: case for case in (CuttingCase(d, seed, strengths, data) for d in TEST_DATASETS)}
     say(f"training on {', '.join(TRAIN_FILES)} ({sum(len(r) for r in train)} samples); "

@@ -104,7 +104,7 @@ def _pass_errors(estimate, truth, velocity) -> dict:
 def _coverage(model, log, config, calibration, truth) -> dict:
     """Coverage of the true force by the interval calibrated on ``calibration``, overall and in cut, and its width."""
     interval = calibrate_interval(model, calibration, coverage=COVERAGE)
-    low, high = predict_process(model, log, axis_config=config, interval=interval).force_bounds
+    low, high = predict_process(model, log, axis_config=config, interval=interval).load_bounds
     covered = (low <= truth) & (truth <= high)
     in_cut = truth != 0.0
     return {"coverage": float(np.mean(covered)), "coverage_in_cut": float(np.mean(covered[in_cut])),
@@ -142,7 +142,7 @@ def run_member(index: int, family_seed: int, *, settings: Mapping | None = None,
     started = time.perf_counter()
     member = draw_member(index, family_seed)
     config = member.plant.axis_config(member.axis)
-    blind = config.force_constants_N_per_A[0]
+    blind = config.load_constants[0]
     logs = {d: prepare(member_dataset(member, d, duration_s=duration_s))[0] for d in experiment.train}
     (log,) = prepare(member_dataset(member, "D", cutting=cut))
     logs["D"] = log
@@ -154,7 +154,7 @@ def run_member(index: int, family_seed: int, *, settings: Mapping | None = None,
     for result in results.experiments[experiment.number]:
         process = predict_process(result.model, log, axis_config=config)
         models[result.name] = {
-            "axis_file": _pass_errors(process.force, truth, log.velocity),
+            "axis_file": _pass_errors(process.load, truth, log.velocity),
             "one_factor": _pass_errors(blind * process.process, truth, log.velocity),
             "interval": {name: _coverage(result.model, log, config, calibration, truth)
                          for name, calibration in held_out.items()}}

@@ -38,11 +38,12 @@ SAMPLE_TIME_S = 0.002
 
 #: Truth channels a synthetic log carries (the last two only with an effect or cutting).
 TRUTH_CHANNELS = ("truth_current_A", "truth_friction_A", "truth_inertia_A", "truth_cogging_A", "truth_noise_A",
-                  "truth_effect_A", "truth_process_A", "truth_process_force_N")
+                  "truth_effect_A", "truth_process_A", "truth_process_force_N", "truth_process_torque_Nm")
 
 #: Truth channels kept in compact files: the noise-free current (for the noise
 #: floor) and the injected components.
-ESSENTIAL_TRUTH_CHANNELS = ("truth_current_A", "truth_effect_A", "truth_process_A", "truth_process_force_N")
+ESSENTIAL_TRUTH_CHANNELS = ("truth_current_A", "truth_effect_A", "truth_process_A", "truth_process_force_N",
+                            "truth_process_torque_Nm")
 
 #: Resolution [A] to which truth channels are rounded when written to files.
 TRUTH_STORAGE_RESOLUTION_A = 1e-6
@@ -72,7 +73,7 @@ def dataset_motion(axis: str, dataset: str, seed: int, duration_s: float | None 
 
     Parameters
     ----------
-    axis : {"X", "Y"}
+    axis : {"X", "Y", "C"}
         Axis of the synthetic machine.
     dataset : {"A", "B", "C", "D", "P"}
         Dataset id.
@@ -109,7 +110,7 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
 
     Parameters
     ----------
-    axis : {"X", "Y"}, default "X"
+    axis : {"X", "Y", "C"}, default "X"
         Axis of the synthetic machine.
     dataset : {"A", "B", "C", "D", "P"}, default "A"
         Dataset id (see :data:`greybox.twin.trajectories.DATASETS`).
@@ -143,6 +144,7 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         ``truth_inertia_A``, ``truth_cogging_A``, ``truth_noise_A`` (logged minus noise-free current),
         and ``truth_effect_A`` / ``truth_process_A`` when injected; with cutting also
         ``truth_process_force_N``, the process force on the table [N] behind ``truth_process_A``
+        (``truth_process_torque_Nm`` on the rotary C axis)
         (:mod:`greybox.twin.drive`; the axis file that converts one into the other is in
         ``attrs["cutting"]["axis_config"]``).
         ``attrs`` holds the seed, plant, trajectory, noise, sensors, effect and cutting settings.
@@ -198,14 +200,17 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
     position = sensors.position(response.position_mm)
     extras = {"truth_current_A": noise_free, **truth, "truth_noise_A": current - noise_free}
     if process is not None:
-        extras["truth_process_force_N"] = plant.process_force_N(process, response.velocity_mm_s)
-        attrs["cutting"]["axis_config"] = plant.axis_config(geometry.name).to_dict()
+        config = plant.axis_config(geometry.name)
+        extras[f"truth_process_{config.units.load}_{config.units.load_unit}"] = plant.process_load(
+            process, response.velocity_mm_s)
+        attrs["cutting"]["axis_config"] = config.to_dict()
     return AxisLog(
         time=time,
         position=position,
         effort=current,
         velocity=sensors.velocity(position, SAMPLE_TIME_S),
         effort_unit="A",
+        motion=geometry.motion,
         axis=geometry.name,
         dataset=key,
         extras=extras,
@@ -234,8 +239,9 @@ def _for_storage(log: AxisLog, keep: Sequence[str]) -> AxisLog:
 
 def synthesize(axis: str | Sequence[str], seed: int, out_dir, datasets: Sequence[str] = DEFAULT_DATASETS, *,
                force: bool = False, truth_channels: Sequence[str] | None = None,
-               progress: Callable[[str], None] | None = None, **options) -> list[Path]:
-    """Synthesise datasets and write each to ``out_dir/<axis>_<dataset>.mcap``.
+               progress: Callable[[str], None] | None = None, one_file: str | None = None,
+               **options) -> list[Path]:
+    """Synthesise datasets and write each to ``out_dir/<axis>_<dataset>.mcap`` (or all axes to one file).
 
     Parameters
     ----------
@@ -254,6 +260,11 @@ def synthesize(axis: str | Sequence[str], seed: int, out_dir, datasets: Sequence
         for compact files. Kept channels are rounded to 1 uA.
     progress : callable, optional
         Called with one line of text per written file.
+    one_file : {"csv", "parquet", "mcap"}, optional
+        Write each dataset of all axes to one file ``out_dir/<dataset>.<one_file>``, as a machine
+        logs its axes together: the axes move at once, each on its own trajectory, cut to the
+        shortest; CSV and Parquet name the columns ``X_position_mm``, ``Y_current_A``, ...,
+        MCAP holds a channel per axis.
     **options
         Passed to :func:`make_dataset` (effect, effect_strength, effect_params,
         cutting, duration_s, plant, noise, sensors).
@@ -280,7 +291,12 @@ def synthesize(axis: str | Sequence[str], seed: int, out_dir, datasets: Sequence
     keep = _kept_truth_channels(truth_channels)
     if options.get("effect") is not None:
         effect_parameters(options["effect"])
-    targets = [(g.name, key, dataset_path(out_dir, g.name, key)) for g in geometries for key in ids]
+    if one_file is not None:
+        if one_file not in ("csv", "parquet", "mcap"):
+            raise GreyboxError(f"unknown format {one_file!r} of the one file per dataset; choose csv, parquet or mcap")
+        targets = [(None, key, Path(out_dir) / f"{key}.{one_file}") for key in ids]
+    else:
+        targets = [(g.name, key, dataset_path(out_dir, g.name, key)) for g in geometries for key in ids]
     existing = [str(path) for _, _, path in targets if path.exists()]
     if existing and not force:
         raise GreyboxError(f"{existing[0]}: file exists ({len(existing)} of {len(targets)} targets exist); "
@@ -289,12 +305,20 @@ def synthesize(axis: str | Sequence[str], seed: int, out_dir, datasets: Sequence
     written = []
     for name, key, path in targets:
         start = clock.perf_counter()
-        log = make_dataset(name, key, seed, **options)
-        write_log(_for_storage(log, keep), path)
+        if name is None:  # every axis in one file, cut to the shortest
+            logs = [make_dataset(g.name, key, seed, **options) for g in geometries]
+            shortest = min(len(log) for log in logs)
+            logs = [log.select(slice(0, shortest)) for log in logs]
+            write_log([_for_storage(log, keep) for log in logs], path)
+            label, log = f"{'+'.join(g.name for g in geometries)} {key}", logs[0]
+        else:
+            log = make_dataset(name, key, seed, **options)
+            write_log(_for_storage(log, keep), path)
+            label = f"{name}_{key}"
         written.append(path)
         if progress is not None:
             noise_floor = float(np.std(log.extras["truth_noise_A"]))
-            progress(f"{name}_{key}: {log.duration:7.1f} s, {len(log):6d} samples, "
+            progress(f"{label}: {log.duration:7.1f} s, {len(log):6d} samples, "
                      f"noise floor {noise_floor:.4f} A -> {path} "
                      f"({path.stat().st_size / 1e6:.2f} MB, {clock.perf_counter() - start:.1f} s)")
     return written

@@ -4,8 +4,8 @@ A process force ``F`` on the table (the cutting load) reaches the motor
 through the screw. Through a lossless drive train it would need the current
 ``F / K_0``, ``K_0 = k_t i 2 pi / h``; the losses that grow with the load are
 written two ways in the twin, and each synthetic log's axis file
-(``attrs["cutting"]["axis_config"]``, :meth:`AxisConfig.process_force_N
-<greybox.data.axis_config.AxisConfig.process_force_N>`) converts its process
+(``attrs["cutting"]["axis_config"]``, :meth:`AxisConfig.process_load
+<greybox.data.axis_config.AxisConfig.process_load>`) converts its process
 current back into ``F`` either way:
 
 * the X and Y axes book them in the process current: ``truth_process_A`` is
@@ -30,7 +30,8 @@ from __future__ import annotations
 
 from ..data.axis_config import AxisConfig
 
-__all__ = ["TORQUE_CONSTANT_NM_PER_A", "GEAR_RATIO", "AXIS_EFFICIENCIES", "load_gain_efficiencies", "drive_config"]
+__all__ = ["TORQUE_CONSTANT_NM_PER_A", "GEAR_RATIO", "AXIS_EFFICIENCIES", "WORM_EFFICIENCIES",
+           "load_gain_efficiencies", "drive_config"]
 
 #: Motor torque constant of every synthetic axis [Nm/A] (that of examples/axis_x.toml).
 TORQUE_CONSTANT_NM_PER_A = 1.35
@@ -41,29 +42,43 @@ GEAR_RATIO = 1.0
 #: Efficiencies (driving, back-driven) of the X and Y axes' screws (those of examples/axis_x.toml).
 AXIS_EFFICIENCIES = (0.9, 0.85)
 
+#: Efficiencies (driving, back-driven) of the rotary C axis's worm gear (those of examples/axis_c.toml):
+#: a preloaded worm loses more than a ball screw, and more still when the table drives the worm.
+WORM_EFFICIENCIES = (0.8, 0.7)
+
 
 def load_gain_efficiencies(load_gain: float) -> tuple[float, float]:
     """Efficiencies (driving, back-driven) that friction rising by ``load_gain`` A per A of axial load implies."""
     return 1.0 / (1.0 + load_gain), 1.0 - load_gain
 
 
-def drive_config(lead_mm: float, efficiencies: tuple[float, float], name: str = "") -> AxisConfig:
+def drive_config(lead_mm: float, efficiencies: tuple[float, float], name: str = "",
+                 motion: str = "linear") -> AxisConfig:
     """The axis file of a synthetic axis.
 
     Parameters
     ----------
     lead_mm : float
-        Screw lead [mm].
+        Axis travel per revolution of the driven element [mm]: the screw lead, or for a rotary
+        axis the angle [deg] the table turns per revolution of the worm.
     efficiencies : (float, float)
         Driving and back-driven efficiency [-].
     name : str, default ""
         Axis name.
+    motion : {"linear", "rotary"}, default "linear"
+        Kind of axis.
 
     Returns
     -------
     AxisConfig
-        With the twin's motor (:data:`TORQUE_CONSTANT_NM_PER_A`) and coupling (:data:`GEAR_RATIO`).
+        With the twin's motor (:data:`TORQUE_CONSTANT_NM_PER_A`) and coupling (:data:`GEAR_RATIO`); a
+        rotary axis's motor turns the worm directly, gear ratio ``360 / lead``.
     """
+    if motion == "rotary":
+        return AxisConfig(torque_constant_Nm_per_A=TORQUE_CONSTANT_NM_PER_A, screw_lead_mm=None,
+                          gear_ratio=360.0 / float(lead_mm), efficiency_driving=float(efficiencies[0]),
+                          efficiency_backdriven=float(efficiencies[1]), name=name, motion=motion,
+                          source="greybox.twin")
     return AxisConfig(torque_constant_Nm_per_A=TORQUE_CONSTANT_NM_PER_A, screw_lead_mm=float(lead_mm),
                       gear_ratio=GEAR_RATIO, efficiency_driving=float(efficiencies[0]),
                       efficiency_backdriven=float(efficiencies[1]), name=name, source="greybox.twin")

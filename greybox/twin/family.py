@@ -153,9 +153,9 @@ class FamilyPlant:
         """The axis file of this member: the twin's motor, this screw lead, the efficiencies of its load friction."""
         return drive_config(self.lead_mm, load_gain_efficiencies(self.load_gain), name)
 
-    def process_force_N(self, process_A, velocity_mm_s) -> np.ndarray:
+    def process_load(self, process_A, velocity_mm_s) -> np.ndarray:
         """Process force [N] on the table behind a process current [A] (losses booked in the friction)."""
-        return self.axis_config().lossless_force_constant_N_per_A * np.asarray(process_A, dtype=float)
+        return self.axis_config().lossless_load_constant * np.asarray(process_A, dtype=float)
 
     def to_dict(self) -> dict:
         """JSON-serialisable parameters, the law's under ``"law"``."""

@@ -55,7 +55,7 @@ from ..base import PlantLaw
 from ..data.axis_config import AxisConfig
 from ..errors import GreyboxError
 from .axes import axis_geometry
-from .drive import AXIS_EFFICIENCIES, drive_config
+from .drive import AXIS_EFFICIENCIES, WORM_EFFICIENCIES, drive_config
 
 __all__ = [
     "PlantParameters",
@@ -119,6 +119,9 @@ class PlantParameters:
         ``lambda_cog``: table travel [mm] of one cogging period (10 mm lead, 4 pole pairs, 6th harmonic).
     cogging_phase_rad : float, default 0.0
         ``phi_cog``: phase [rad] of the cogging current.
+    motion : {"linear", "rotary"}, default "linear"
+        Kind of axis. The plant's lengths of a rotary axis are in deg (``travel_mm``, ``lead_mm``: the
+        table's turn per worm revolution, deflections, ``A/mm`` as ``A/deg``); its axis file gives a torque.
     """
 
     breakaway_A: tuple
@@ -139,6 +142,7 @@ class PlantParameters:
     cogging_A: float = 0.0
     cogging_period_mm: float = 10.0 / 24.0
     cogging_phase_rad: float = 0.0
+    motion: str = "linear"
 
     def __post_init__(self):
         breakaway = np.asarray(self.breakaway_A, dtype=float)
@@ -190,12 +194,14 @@ class PlantParameters:
                 float(self.cogging_period_mm), float(self.cogging_phase_rad))
 
     def axis_config(self, name: str = "") -> AxisConfig:
-        """The axis file of this axis: the twin's motor, this screw lead, the X and Y axes' efficiencies."""
-        return drive_config(self.lead_mm, AXIS_EFFICIENCIES, name)
+        """The axis file of this axis: the twin's motor, this lead, the X and Y axes' (or the C axis's) efficiencies."""
+        efficiencies = WORM_EFFICIENCIES if self.motion == "rotary" else AXIS_EFFICIENCIES
+        return drive_config(self.lead_mm, efficiencies, name, self.motion)
 
-    def process_force_N(self, process_A, velocity_mm_s) -> np.ndarray:
-        """Process force [N] on the table behind a process current [A] (losses booked in the current)."""
-        return self.axis_config().process_force_N(process_A, velocity_mm_s)
+    def process_load(self, process_A, velocity_mm_s) -> np.ndarray:
+        """Process force [N] on the table (torque [Nm] on a rotary axis) behind a process current [A] (losses
+        booked in the current)."""
+        return self.axis_config().process_load(process_A, velocity_mm_s)
 
     def position_factor(self, position_mm) -> np.ndarray:
         """Position factor ``g(x)`` of the Maxwell-slip friction (dimensionless; :func:`position_factor_at`)."""
@@ -243,19 +249,29 @@ def default_plant_parameters(axis: str = "X", travel_mm=None) -> PlantParameters
     the paper's experiments show the pattern of its Tables 3 and 4 (see
     docs/synthetic-axis.md, 'Calibration against the paper').
 
+    The rotary table C (not in the paper) turns through a worm gear of ratio
+    90 (4 deg per worm revolution, the period of its position-periodic
+    friction), with less friction and inertia per degree than X per mm, a
+    weak variation of the worm's preload over the turn and the motor's
+    cogging at 4/24 deg; its lengths are in deg.
+
     Parameters
     ----------
-    axis : {"X", "Y"}
+    axis : {"X", "Y", "C"}
         Axis name.
     travel_mm : tuple of float, optional
         Travel [mm] for the preload profile; default the axis' travel.
     """
     geometry = axis_geometry(axis)
     travel = tuple(travel_mm) if travel_mm is not None else geometry.travel_mm
+    lead = 10.0
     if geometry.name == "X":
         static, viscous, inertia, phase, preload, tilt = 1.25, 0.006, 2.8e-4, 0.4, 0.2, 0.05
-    else:
+    elif geometry.name == "Y":
         static, viscous, inertia, phase, preload, tilt = 1.45, 0.007, 4.2e-4, 1.9, 0.35, 0.7
+    else:
+        static, viscous, inertia, phase, preload, tilt = 0.9, 0.004, 1.5e-4, 1.0, 0.05, 0.1
+        lead = 4.0
     breakaway, deflection = _element_distribution(static)
     return PlantParameters(
         breakaway_A=breakaway,
@@ -268,13 +284,14 @@ def default_plant_parameters(axis: str = "X", travel_mm=None) -> PlantParameters
         inertia_A_s2_mm=inertia,
         travel_mm=travel,
         preload_gain=preload,
-        lead_mm=10.0,
+        lead_mm=lead,
         lead_gain=0.04,
         lead_phase_rad=phase,
         tilt_gain=tilt,
         cogging_A=0.1,
-        cogging_period_mm=10.0 / 24.0,
+        cogging_period_mm=lead / 24.0,
         cogging_phase_rad=0.0,
+        motion=geometry.motion,
     )
 
 
