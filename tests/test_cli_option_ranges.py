@@ -23,12 +23,14 @@ from greybox.cli._types import (
     POSITIVE,
     POSITIVE_INT,
     SEED,
+    NumberList,
     NumberRange,
+    NumberSpan,
     WordOrNumber,
     positive,
 )
 
-CHECKED_TYPES = (NumberRange, WordOrNumber)
+CHECKED_TYPES = (NumberRange, WordOrNumber, NumberSpan, NumberList)
 
 
 def _subparsers() -> dict[str, argparse.ArgumentParser]:

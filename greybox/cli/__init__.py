@@ -20,7 +20,8 @@ from ..errors import GreyboxError
 from ._notes import command_notes, error_message
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
-COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate")
+COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate",
+            "plan")
 
 
 class OneLineParser(argparse.ArgumentParser):

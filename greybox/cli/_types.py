@@ -26,6 +26,8 @@ __all__ = [
     "SEED",
     "MAX_SEED",
     "WordOrNumber",
+    "NumberSpan",
+    "NumberList",
     "positive",
     "non_negative",
 ]
@@ -194,3 +196,65 @@ class WordOrNumber:
 
     def __repr__(self) -> str:
         return f"WordOrNumber({self.description!r})"
+
+
+class NumberSpan:
+    """An argparse ``type``: ``LOW:HIGH``, two numbers of a :class:`NumberRange` with LOW < HIGH.
+
+    Parameters
+    ----------
+    number : NumberRange
+        Range of each end, e.g. :data:`FINITE` for positions, :data:`POSITIVE` for feeds.
+    """
+
+    def __init__(self, number: NumberRange):
+        self.number = number
+        self.description = f"LOW:HIGH, LOW < HIGH, each {number.description}"
+        self.__name__ = self.description
+
+    def __call__(self, text: str) -> tuple[float, float]:
+        """Return ``(low, high)``; raise :class:`argparse.ArgumentTypeError` for anything else."""
+        parts = str(text).strip().split(":")
+        try:
+            low, high = (self.number(part) for part in parts)
+        except (ValueError, argparse.ArgumentTypeError):
+            raise argparse.ArgumentTypeError(f"must be {self.description}, got {text}") from None
+        if not low < high:
+            raise argparse.ArgumentTypeError(f"must be {self.description}, got {text}")
+        return float(low), float(high)
+
+    def outside(self) -> list[str]:
+        """Texts this type refuses: ends out of range, a reversed or empty span, not two numbers."""
+        return [f"{value}:{value}" for value in self.number.outside()] + ["5:1", "1:1", "3", "1:2:3"]
+
+    def __repr__(self) -> str:
+        return f"NumberSpan({self.description!r})"
+
+
+class NumberList:
+    """An argparse ``type``: one or more numbers of a :class:`NumberRange`, separated by commas.
+
+    Parameters
+    ----------
+    number : NumberRange
+        Range of every number.
+    """
+
+    def __init__(self, number: NumberRange):
+        self.number = number
+        self.description = f"numbers separated by commas, each {number.description}"
+        self.__name__ = self.description
+
+    def __call__(self, text: str) -> tuple[float, ...]:
+        """Return the numbers; raise :class:`argparse.ArgumentTypeError` for anything else."""
+        try:
+            return tuple(float(self.number(part)) for part in str(text).split(","))
+        except argparse.ArgumentTypeError:
+            raise argparse.ArgumentTypeError(f"must be {self.description}, got {text}") from None
+
+    def outside(self) -> list[str]:
+        """Texts this type refuses: a number out of range among good ones, an empty entry."""
+        return [f"600,{value}" for value in self.number.outside()] + ["600,,1800"]
+
+    def __repr__(self) -> str:
+        return f"NumberList({self.description!r})"

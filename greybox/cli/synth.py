@@ -41,6 +41,9 @@ def add_parser(subparsers) -> None:
                         help="output directory (created if missing; a non-empty one only with --force)")
     parser.add_argument("--seed", required=True, type=SEED, metavar="N",
                         help=f"master seed (an integer from 0 to {MAX_SEED})")
+    parser.add_argument("--plan", metavar="PROGRAM",
+                        help="run an NC program instead of the datasets (one-axis G-code, e.g. from 'greybox plan'): "
+                        "the axis it moves, written as DIR/<axis>_<program name>.mcap")
     parser.add_argument("--datasets", nargs="+", default=list(DEFAULT_DATASETS), metavar="ID",
                         help=f"dataset ids from {', '.join(DATASETS)} (default: {' '.join(DEFAULT_DATASETS)})")
     parser.add_argument("--effect", metavar="NAME",
@@ -178,6 +181,41 @@ def _check_duration(args: argparse.Namespace, axes, datasets) -> None:
               file=sys.stderr)
 
 
+def _run_plan(args: argparse.Namespace, cutting) -> int:
+    """``synth --plan PROGRAM``: the twin axis the program moves runs it; one log."""
+    from ..data.io import write_log
+    from ..nc.gcode import read_program
+    from ..twin.axes import axis_geometry
+    from ..twin.datasets import make_dataset, stored
+    from ..twin.nc_run import program_trajectory
+
+    given = [flag for flag, value in (("--family", args.family), ("--axis", args.axis), ("--duration", args.duration),
+                                      ("--one-file", args.one_file)) if value is not None]
+    if given:
+        raise GreyboxError(f"--plan runs the program's own axis and motion; {', '.join(given)} does not apply")
+    program = read_program(args.plan)
+    geometry = axis_geometry(program.axis)
+    trajectory = program_trajectory(program, geometry)
+    out = Path(args.out) / f"{geometry.name}_{Path(args.plan).stem}.mcap"
+    if out.exists() and not args.force:
+        raise GreyboxError(f"{out}: file exists; pass --force to overwrite it")
+    options = _effect_options(args)
+    if cutting is not None:
+        options["cutting"] = cutting
+    log = make_dataset(geometry.name, "N", args.seed, trajectory=trajectory,
+                       noise=CurrentNoise(std_A=args.noise_std), **options)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    write_log(stored(log, ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None), out)
+    lowered = trajectory.description["feeds_lowered"]
+    print(f"{Path(args.plan).name}: axis {geometry.name}, {len(program.blocks)} blocks, {log.duration:.1f} s, "
+          f"{len(log)} samples -> {out}")
+    if lowered:
+        print(f"note: {Path(args.plan).name}: the twin's acceleration limit lowered the feeds of {len(lowered)} "
+              f"stroke(s) (first at line {lowered[0]['line']}, to {100 * lowered[0]['factor']:.0f} %)",
+              file=sys.stderr)
+    return 0
+
+
 def _run_family(args: argparse.Namespace, datasets, cutting) -> int:
     given = [flag for flag, value in (("--axis", args.axis), ("--effect", args.effect),
                                       ("--strength", args.strength), ("--effect-param", args.effect_param))
@@ -207,6 +245,8 @@ def run(args: argparse.Namespace) -> int:
     if args.cutting:
         cutting = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm, teeth=args.teeth,
                               return_pass=args.cutting_return_pass)
+    if args.plan is not None:
+        return _run_plan(args, cutting)
     if args.family is not None:
         if not datasets:
             raise GreyboxError("give at least one dataset (--datasets)")

@@ -30,6 +30,7 @@ __all__ = [
     "dataset_motion",
     "make_dataset",
     "dataset_path",
+    "stored",
     "synthesize",
 ]
 
@@ -105,7 +106,7 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
                  effect_strength: float = 0.2, effect_params: dict | None = None,
                  cutting: bool | CuttingSpec | None = None, duration_s: float | None = None,
                  plant: PlantParameters | None = None, noise: CurrentNoise | None = None,
-                 sensors: Sensors | None = None) -> AxisLog:
+                 sensors: Sensors | None = None, trajectory: Trajectory | None = None) -> AxisLog:
     """Synthesise one axis log.
 
     Parameters
@@ -134,6 +135,10 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         Current noise; default ``CurrentNoise()`` (0.09 A, lag-1 correlation 0.7).
     sensors : Sensors, optional
         Resolutions of the logged channels.
+    trajectory : Trajectory, optional
+        The motion to run instead of the dataset's (e.g. an NC program,
+        :func:`greybox.twin.nc_run.program_trajectory`); ``dataset`` then only labels the log and
+        seeds its noise.
 
     Returns
     -------
@@ -156,7 +161,10 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
     """
     geometry = axis_geometry(axis)
     key = str(dataset).strip().upper()
-    trajectory = dataset_motion(geometry.name, dataset, seed, duration_s)
+    if trajectory is None:
+        trajectory = dataset_motion(geometry.name, dataset, seed, duration_s)
+    elif len(key) != 1:
+        raise GreyboxError(f"dataset label {dataset!r} of a given trajectory must be one letter")
     _, noise_rng = dataset_streams(seed, geometry.name, key)
     plant = plant if plant is not None else default_plant_parameters(geometry.name)
     noise = noise if noise is not None else CurrentNoise()
@@ -177,7 +185,8 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         "seed": int(seed),
         "sample_time_s": SAMPLE_TIME_S,
         "plant": plant.to_dict(),
-        "trajectory": {"dataset": key, "description": DATASETS[key], **trajectory.description},
+        "trajectory": {"dataset": key, "description": DATASETS.get(key, trajectory.description.get("kind", "")),
+                       **trajectory.description},
         "noise": noise.to_dict(),
         "sensors": sensors.to_dict(),
         "effect": None,
@@ -235,6 +244,17 @@ def _for_storage(log: AxisLog, keep: Sequence[str]) -> AxisLog:
     extras = {name: quantise(values, TRUTH_STORAGE_RESOLUTION_A)
               for name, values in log.extras.items() if name in keep}
     return log.replace(extras=extras)
+
+
+def stored(log: AxisLog, truth_channels: Sequence[str] | None = None) -> AxisLog:
+    """The log as synthesised logs are written: only the given truth channels (default all), rounded to 1 uA.
+
+    Raises
+    ------
+    GreyboxError
+        For an unknown truth channel.
+    """
+    return _for_storage(log, _kept_truth_channels(truth_channels))
 
 
 def synthesize(axis: str | Sequence[str], seed: int, out_dir, datasets: Sequence[str] = DEFAULT_DATASETS, *,
