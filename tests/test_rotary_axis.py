@@ -219,9 +219,15 @@ def test_discover_names_effect_parameters_in_deg(rotary, tmp_path, capsys):
     assert json.loads(document.read_text())["length_unit"] == "deg"
 
 
-def test_compensate_refuses_a_rotary_model_in_one_line(rotary, tmp_path, capsys):
+def test_compensate_on_the_rotary_twin_reports_in_mdeg_and_refuses_a_mixed_study(rotary, tmp_path, capsys):
     root, _, _ = rotary
+    out = tmp_path / "loop"
+    assert cli.main(["compensate", "--plant", "twin-C", "--model-file", str(root / "c.gbm"), "--out", str(out),
+                     "--duration", "4", "--quiet"]) == 0
+    assert "RMS mdeg" in capsys.readouterr().out
+    assert "RMS error [mdeg]" in (out / "compensation.md").read_text()
+    assert "rms_error_deg" in pd.read_csv(out / "compensation.csv").columns
     status = cli.main(["compensate", "--plant", "twin-X", "--model-file", str(root / "c.gbm"),
-                       "--out", str(tmp_path / "loop")])
+                       "--out", str(tmp_path / "mixed")])
     error = capsys.readouterr().err.strip()
-    assert status == 2 and "c.gbm: a rotary axis (deg)" in error and "\n" not in error
+    assert status == 2 and "c.gbm: a rotary axis, the plant twin-X is a linear one" in error and "\n" not in error

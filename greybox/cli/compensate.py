@@ -13,7 +13,7 @@ from ._types import FINITE, NON_NEGATIVE, POSITIVE, SEED, WordOrNumber, positive
 __all__ = ["add_parser", "run"]
 
 #: Plants given by name rather than by a model file.
-TWIN_PLANTS = {"twin-x": "X", "twin-y": "Y"}
+TWIN_PLANTS = {"twin-x": "X", "twin-y": "Y", "twin-c": "C"}
 
 #: Generated references.
 STROKE_REFERENCES = ("low", "high")
@@ -33,7 +33,8 @@ def add_parser(subparsers) -> None:
         "plots of the tracking error.",
     )
     parser.add_argument("--plant", required=True, metavar="PLANT",
-                        help="twin-X, twin-Y (the synthetic axis's truth plant) or a gms/lugre model file")
+                        help="twin-X, twin-Y, twin-C (the synthetic axes' truth plants; C is the rotary table, in deg) "
+                        "or a gms/lugre model file")
     parser.add_argument("--model-file", nargs="+", default=[], metavar="MODEL", dest="model_files",
                         help="feed-forward model files (.gbm)")
     parser.add_argument("--model", nargs="+", metavar="KIND", dest="kinds",
@@ -46,14 +47,16 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--force", action="store_true", help="overwrite existing report files in DIR")
     group = parser.add_argument_group("references")
     group.add_argument("--reference", nargs="+", default=list(STROKE_REFERENCES), metavar="REF",
-                       help=f"low ({STROKES_MM['low']:g} mm stroke), high ({STROKES_MM['high']:g} mm stroke) or a "
+                       help=f"low ({STROKES_MM['low']:g} mm stroke; deg on a rotary plant), high "
+                       f"({STROKES_MM['high']:g} mm stroke) or a "
                        "log whose position is the reference (default: low high)")
     group.add_argument("--duration", type=positive("seconds"), default=60.0, metavar="S",
                        help="length [s] of the generated references (default 60)")
     group.add_argument("--seed", type=SEED, default=0, metavar="N",
                        help="seed of the references, the synthetic training data and the disturbance (default 0)")
-    group.add_argument("--start", type=FINITE, metavar="MM",
-                       help="start position [mm] of the generated references (default: the middle of the twin's "
+    group.add_argument("--start", type=FINITE, metavar="POS",
+                       help="start position [mm, or deg on a rotary plant] of the generated references (default: the "
+                       "middle of the twin's "
                        "measurement window, 0 for a model plant)")
     group.add_argument("--reference-step", type=positive("seconds"), metavar="S",
                        help="step [s] of the generated references (default: the feed-forward models' sample time, "
@@ -62,7 +65,7 @@ def add_parser(subparsers) -> None:
     group.add_argument("--inertia", default="plant", metavar="J",
                        type=WordOrNumber(("plant", "model"), NON_NEGATIVE),
                        help="inertia of the feed-forward: 'plant' (the plant's, for every row; default), 'model' "
-                       "(each model's own) or a value [A s^2/mm]")
+                       "(each model's own) or a value [A s^2/mm, or A s^2/deg]")
     group.add_argument("--bandwidth", type=POSITIVE, metavar="HZ",
                        help="closed-loop bandwidth [Hz] of the PID pole placement (default 0.1 / (2 pi T))")
     group.add_argument("--controller-period", type=positive("seconds"), metavar="S",
@@ -70,7 +73,7 @@ def add_parser(subparsers) -> None:
     group.add_argument("--current-limit", type=POSITIVE, default=10.0, metavar="A",
                        help="saturation of the motor current [A] (default 10)")
     group.add_argument("--resolution", type=NON_NEGATIVE, default=1e-4, metavar="MM",
-                       help="encoder resolution [mm] (default 0.0001)")
+                       help="encoder resolution [mm, or deg on a rotary plant] (default 0.0001)")
     group.add_argument("--disturbance-std", type=NON_NEGATIVE, default=0.0, metavar="A",
                        help="standard deviation [A] of an AR(1) disturbance current (default 0: none)")
     parser.add_argument("--quiet", action="store_true", help="no progress messages")
@@ -93,11 +96,11 @@ def _load(path: str):
     return load_model(path)
 
 
-def _linear_only(source, motion: str) -> None:
-    """Refuse a model or log of a rotary axis: the loop study's references, gains and report are in mm."""
-    if motion != "linear":
-        raise GreyboxError(f"{source}: a {motion} axis (deg); the position-loop study of greybox compensate "
-                           "simulates linear feed axes in mm only")
+def _same_axis_kind(source, motion: str, plant) -> None:
+    """Refuse a model or log of another kind of axis than the plant's (mm against deg)."""
+    if motion != plant.motion:
+        raise GreyboxError(f"{source}: a {motion} axis, the plant {plant.name} is a {plant.motion} one; feed-forward "
+                           "models, training logs and references must be of the plant's kind of axis")
 
 
 def _plant(args):
@@ -110,10 +113,9 @@ def _plant(args):
         twins = ", ".join(f"twin-{axis}" for axis in TWIN_PLANTS.values())
         raise GreyboxError(f"{args.plant}: no such twin; the twin plants are {twins} (--plant)")
     if not os.path.isfile(args.plant):
-        raise GreyboxError(f"{args.plant}: no such model file; the plant is twin-X, twin-Y or a gms/lugre model "
-                           "file (--plant)")
+        raise GreyboxError(f"{args.plant}: no such model file; the plant is twin-X, twin-Y, twin-C or a gms/lugre "
+                           "model file (--plant)")
     model = _load(args.plant)  # its errors name the file already
-    _linear_only(args.plant, model.units_.name)
     try:
         return ModelPlant(model, name=Path(args.plant).stem)
     except GreyboxError as error:
@@ -143,7 +145,7 @@ def _training_runs(args, plant):
     if args.train:
         runs = read_logs(args, args.train)
         for run in runs:
-            _linear_only(run.source or "--train", run.motion)
+            _same_axis_kind(run.source or "--train", run.motion, plant)
         return runs
     if not isinstance(plant, TwinPlant) or plant.axis is None:
         raise GreyboxError("--model with a model plant needs training logs: give --train LOG ...")
@@ -159,7 +161,7 @@ def _models(args, plant) -> dict:
     entries = []
     for path in args.model_files:
         model = _load(path)
-        _linear_only(path, model.units_.name)
+        _same_axis_kind(path, model.units_.name, plant)
         entries.append((model_kind(model), Path(path).stem, model))
     kinds = _fit_kinds(args)
     if kinds:
@@ -194,7 +196,7 @@ def _inertia(args):
                            ) from None
 
 
-def _references(args) -> list:
+def _references(args, plant) -> list:
     from ._options import read_logs
 
     references = []
@@ -205,7 +207,7 @@ def _references(args) -> list:
         if not os.path.isfile(value):
             raise GreyboxError(f"{value}: no such log; --reference takes low, high or log files")
         for run in read_logs(args, [value]):
-            _linear_only(value, run.motion)
+            _same_axis_kind(value, run.motion, plant)
             references.append(run)
     return references
 
@@ -243,18 +245,20 @@ def run(args: argparse.Namespace) -> int:
     plant = _plant(args)
     models = _models(args, plant)
     started = time.perf_counter()
-    study = compensation_study(plant, models, references=_references(args), duration_s=args.duration,
+    study = compensation_study(plant, models, references=_references(args, plant), duration_s=args.duration,
                                seed=args.seed, start_mm=args.start, reference_step_s=args.reference_step,
                                inertia=_inertia(args), bandwidth_hz=args.bandwidth,
                                controller_period_s=args.controller_period, current_limit_A=args.current_limit,
                                resolution_mm=args.resolution, disturbance_std_A=args.disturbance_std,
                                progress=lambda text: _say(args, text))
     _say(args, f"simulated {len(study.results)} closed-loop runs in {time.perf_counter() - started:.1f} s")
-    print(f"  {'reference':<16} {'feed-forward':<16} {'RMS um':>10} {'max um':>10} {'vs none %':>10}")
+    units = study.results[0].units
+    fine, rms, peak = units.fine_unit, units.relabel("rms_error_mm"), units.relabel("peak_error_mm")
+    print(f"  {'reference':<16} {'feed-forward':<16} {'RMS ' + fine:>10} {'max ' + fine:>10} {'vs none %':>10}")
     for row in comparison_rows(study.results):
         relative = f"{100.0 * row['rms_vs_none']:.1f}" if row["rms_vs_none"] == row["rms_vs_none"] else ""
-        print(f"  {row['reference'][:16]:<16} {row['feedforward'][:16]:<16} {1e3 * row['rms_error_mm']:>10.4g} "
-              f"{1e3 * row['peak_error_mm']:>10.4g} {relative:>10}")
+        print(f"  {row['reference'][:16]:<16} {row['feedforward'][:16]:<16} {1e3 * row[rms]:>10.4g} "
+              f"{1e3 * row[peak]:>10.4g} {relative:>10}")
     settings = {**study.settings, "model_files": list(args.model_files), "fitted": list(args.kinds or ()),
                 "training_logs": list(args.train or ())}
     written = write_report(study.results, args.out, settings=settings, force=args.force)

@@ -95,9 +95,7 @@ class ModelFeedForward:
 
     def friction(self, reference: Reference) -> np.ndarray:
         """Friction current of the model along the reference, plus its offset [A]."""
-        log = reference.to_log()
-        if self.effort_unit != log.effort_unit:
-            log = log.replace(effort_unit=self.effort_unit)
+        log = reference.to_log(motion=self.model.units_.name, effort_unit=self.effort_unit)
         return self.model.friction(log) + self.model.offset_
 
     def current(self, reference: Reference) -> np.ndarray:

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.quantities import MOTIONS, Motion
 from ..errors import GreyboxError
 from ..twin.noise import CurrentNoise
 from .feedforward import InertiaFeedForward
@@ -69,6 +70,8 @@ class LoopResult:
         Fraction of the controller periods of each sample at the current limit.
     settings : dict
         Gains, period, limits and disturbance of the run (JSON-serialisable).
+    motion : str, default "linear"
+        Kind of axis of the plant: positions and errors in mm, or deg for ``"rotary"``.
     """
 
     reference: Reference
@@ -80,6 +83,12 @@ class LoopResult:
     plant_friction_A: np.ndarray
     saturated: np.ndarray
     settings: dict = field(default_factory=dict)
+    motion: str = "linear"
+
+    @property
+    def units(self) -> Motion:
+        """Units of the plant's axis (mm or deg)."""
+        return MOTIONS[self.motion]
 
     @property
     def error_mm(self) -> np.ndarray:
@@ -102,9 +111,11 @@ class LoopResult:
         return float(np.mean(self.saturated))
 
     def summary(self) -> dict:
-        """Row of the comparison table (errors in mm, JSON-serialisable)."""
+        """Row of the comparison table (errors ``rms_error_mm``, ``peak_error_mm`` in mm, or
+        ``rms_error_deg``, ``peak_error_deg`` for a rotary axis; JSON-serialisable)."""
+        relabel = self.units.relabel
         return {"reference": self.reference.name, "feedforward": self.feedforward_name, "plant": self.plant_name,
-                "rms_error_mm": self.rms_error_mm, "peak_error_mm": self.peak_error_mm,
+                relabel("rms_error_mm"): self.rms_error_mm, relabel("peak_error_mm"): self.peak_error_mm,
                 "rms_current_A": float(np.sqrt(np.mean(self.current_A**2))),
                 "saturated_fraction": self.saturated_fraction}
 
@@ -192,7 +203,7 @@ def simulate_loop(plant, reference: Reference, feedforward=None, gains: PIDGains
             "current_limit_A": float(current_limit_A), "resolution_mm": float(resolution_mm),
             "disturbance": None if disturbance is None else {**disturbance.to_dict(), "seed": int(seed)}}
     return LoopResult(reference, feedforward.name, plant.name, current_ff, trace.current_A, trace.position_mm,
-                      trace.friction_A, trace.saturated, info)
+                      trace.friction_A, trace.saturated, info, motion=plant.motion)
 
 
 def compare_feedforwards(plant, references, feedforwards, gains: PIDGains | None = None, **options

@@ -252,15 +252,20 @@ class TwinPlant:
 
     @classmethod
     def for_axis(cls, axis: str, *, friction: bool = True) -> "TwinPlant":
-        """Default truth plant of axis ``"X"`` or ``"Y"``, named ``twin-X`` / ``twin-Y``."""
+        """Default truth plant of axis ``"X"``, ``"Y"`` or ``"C"`` (rotary, deg), named ``twin-X`` / ...."""
         key = str(axis).strip().upper()
         suffix = "" if friction else " (no friction)"
         return cls(default_plant_parameters(key), friction=friction, name=f"twin-{key}{suffix}", axis=key)
 
     @property
     def inertia_A_s2_mm(self) -> float:
-        """Inertia ``J`` [A s^2/mm]."""
+        """Inertia ``J`` [A s^2/mm], or [A s^2/deg] for a rotary axis."""
         return float(self.params.inertia_A_s2_mm)
+
+    @property
+    def motion(self) -> str:
+        """``"linear"`` or ``"rotary"``: lengths of the loop in mm or deg."""
+        return self.params.motion
 
     def plant_law(self) -> PlantLaw:
         """The truth plant's law (:func:`greybox.twin.plant.twin_plant_law`)."""
@@ -322,8 +327,13 @@ class ModelPlant:
 
     @property
     def inertia_A_s2_mm(self) -> float:
-        """Inertia ``J`` [A s^2/mm] (or [N s^2/mm] for force models)."""
+        """Inertia ``J`` [A s^2/mm] (or [N s^2/mm] for force models; per deg for a rotary axis)."""
         return float(self.law.inertia)
+
+    @property
+    def motion(self) -> str:
+        """``"linear"`` or ``"rotary"``, the kind of axis the model was fitted on."""
+        return self.model.units_.name
 
     def plant_law(self) -> PlantLaw:
         """The model's plant law."""

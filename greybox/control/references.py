@@ -86,11 +86,19 @@ class Reference:
         """Time from the first to the last sample [s]."""
         return float(self.time[-1] - self.time[0])
 
-    def to_log(self) -> AxisLog:
-        """The reference as a prepared :class:`AxisLog` (effort zero, in A), to evaluate models on it."""
+    def to_log(self, *, motion: str = "linear", effort_unit: str = "A") -> AxisLog:
+        """The reference as a prepared :class:`AxisLog` (effort zero), to evaluate models on it.
+
+        Parameters
+        ----------
+        motion : {"linear", "rotary"}, default "linear"
+            Kind of axis the positions belong to (mm or deg).
+        effort_unit : str, default "A"
+            Unit of the (zero) effort, that of the model evaluated on the log.
+        """
         return AxisLog(time=self.time, position=self.position, effort=np.zeros(self.time.size),
-                       velocity=self.velocity, acceleration=self.acceleration, effort_unit="A",
-                       dataset=self.name, attrs=self.attrs)
+                       velocity=self.velocity, acceleration=self.acceleration, effort_unit=effort_unit,
+                       motion=motion, dataset=self.name, attrs=self.attrs)
 
 
 def _derivatives(position: np.ndarray, sample_time: float) -> tuple[np.ndarray, np.ndarray]:

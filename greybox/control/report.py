@@ -70,26 +70,27 @@ def comparison_rows(results: list[LoopResult]) -> list[dict]:
         baseline = next((r.rms_error_mm for r in group if r.feedforward_name == BASELINE), float("nan"))
         for result in group:
             row = result.summary()
-            row["rms_vs_none"] = row["rms_error_mm"] / baseline if baseline > 0 else float("nan")
+            row["rms_vs_none"] = result.rms_error_mm / baseline if baseline > 0 else float("nan")
             rows.append(row)
     return rows
 
 
 def format_tables(results: list[LoopResult]) -> str:
-    """Markdown tables of RMS and peak tracking error [um], one per reference."""
-    rows = comparison_rows(results)
+    """Markdown tables of RMS and peak tracking error [um, or mdeg for a rotary axis], one per reference."""
     lines = []
     for name in _reference_names(results):
-        first = next(result for result in results if result.reference.name == name)
+        group = [result for result in results if result.reference.name == name]
+        first, fine = group[0], group[0].units.fine_unit
         lines += [f"Tracking error on the {name} reference "
                   f"({first.reference.duration:g} s, plant {first.plant_name})", "",
-                  "| friction feed-forward | RMS error [um] | max error [um] | RMS vs none [%] |",
+                  f"| friction feed-forward | RMS error [{fine}] | max error [{fine}] | RMS vs none [%] |",
                   "|---|---:|---:|---:|"]
-        for row in (r for r in rows if r["reference"] == name):
+        rows = [row for row in comparison_rows(results) if row["reference"] == name]
+        for result, row in zip(group, rows):
             relative = "" if np.isnan(row["rms_vs_none"]) else f"{100.0 * row['rms_vs_none']:.1f}"
-            lines.append(f"| {row['feedforward']} | {1e3 * row['rms_error_mm']:.4g} | "
-                         f"{1e3 * row['peak_error_mm']:.4g} | {relative} |")
-        saturated = [r["feedforward"] for r in rows if r["reference"] == name and r["saturated_fraction"] > 0]
+            lines.append(f"| {row['feedforward']} | {1e3 * result.rms_error_mm:.4g} | "
+                         f"{1e3 * result.peak_error_mm:.4g} | {relative} |")
+        saturated = [r["feedforward"] for r in rows if r["saturated_fraction"] > 0]
         if saturated:
             lines.append(f"\nThe current hit its limit with: {', '.join(saturated)}.")
         lines.append("")
@@ -97,7 +98,7 @@ def format_tables(results: list[LoopResult]) -> str:
 
 
 def plot_tracking_errors(results: list[LoopResult], reference_name: str, path=None):
-    """Reference position and every feed-forward's tracking error [um] over time.
+    """Reference position and every feed-forward's tracking error [um, or mdeg] over time.
 
     Parameters
     ----------
@@ -120,13 +121,15 @@ def plot_tracking_errors(results: list[LoopResult], reference_name: str, path=No
     figure, axes = plt.subplots(len(group) + 1, 1, sharex=True, figsize=(10, 1.6 * (len(group) + 1) + 1),
                                 layout="constrained")
     axes[0].plot(reference.time, reference.position, lw=0.8, color="k")
-    axes[0].set_ylabel("reference\n[mm]")
+    units = group[0].units
+    fine = units.fine_unit
+    axes[0].set_ylabel(f"reference\n[{units.length}]")
     limit = max(1e3 * result.peak_error_mm for result in group)
     for ax, result in zip(axes[1:], group):
         ax.plot(reference.time, 1e3 * result.error_mm, lw=0.6)
         ax.set_ylim(-1.05 * limit, 1.05 * limit)
-        ax.set_ylabel(f"{result.feedforward_name}\n[um]")
-        ax.text(0.995, 0.95, f"RMS {1e3 * result.rms_error_mm:.3g} um, max {1e3 * result.peak_error_mm:.3g} um",
+        ax.set_ylabel(f"{result.feedforward_name}\n[{fine}]")
+        ax.text(0.995, 0.95, f"RMS {1e3 * result.rms_error_mm:.3g} {fine}, max {1e3 * result.peak_error_mm:.3g} {fine}",
                 transform=ax.transAxes, ha="right", va="top", fontsize=8)
     for ax in axes:
         ax.grid(True, alpha=0.3)

@@ -53,6 +53,11 @@ class Motion:
         return f"{self.length}/s^2"
 
     @property
+    def fine_unit(self) -> str:
+        """A thousandth of the length unit, for tracking errors: ``"um"`` or ``"mdeg"``."""
+        return "um" if self.length == "mm" else f"m{self.length}"
+
+    @property
     def feed_unit(self) -> str:
         """Unit machinists give feeds in, e.g. ``"mm/min"``."""
         return f"{self.length}/min"
