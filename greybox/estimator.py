@@ -26,7 +26,11 @@ from .errors import LogError, ParameterError
 from .identify.progress import make_progress
 from .metrics import rmse
 
-__all__ = ["CurrentModel", "check_runs"]
+__all__ = ["CurrentModel", "check_runs", "MAX_PARAMETER_MAGNITUDE"]
+
+#: Largest magnitude of an identified parameter a model file may carry: currents of a feed axis are
+#: amperes, stiffnesses thousands of A/mm; 1e12 in any unit is a corrupt or hostile file.
+MAX_PARAMETER_MAGNITUDE = 1e12
 
 #: Learned attributes that record the training region: name -> channel of the runs (range [mm] or [mm/s]).
 _REGION_CHANNELS = {"position_range_mm_": "position", "velocity_range_mm_s_": "velocity"}
@@ -284,8 +288,9 @@ class CurrentModel(ModelProtocol):
         Raises
         ------
         ParameterError
-            Naming the missing or malformed learned attribute or the invalid
-            hyperparameter, or the error the probe prediction gave.
+            Naming the missing or malformed learned attribute, a parameter that is not finite or
+            beyond :data:`MAX_PARAMETER_MAGNITUDE`, the invalid hyperparameter, or the error the
+            probe prediction gave.
         """
         self._check_params()
         try:
@@ -297,8 +302,12 @@ class CurrentModel(ModelProtocol):
                 raise ParameterError(f"effort_unit_ of a {motion} axis must be one of "
                                      f"{MOTIONS[motion].effort_units}, got {self.effort_unit_!r}")
             for row in self.parameter_table():
-                if not np.all(np.isfinite(np.asarray(row.value, dtype=float))):
+                values = np.asarray(row.value, dtype=float)
+                if not np.all(np.isfinite(values)):
                     raise ParameterError(f"parameter {row.name} is not finite: {row.value!r}")
+                if values.size and np.max(np.abs(values)) > MAX_PARAMETER_MAGNITUDE:
+                    raise ParameterError(f"parameter {row.name} = {np.max(np.abs(values)):.3g} in magnitude, beyond "
+                                         f"{MAX_PARAMETER_MAGNITUDE:g}: not a model of a feed axis")
             step = float(self.sample_time_)
             if not (np.isfinite(step) and step > 0.0):
                 raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")

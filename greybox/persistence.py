@@ -66,6 +66,17 @@ _ARRAY_DIR = "arrays/"
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 _ARRAY_KINDS = "biufcU"  # bool, integers, floats, complex, unicode: never object
 _ATTRIBUTE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*_$")
+#: Names an array member may have (what :class:`_Encoder` writes): no folders, no ``..``, no backslash.
+_ARRAY_MEMBER = re.compile(r"^arrays/[0-9]{3,}_[A-Za-z0-9_.-]{0,80}\.npy$")
+
+#: Limits of what a model file may declare, checked before anything is decompressed: a model holds a
+#: JSON document and some arrays of support vectors and parameters (tens of MB at most).
+MAX_MEMBERS = 10_000
+MAX_JSON_BYTES = 64 << 20
+MAX_MEMBER_BYTES = 512 << 20
+MAX_TOTAL_BYTES = 1 << 30
+#: Largest compression ratio of a member above 1 MiB (a zip bomb compresses by 1000 and more).
+MAX_COMPRESSION_RATIO = 200
 
 
 # ------------------------------------------------------------------- writing
@@ -199,6 +210,7 @@ class _Decoder:
         self.path = path
         self.archive = archive
         self.version = version
+        self.referenced: set[str] = set()
 
     def fail(self, problem: str):
         raise ModelFileError(f"{self.path}: {problem}")
@@ -250,16 +262,59 @@ class _Decoder:
         return {key: self.value(v, f"{where}[{key!r}]") for key, v in value.items()}
 
     def array(self, member, where: str) -> np.ndarray:
-        if not isinstance(member, str) or not member.startswith(_ARRAY_DIR):
+        if not isinstance(member, str) or not _ARRAY_MEMBER.match(member):
             self.fail(f"bad array reference in {where}: {member!r}")
+        if member in self.referenced:
+            self.fail(f"array {member} is referenced twice ({where})")
         try:
-            data = self.archive.read(member)
+            data = _read_member(self.archive, member, MAX_MEMBER_BYTES)
         except KeyError:
             self.fail(f"array {member} of {where} is missing")
+        self.referenced.add(member)
         try:
-            return np.load(io.BytesIO(data), allow_pickle=False)
-        except ValueError as error:
+            array = np.load(io.BytesIO(data), allow_pickle=False)
+        except (ValueError, EOFError, OSError) as error:
             self.fail(f"array {member} of {where} cannot be read: {error}")
+        if not isinstance(array, np.ndarray) or array.dtype.kind not in _ARRAY_KINDS or array.dtype.fields:
+            self.fail(f"array {member} of {where} has dtype {getattr(array, 'dtype', type(array).__name__)}; "
+                      "model files hold numbers, booleans and text only")
+        return array
+
+
+def _read_member(archive: zipfile.ZipFile, name: str, limit: int) -> bytes:
+    """A member's bytes, reading at most ``limit`` (a member whose real size exceeds its header is refused)."""
+    with archive.open(name) as stream:
+        data = stream.read(limit + 1)
+    if len(data) > limit:
+        raise ModelFileError(f"{archive.filename}: member {name} holds more than {limit} bytes")
+    return data
+
+
+def _check_members(archive: zipfile.ZipFile, path: Path) -> None:
+    """Refuse a ZIP whose members a model file does not have, or whose declared sizes are out of bounds."""
+    infos = archive.infolist()
+    if len(infos) > MAX_MEMBERS:
+        raise ModelFileError(f"{path}: {len(infos)} members; a model file has at most {MAX_MEMBERS}")
+    names = [info.filename for info in infos]
+    if _JSON_MEMBER not in names:
+        raise ModelFileError(f"{path}: not a greybox model file ({_JSON_MEMBER} missing)")
+    if len(set(names)) != len(names):
+        twice = sorted({name for name in names if names.count(name) > 1})
+        raise ModelFileError(f"{path}: the member {twice[0]!r} is stored twice")
+    for info in infos:
+        if info.filename != _JSON_MEMBER and not _ARRAY_MEMBER.match(info.filename):
+            raise ModelFileError(f"{path}: unexpected member {info.filename!r} (a model file holds {_JSON_MEMBER} "
+                                 f"and {_ARRAY_DIR}NNN_name.npy only)")
+        limit = MAX_JSON_BYTES if info.filename == _JSON_MEMBER else MAX_MEMBER_BYTES
+        if info.file_size > limit:
+            raise ModelFileError(f"{path}: member {info.filename} declares {info.file_size} bytes, more than the "
+                                 f"{limit} a model file may hold")
+        if info.file_size > (1 << 20) and info.file_size > MAX_COMPRESSION_RATIO * max(info.compress_size, 1):
+            ratio = info.file_size // max(info.compress_size, 1)
+            raise ModelFileError(f"{path}: member {info.filename} expands {ratio} times (a ZIP bomb?); refused")
+    total = sum(info.file_size for info in infos)
+    if total > MAX_TOTAL_BYTES:
+        raise ModelFileError(f"{path}: members of {total} bytes in all, more than {MAX_TOTAL_BYTES}")
 
 
 def load_model(path: str | PathLike):
@@ -291,11 +346,14 @@ def load_model(path: str | PathLike):
         raise ModelFileError(f"{path}: no such model file")
     try:
         with zipfile.ZipFile(path) as archive:
+            _check_members(archive, path)
             try:
-                document = json.loads(archive.read(_JSON_MEMBER).decode("utf-8"))
+                document = json.loads(_read_member(archive, _JSON_MEMBER, MAX_JSON_BYTES).decode("utf-8"))
             except KeyError:
                 raise ModelFileError(f"{path}: not a greybox model file ({_JSON_MEMBER} missing)") from None
-            except (UnicodeDecodeError, json.JSONDecodeError) as error:
+            except GreyboxError:
+                raise
+            except (UnicodeDecodeError, ValueError, RecursionError) as error:  # ValueError: also too long a number
                 raise ModelFileError(f"{path}: {_JSON_MEMBER} is not valid JSON: {error}") from None
             if not isinstance(document, dict) or document.get("format") != FORMAT_NAME:
                 raise ModelFileError(f"{path}: not a greybox model file (format is not {FORMAT_NAME!r})")
@@ -308,7 +366,16 @@ def load_model(path: str | PathLike):
                     f"({document.get('greybox_version', 'unknown version')}); this greybox reads versions "
                     f"up to {FORMAT_VERSION}: upgrade greybox"
                 )
-            model = _Decoder(path, archive, version).estimator(document.get("model"), "model")
+            decoder = _Decoder(path, archive, version)
+            try:
+                model = decoder.estimator(document.get("model"), "model")
+            except GreyboxError:
+                raise
+            except RecursionError:
+                raise ModelFileError(f"{path}: values nested too deeply") from None
+            except (TypeError, ValueError) as error:  # the class refused a parameter value
+                raise ModelFileError(f"{path}: a parameter of the model is malformed: {error}") from None
+            unused = sorted(set(archive.namelist()) - {_JSON_MEMBER} - decoder.referenced)
     except (zipfile.BadZipFile, zlib.error, EOFError, RuntimeError, NotImplementedError) as error:
         # a flipped bit in a ZIP header may also read as "encrypted" or "unsupported compression"
         if zipfile.is_zipfile(path):
@@ -317,10 +384,11 @@ def load_model(path: str | PathLike):
         raise ModelFileError(f"{path}: not a greybox model file (not a ZIP archive)") from None
     except (zipfile.LargeZipFile, OSError) as error:
         raise ModelFileError(f"{path}: cannot read model file: {error}") from None
-    if not any(name.endswith("_") and not name.startswith("_") for name in vars(model)):
-        return model  # an unfitted model: its parameters were checked by the decoder
-    try:
-        model.validate_fitted()
-    except GreyboxError as error:
-        raise ModelFileError(f"{path}: invalid {type(model).__name__} in the model file: {error}") from None
+    if any(name.endswith("_") and not name.startswith("_") for name in vars(model)):  # fitted: check it works
+        try:
+            model.validate_fitted()
+        except GreyboxError as error:
+            raise ModelFileError(f"{path}: invalid {type(model).__name__} in the model file: {error}") from None
+    if unused:
+        raise ModelFileError(f"{path}: member {unused[0]} is not part of the model (no value refers to it)")
     return model

@@ -14,7 +14,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
+import threading
 
 from ..errors import GreyboxError
 from ._notes import command_notes, error_message
@@ -48,22 +50,43 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (a scheduler or ``kill`` stopping the command), raised like Ctrl-C so that half-written outputs
+    are removed on the way out (:func:`greybox.atomic.atomic_output`)."""
+
+
+def _terminate(signum, frame):
+    raise Terminated()
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the ``greybox`` command and return its exit status."""
+    """Run the ``greybox`` command and return its exit status.
+
+    SIGTERM ends the command like Ctrl-C: no output is left half-written, an earlier file of the same
+    name is kept, and the status is 143 (130 for Ctrl-C).
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
+    installed = threading.current_thread() is threading.main_thread()  # signals reach the main thread only
+    previous = signal.signal(signal.SIGTERM, _terminate) if installed else None
     try:
         with command_notes(args):  # warnings as one-line notes naming options, not Python
             return int(args.run(args) or 0)
     except GreyboxError as error:
         print(f"greybox {args.command}: error: {error_message(error, args)}", file=sys.stderr)
         return 2
+    except Terminated:
+        print(f"greybox {args.command}: terminated (SIGTERM); no output was left half-written", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print(f"greybox {args.command}: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader of the output went away (``greybox ... | head``): stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
+    finally:
+        if installed:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -25,13 +25,12 @@ delimiter a decimal comma is accepted. Column names follow
 from __future__ import annotations
 
 import csv
-import json
 from typing import Mapping, Sequence
 
 import pandas as pd
 
 from ..errors import LogError
-from .file_metadata import logs_metadata, metadata_fields, read_sidecar, sidecar_path, sidecar_text
+from .file_metadata import logs_metadata, metadata_fields, parse_metadata, read_sidecar, sidecar_path, sidecar_text
 from .log import AxisLog
 from .units import log_from_columns, several_axes_table
 
@@ -49,11 +48,8 @@ def _preamble(path) -> tuple[int, dict, str]:
                 if not line.startswith("#"):
                     return comments, metadata, line
                 if line.startswith(_METADATA_TAG):
-                    try:
-                        metadata = json.loads(line[len(_METADATA_TAG):])
-                    except json.JSONDecodeError as exc:
-                        raise LogError(path, f"line {comments + 1}: greybox metadata is not valid JSON "
-                                             f"({exc.msg})") from None
+                    metadata = parse_metadata(line[len(_METADATA_TAG):], path,
+                                              f"line {comments + 1}: greybox metadata")
                 comments += 1
     except UnicodeDecodeError as exc:
         raise LogError(path, f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None

@@ -19,8 +19,8 @@ from typing import Mapping
 from ..errors import LogError
 from .log import AxisLog
 
-__all__ = ["SIDECAR_SUFFIX", "log_metadata", "logs_metadata", "metadata_fields", "read_sidecar", "sidecar_path",
-           "sidecar_text"]
+__all__ = ["SIDECAR_SUFFIX", "log_metadata", "logs_metadata", "metadata_fields", "parse_metadata", "read_sidecar",
+           "sidecar_path", "sidecar_text"]
 
 #: Appended to a CSV file's name to give its metadata file: ``x.csv`` -> ``x.csv.json``.
 SIDECAR_SUFFIX = ".json"
@@ -39,6 +39,28 @@ def logs_metadata(logs) -> dict[str, object]:
     return {"axes": {log.axis: log_metadata(log) for log in logs}}
 
 
+def parse_metadata(text: str | bytes, source, what: str = "greybox metadata") -> dict:
+    """The metadata object of JSON ``text``.
+
+    Raises
+    ------
+    LogError
+        Naming ``source`` and ``what``, for text that is not UTF-8, not JSON (or nested or numbered
+        beyond what JSON readers take), or JSON that is not an object.
+    """
+    try:
+        metadata = json.loads(text)
+    except UnicodeDecodeError as exc:
+        raise LogError(source, f"{what} is not UTF-8 text (byte {exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise LogError(source, f"{what} is not valid JSON (line {exc.lineno}: {exc.msg})") from None
+    except (ValueError, RecursionError) as exc:  # a number of too many digits, nesting too deep
+        raise LogError(source, f"{what} is not JSON greybox reads ({type(exc).__name__}: {exc})") from None
+    if not isinstance(metadata, dict):
+        raise LogError(source, f"{what} holds a JSON {type(metadata).__name__}, not an object")
+    return metadata
+
+
 def metadata_fields(metadata: Mapping[str, object], axis: str | None = None) -> dict[str, object]:
     """Keyword arguments of :func:`greybox.data.units.log_from_columns` from a read metadata object.
 
@@ -53,11 +75,12 @@ def metadata_fields(metadata: Mapping[str, object], axis: str | None = None) -> 
     if isinstance(metadata.get("axes"), dict):
         entry = metadata["axes"].get(axis) if axis is not None else None
         metadata = entry if isinstance(entry, dict) else {}
+    unit, attrs = metadata.get("effort_unit"), metadata.get("attrs", {})
     return {
-        "effort_unit": metadata.get("effort_unit"),
+        "effort_unit": unit if isinstance(unit, str) else None,
         "axis": str(metadata.get("axis", "")),
         "dataset": str(metadata.get("dataset", "")),
-        "attrs": metadata.get("attrs", {}),
+        "attrs": attrs if isinstance(attrs, dict) else {"attrs": attrs},
     }
 
 
@@ -97,12 +120,5 @@ def read_sidecar(path: str | os.PathLike) -> dict | None:
     side = sidecar_path(path)
     if not side.is_file():
         return None
-    try:
-        metadata = json.loads(side.read_text(encoding="utf-8-sig"))
-    except UnicodeDecodeError as exc:
-        raise LogError(side, f"metadata file is not UTF-8 text (byte {exc.start})") from None
-    except json.JSONDecodeError as exc:
-        raise LogError(side, f"metadata file is not valid JSON (line {exc.lineno}: {exc.msg})") from None
-    if not isinstance(metadata, dict):
-        raise LogError(side, f"metadata file holds a JSON {type(metadata).__name__}, not an object")
-    return metadata
+    data = side.read_bytes()
+    return parse_metadata(data[3:] if data.startswith(b"\xef\xbb\xbf") else data, side, "metadata file")

@@ -508,7 +508,7 @@ def read_mcap(
     metadata = channel.metadata
     try:
         attrs = json.loads(metadata.get("attrs", "{}"))
-    except json.JSONDecodeError:
+    except (ValueError, RecursionError):
         raise LogError(path, f"channel '{channel.topic}': metadata 'attrs' is not JSON text") from None
     return log_from_columns(
         table,

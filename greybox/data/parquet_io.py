@@ -17,7 +17,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..errors import LogError
-from .file_metadata import logs_metadata, metadata_fields
+from .file_metadata import logs_metadata, metadata_fields, parse_metadata
 from .log import AxisLog
 from .units import log_from_columns, several_axes_table
 
@@ -61,10 +61,7 @@ def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time:
     if table.num_rows == 0:
         raise LogError(path, "no data rows")
     raw = (table.schema.metadata or {}).get(_METADATA_KEY)
-    try:
-        metadata = json.loads(raw) if raw else {}
-    except json.JSONDecodeError:
-        raise LogError(path, "the greybox schema metadata is not valid JSON") from None
+    metadata = parse_metadata(raw, path, "the greybox schema metadata") if raw else {}
     arrays = {}
     for name in table.column_names:
         column = table.column(name)

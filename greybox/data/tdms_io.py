@@ -13,6 +13,9 @@ columns.
 
 from __future__ import annotations
 
+import contextlib
+import logging
+import warnings
 from pathlib import Path
 from typing import Mapping
 
@@ -37,6 +40,33 @@ def _group(tdms, path, topic: str | None):
         listed = ", ".join(names) or "none"
         raise LogError(path, f"the file holds {len(groups)} TDMS groups ({listed}); choose one with --topic GROUP")
     return groups[0]
+
+
+@contextlib.contextmanager
+def _notes_of_nptdms(path):
+    """npTDMS's log messages (a truncated last segment, ...) as warnings naming the file, not log lines; none when
+    the read fails (its error says it all)."""
+
+    class Collect(logging.Handler):
+        def emit(self, record):
+            messages.append(record.getMessage())
+
+    messages: list[str] = []
+    collector = Collect(logging.WARNING)
+    loggers = [logging.getLogger(name) for name in list(logging.Logger.manager.loggerDict)
+               if name == "nptdms" or name.startswith("nptdms.")]
+    saved = [(logger, list(logger.handlers), logger.propagate) for logger in loggers]
+    for logger in loggers:
+        logger.handlers = [collector]
+        logger.propagate = False
+    try:
+        yield
+    finally:
+        for logger, handlers, propagate in saved:
+            logger.handlers, logger.propagate = handlers, propagate
+    for message in dict.fromkeys(messages):  # only when the file was read: a failed read is its error alone
+        shown = message if len(message) <= 200 else message[:200] + "..."
+        warnings.warn(f"{path}: {shown} (npTDMS)", stacklevel=3)
 
 
 def _has_time_column(names, columns: Mapping[str, str] | None) -> bool:
@@ -75,10 +105,11 @@ def read_tdms(path, *, columns: Mapping[str, str] | None = None, topic: str | No
     """
     from nptdms import TdmsFile
 
-    try:
-        tdms = TdmsFile.read(path)
-    except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on corrupt files
-        raise LogError(path, f"not a readable TDMS file ({type(exc).__name__}: {exc})") from None
+    with _notes_of_nptdms(path):
+        try:
+            tdms = TdmsFile.read(path)
+        except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on corrupt files
+            raise LogError(path, f"not a readable TDMS file ({type(exc).__name__}: {exc})") from None
     select = axis
     if axis is not None and topic is None and any(group.name == axis for group in tdms.groups()):
         topic, select = axis, None
