@@ -51,7 +51,7 @@ def test_a_table_of_several_axes_names_them(tmp_path):
     columns = pd.read_csv(path, nrows=1).columns
     assert columns[0] == "time_s" and {"X_position_mm", "Y_current_A", "C_position_deg"} <= set(columns)
     assert axes_in_columns(columns) == ["X", "Y", "C"]
-    with pytest.raises(LogError, match=r"holds several axes \(X, Y, C\); choose one with axis="):
+    with pytest.raises(LogError, match=r"holds several axes \(X, Y, C\); choose one with --axis"):
         read_log(path)
     with pytest.raises(LogError, match="no columns of axis 'Z' .* the axes in the file: X, Y, C"):
         read_log(path, axis="Z")
@@ -202,3 +202,19 @@ def test_machine_options_are_checked(three_axis_csvs, tmp_path, capsys, fitted):
     status = cli.main(["train", "--model", "stribeck", "--train", str(root / "air_A.csv"), "--axes", "X",
                        "--out", str(machine_dir)])
     assert status == 2 and "file exists" in capsys.readouterr().err
+
+
+def test_missing_axes_are_named_as_such(tmp_path, fitted, capsys):
+    single = make_dataset("C", "A", 1, duration_s=3)
+    assert axes_in_columns(dict(single.named_channels(time=True))) == []  # truth_* columns are no axis "truth"
+    logs = _machine_logs()
+    write_log([logs[0], logs[2]], tmp_path / "xc.mcap")  # no Y
+    with pytest.raises(LogError, match=r"no channel of axis 'Y' \(/axis/Y\); the channels in the file: /axis/C, "
+                                       r"/axis/X"):
+        read_log(tmp_path / "xc.mcap", axis="Y")
+    write_log([logs[0], logs[2]], tmp_path / "xc.csv")
+    status = cli.main(["train", "--model", "stribeck", "--train", str(tmp_path / "xc.csv"), "--axes", "X", "Y",
+                       "--out", str(tmp_path / "m"), "--quiet"])
+    captured = capsys.readouterr()
+    assert status == 2 and "no columns of axis 'Y'" in captured.err and "trained" not in captured.out
+    assert not (tmp_path / "m").exists()

@@ -160,3 +160,21 @@ def cli_example(name: str):
     from pathlib import Path
 
     return Path(__file__).resolve().parents[1] / "examples" / name
+
+
+def test_fanuc_numbers_carry_a_point_and_rotary_programs_turn_by_increments():
+    plan = AirCutPlan("C", (-180.0, 180.0), (-25.0, 25.0), (100.0, 2000.0), duration_a_s=20.0, warmup_strokes=1)
+    program = plan_air_cuts(plan, seed=2)
+    text = write_program(program, dialect="fanuc")
+    lines = text.splitlines()
+    assert lines[:2] == ["%", "O1000 (GREYBOX AIR CUT)"] and lines[-1] == "%"
+    assert "N40 G1 C-180. F1000." in lines  # from 0 to the travel's end, incrementally
+    assert "N50 G1 C360." in lines  # a whole turn, not "to 180", which a modulo table already is at
+    assert all(" C" in line for line in lines if " G1 " in line) and "G04 X0.2" in text  # X: the dwell time
+    back = parse_program(text)
+    np.testing.assert_allclose(back.positions, program.positions, atol=1e-9)
+    with pytest.raises(GreyboxError, match="--duration-a 5: dataset A needs at least 10 s"):
+        plan_air_cuts(AirCutPlan(**{**X_PLAN.__dict__, "duration_a_s": 5.0}))
+    short = plan_air_cuts(AirCutPlan(**{**X_PLAN.__dict__, "duration_a_s": 10.0}), seed=1)
+    a_moves = short.blocks[short.sections[1][0]:short.sections[2][0]]
+    assert len([block for block in a_moves if isinstance(block, Move)]) > 24  # random moves and a whole sine

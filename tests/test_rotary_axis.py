@@ -231,3 +231,14 @@ def test_compensate_on_the_rotary_twin_reports_in_mdeg_and_refuses_a_mixed_study
                        "--out", str(tmp_path / "mixed")])
     error = capsys.readouterr().err.strip()
     assert status == 2 and "c.gbm: a rotary axis, the plant twin-X is a linear one" in error and "\n" not in error
+
+
+def test_a_modulo_axis_is_unwrapped_with_a_note(tmp_path):
+    time = np.arange(10000) * 0.002
+    path = tmp_path / "modulo.csv"
+    pd.DataFrame({"time_s": time, "position_deg": (60.0 * time) % 360.0, "velocity_deg_s": np.full_like(time, 60.0),
+                  "current_A": np.zeros_like(time)}).to_csv(path, index=False)
+    with pytest.warns(UserWarning, match="wraps around a turn 3 time"):
+        log = read_log(path)
+    np.testing.assert_allclose(log.position, 60.0 * time, atol=1e-9)
+    assert check_velocity_units(log) == pytest.approx(1.0, rel=1e-3)

@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     if not out.parent.is_dir():
         raise GreyboxError(f"{out}: directory {out.parent} does not exist")
     write_text_atomic(out, write_program(program, dialect=args.dialect, header=header))
-    moves = sum(1 for position in program.positions)
-    print(f"wrote {out}: {len(program.blocks)} blocks ({moves} moves), axis {plan.axis}, sections: "
+    moves = len(program.positions)
+    print(f"wrote {out}: {moves} moves and {len(program.blocks) - moves} dwells, axis {plan.axis}, sections: "
           + "; ".join(title.split(":")[0] for _, title in program.sections))
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -11,7 +12,7 @@ import numpy as np
 
 from ..errors import GreyboxError
 from ._options import add_log_arguments
-from ._types import FRACTION, non_negative, positive
+from ._types import FRACTION, POSITIVE_INT, non_negative, positive
 from ._window import add_window_argument, check_window
 
 #: Nominal coverage of the bounds when --calibration is given without --interval.
@@ -36,7 +37,10 @@ def add_parser(subparsers) -> None:
     parser.add_argument("model", metavar="MODEL",
                         help="model file written by 'greybox train' (.gbm), or a machine model directory "
                         "('greybox train --axes')")
-    parser.add_argument("log", metavar="LOG", help="cutting log (CSV, Parquet, MCAP, TDMS or MATLAB .mat)")
+    parser.add_argument("logs", nargs="+", metavar="LOG",
+                        help="cutting log (CSV, Parquet, MCAP, TDMS or MATLAB .mat); several logs, directories "
+                        "(searched recursively) or glob patterns make a fleet run: one task per log on Dask, "
+                        "--out a directory of a Parquet dataset partitioned machine/axis/log with _manifest.json")
     parser.add_argument("--out", required=True, metavar="OUT",
                         help="table to write: .csv, .parquet or .mcap (CSV: plain, header first, metadata in "
                         "OUT.json beside it; MCAP: one message per sample, topic /process/<axis>)")
@@ -64,6 +68,12 @@ def add_parser(subparsers) -> None:
     add_window_argument(parser, "--plot-window")
     parser.add_argument("--force", action="store_true", help="overwrite OUT (and OUT.json) and PNG if they exist")
     parser.add_argument("--quiet", action="store_true", help="no progress display (one line per chunk on stderr)")
+    fleet = parser.add_argument_group("fleet runs (several logs)")
+    fleet.add_argument("--scheduler", metavar="ADDRESS",
+                       help="address of a running dask.distributed scheduler, e.g. tcp://10.0.0.5:8786 (default: a "
+                       "local cluster of processes)")
+    fleet.add_argument("--workers", type=POSITIVE_INT, metavar="N",
+                       help="processes of the local cluster (default: one per core)")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -171,9 +181,20 @@ def _print_result(result, args: argparse.Namespace, interval, axis_file: str | N
               f"half-width [{unit}] {widths}; mean {np.mean(result.half_width):.3g} {unit}")
 
 
+def _is_fleet(args: argparse.Namespace) -> bool:
+    """Several logs, a directory or a pattern: a fleet run."""
+    item = args.logs[0]
+    return len(args.logs) > 1 or os.path.isdir(item) or any(ch in item for ch in "*?[")
+
+
 def run(args: argparse.Namespace) -> int:
     from ..machine_model import is_machine_model
 
+    if _is_fleet(args):
+        return _run_fleet(args)
+    if args.scheduler or args.workers:
+        raise GreyboxError("--scheduler and --workers apply to fleet runs (several logs, a directory or a pattern)")
+    args.log = args.logs[0]
     if is_machine_model(args.model):
         return _run_machine(args)
     run_started = time.perf_counter()
@@ -224,6 +245,61 @@ def _write_outputs(args: argparse.Namespace, result, out: Path, inputs: list, wi
         print(f"wrote {args.plot}")
 
 
+def _run_fleet(args: argparse.Namespace) -> int:
+    """``greybox predict MODEL LOG... --out DIR``: every log a task on Dask, a partitioned Parquet dataset."""
+    from ..data.io import parse_column_mapping
+    from ..fleet import MANIFEST, expand_logs, fleet_jobs, run_fleet
+    from ..machine_model import is_machine_model
+    from ..persistence import load_model
+
+    for option, value in (("--plot", args.plot), ("--plot-window", args.plot_window),
+                          ("--calibration", args.calibration), ("--interval", args.interval),
+                          ("--machine", args.machine)):
+        if value is not None:
+            raise GreyboxError(f"{option} applies to one log; a fleet run (several logs) writes the process tables")
+    if is_machine_model(args.model):
+        raise GreyboxError(f"{args.model}: a fleet run takes one model file; run one fleet per axis of the machine "
+                           "model with its file and --axis")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise GreyboxError(f"{out}: exists and is not a directory; the output of a fleet run is a directory")
+    logs = expand_logs(args.logs)
+    load_model(args.model)  # a bad model file is one error before any cluster starts
+    read = {"columns": parse_column_mapping(args.columns) if args.columns else None, "topic": args.topic,
+            "axis": args.axis, "sample_time": args.sample_time, "time_tolerance": args.time_tolerance,
+            "cutoff_hz": args.cutoff_hz, "resample": args.resample, "max_gap": args.max_gap}
+    jobs = fleet_jobs(logs, str(Path(args.model).resolve()), str(out.resolve()),
+                      axis_config=str(Path(args.axis_config).resolve()) if args.axis_config else None, read=read,
+                      chunk_s=args.chunk_s)
+    if args.force and (out / MANIFEST).exists():
+        (out / MANIFEST).unlink()  # --force: predict every log again (the outputs are replaced atomically)
+    started = time.perf_counter()
+    terminal = sys.stderr.isatty()
+    failed = 0
+
+    def show(done: int, total: int, entry: dict) -> None:
+        nonlocal failed
+        failed += entry["status"] == "failed"
+        if args.quiet:
+            return
+        text = (f"fleet: {done}/{total} logs, {failed} failed, {time.perf_counter() - started:.1f} s elapsed "
+                f"({Path(entry['log']).name}: {entry['status']})")
+        print("\r" + text.ljust(100) if terminal else text, end="\n" if not terminal or done == total else "",
+              file=sys.stderr, flush=True)
+
+    manifest = run_fleet(jobs, scheduler=args.scheduler, workers=args.workers, progress=show)
+    counts = manifest["counts"]
+    cluster = manifest["cluster"]
+    where = (f" on {cluster['workers']} worker(s) of {cluster['scheduler']}" if cluster["workers"] else "")
+    print(f"fleet: {counts['ok']} predicted, {counts['skipped']} skipped (complete from an earlier run), "
+          f"{counts['failed']} failed of {len(jobs)} logs in {manifest['seconds']:.1f} s{where}")
+    for entry in manifest["logs"]:
+        if entry["status"] == "failed":
+            print(f"  failed: {entry['error']}")
+    print(f"wrote {out / MANIFEST} and the dataset {out}/machine=*/axis=*/log=*/part-0.parquet")
+    return 2 if counts["failed"] else 0
+
+
 def _run_machine(args: argparse.Namespace) -> int:
     """``greybox predict`` with a machine model: every axis of the log, and the resultant force."""
     run_started = time.perf_counter()
@@ -240,6 +316,10 @@ def _run_machine(args: argparse.Namespace) -> int:
     out = _check_outputs(args, inputs)
     machine = load_machine(args.model)
     config = read_machine_config(args.machine) if args.machine else None
+    missing = [name for name in machine.axes if config is not None and name not in config.axes]
+    if missing:
+        raise GreyboxError(f"{args.machine}: no [axes.{missing[0]}] table; the machine model {args.model} has axes "
+                           f"{', '.join(machine.axes)}, the machine file {', '.join(config.axes)}")
     described = {name: config.axis(name) for name in machine.axes} if config else {}
 
     def read(path, name):

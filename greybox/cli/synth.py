@@ -207,8 +207,8 @@ def _run_plan(args: argparse.Namespace, cutting) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     write_log(stored(log, ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None), out)
     lowered = trajectory.description["feeds_lowered"]
-    print(f"{Path(args.plan).name}: axis {geometry.name}, {len(program.blocks)} blocks, {log.duration:.1f} s, "
-          f"{len(log)} samples -> {out}")
+    print(f"{Path(args.plan).name}: axis {geometry.name}, {len(program.blocks)} moves and dwells, "
+          f"{log.duration:.1f} s, {len(log)} samples -> {out}")
     if lowered:
         print(f"note: {Path(args.plan).name}: the twin's acceleration limit lowered the feeds of {len(lowered)} "
               f"stroke(s) (first at line {lowered[0]['line']}, to {100 * lowered[0]['factor']:.0f} %)",

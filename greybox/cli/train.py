@@ -39,8 +39,8 @@ def add_parser(subparsers) -> None:
     )
     parser.add_argument("--out", required=True, metavar="MODEL",
                         help="model file to write (.gbm); with --axes or --machine, the machine model's directory")
-    parser.add_argument("--axes", metavar="A,B,...",
-                        help="axes to fit, comma-separated (e.g. X,Y,Z): one model each, from the logs' columns "
+    parser.add_argument("--axes", nargs="+", metavar="AXIS",
+                        help="axes to fit (X Y Z, or X,Y,Z): one model each, from the logs' columns "
                         "X_position_mm, X_current_A, ... (MCAP channels /axis/X, TDMS groups X; default with "
                         "--machine: all its axes)")
     parser.add_argument("--machine", metavar="TOML",
@@ -91,18 +91,23 @@ def _read(args: argparse.Namespace, paths, axis=None) -> tuple[list[str], list]:
     return names, runs
 
 
-def _fit(model, args: argparse.Namespace, axis=None):
-    """Fit ``model`` as the options say (to one axis of a machine); return the names and runs it was fitted on."""
+def _read_all(args: argparse.Namespace, axis=None) -> tuple[list, list, list]:
+    """The names and runs of --train, and the runs of --stage2 (of one axis of a machine)."""
+    names, runs = _read(args, args.train, axis)
+    second_names, second = _read(args, args.stage2, axis) if args.stage2 else ([], [])
+    return names + second_names, runs, second
+
+
+def _fit(model, args: argparse.Namespace, names, runs, second):
+    """Fit ``model`` as the options say; return the names and runs it was fitted on."""
     progress = None if args.quiet else True
     if args.stage2 and model.first_stage() is None:
         raise GreyboxError(f"option --stage2 does not apply to the {args.model} model: it has one stage")
-    names, runs = _read(args, args.train, axis)
     if not args.stage2:
         model.fit(runs, progress=progress)
-        return names, runs
-    second_names, second = _read(args, args.stage2, axis)
-    model.fit_staged(runs, second, progress=progress)
-    return names + second_names, runs + second
+    else:
+        model.fit_staged(runs, second, progress=progress)
+    return names, runs + second
 
 
 def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
@@ -115,11 +120,11 @@ def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
     if args.axis:
         raise GreyboxError("give the axes to fit with --axes A,B,... (--axis reads one axis into one model file)")
     machine = read_machine_config(args.machine) if args.machine else None
-    names = [name.strip() for name in (args.axes or "").split(",") if name.strip()]
+    names = [name.strip() for group in (args.axes or []) for name in group.split(",") if name.strip()]
     if args.axes is not None and not names:
-        raise GreyboxError(f"--axes names no axis: {args.axes!r}")
+        raise GreyboxError(f"--axes names no axis: {' '.join(args.axes)!r}")
     if len(set(names)) != len(names):
-        raise GreyboxError(f"--axes names an axis twice: {args.axes}")
+        raise GreyboxError(f"--axes names an axis twice: {' '.join(args.axes)}")
     if machine is None:
         return "", [MachineAxis(name, "linear") for name in names]
     return machine.name, [machine.axis(name) for name in (names or list(machine.axes))]
@@ -153,12 +158,13 @@ def _run_machine(args: argparse.Namespace) -> int:
 
     name, axes = _machine_axes(args)
     check_machine_output(args.out, [axis.name for axis in axes], overwrite=args.force)
+    data = {axis.name: _read_all(args, axis) for axis in axes}  # every axis read before any training
     models = {}
     predictions = {}
     for axis in axes:
         model = build_model(args.model, args)
         started = time.perf_counter()
-        names, runs = _fit(model, args, axis)
+        names, runs = _fit(model, args, *data[axis.name])
         predictions[axis.name] = (runs, _report_fit(model, names, runs, time.perf_counter() - started,
                                                     f"{args.model} for axis {axis.name}"))
         models[axis.name] = model
@@ -184,7 +190,7 @@ def run(args: argparse.Namespace) -> int:
                       inputs_name="one of the training logs")
     model = build_model(args.model, args)
     started = time.perf_counter()
-    names, runs = _fit(model, args)
+    names, runs = _fit(model, args, *_read_all(args))
     predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
     save_model(model, out, overwrite=args.force)
     reloaded = load_model(out)

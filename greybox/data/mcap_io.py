@@ -492,6 +492,9 @@ def read_mcap(
         topic = topic_for(axis)
         channels, collector = _collect(path, topic)
         if not any(channel.topic == topic for channel in channels.values()):
+            if len(channels) > 1:
+                listed = ", ".join(sorted(channel.topic for channel in channels.values()))
+                raise LogError(path, f"no channel of axis '{axis}' ({topic}); the channels in the file: {listed}")
             topic, select = None, axis
             channels, collector = _collect(path, None)
     else:

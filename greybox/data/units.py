@@ -21,6 +21,7 @@ ordinary extra.
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Mapping
 
 import numpy as np
@@ -40,6 +41,7 @@ __all__ = [
     "axes_in_columns",
     "select_axis",
     "several_axes_table",
+    "unwrap_modulo",
     "log_from_columns",
 ]
 
@@ -245,8 +247,8 @@ def resolve_columns(
                 del found[quantity], units[quantity]
     axes = axes_in_columns(names)
     if "position" not in found and axes:
-        raise LogError(source, f"the file holds several axes ({', '.join(axes)}); choose one with axis= "
-                               f"(--axis {axes[0]} on the command line)")
+        raise LogError(source, f"the file holds several axes ({', '.join(axes)}); choose one with --axis "
+                               f"(axis= in Python), e.g. --axis {axes[0]}")
     if "position" not in found:
         raise LogError(
             source,
@@ -284,7 +286,8 @@ def axes_in_columns(names) -> list[str]:
     list of str
         The axis names in the order of their first column (``["X", "Y"]``); empty for a one-axis table.
     """
-    found = [prefixed[0] for prefixed in map(_axis_prefix, names) if prefixed is not None]
+    found = [prefixed[0] for prefixed in map(_axis_prefix, names)
+             if prefixed is not None and prefixed[1].startswith("position_")]  # an axis has a position
     return list(dict.fromkeys(found))
 
 
@@ -322,7 +325,7 @@ def select_axis(table: Mapping[str, np.ndarray], axis: str, *, source,
     mapped = set((columns or {}).values())
     if axis not in axes and not mapped:
         held = f"the axes in the file: {', '.join(axes)}" if axes else \
-            "the file holds one axis (no column named <axis>_<quantity>_<unit>, e.g. X_position_mm)"
+            "the file holds one axis (no column named <axis>_position_<unit>, e.g. X_position_mm)"
         raise LogError(source, f"no columns of axis '{axis}' (named {axis}_position_mm, {axis}_current_A, ...); "
                                f"{held}")
     selected: dict[str, np.ndarray] = {}
@@ -335,6 +338,36 @@ def select_axis(table: Mapping[str, np.ndarray], axis: str, *, source,
         elif head not in axes or not rest:
             selected[name] = values
     return selected
+
+
+def unwrap_modulo(angle_deg: np.ndarray, source) -> np.ndarray:
+    """The angle of a rotary axis logged modulo a turn (0..360 deg, as a SINUMERIK modulo axis), unwrapped.
+
+    A step of more than half a turn between two samples is a wrap of the display, not motion (it
+    would be 90 000 deg/s at 2 ms); it is undone, with one warning naming the file and the count.
+
+    Parameters
+    ----------
+    angle_deg : ndarray
+        Logged angle [deg].
+    source : str or path-like
+        File, for the warning.
+
+    Returns
+    -------
+    ndarray
+        The continuous angle [deg]; the input itself when it does not wrap.
+    """
+    steps = np.diff(angle_deg)
+    wraps = int(np.count_nonzero(np.abs(steps[np.isfinite(steps)]) > 180.0))
+    if not wraps:
+        return angle_deg
+    warnings.warn(f"{source}: the rotary position wraps around a turn {wraps} time(s) (a modulo axis); "
+                  "unwrapped so that the angle runs on", stacklevel=3)
+    finite = np.isfinite(angle_deg)
+    out = angle_deg.copy()
+    out[finite] = np.unwrap(angle_deg[finite], period=360.0)
+    return out
 
 
 def several_axes_table(logs, *, source) -> dict[str, np.ndarray]:
@@ -484,6 +517,9 @@ def log_from_columns(
         )
 
     effort = next(quantity for quantity in EFFORT_QUANTITIES if quantity in found)
+    position = channel("position")
+    if motion == "rotary":
+        position = unwrap_modulo(position, source)
     extras = {}
     for name in names:
         if name in used:
@@ -493,7 +529,7 @@ def log_from_columns(
             extras[str(name)] = values
     return AxisLog(
         time=time_s,
-        position=channel("position"),
+        position=position,
         effort=channel(effort),
         velocity=channel("velocity"),
         acceleration=channel("acceleration"),

@@ -9,7 +9,11 @@ Written (``dialect="sinumerik"``)::
     N40 G4 F0.5           ; dwell 0.5 s
     N50 M30
 
-``dialect="fanuc"`` writes the dwell ``G04 X0.5`` and comments in parentheses.
+``dialect="fanuc"`` writes the dwell ``G04 X0.5``, comments in parentheses, every number with a decimal
+point (``X-250.``: without calculator-type input a Fanuc reads ``X-250`` as -0.25 mm) and the program
+between ``%`` lines with a number ``O1000``. A rotary axis's program turns by increments (``G91``) after
+its first, absolute move, so that a modulo table (0..360 deg) turns the programmed angle, say from -180
+to 180 deg, instead of standing still at the same angle.
 
 Read: blocks of address letters and numbers, optional ``N`` numbers, comments after ``;`` or in
 ``( )``, ``G0``/``G00`` (rapid), ``G1``/``G01`` (feed move, ``F`` modal), ``G90``/``G91``
@@ -40,9 +44,11 @@ _REFUSED_G = {20: "inch units (G20)", 70: "inch units (G70)", 95: "feed per revo
 _END_M = {2, 17, 30}
 
 
-def _number(value: float) -> str:
+def _number(value: float, point: bool = False) -> str:
+    """Shortest text of ``value`` at 4 decimals; with ``point`` always with a decimal point (``-250.``)."""
     text = f"{value:.4f}".rstrip("0").rstrip(".")
-    return "0" if text in ("-0", "") else text
+    text = "0" if text in ("-0", "") else text
+    return text + "." if point and "." not in text else text
 
 
 def write_program(program: Program, *, dialect: str = "sinumerik", header=()) -> str:
@@ -69,7 +75,9 @@ def write_program(program: Program, *, dialect: str = "sinumerik", header=()) ->
     def comment(text: str) -> str:
         return f"; {text}" if dialect == "sinumerik" else f"({text.replace('(', '[').replace(')', ']')})"
 
-    lines = [comment(text) for text in header]
+    fanuc = dialect == "fanuc"
+    lines = ["%", "O1000 (GREYBOX AIR CUT)"] if fanuc else []  # Fanuc: tape start and a program number
+    lines += [comment(text) for text in header]
     number = 0
 
     def block(text: str, note: str = "") -> None:
@@ -77,24 +85,39 @@ def write_program(program: Program, *, dialect: str = "sinumerik", header=()) ->
         number += 10
         lines.append(f"N{number} {text}" + (f" {comment(note)}" if note else ""))
 
+    def number_text(value: float) -> str:  # Fanuc reads "250" as 0.250 mm without calculator-type input
+        return _number(value, point=fanuc)
+
     unit = "mm" if program.motion == "linear" else "deg"
     block("G90 G94 G64", f"absolute positions, feed in {unit}/min, continuous path")
     titles = dict(program.sections)
     feed = None
+    position = None
+    rotary = program.motion == "rotary"
     for index, item in enumerate(program.blocks):
         if index in titles:
             lines.append(comment(titles[index]))
         if isinstance(item, Dwell):
-            block(f"G4 F{_number(item.seconds)}" if dialect == "sinumerik" else f"G04 X{_number(item.seconds)}")
-        elif item.feed is None:
-            block(f"G0 {program.axis}{_number(item.target)}")
+            block(f"G4 F{number_text(item.seconds)}" if not fanuc else f"G04 X{number_text(item.seconds)}")
+            continue
+        if rotary and position is not None:  # incremental: a modulo table turns by the angle programmed
+            target = round(item.target, 4) - round(position, 4)
         else:
-            words = f"G1 {program.axis}{_number(item.target)}"
+            target = item.target
+        if item.feed is None:
+            block(f"G0 {program.axis}{number_text(target)}")
+        else:
+            words = f"G1 {program.axis}{number_text(target)}"
             if item.feed != feed:
-                words += f" F{_number(item.feed)}"
+                words += f" F{number_text(item.feed)}"
                 feed = item.feed
             block(words)
+        if rotary and position is None:
+            block("G91", "incremental from here: the table turns by each angle, also on a modulo axis")
+        position = item.target
     block("M30")
+    if fanuc:
+        lines.append("%")
     return "\n".join(lines) + "\n"
 
 
@@ -169,7 +192,7 @@ def parse_program(text: str, *, source: str = "") -> Program:
             blocks.append(Dwell(seconds, number))
             continue
         for letter, value in words:
-            if letter in "GMN":
+            if letter in "GMNO":  # O: the program number
                 continue
             if letter == "F":
                 if not value > 0:

@@ -32,10 +32,13 @@ import numpy as np
 from ..errors import GreyboxError
 from .blocks import AXIS_LETTERS, Dwell, Move, Program
 
-__all__ = ["AirCutPlan", "plan_air_cuts", "SEGMENTS_PER_PERIOD"]
+__all__ = ["AirCutPlan", "plan_air_cuts", "SEGMENTS_PER_PERIOD", "MIN_DURATION_A_S"]
 
 #: Feed moves per period of the sinusoidal motion (a multiple of 4: the reversals fall on block ends).
 SEGMENTS_PER_PERIOD = 24
+
+#: Shortest dataset A [s]: at least one block of random moves and one sinusoidal motion.
+MIN_DURATION_A_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -112,14 +115,17 @@ class AirCutPlan:
         if 2.0 * reach > 0.5 * (w_high - w_low):
             raise GreyboxError(
                 f"--window {w_low:g}:{w_high:g}: {w_high - w_low:g} {unit} is too short to reach {f_high:g} "
-                f"{unit}/min and stop again at {self.max_acceleration:g} {unit}/s^2 (needs {4 * reach:.3g} {unit}); "
+                f"{unit}/min and stop again at {self.max_acceleration:g} {unit}/s^2 (needs {4 * reach:.1f} {unit}); "
                 "widen the window, lower --feed or raise --max-acceleration")
         for feed in self.sweep_feeds:
             if 2.0 * _stopping_distance(feed, self.max_acceleration) > high - low:
                 raise GreyboxError(f"--sweep-feeds: {feed:g} {unit}/min cannot be reached over the travel at "
                                    f"{self.max_acceleration:g} {unit}/s^2")
-        if not self.duration_a_s > 0 or self.warmup_strokes < 0 or not self.dwell_s >= 0:
-            raise GreyboxError("the duration of dataset A must be positive, the warm-up strokes and dwell non-negative")
+        if not self.duration_a_s >= MIN_DURATION_A_S:
+            raise GreyboxError(f"--duration-a {self.duration_a_s:g}: dataset A needs at least {MIN_DURATION_A_S:g} s "
+                               "(random feed steps with reversals, then a sinusoidal motion)")
+        if self.warmup_strokes < 0 or not self.dwell_s >= 0:
+            raise GreyboxError("the warm-up strokes and the dwell must not be negative")
 
     def to_dict(self) -> dict:
         """The settings as a JSON-able dict."""
@@ -244,7 +250,7 @@ def plan_air_cuts(plan: AirCutPlan, seed: int = 0) -> Program:
                 f"{plan.window[1]:g} {unit}, feeds {plan.feed[0]:g}-{plan.feed[1]:g} {unit}/min")
     elapsed = 0.0
     random_steps = True
-    while elapsed < plan.duration_a_s:
+    while elapsed < plan.duration_a_s or not random_steps:  # ends after a sine: both kinds are in
         if random_steps:
             elapsed += _random_moves(out, plan, rng, w_low, w_high, min(rng.uniform(15.0, 30.0),
                                                                          plan.duration_a_s - elapsed))

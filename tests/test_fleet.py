@@ -1,0 +1,104 @@
+"""Fleet runs: ``greybox predict MODEL LOG... --out DIR`` on a Dask cluster (a LocalCluster of 2 workers here)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.dataset as ds
+import pytest
+
+import greybox.cli as cli
+from greybox.data.io import write_log
+from greybox.data.prepare import prepare
+from greybox.errors import GreyboxError
+from greybox.fleet import MANIFEST, expand_logs
+from greybox.friction import StribeckModel
+from greybox.persistence import save_model
+from greybox.twin import make_dataset
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
+
+
+@pytest.fixture(scope="module")
+def plant(tmp_path_factory):
+    """Two machines' logs (one of them broken) and a model file."""
+    root = tmp_path_factory.mktemp("plant")
+    (root / "mill1").mkdir()
+    (root / "mill2").mkdir()
+    write_log(make_dataset("X", "D", 11, cutting=True), root / "mill1" / "monday.mcap")
+    write_log(make_dataset("X", "C", 12, duration_s=20, cutting=True), root / "mill1" / "tuesday.parquet")
+    write_log(make_dataset("X", "D", 13, cutting=True), root / "mill2" / "monday.csv")
+    (root / "mill2" / "broken.csv").write_text("not,a\nlog,x\n")
+    save_model(StribeckModel().fit(prepare([make_dataset("X", "A", 1, duration_s=20)])), root / "x.gbm")
+    return root
+
+
+def test_logs_come_from_files_directories_and_patterns(plant):
+    logs = expand_logs([str(plant)])
+    assert [path.name for path in logs] == ["monday.mcap", "tuesday.parquet", "broken.csv", "monday.csv"]
+    assert expand_logs([str(plant / "mill*" / "monday.*")]) == [plant / "mill1" / "monday.mcap",
+                                                                 plant / "mill2" / "monday.csv"]
+    with pytest.raises(GreyboxError, match="matches no log file"):
+        expand_logs([str(plant / "*.tdms")])
+    with pytest.raises(GreyboxError, match="no such log, directory or pattern"):
+        expand_logs([str(plant / "absent.csv")])
+
+
+def test_a_fleet_run_writes_a_partitioned_dataset_and_a_manifest(plant, tmp_path, capsys):
+    out = tmp_path / "results"
+    argv = ["predict", str(plant / "x.gbm"), str(plant / "mill1"), str(plant / "mill2"), "--out", str(out),
+            "--axis-config", str(EXAMPLE), "--workers", "2", "--quiet"]
+    assert cli.main(argv) == 2  # one log is broken: reported, the others predicted
+    printed = capsys.readouterr().out
+    assert "3 predicted, 0 skipped" in printed and "1 failed of 4 logs" in printed and "on 2 worker(s)" in printed
+    assert "broken.csv: missing required column" in printed
+    manifest = json.loads((out / MANIFEST).read_text())
+    assert manifest["counts"] == {"ok": 3, "skipped": 0, "failed": 1} and manifest["versions"]["distributed"]
+    table = ds.dataset(out, format="parquet", partitioning="hive").to_table().to_pandas()
+    assert set(table["machine"]) == {"mill1", "mill2"} and set(table["axis"]) == {"X"}
+    assert set(table["log"]) == {"monday", "tuesday"}
+    # a log's partition holds what greybox predict writes for that log alone
+    single = tmp_path / "single.parquet"
+    assert cli.main(["predict", str(plant / "x.gbm"), str(plant / "mill2" / "monday.csv"), "--out", str(single),
+                     "--axis-config", str(EXAMPLE), "--quiet"]) == 0
+    alone = pd.read_parquet(single)
+    part = pd.read_parquet(out / "machine=mill2" / "axis=X" / "log=monday" / "part-0.parquet")
+    pd.testing.assert_frame_equal(part, alone)
+    assert np.any(np.abs(part["force_process_N"]) > 100.0)
+
+    capsys.readouterr()
+    assert cli.main(argv) == 2  # a re-run skips what is complete
+    assert "0 predicted, 3 skipped" in capsys.readouterr().out
+    log = plant / "mill1" / "tuesday.parquet"
+    os.utime(log, ns=(log.stat().st_atime_ns, log.stat().st_mtime_ns + 10**9))  # the log changed
+    assert cli.main(argv) == 2
+    assert "1 predicted, 2 skipped" in capsys.readouterr().out
+    assert cli.main(argv + ["--force"]) == 2
+    assert "3 predicted, 0 skipped" in capsys.readouterr().out
+
+
+def test_a_fleet_runs_on_a_scheduler_address(plant, tmp_path, capsys):
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        assert cli.main(["predict", str(plant / "x.gbm"), str(plant / "mill1" / "*.mcap"), str(plant / "mill1"),
+                         "--out", str(tmp_path / "r"), "--scheduler", cluster.scheduler_address, "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    assert "2 predicted" in printed and f"of {cluster.scheduler_address}" in printed
+
+
+def test_fleet_options_are_checked(plant, tmp_path, capsys):
+    base = ["predict", str(plant / "x.gbm"), str(plant / "mill1"), "--out"]
+    for extra, message in (([str(tmp_path / "a"), "--plot", str(tmp_path / "p.png")], "--plot applies to one log"),
+                           ([str(plant / "x.gbm")], "exists and is not a directory"),
+                           ([str(tmp_path / "b"), "--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask")):
+        assert cli.main(base + extra) == 2
+        error = capsys.readouterr().err.strip()
+        assert message in error and "\n" not in error
+    status = cli.main(["predict", str(plant / "x.gbm"), str(plant / "mill1" / "monday.mcap"), "--out",
+                       str(tmp_path / "c.csv"), "--workers", "2"])
+    assert status == 2 and "--scheduler and --workers apply to fleet runs" in capsys.readouterr().err
