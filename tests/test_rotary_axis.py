@@ -203,6 +203,9 @@ def test_every_command_runs_on_a_rotary_log(rotary, tmp_path, capsys):
     table = pd.read_csv(out)
     assert {"torque_process_Nm", "torque_process_lower_Nm", "torque_process_upper_Nm",
             "position_deg", "velocity_deg_s"} <= set(table.columns)
+    metadata = json.loads(Path(f"{out}.json").read_text())
+    assert "low_velocity_deg_s" in metadata["attrs"]["interval"]["thresholds"]
+    assert "_mm" not in json.dumps(metadata["attrs"]["interval"]) + json.dumps(metadata["attrs"]["axis_config"])
     assert cli.main(["plot", str(root / "cut.mcap"), "--out", str(tmp_path / "cut.png")]) == 0
     assert (tmp_path / "cut.png").stat().st_size > 10_000
 

@@ -321,12 +321,14 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
         missing = [key for key in missing if key not in _EFFICIENCIES]
         _fail(where, "missing efficiency (the share of the motor's power reaching the table, about 0.9 for a ball "
                      "screw): give 'efficiency' for both directions, or efficiency_driving and efficiency_backdriven"
-                     + (f"; also missing {', '.join(missing)}" if missing else ""))
+                     + (f"; also missing {', '.join(missing)}" if missing else "")
+                     + (f" (for a rotary axis write motion = \"rotary\" instead of a {_SCREW})"
+                        if _SCREW in missing and motion == "linear" else ""))
     if missing:
         lines = "; ".join(f"{key} ({QUANTITIES[key][0]} in {QUANTITIES[key][1]}: {QUANTITIES[key][2]})"
                           for key in missing)
         hint = (f" (for a rotary axis write motion = \"rotary\" instead of a {_SCREW})"
-                if missing == [_SCREW] and motion == "linear" else "")
+                if _SCREW in missing and motion == "linear" else "")
         _fail(where, f"missing {lines}{hint}")
     _check_values(values, where, {key: SHARED_EFFICIENCY for key in _EFFICIENCIES} if shared is not None else None)
     channels = check_channels(document.get("channels", {}), where)

@@ -31,6 +31,7 @@ from typing import Sequence
 import numpy as np
 
 from ..data.log import AxisLog, as_log_list
+from ..data.quantities import MOTIONS
 from ..errors import GreyboxError
 from ..models.chunked import predict_chunked
 from .regimes import RegimeThresholds, regime_masks
@@ -77,6 +78,8 @@ class ProcessInterval:
         Regime thresholds of the calibration logs.
     sources : tuple of str
         Calibration logs.
+    motion : str, default "linear"
+        Kind of axis of the calibration logs: the thresholds are in mm/s, or deg/s for ``"rotary"``.
     """
 
     coverage: float
@@ -84,6 +87,7 @@ class ProcessInterval:
     samples: dict
     thresholds: RegimeThresholds
     sources: tuple = ()
+    motion: str = "linear"
 
     def half_widths(self, log: AxisLog) -> np.ndarray:
         """Half-width [A] at every sample of one prepared run."""
@@ -92,9 +96,11 @@ class ProcessInterval:
 
     def to_dict(self) -> dict:
         """JSON-able description (for output metadata)."""
+        relabel = MOTIONS[self.motion].relabel  # thresholds named in mm/s; deg/s on a rotary axis
         return {"coverage": self.coverage, "method": "split conformal per regime",
                 "half_width": dict(self.half_width_A), "calibration_samples": dict(self.samples),
-                "thresholds": asdict(self.thresholds), "calibration_logs": list(self.sources)}
+                "thresholds": {relabel(name): value for name, value in asdict(self.thresholds).items()},
+                "calibration_logs": list(self.sources)}
 
 
 def calibrate_interval(model, logs: AxisLog | Sequence[AxisLog], *, coverage: float = 0.95,
@@ -138,4 +144,4 @@ def calibrate_interval(model, logs: AxisLog | Sequence[AxisLog], *, coverage: fl
         samples[name] = int(chosen.size)
         half[name] = _conformal_half_width(chosen, coverage) if chosen.size >= MIN_CLASS_SAMPLES else overall
     return ProcessInterval(coverage=float(coverage), half_width_A=half, samples=samples, thresholds=thresholds,
-                           sources=tuple(run.source or "" for run in runs))
+                           sources=tuple(run.source or "" for run in runs), motion=runs[0].motion)
