@@ -218,3 +218,13 @@ def test_missing_axes_are_named_as_such(tmp_path, fitted, capsys):
     captured = capsys.readouterr()
     assert status == 2 and "no columns of axis 'Y'" in captured.err and "trained" not in captured.out
     assert not (tmp_path / "m").exists()
+
+
+def test_the_command_line_names_its_options_not_python_keywords(tmp_path, capsys):
+    logs = _machine_logs()
+    write_log(logs, tmp_path / "m.csv")
+    write_log(logs, tmp_path / "m.mcap")
+    for path, option in ((tmp_path / "m.csv", "--axis X"), (tmp_path / "m.mcap", "--topic TOPIC")):
+        assert cli.main(["info", str(path)]) == 2
+        error = capsys.readouterr().err
+        assert option in error and "axis=" not in error and "topic=" not in error

@@ -139,6 +139,8 @@ _READER_WORDS = (
     (re.compile(r"columns=\{'(\w+)': \.\.\.\}"), r"--columns \1=COLUMN"),
     (re.compile(r"(?<![\w\-])columns=(?![\w{])"), "--columns NAME=COLUMN"),
     (re.compile(r"(?<![\w\-])sample_time(?![\w=])"), "--sample-time"),
+    (re.compile(r"(?<![\w\-])topic= \("), "--topic TOPIC ("),
+    (re.compile(r" \(axis= in Python\)"), ""),
     (re.compile(r" \(or give the format explicitly\)"), ""),
 )
 
