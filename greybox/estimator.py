@@ -320,7 +320,8 @@ class CurrentModel(ModelProtocol):
             if not np.allclose(np.concatenate((first, second)), whole, rtol=0, atol=1e-9 * (1 + np.abs(whole).max())):
                 raise ParameterError("chunked and one-shot prediction of a probe run differ")
         except AttributeError as error:
-            raise ParameterError(f"a learned attribute is missing: {error}") from None
+            missing = getattr(error, "name", None)  # the attribute's name; else Python's message
+            raise ParameterError(f"a learned attribute is missing: {missing or error}") from None
         except (TypeError, ValueError, IndexError, KeyError) as error:
             if isinstance(error, ParameterError):
                 raise
