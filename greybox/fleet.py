@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .atomic import atomic_output, write_text_atomic
+from .atomic import write_text_atomic
 from .errors import GreyboxError
 
 __all__ = ["LOG_SUFFIXES", "MANIFEST", "FleetJob", "expand_logs", "fleet_jobs", "predict_log", "run_fleet"]
@@ -168,13 +168,11 @@ def _peak_rss_mb() -> float | None:
 
 
 def _predict_and_write(job: FleetJob) -> tuple[str, str, int]:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
     from .data.axis_config import read_axis_config
     from .data.io import read_log
     from .data.prepare import MAX_GAP_STEPS, prepare
     from .evaluate.process import predict_process
+    from .evaluate.process_io import write_process
     from .persistence import load_model
 
     options = job.read
@@ -190,13 +188,7 @@ def _predict_and_write(job: FleetJob) -> tuple[str, str, int]:
     axis = _partition(result.axis or "-")
     target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={axis}" / f"log={_partition(Path(job.log).stem)}"
     target.mkdir(parents=True, exist_ok=True)
-    path = target / "part-0.parquet"
-    metadata = {"axis": result.axis, "dataset": result.dataset, "effort_unit": result.effort_unit,
-                "attrs": result.attrs}
-    table = pa.table({name: pa.array(values, pa.float64()) for name, values in result.columns().items()},
-                     metadata={b"greybox": json.dumps(metadata).encode()})
-    with atomic_output(path) as temporary:
-        pq.write_table(table, temporary, compression="zstd")
+    path = write_process(result, target / "part-0.parquet", overwrite=True)  # the table `predict` writes
     return str(path), axis, len(result.time)
 
 
