@@ -1,12 +1,15 @@
-"""The batched RBF expansion against a plain reference and against libsvm."""
+"""The compiled RBF expansion against a plain reference and against libsvm, and its error bound."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pytest
 from sklearn.svm import SVR
 
-from greybox.models.rbf import rbf_expansion
+from greybox.models import rbf
+from greybox.models.rbf import EXP_RELATIVE_ERROR, MAX_CUTOFF, rbf_expansion
 
 
 def reference_expansion(X, sv, alpha, intercept, gamma):
@@ -15,20 +18,55 @@ def reference_expansion(X, sv, alpha, intercept, gamma):
     for x in X:
         total = 0.0
         for s, a in zip(sv, alpha):
-            total += a * np.exp(-gamma * sum((xi - si) ** 2 for xi, si in zip(x, s)))
+            total += a * math.exp(-gamma * sum((xi - si) ** 2 for xi, si in zip(x, s)))
         out.append(total + intercept)
     return np.array(out)
 
 
-def test_matches_reference_for_every_chunk_size():
+def test_matches_reference_far_from_the_origin():
     rng = np.random.default_rng(0)
-    X = rng.normal(size=(37, 3)) * 5.0 + 100.0  # offset: the centring must remove it
+    X = rng.normal(size=(37, 3)) * 5.0 + 100.0  # offset: no cancellation in the distances
     sv = rng.normal(size=(11, 3)) * 5.0 + 100.0
     alpha = rng.normal(size=11)
     expected = reference_expansion(X, sv, alpha, 0.3, 0.05)
-    for chunk in (1, 7, 11, 50, 1 << 16):
-        got = rbf_expansion(X, sv, alpha, 0.3, 0.05, chunk_elements=chunk)
-        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+    got = rbf_expansion(X, sv, alpha, 0.3, 0.05, tolerance=1e-14)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-14 + 1e-13 * np.abs(alpha).sum())
+
+
+def test_compiled_exponential_within_its_stated_relative_error():
+    t = np.concatenate([np.linspace(0.0, MAX_CUTOFF, 200_001), np.arange(65) + 0.5, np.arange(65) - 1e-12])
+    t = t[(t >= 0) & (t <= MAX_CUTOFF)]
+    approx = np.array([rbf._exp_neg(value) for value in t[::50]])
+    exact = np.array([math.exp(-value) for value in t[::50]])
+    assert np.max(np.abs(approx / exact - 1.0)) <= EXP_RELATIVE_ERROR
+
+
+@pytest.mark.parametrize("tolerance", [1e-3, 1e-6, 1e-10])
+def test_terms_left_out_stay_within_the_tolerance(tolerance):
+    """Dense time-ordered samples and wide-spread support vectors: many terms are cut, the bound holds."""
+    rng = np.random.default_rng(3)
+    path = np.cumsum(rng.normal(scale=0.02, size=(3000, 2)), axis=0)
+    sv = rng.uniform(path.min(0) - 1, path.max(0) + 1, size=(300, 2))
+    alpha = rng.normal(size=300)
+    gamma = 4.0
+    exact = np.exp(-gamma * ((path[:, None, :] - sv[None]) ** 2).sum(-1)) @ alpha
+    got = rbf_expansion(path, sv, alpha, 0.0, gamma, tolerance=tolerance)
+    error = np.abs(got - exact)
+    assert error.max() <= tolerance + EXP_RELATIVE_ERROR * np.abs(alpha).sum() + 1e-13
+    if tolerance >= 1e-6:
+        assert error.max() > 1e-3 * tolerance  # terms were left out: the bound is not vacuous
+
+
+def test_threads_share_the_work_without_changing_a_bit():
+    rng = np.random.default_rng(4)
+    X = np.cumsum(rng.normal(scale=0.05, size=(40_000, 3)), axis=0)
+    sv = rng.normal(size=(200, 3)) * X.std(0)
+    alpha = rng.normal(size=200)
+    one = rbf_expansion(X, sv, alpha, 0.1, 0.5, threads=1)
+    two = rbf_expansion(X, sv, alpha, 0.1, 0.5, threads=2)
+    three = rbf_expansion(X, sv, alpha, 0.1, 0.5, threads=3)
+    np.testing.assert_array_equal(one, two)
+    np.testing.assert_array_equal(one, three)
 
 
 def test_kernel_is_one_at_a_support_vector():
@@ -58,3 +96,14 @@ def test_empty_inputs_and_bad_shapes():
         rbf_expansion(np.zeros((4, 2)), np.ones((3, 2)), np.ones(2))
     with pytest.raises(ValueError, match="gamma"):
         rbf_expansion(np.zeros((4, 2)), np.ones((3, 2)), np.ones(3), gamma=0.0)
+    with pytest.raises(ValueError, match="tolerance must be positive"):
+        rbf_expansion(np.zeros((4, 2)), np.ones((3, 2)), np.ones(3), tolerance=0.0)
+    with pytest.raises(ValueError, match="threads"):
+        rbf_expansion(np.zeros((4, 2)), np.ones((3, 2)), np.ones(3), threads=0)
+    with pytest.raises(ValueError, match="too small"):
+        rbf_expansion(np.zeros((4, 2)), np.ones((3, 2)), np.full(3, 1e20), tolerance=1e-10)
+
+
+def test_coefficients_within_the_tolerance_give_the_intercept():
+    got = rbf_expansion(np.zeros((5, 2)), np.zeros((2, 2)), [3e-11, -3e-11], 1.5, 1.0, tolerance=1e-10)
+    np.testing.assert_array_equal(got, 1.5)
