@@ -1,23 +1,29 @@
-"""A plant's worth of logs: ``greybox predict`` over many logs, one task per log on dask.distributed.
+"""A plant's worth of logs on dask.distributed: the engine of fleet runs, and ``greybox predict`` over many logs.
 
 :func:`expand_logs` turns files, directories (searched recursively for log files) and glob patterns
-into the list of logs; :func:`run_fleet` predicts each on a Dask cluster, by default a local cluster
-of processes, one per core, or the cluster of a scheduler address, so that the same command runs on a
-laptop and on a cluster. Each log's process table goes to a Parquet dataset partitioned like the plant::
+into the list of logs. :func:`run_tasks` is the one engine of every fleet run (``greybox predict`` here,
+``greybox train --per-machine`` in :mod:`greybox.fleet_train`): it runs one task per job on a Dask
+cluster, by default a local cluster of processes, one per core and one thread each, or the cluster of a
+scheduler address, so that the same command runs on a laptop and on a cluster; it skips the jobs
+complete from an earlier run, reports a job that fails and goes on, and writes ``OUT/_manifest.json``.
+
+:func:`run_fleet` predicts each log and writes its process table to a Parquet dataset partitioned like
+the plant::
 
     OUT/machine=<folder of the log>/axis=<axis>/log=<file stem>/part-0.parquet
 
-(``pyarrow.dataset.dataset(OUT, partitioning="hive")`` reads it whole, with the partition columns),
-and ``OUT/_manifest.json`` records what ran: every log with its status (``ok``, ``skipped``,
-``failed`` with its one-line error), output, samples and seconds, the model file and its SHA-256,
-the versions of greybox and its libraries, the cluster and the wall time. A log that fails is
-reported and the others go on. A re-run skips every log whose output is complete: listed ``ok`` in
-the manifest for the same model file (hash) and the same log file (size and modification time),
-its output still there. Every file is written atomically.
+(``pyarrow.dataset.dataset(OUT, partitioning="hive")`` reads it whole, with the partition columns).
+The manifest records what ran: every log with its status (``ok``, ``skipped``, ``failed`` with its
+one-line error), output, samples, seconds and the worker's peak memory, its model file and the
+file's SHA-256, the versions of greybox and its libraries, the cluster and the wall time. A re-run
+skips every log whose output is complete: listed ``ok`` in the manifest for the same model file (hash)
+and the same log file (size and modification time), its output still there. Every file is written
+atomically.
 """
 
 from __future__ import annotations
 
+import contextlib
 import glob
 import hashlib
 import json
@@ -25,18 +31,23 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 from .atomic import write_text_atomic
 from .errors import GreyboxError
 
-__all__ = ["LOG_SUFFIXES", "MANIFEST", "FleetJob", "expand_logs", "fleet_jobs", "predict_log", "run_fleet"]
+__all__ = ["LOG_SUFFIXES", "MANIFEST", "FleetJob", "attempt", "expand_logs", "fleet_jobs",
+           "log_stamp", "machine_of", "partition", "predict_log", "read_manifest", "read_prepared",
+           "run_fleet", "run_tasks"]
 
 #: File extensions taken as logs when a directory is given.
 LOG_SUFFIXES = (".csv", ".parquet", ".pq", ".mcap", ".mat", ".tdms")
 
 #: Name of the manifest in the output directory (a leading "_": dataset readers skip it).
 MANIFEST = "_manifest.json"
+
+#: ``format`` of the manifest of a fleet prediction.
+PREDICT_FORMAT = "greybox-fleet"
 
 _GLOB_CHARACTERS = set("*?[")
 
@@ -72,89 +83,72 @@ def expand_logs(items: Sequence[str]) -> list[Path]:
             raise GreyboxError(f"{item}: no such log, directory or pattern")
     unique = list(dict.fromkeys(path.resolve() for path in logs))
     if not unique:
-        raise GreyboxError("no log to predict")
+        raise GreyboxError("no log given")
     return unique
 
 
-@dataclass(frozen=True)
-class FleetJob:
-    """One log of a fleet run: what to read, with which model, and where the outputs go.
-
-    Parameters
-    ----------
-    log : str
-        Log file.
-    machine : str
-        Machine the log belongs to (its folder's name), the first partition level.
-    model : str
-        Model file.
-    out_dir : str
-        Root of the Parquet dataset.
-    axis_config : str, optional
-        Axis file (force or torque).
-    read : dict
-        Options of reading and preparing the log: ``columns``, ``topic``, ``axis``, ``sample_time``,
-        ``time_tolerance``, ``cutoff_hz``, ``resample``, ``max_gap`` (:func:`greybox.data.io.read_log`,
-        :func:`greybox.data.prepare.prepare`).
-    chunk_s : float
-        Chunk length of the prediction [s].
-    """
-
-    log: str
-    machine: str
-    model: str
-    out_dir: str
-    axis_config: str | None = None
-    read: dict = field(default_factory=dict)
-    chunk_s: float = 60.0
-
-
-def _partition(value: str) -> str:
+def partition(value: str) -> str:
     """A partition value safe in a path: letters, digits, ``-``, ``_`` and ``.``."""
     return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in value) or "_"
 
 
-def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: str | None = None,
-               read: dict | None = None, chunk_s: float = 60.0) -> list[FleetJob]:
-    """One job per log; the machine is the name of the log's folder."""
-    return [FleetJob(str(log), _partition(Path(log).parent.name), str(model), str(out_dir), axis_config,
-                     dict(read or {}), float(chunk_s)) for log in logs]
+def machine_of(log: str | os.PathLike) -> str:
+    """The machine a log belongs to: the name of its folder, made safe for a path (:func:`partition`)."""
+    return partition(Path(log).parent.name)
 
 
-def _file_hash(path: str) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
-def _log_stamp(path: str) -> dict:
+def log_stamp(path: str | os.PathLike) -> dict:
+    """``size`` [bytes] and ``mtime_ns`` [ns] of a file: a log changed since a run differs in one of them."""
     stat = os.stat(path)
     return {"size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
 
 
-def predict_log(job: FleetJob) -> dict:
-    """Predict one log and write its process table; the task each worker runs.
+def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None = None) -> list:
+    """Read and prepare one log as ``greybox predict`` and ``greybox train`` do: its runs (AxisLog).
+
+    Parameters
+    ----------
+    path : str
+        Log file.
+    read : mapping
+        Options of reading and preparing: ``columns``, ``topic``, ``axis``, ``sample_time``,
+        ``time_tolerance`` (fraction of the step), ``cutoff_hz`` [Hz], ``resample`` [s], ``max_gap``
+        [steps] (:func:`greybox.data.io.read_log`, :func:`greybox.data.prepare.prepare`); missing ones
+        take their defaults.
+    columns : mapping, optional
+        Column mapping under ``read["columns"]`` (an axis file's channels).
+    """
+    from .data.io import read_log
+    from .data.prepare import MAX_GAP_STEPS, prepare
+
+    columns = {**(columns or {}), **(read.get("columns") or {})} or None
+    resample = read.get("resample")
+    tolerance = read.get("time_tolerance", 0.25)
+    log = read_log(path, columns=columns, topic=read.get("topic"), sample_time=read.get("sample_time"),
+                   axis=read.get("axis"), time_tolerance=None if resample else tolerance)
+    return prepare([log], cutoff_hz=read.get("cutoff_hz"), sample_time=resample, tolerance=tolerance,
+                   max_gap_steps=read.get("max_gap", MAX_GAP_STEPS))
+
+
+def attempt(label: str, work: Callable[[], dict]) -> dict:
+    """Run one task's ``work`` on a worker and say how it went; never raises for bad input.
 
     Returns
     -------
     dict
-        ``log``, ``machine``, ``status`` (``ok`` or ``failed``), ``output``, ``axis``, ``samples``,
-        ``seconds``, ``peak_rss_mb`` (of the worker process so far), and for a failure its ``error``
-        (one line). Never raises for a bad log.
+        ``status`` ``ok`` with what ``work`` returned, ``seconds`` and ``peak_rss_mb`` (of the worker
+        process so far [MB]); or ``failed`` with ``error``, one line (a bug is named an internal
+        error of ``label``), and ``seconds``.
     """
     started = time.perf_counter()
-    entry = {"log": job.log, "machine": job.machine, **_log_stamp(job.log)}
     try:
-        output, axis, samples = _predict_and_write(job)
+        result = work()
     except GreyboxError as error:
-        return {**entry, "status": "failed", "error": str(error), "seconds": time.perf_counter() - started}
-    except Exception as error:  # a bug, not a bad log: reported in the manifest, the fleet goes on
-        return {**entry, "status": "failed", "error": f"{job.log}: internal error {type(error).__name__}: {error}",
+        return {"status": "failed", "error": str(error), "seconds": time.perf_counter() - started}
+    except Exception as error:  # a bug, not bad input: reported in the manifest, the fleet goes on
+        return {"status": "failed", "error": f"{label}: internal error {type(error).__name__}: {error}",
                 "seconds": time.perf_counter() - started}
-    return {**entry, "status": "ok", "output": output, "axis": axis, "samples": samples,
-            "seconds": time.perf_counter() - started, "peak_rss_mb": _peak_rss_mb()}
+    return {"status": "ok", **result, "seconds": time.perf_counter() - started, "peak_rss_mb": _peak_rss_mb()}
 
 
 def _peak_rss_mb() -> float | None:
@@ -167,47 +161,29 @@ def _peak_rss_mb() -> float | None:
     return peak / 1024.0 if os.uname().sysname != "Darwin" else peak / 2**20
 
 
-def _predict_and_write(job: FleetJob) -> tuple[str, str, int]:
-    from .data.axis_config import read_axis_config
-    from .data.io import read_log
-    from .data.prepare import MAX_GAP_STEPS, prepare
-    from .evaluate.process import predict_process
-    from .evaluate.process_io import write_process
-    from .persistence import load_model
-
-    options = job.read
-    config = read_axis_config(job.axis_config) if job.axis_config else None
-    columns = {**(config.channels if config else {}), **(options.get("columns") or {})} or None
-    resample = options.get("resample")
-    log = read_log(job.log, columns=columns, topic=options.get("topic"), sample_time=options.get("sample_time"),
-                   axis=options.get("axis"), time_tolerance=None if resample else options.get("time_tolerance", 0.25))
-    runs = prepare([log], cutoff_hz=options.get("cutoff_hz"), sample_time=resample,
-                   tolerance=options.get("time_tolerance", 0.25), max_gap_steps=options.get("max_gap", MAX_GAP_STEPS))
-    result = predict_process(load_model(job.model), runs, axis_config=config, chunk_s=job.chunk_s)
-    result.attrs.update({"model_file": job.model, "log_file": job.log})
-    axis = _partition(result.axis or "-")
-    target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={axis}" / f"log={_partition(Path(job.log).stem)}"
-    target.mkdir(parents=True, exist_ok=True)
-    path = write_process(result, target / "part-0.parquet", overwrite=True)  # the table `predict` writes
-    return str(path), axis, len(result.time)
+def _canonical(value) -> str:
+    return json.dumps(value, sort_keys=True)
 
 
-def _previous(out_dir: Path, model_hash: str) -> dict:
-    """Entries of the last manifest that a re-run may keep: ok, same model, output still there."""
-    path = out_dir / MANIFEST
+def read_manifest(directory: str | os.PathLike, fmt: str) -> dict:
+    """The manifest of ``fmt`` in ``directory``, or ``{}`` when there is none, it is unreadable or of another format."""
+    path = Path(directory) / MANIFEST
     if not path.is_file():
         return {}
     try:
         document = json.loads(path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, ValueError, RecursionError):
         return {}
-    if not isinstance(document, dict) or document.get("model_sha256") != model_hash:
-        return {}
+    return document if isinstance(document, dict) and document.get("format") == fmt else {}
+
+
+def _complete(document: dict, items: str, out_dir: Path, fields: Sequence[str]) -> dict:
+    """Entries of an earlier manifest a re-run may keep, by their ``fields``: ok, output still there."""
     kept = {}
-    for entry in document.get("logs", []):
+    for entry in document.get(items, []):
         if isinstance(entry, dict) and entry.get("status") in ("ok", "skipped") and \
-                isinstance(entry.get("output"), str) and os.path.isfile(entry["output"]):
-            kept[entry.get("log")] = entry
+                isinstance(entry.get("output"), str) and (out_dir / entry["output"]).is_file():
+            kept[_canonical({name: entry.get(name) for name in fields})] = entry
     return kept
 
 
@@ -223,69 +199,86 @@ def _versions() -> dict:
     return out
 
 
-def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers: int | None = None,
-              progress: Callable[[int, int, dict], None] | None = None) -> dict:
-    """Predict every job's log on a Dask cluster and write the manifest.
+def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, out_dir: str | os.PathLike,
+              header: dict, items: str, scheduler: str | None = None, workers: int | None = None,
+              force: bool = False, progress: Callable[[int, int, dict], None] | None = None) -> dict:
+    """Run ``task(job)`` for every job not complete from an earlier run, on a Dask cluster; write the manifest.
 
     Parameters
     ----------
-    jobs : sequence of FleetJob
-        All with the same model and output directory (:func:`fleet_jobs`).
+    task : callable
+        Picklable function a worker runs, ``task(job) -> dict`` (an entry with ``status``, ``output``
+        relative to ``out_dir`` or absolute, ...; see :func:`attempt`).
+    jobs : sequence
+        Picklable jobs.
+    fingerprints : sequence of dict
+        Per job, what makes its output current (its inputs' names, stamps, options), JSON values,
+        the same keys for all jobs; merged into its entry. A job whose fingerprint matches an ``ok``
+        entry of the earlier manifest, its output still there, is skipped.
+    out_dir : path-like
+        Output directory (created); the manifest is ``out_dir/_manifest.json``.
+    header : dict
+        First fields of the manifest; ``header["format"]`` names its format.
+    items : str
+        Name of the manifest's list of entries (``"logs"``, ``"models"``), in the order of ``jobs``.
     scheduler : str, optional
         Address of a running ``dask.distributed`` scheduler (``tcp://host:8786``); default a local
         cluster of ``workers`` processes, one thread each.
     workers : int, optional
         Processes of the local cluster (default: the machine's cores).
+    force : bool, default False
+        Run every job, whatever the earlier manifest says.
     progress : callable, optional
-        ``progress(done, total, entry)`` after each log.
+        ``progress(done, total, entry)`` after each job.
 
     Returns
     -------
     dict
-        The manifest (also written to ``OUT/_manifest.json``).
+        The manifest: ``header``, ``cluster``, ``versions``, ``seconds`` (wall time [s]), ``counts``
+        per status and the entries.
 
     Raises
     ------
     GreyboxError
-        When the scheduler cannot be reached or the jobs disagree on model or output.
+        When the scheduler cannot be reached.
     """
-    if not jobs:
-        raise GreyboxError("no log to predict")
-    models, outs = {job.model for job in jobs}, {job.out_dir for job in jobs}
-    if len(models) != 1 or len(outs) != 1:
-        raise GreyboxError("a fleet run has one model file and one output directory")
-    out_dir = Path(outs.pop())
+    out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    model = models.pop()
-    model_hash = _file_hash(model)
     started = time.perf_counter()
-    previous = _previous(out_dir, model_hash)
-    entries, todo, total = [], [], len(jobs)
-    for job in jobs:
-        kept = previous.get(job.log)
-        if kept is not None and {k: kept.get(k) for k in ("size", "mtime_ns")} == _log_stamp(job.log):
-            entries.append({**kept, "status": "skipped"})
-            if progress is not None:
-                progress(len(entries), total, entries[-1])
+    fields = list(fingerprints[0]) if fingerprints else []
+    previous = {} if force else _complete(read_manifest(out_dir, header["format"]), items, out_dir, fields)
+    entries: list[dict | None] = [None] * len(jobs)
+    done = 0
+
+    def finish(index: int, entry: dict) -> None:
+        nonlocal done
+        entries[index] = {**fingerprints[index], **entry}
+        done += 1
+        if progress is not None:
+            progress(done, len(jobs), entries[index])
+
+    todo = []
+    for index, fingerprint in enumerate(fingerprints):
+        kept = previous.get(_canonical(fingerprint))
+        if kept is not None:
+            finish(index, {**kept, "status": "skipped"})
         else:
-            todo.append(job)
-    cluster_info = _run_on_cluster(todo, scheduler, workers, entries, total, progress)
-    manifest = {"format": "greybox-fleet", "format_version": 1, "model": model, "model_sha256": model_hash,
-                "axis_config": jobs[0].axis_config, "read": jobs[0].read, "chunk_s": jobs[0].chunk_s,
-                "cluster": cluster_info, "versions": _versions(), "seconds": time.perf_counter() - started,
+            todo.append(index)
+    cluster = _run_on_cluster(task, [(index, jobs[index]) for index in todo], scheduler, workers, finish)
+    manifest = {**header, "cluster": cluster, "versions": _versions(), "seconds": time.perf_counter() - started,
                 "counts": {status: sum(entry["status"] == status for entry in entries)
                            for status in ("ok", "skipped", "failed")},
-                "logs": sorted(entries, key=lambda entry: entry["log"])}
+                items: entries}
     write_text_atomic(out_dir / MANIFEST, json.dumps(manifest, indent=1) + "\n")
     return manifest
 
 
-def _run_on_cluster(todo, scheduler, workers, entries, total, progress) -> dict:
-    if not todo:
-        return {"scheduler": scheduler, "workers": 0}
+@contextlib.contextmanager
+def _client(scheduler: str | None, workers: int | None) -> Iterator:
+    """A Dask client of the scheduler at ``scheduler``, or of a local cluster of ``workers`` processes."""
     import logging
 
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, LocalCluster
 
     if scheduler is not None:
         try:
@@ -300,16 +293,138 @@ def _run_on_cluster(todo, scheduler, workers, entries, total, progress) -> dict:
                                env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
         client = Client(cluster)
     try:
-        info = {"scheduler": scheduler or "local", "workers": len(client.scheduler_info().get("workers", {}))}
-        futures = client.map(predict_log, todo, pure=False)
-        for future in as_completed(futures):
-            entry = future.result()
-            entries.append(entry)
-            if progress is not None:
-                progress(len(entries), total, entry)
-        return info
+        yield client
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
 
+
+def _run_on_cluster(task: Callable, todo: list, scheduler: str | None, workers: int | None,
+                    finish: Callable[[int, dict], None]) -> dict:
+    """Run ``task`` on every ``(index, job)`` of ``todo``; ``finish(index, entry)`` as each ends; the cluster."""
+    if not todo:
+        return {"scheduler": scheduler, "workers": 0}
+    from distributed import as_completed
+
+    with _client(scheduler, workers) as client:
+        info = {"scheduler": scheduler or "local", "workers": len(client.scheduler_info().get("workers", {}))}
+        futures = client.map(task, [job for _, job in todo], pure=False)
+        index = {future.key: position for future, (position, _) in zip(futures, todo)}
+        for future in as_completed(futures):
+            error = future.exception() if future.status == "error" else None
+            finish(index[future.key], future.result() if error is None else
+                   {"status": "failed", "error": f"lost on the cluster: {type(error).__name__}: {error}"})
+        return info
+
+
+@dataclass(frozen=True)
+class FleetJob:
+    """One log of a fleet prediction: what to read, with which model, and where the outputs go.
+
+    Parameters
+    ----------
+    log : str
+        Log file.
+    machine : str
+        Machine the log belongs to (its folder's name), the first partition level.
+    model : str
+        Model file.
+    out_dir : str
+        Root of the Parquet dataset.
+    axis_config : str, optional
+        Axis file (force or torque).
+    read : dict
+        Options of reading and preparing the log (:func:`read_prepared`).
+    chunk_s : float
+        Chunk length of the prediction [s].
+    """
+
+    log: str
+    machine: str
+    model: str
+    out_dir: str
+    axis_config: str | None = None
+    read: dict = field(default_factory=dict)
+    chunk_s: float = 60.0
+
+
+def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: str | None = None,
+               read: dict | None = None, chunk_s: float = 60.0) -> list[FleetJob]:
+    """One job per log; the machine is the name of the log's folder."""
+    return [FleetJob(str(log), machine_of(log), str(model), str(out_dir), axis_config, dict(read or {}),
+                     float(chunk_s)) for log in logs]
+
+
+def _file_hash(path: str) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def predict_log(job: FleetJob) -> dict:
+    """Predict one log and write its process table; the task each worker runs.
+
+    Returns
+    -------
+    dict
+        ``log``, ``machine``, ``status`` (``ok`` or ``failed``), ``output``, ``axis``, ``samples``,
+        ``seconds``, ``peak_rss_mb`` (of the worker process so far), and for a failure its ``error``
+        (one line). Never raises for a bad log.
+    """
+    return {"log": job.log, "machine": job.machine, **attempt(job.log, lambda: _predict_and_write(job))}
+
+
+def _predict_and_write(job: FleetJob) -> dict:
+    from .data.axis_config import read_axis_config
+    from .evaluate.process import predict_process
+    from .evaluate.process_io import write_process
+    from .persistence import load_model
+
+    config = read_axis_config(job.axis_config) if job.axis_config else None
+    runs = read_prepared(job.log, job.read, columns=config.channels if config else None)
+    result = predict_process(load_model(job.model), runs, axis_config=config, chunk_s=job.chunk_s)
+    result.attrs.update({"model_file": job.model, "log_file": job.log})
+    axis = partition(result.axis or "-")
+    target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={axis}" / f"log={partition(Path(job.log).stem)}"
+    target.mkdir(parents=True, exist_ok=True)
+    path = write_process(result, target / "part-0.parquet", overwrite=True)  # the table `predict` writes
+    return {"output": str(path), "axis": axis, "samples": len(result.time)}
+
+
+def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers: int | None = None,
+              force: bool = False, progress: Callable[[int, int, dict], None] | None = None) -> dict:
+    """Predict every job's log on a Dask cluster and write the manifest (:func:`run_tasks`).
+
+    Parameters
+    ----------
+    jobs : sequence of FleetJob
+        All with the same output directory (:func:`fleet_jobs`).
+    scheduler, workers, force, progress
+        The cluster, whether to predict again the logs complete from an earlier run, and the progress
+        callback, as in :func:`run_tasks`.
+
+    Returns
+    -------
+    dict
+        The manifest (also written to ``OUT/_manifest.json``).
+
+    Raises
+    ------
+    GreyboxError
+        When the scheduler cannot be reached or the jobs disagree on the output directory.
+    """
+    if not jobs:
+        raise GreyboxError("no log to predict")
+    outs = {job.out_dir for job in jobs}
+    if len(outs) != 1:
+        raise GreyboxError("a fleet run has one output directory")
+    hashes = {model: _file_hash(model) for model in {job.model for job in jobs}}
+    fingerprints = [{"log": job.log, "model": job.model, "model_sha256": hashes[job.model], **log_stamp(job.log)}
+                    for job in jobs]
+    header = {"format": PREDICT_FORMAT, "format_version": 2, "axis_config": jobs[0].axis_config,
+              "read": jobs[0].read, "chunk_s": jobs[0].chunk_s}
+    return run_tasks(predict_log, jobs, fingerprints, out_dir=outs.pop(), header=header, items="logs",
+                     scheduler=scheduler, workers=workers, force=force, progress=progress)

@@ -247,10 +247,10 @@ def _write_outputs(args: argparse.Namespace, result, out: Path, inputs: list, wi
 
 def _run_fleet(args: argparse.Namespace) -> int:
     """``greybox predict MODEL LOG... --out DIR``: every log a task on Dask, a partitioned Parquet dataset."""
-    from ..data.io import parse_column_mapping
     from ..fleet import MANIFEST, expand_logs, fleet_jobs, run_fleet
     from ..machine_model import is_machine_model
     from ..persistence import load_model
+    from ._fleet import check_out_dir, fleet_progress, read_options, report_fleet
 
     for option, value in (("--plot", args.plot), ("--plot-window", args.plot_window),
                           ("--calibration", args.calibration), ("--interval", args.interval),
@@ -260,44 +260,17 @@ def _run_fleet(args: argparse.Namespace) -> int:
     if is_machine_model(args.model):
         raise GreyboxError(f"{args.model}: a fleet run takes one model file; run one fleet per axis of the machine "
                            "model with its file and --axis")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise GreyboxError(f"{out}: exists and is not a directory; the output of a fleet run is a directory")
-    logs = expand_logs(args.logs)
-    load_model(args.model)  # a bad model file is one error before any cluster starts
-    read = {"columns": parse_column_mapping(args.columns) if args.columns else None, "topic": args.topic,
-            "axis": args.axis, "sample_time": args.sample_time, "time_tolerance": args.time_tolerance,
-            "cutoff_hz": args.cutoff_hz, "resample": args.resample, "max_gap": args.max_gap}
-    jobs = fleet_jobs(logs, str(Path(args.model).resolve()), str(out.resolve()),
-                      axis_config=str(Path(args.axis_config).resolve()) if args.axis_config else None, read=read,
-                      chunk_s=args.chunk_s)
-    if args.force and (out / MANIFEST).exists():
-        (out / MANIFEST).unlink()  # --force: predict every log again (the outputs are replaced atomically)
-    started = time.perf_counter()
-    terminal = sys.stderr.isatty()
-    failed = 0
-
-    def show(done: int, total: int, entry: dict) -> None:
-        nonlocal failed
-        failed += entry["status"] == "failed"
-        if args.quiet:
-            return
-        text = (f"fleet: {done}/{total} logs, {failed} failed, {time.perf_counter() - started:.1f} s elapsed "
-                f"({Path(entry['log']).name}: {entry['status']})")
-        print("\r" + text.ljust(100) if terminal else text, end="\n" if not terminal or done == total else "",
-              file=sys.stderr, flush=True)
-
-    manifest = run_fleet(jobs, scheduler=args.scheduler, workers=args.workers, progress=show)
-    counts = manifest["counts"]
-    cluster = manifest["cluster"]
-    where = (f" on {cluster['workers']} worker(s) of {cluster['scheduler']}" if cluster["workers"] else "")
-    print(f"fleet: {counts['ok']} predicted, {counts['skipped']} skipped (complete from an earlier run), "
-          f"{counts['failed']} failed of {len(jobs)} logs in {manifest['seconds']:.1f} s{where}")
-    for entry in manifest["logs"]:
-        if entry["status"] == "failed":
-            print(f"  failed: {entry['error']}")
+    out = check_out_dir(args.out)
+    jobs = fleet_jobs(expand_logs(args.logs), str(Path(args.model).resolve()), str(out),
+                      axis_config=str(Path(args.axis_config).resolve()) if args.axis_config else None,
+                      read=read_options(args), chunk_s=args.chunk_s)
+    for model in sorted({job.model for job in jobs}):
+        load_model(model)  # a bad model file is one error before any cluster starts
+    manifest = run_fleet(jobs, scheduler=args.scheduler, workers=args.workers, force=args.force,
+                         progress=fleet_progress("logs", args.quiet, lambda entry: Path(entry["log"]).name))
+    status = report_fleet(manifest, "logs", "predicted", lambda entry: entry["error"])
     print(f"wrote {out / MANIFEST} and the dataset {out}/machine=*/axis=*/log=*/part-0.parquet")
-    return 2 if counts["failed"] else 0
+    return status
 
 
 def _run_machine(args: argparse.Namespace) -> int:
