@@ -18,7 +18,8 @@ one-line error), output, samples, seconds and the worker's peak memory, its mode
 file's SHA-256, the versions of greybox and its libraries, the cluster and the wall time. A re-run
 skips every log whose output is complete: listed ``ok`` in the manifest for the same model file (hash)
 and the same log file (size and modification time), its output still there. Every file is written
-atomically.
+atomically. The model is one model file, or a directory of models written by ``greybox train
+--per-machine``, from which each log gets its machine's model (:func:`machine_models`).
 """
 
 from __future__ import annotations
@@ -36,15 +37,18 @@ from typing import Callable, Iterator, Mapping, Sequence
 from .atomic import write_text_atomic
 from .errors import GreyboxError
 
-__all__ = ["LOG_SUFFIXES", "MANIFEST", "FleetJob", "attempt", "expand_logs", "fleet_jobs",
-           "log_stamp", "machine_of", "partition", "predict_log", "read_manifest", "read_prepared",
-           "run_fleet", "run_tasks"]
+__all__ = ["LOG_SUFFIXES", "MANIFEST", "MODELS_FORMAT", "FleetJob", "attempt", "expand_logs", "fleet_jobs",
+           "log_stamp", "machine_models", "machine_of", "out_dir_of", "partition", "predict_log", "read_manifest",
+           "read_prepared", "run_fleet", "run_tasks"]
 
 #: File extensions taken as logs when a directory is given.
 LOG_SUFFIXES = (".csv", ".parquet", ".pq", ".mcap", ".mat", ".tdms")
 
 #: Name of the manifest in the output directory (a leading "_": dataset readers skip it).
 MANIFEST = "_manifest.json"
+
+#: ``format`` of the manifest of a directory of models written by ``greybox train --per-machine``.
+MODELS_FORMAT = "greybox-fleet-models"
 
 #: ``format`` of the manifest of a fleet prediction.
 PREDICT_FORMAT = "greybox-fleet"
@@ -252,7 +256,7 @@ def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, o
 
     def finish(index: int, entry: dict) -> None:
         nonlocal done
-        entries[index] = {**fingerprints[index], **entry}
+        entries[index] = {**entry, **fingerprints[index]}
         done += 1
         if progress is not None:
             progress(done, len(jobs), entries[index])
@@ -271,6 +275,22 @@ def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, o
                 items: entries}
     write_text_atomic(out_dir / MANIFEST, json.dumps(manifest, indent=1) + "\n")
     return manifest
+
+
+def out_dir_of(jobs: Sequence, nothing: str) -> str:
+    """The one output directory of a fleet's jobs (their ``out_dir``).
+
+    Raises
+    ------
+    GreyboxError
+        With the message ``nothing`` for no job, or for jobs that disagree.
+    """
+    if not jobs:
+        raise GreyboxError(nothing)
+    outs = {job.out_dir for job in jobs}
+    if len(outs) != 1:
+        raise GreyboxError("a fleet run has one output directory")
+    return outs.pop()
 
 
 @contextlib.contextmanager
@@ -349,11 +369,66 @@ class FleetJob:
     chunk_s: float = 60.0
 
 
+def machine_models(directory: str | os.PathLike) -> dict[str, dict[str, str]]:
+    """The models of a directory written by ``greybox train --per-machine``: ``{machine: {axis: model file}}``.
+
+    Only the models its manifest lists as trained (``ok`` or ``skipped``) whose file is there count.
+
+    Raises
+    ------
+    GreyboxError
+        For a directory without such a manifest.
+    """
+    directory = Path(directory)
+    document = read_manifest(directory, MODELS_FORMAT)
+    if not document:
+        raise GreyboxError(f"{directory}: a directory without the {MANIFEST} of 'greybox train --per-machine'; "
+                           "give a model file or a directory of models it wrote")
+    table: dict[str, dict[str, str]] = {}
+    for entry in document.get("models", []):
+        if isinstance(entry, dict) and entry.get("status") in ("ok", "skipped") and \
+                isinstance(entry.get("output"), str) and (directory / entry["output"]).is_file():
+            table.setdefault(str(entry.get("machine")), {})[str(entry.get("axis"))] = str(directory / entry["output"])
+    return table
+
+
+def _model_for(log: Path, machine: str, models: dict[str, dict[str, str]], directory: str, axis: str | None) -> str:
+    """The model file of ``log``'s machine in a models directory (of ``axis`` where it has several)."""
+    by_axis = models.get(machine)
+    if not by_axis:
+        known = ", ".join(sorted(models)) or "none"
+        raise GreyboxError(f"{log}: no trained model of machine {machine} in {directory} (machines: {known})")
+    if axis is not None:
+        if axis not in by_axis:
+            raise GreyboxError(f"{log}: --axis {axis}: machine {machine} has models of axes "
+                               f"{', '.join(sorted(by_axis))}")
+        return by_axis[axis]
+    if len(by_axis) > 1:
+        raise GreyboxError(f"{log}: machine {machine} has models of axes {', '.join(sorted(by_axis))} in {directory}; "
+                           "give --axis NAME (one fleet per axis)")
+    return next(iter(by_axis.values()))
+
+
 def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: str | None = None,
                read: dict | None = None, chunk_s: float = 60.0) -> list[FleetJob]:
-    """One job per log; the machine is the name of the log's folder."""
-    return [FleetJob(str(log), machine_of(log), str(model), str(out_dir), axis_config, dict(read or {}),
-                     float(chunk_s)) for log in logs]
+    """One job per log; the machine is the name of the log's folder.
+
+    ``model`` is one model file for every log, or a directory written by ``greybox train --per-machine``:
+    each log then gets its machine's model (of ``read["axis"]`` where the machine has several).
+
+    Raises
+    ------
+    GreyboxError
+        For a models directory without a model of a log's machine (or axis).
+    """
+    read = dict(read or {})
+    if os.path.isdir(model):
+        models = machine_models(model)
+        chosen = [_model_for(Path(log), machine_of(log), models, model, read.get("axis")) for log in logs]
+    else:
+        chosen = [str(model)] * len(logs)
+    return [FleetJob(str(log), machine_of(log), path, str(out_dir), axis_config, read, float(chunk_s))
+            for log, path in zip(logs, chosen)]
 
 
 def _file_hash(path: str) -> str:
@@ -416,15 +491,11 @@ def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers
     GreyboxError
         When the scheduler cannot be reached or the jobs disagree on the output directory.
     """
-    if not jobs:
-        raise GreyboxError("no log to predict")
-    outs = {job.out_dir for job in jobs}
-    if len(outs) != 1:
-        raise GreyboxError("a fleet run has one output directory")
+    out_dir = out_dir_of(jobs, "no log to predict")
     hashes = {model: _file_hash(model) for model in {job.model for job in jobs}}
     fingerprints = [{"log": job.log, "model": job.model, "model_sha256": hashes[job.model], **log_stamp(job.log)}
                     for job in jobs]
     header = {"format": PREDICT_FORMAT, "format_version": 2, "axis_config": jobs[0].axis_config,
               "read": jobs[0].read, "chunk_s": jobs[0].chunk_s}
-    return run_tasks(predict_log, jobs, fingerprints, out_dir=outs.pop(), header=header, items="logs",
+    return run_tasks(predict_log, jobs, fingerprints, out_dir=out_dir, header=header, items="logs",
                      scheduler=scheduler, workers=workers, force=force, progress=progress)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from pathlib import Path
 
@@ -15,6 +16,7 @@ from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model
 from ._options import add_log_arguments, read_named_runs
+from ._types import POSITIVE_INT
 
 
 def add_parser(subparsers) -> None:
@@ -24,12 +26,14 @@ def add_parser(subparsers) -> None:
         description="Read and prepare every training log as a separate run, fit the model to all runs, "
         "print the training error and the identified parameters, and save the model file. With --axes (or "
         "--machine), fit one model per axis of logs that hold several axes and write a machine model: a "
-        "directory with one model file per axis and a manifest machine.json.",
+        "directory with one model file per axis and a manifest machine.json. With --per-machine, train one model "
+        "per machine (the folder of its logs) and axis, on Dask.",
     )
     parser.add_argument("--model", required=True, choices=sorted(MODEL_CLASSES), help="model kind")
     parser.add_argument(
         "--train", required=True, nargs="+", metavar="LOG",
-        help="training logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat)"
+        help="training logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat); with --per-machine also directories "
+        "(searched recursively) and glob patterns"
     )
     parser.add_argument(
         "--stage2",
@@ -38,7 +42,8 @@ def add_parser(subparsers) -> None:
         help="gmssvr only: logs for the SVR stage; the GMS stage is then fitted on --train alone",
     )
     parser.add_argument("--out", required=True, metavar="MODEL",
-                        help="model file to write (.gbm); with --axes or --machine, the machine model's directory")
+                        help="model file to write (.gbm); with --axes or --machine, the machine model's directory; "
+                        "with --per-machine, the directory of the models OUT/<machine>/<axis>.gbm")
     parser.add_argument("--axes", nargs="+", metavar="AXIS",
                         help="axes to fit (X Y Z, or X,Y,Z): one model each, from the logs' columns "
                         "X_position_mm, X_current_A, ... (MCAP channels /axis/X, TDMS groups X; default with "
@@ -46,9 +51,23 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--machine", metavar="TOML",
                         help="machine file: the axes, their channels in the logs and mechanics (see "
                         "examples/machine.toml)")
-    parser.add_argument("--force", action="store_true", help="overwrite MODEL (the machine model) if it exists")
+    parser.add_argument("--force", action="store_true",
+                        help="overwrite MODEL (the machine model) if it exists; with --per-machine, train every "
+                        "model again, also those complete from an earlier run")
     add_model_arguments(parser, backlash=True)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
+    fleet = parser.add_argument_group("fleets (one model per machine)")
+    fleet.add_argument("--per-machine", action="store_true",
+                       help="train one model per machine and axis, each on all that machine's logs (the machine of "
+                       "a log is its folder's name; with --axes a model per axis of logs of several), one task each "
+                       "on Dask; --out is a directory OUT/<machine>/<axis>.gbm with OUT/_manifest.json; a re-run "
+                       "skips the models complete for the same logs and options; 'greybox predict OUT LOG... --out "
+                       "DIR' then predicts each log with its machine's model")
+    fleet.add_argument("--scheduler", metavar="ADDRESS",
+                       help="with --per-machine: address of a running dask.distributed scheduler, e.g. "
+                       "tcp://10.0.0.5:8786 (default: a local cluster of processes)")
+    fleet.add_argument("--workers", type=POSITIVE_INT, metavar="N",
+                       help="with --per-machine: processes of the local cluster (default: one per core)")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -178,7 +197,54 @@ def _run_machine(args: argparse.Namespace) -> int:
     return 0
 
 
+def _label(entry: dict) -> str:
+    """``machine/axis`` of a fleet's model (the machine alone while its axis is not known)."""
+    return "/".join(part for part in (entry["machine"], entry.get("axis") or entry["read"].get("axis")) if part)
+
+
+def _run_per_machine(args: argparse.Namespace) -> int:
+    """``greybox train --per-machine``: a model per machine and axis on Dask (:mod:`greybox.fleet_train`)."""
+    from ..fleet import MANIFEST, expand_logs
+    from ..fleet_train import run_training, train_jobs
+    from ._fleet import check_out_dir, fleet_progress, read_options, report_fleet
+
+    for option, value in (("--stage2", args.stage2), ("--machine", args.machine)):
+        if value:
+            raise GreyboxError(f"{option} does not apply with --per-machine: every machine's model is fitted on "
+                               "its logs in --train (give the axes of logs of several with --axes)")
+    axes = [axis.name for axis in _machine_axes(args)[1]] if args.axes is not None else None
+    out = check_out_dir(args.out, args.train)
+    logs = expand_logs(args.train)
+    model = build_model(args.model, args)  # a bad option is one error before any cluster starts
+    jobs = train_jobs(logs, model, str(out), axes=axes, read=read_options(args))
+    manifest = run_training(jobs, scheduler=args.scheduler, workers=args.workers, force=args.force,
+                            progress=fleet_progress("models", args.quiet, _label))
+    status = report_fleet(manifest, "models", "trained", lambda entry: f"{_label(entry)}: {entry['error']}")
+    for entry in manifest["models"]:
+        if entry["status"] != "failed":
+            print(f"  {_label(entry)}: {len(entry['logs'])} log(s), {entry['samples']} samples, training RMSE "
+                  f"{entry['rmse']:.4g} {entry['effort_unit']}, RE {entry['re']:.3f} % ({entry['status']}) "
+                  f"-> {out / entry['output']}")
+    print("  (RE = RMSE / mean |effort|)")
+    print(f"wrote {out / MANIFEST}; predict each machine's logs with its model: greybox predict {args.out} LOG... "
+          "--out DIR")
+    return status
+
+
+def _refuse_fleet_items(items) -> None:
+    """A directory or pattern in --train asks for --per-machine (one model is trained on named log files)."""
+    for item in items:
+        if os.path.isdir(item) or (not os.path.exists(item) and set("*?[") & set(item)):
+            raise GreyboxError(f"--train {item}: a directory or pattern; name the log files to train one model, "
+                               "or give --per-machine to train one model per machine")
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.per_machine:
+        return _run_per_machine(args)
+    if args.scheduler or args.workers:
+        raise GreyboxError("--scheduler and --workers apply with --per-machine (a model per machine on Dask)")
+    _refuse_fleet_items(args.train)
     inputs = list(args.train) + list(args.stage2 or ())
     if args.axes is not None or args.machine:
         out = Path(args.out)

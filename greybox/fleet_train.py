@@ -1,0 +1,176 @@
+"""``greybox train --per-machine``: one model per machine and axis of a plant's logs, trained on dask.distributed.
+
+The machine of a log is the name of its folder (as in the ``machine=`` partition of a fleet prediction).
+Each machine's model of an axis is fitted on all that machine's logs, one Dask task per (machine, axis),
+on the engine of every fleet run (:func:`greybox.fleet.run_tasks`: a local cluster or a scheduler
+address, failures reported while the rest go on, complete models skipped on a re-run). The output
+directory (manifest format ``greybox-fleet-models``)::
+
+    OUT/<machine>/<axis>.gbm     the model of one axis of one machine, an ordinary greybox model file
+    OUT/_manifest.json           every model: machine, axis, the logs it was fitted on (paths, sizes,
+                                 modification times), status (ok, skipped, failed with its one-line
+                                 error), training RMSE and RE, samples, seconds and the worker's peak
+                                 memory, the model kind and hyperparameters, the reading options; the
+                                 versions, the cluster and the wall time
+
+With axes to read from logs of several (``--axes``) there is one task per machine and axis; otherwise one
+per machine, whose logs must all be of one axis, the model named after it (``-`` where the logs name
+none). A re-run skips every model whose entry is ``ok`` for the same logs (size and modification time),
+kind, hyperparameters and reading options, its file still there. ``greybox predict OUT LOG... --out DIR``
+predicts each log with its machine's model (:func:`greybox.fleet.fleet_jobs`).
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from .errors import GreyboxError
+from .fleet import MODELS_FORMAT, attempt, log_stamp, machine_of, out_dir_of, partition, read_prepared, run_tasks
+
+__all__ = ["TrainJob", "run_training", "train_jobs", "train_model"]
+
+
+@dataclass(frozen=True)
+class TrainJob:
+    """One model of a fleet: a machine's logs, the axis to read from them and the model to fit.
+
+    Parameters
+    ----------
+    machine : str
+        Machine (the folder name of its logs); the model goes to ``out_dir/<machine>/<axis>.gbm``.
+    logs : tuple of str
+        The machine's log files, fitted together as separate runs in this order.
+    model : estimator
+        Unfitted model (a copy is fitted).
+    out_dir : str
+        Directory of the fleet's models.
+    read : dict
+        Options of reading and preparing the logs (:func:`greybox.fleet.read_prepared`); ``read["axis"]``
+        the axis read from logs of several, None for the logs' own.
+    """
+
+    machine: str
+    logs: tuple
+    model: object
+    out_dir: str
+    read: dict
+
+
+def train_jobs(logs: Sequence[Path], model, out_dir: str, *, axes: Sequence[str] | None = None,
+               read: dict | None = None) -> list[TrainJob]:
+    """One job per machine (the folder of its logs), or per machine and axis of ``axes``.
+
+    Parameters
+    ----------
+    logs : sequence of path
+        Log files (:func:`greybox.fleet.expand_logs`).
+    model : estimator
+        Unfitted model, the same kind and hyperparameters for every job.
+    out_dir : str
+        Directory of the models.
+    axes : sequence of str, optional
+        Axes to read from logs of several, a model each; default the axis of each machine's logs.
+    read : dict, optional
+        Options of reading and preparing the logs.
+    """
+    read = dict(read or {})
+    machines: dict[str, list[str]] = {}
+    for log in logs:
+        machines.setdefault(machine_of(log), []).append(str(log))
+    readings = [{**read, "axis": axis} for axis in axes] if axes else [read]
+    return [TrainJob(machine, tuple(paths), model, str(out_dir), reading)
+            for machine, paths in machines.items() for reading in readings]
+
+
+def _hyperparameters(model) -> dict:
+    """Kind and hyperparameters of a model as JSON values: a nested model likewise, other values as text."""
+    from .registry import model_kind
+
+    def value(item):
+        if hasattr(item, "get_params"):
+            return _hyperparameters(item)
+        return item if item is None or isinstance(item, (bool, int, float, str)) else repr(item)
+
+    return {"kind": model_kind(model),
+            "params": {name: value(item) for name, item in sorted(model.get_params(deep=False).items())}}
+
+
+def _axis_of(runs: list, job: TrainJob) -> str:
+    """The axis of a machine's runs: the one read, or the one their logs name."""
+    if job.read.get("axis"):
+        return job.read["axis"]
+    named = sorted({run.axis for run in runs})
+    if len(named) > 1:
+        sources = {run.axis: Path(run.source or "?").name for run in runs}
+        listed = ", ".join(f"{axis or '(unnamed)'} ({sources[axis]})" for axis in named)
+        raise GreyboxError(f"machine {job.machine}: its logs are of several axes, {listed}; keep one axis per "
+                           "folder, or give --axes for logs that hold several")
+    return named[0]
+
+
+def _fit_and_save(job: TrainJob) -> dict:
+    """Fit the job's model on all its logs, save it, and measure the saved model on the training runs."""
+    from .metrics import metrics_table
+    from .persistence import load_model, save_model
+
+    runs = [run for log in job.logs for run in read_prepared(log, job.read)]
+    axis = partition(_axis_of(runs, job) or "-")
+    model = copy.deepcopy(job.model).fit(runs)
+    path = Path(job.out_dir) / job.machine / f"{axis}.gbm"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    saved = load_model(save_model(model, path, overwrite=True))
+    table = metrics_table(np.concatenate([run.effort for run in runs]),
+                          np.concatenate([saved.predict(run) for run in runs]))
+    return {"axis": axis, "output": str(path.relative_to(job.out_dir)), "runs": len(runs), "samples": table["n"],
+            "effort_unit": runs[0].effort_unit, "rmse": table["rmse"], "re": table["re"]}
+
+
+def train_model(job: TrainJob) -> dict:
+    """Train and save one model of the fleet; the task each worker runs.
+
+    Returns
+    -------
+    dict
+        ``machine``, ``status`` (``ok`` or ``failed``), ``axis``, ``output`` (the model file, relative to
+        the output directory), ``runs``, ``samples``, ``effort_unit``, the training ``rmse`` [A or N] and
+        ``re`` [%] of the saved model on all its runs (RE = RMSE / mean |effort|), ``seconds``,
+        ``peak_rss_mb``, and for a failure its ``error`` (one line). Never raises for a bad log.
+    """
+    return {"machine": job.machine, **attempt(f"machine {job.machine}", lambda: _fit_and_save(job))}
+
+
+def run_training(jobs: Sequence[TrainJob], *, scheduler: str | None = None, workers: int | None = None,
+                 force: bool = False, progress: Callable[[int, int, dict], None] | None = None) -> dict:
+    """Train every job's model on a Dask cluster and write the manifest ``OUT/_manifest.json``.
+
+    Parameters
+    ----------
+    jobs : sequence of TrainJob
+        All with the same output directory (:func:`train_jobs`).
+    scheduler, workers, force, progress
+        The cluster, whether to train again the models complete from an earlier run, and the progress
+        callback, as in :func:`greybox.fleet.run_tasks`.
+
+    Returns
+    -------
+    dict
+        The manifest; its ``models`` list has an entry per job (:func:`train_model`) with the
+        ``logs`` it was fitted on (``path``, ``size`` [bytes], ``mtime_ns`` [ns]), the ``model``
+        (``kind`` and ``params``) and the ``read`` options.
+
+    Raises
+    ------
+    GreyboxError
+        For no job, jobs that disagree on the output directory, or a scheduler that cannot be reached.
+    """
+    out_dir = out_dir_of(jobs, "no log to train on")
+    fingerprints = [{"machine": job.machine, "read": job.read, "model": _hyperparameters(job.model),
+                     "logs": [{"path": log, **log_stamp(log)} for log in job.logs]} for job in jobs]
+    return run_tasks(train_model, jobs, fingerprints, out_dir=out_dir,
+                     header={"format": MODELS_FORMAT, "format_version": 1}, items="models", scheduler=scheduler,
+                     workers=workers, force=force, progress=progress)

@@ -1,0 +1,153 @@
+"""Fleet training: ``greybox train --per-machine`` on a Dask cluster (a LocalCluster of 2 workers here)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import greybox.cli as cli
+from greybox.data.io import read_log, write_log
+from greybox.data.prepare import prepare
+from greybox.fleet import MANIFEST, expand_logs
+from greybox.fleet_train import train_jobs, train_model
+from greybox.friction import CoulombModel
+from greybox.metrics import metrics_table
+from greybox.persistence import load_model
+from greybox.twin import make_dataset
+
+#: A short GMS identification (one start, 100 iterations): seconds per model, the same for fleet and plain runs.
+QUICK = ["--model", "gms", "--set", "n_starts=1", "--set", "max_iter=100", "--quiet"]
+
+
+@pytest.fixture(scope="module")
+def plant(tmp_path_factory):
+    """Three machines' air cuts: mill1 two logs, mill2 one, mill3 a broken one."""
+    root = tmp_path_factory.mktemp("plant")
+    for machine in ("mill1", "mill2", "mill3"):
+        (root / machine).mkdir()
+    write_log(make_dataset("X", "A", 1, duration_s=30), root / "mill1" / "a.mcap")
+    write_log(make_dataset("X", "A", 2, duration_s=30), root / "mill1" / "b.parquet")
+    write_log(make_dataset("X", "A", 3, duration_s=30), root / "mill2" / "a.csv")
+    (root / "mill3" / "broken.csv").write_text("not,a\nlog,x\n")
+    return root
+
+
+def _main(capsys, argv) -> tuple[int, str, str]:
+    status = cli.main([str(item) for item in argv])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def _parameters(model) -> dict:
+    return {row.name: np.asarray(row.value, dtype=float) for row in model.parameter_table()}
+
+
+def test_a_model_per_machine_as_plain_training_gives_then_skips_and_retrains(plant, tmp_path, capsys):
+    out = tmp_path / "models"
+    argv = ["train", *QUICK, "--train", plant, "--per-machine", "--out", out, "--workers", "2"]
+    status, printed, _ = _main(capsys, argv)
+    assert status == 2  # mill3 fails, mill1 and mill2 are trained
+    assert "2 trained, 0 skipped" in printed and "1 failed of 3 models" in printed and "on 2 worker(s)" in printed
+    assert "failed: mill3: " in printed and "broken.csv: missing required column" in printed
+    manifest = json.loads((out / MANIFEST).read_text())
+    assert manifest["format"] == "greybox-fleet-models" and manifest["cluster"]["workers"] == 2
+    assert manifest["versions"]["distributed"] and manifest["counts"] == {"ok": 2, "skipped": 0, "failed": 1}
+    entries = {entry["machine"]: entry for entry in manifest["models"]}
+    assert entries["mill3"]["status"] == "failed" and not (out / "mill3").exists()
+    assert [Path(log["path"]).name for log in entries["mill1"]["logs"]] == ["a.mcap", "b.parquet"]
+    assert entries["mill1"]["logs"][1]["size"] == (plant / "mill1" / "b.parquet").stat().st_size
+    assert entries["mill1"]["model"]["params"]["n_starts"] == 1 and entries["mill1"]["peak_rss_mb"] > 0
+    for machine in ("mill1", "mill2"):
+        entry = entries[machine]
+        assert entry["status"] == "ok" and entry["axis"] == "X" and entry["output"] == f"{machine}/X.gbm"
+        fleet = load_model(out / machine / "X.gbm")
+        logs = [log["path"] for log in entry["logs"]]
+        plain = tmp_path / f"{machine}.gbm"
+        assert _main(capsys, ["train", *QUICK, "--train", *logs, "--out", plain])[0] == 0
+        expected = _parameters(load_model(plain))
+        for name, value in _parameters(fleet).items():
+            np.testing.assert_allclose(value, expected[name], rtol=1e-9, atol=0, err_msg=f"{machine} {name}")
+        runs = prepare([read_log(log) for log in logs])
+        table = metrics_table(np.concatenate([run.effort for run in runs]),
+                              np.concatenate([fleet.predict(run) for run in runs]))
+        assert entry["re"] == pytest.approx(table["re"], rel=1e-9) and entry["samples"] == table["n"]
+    assert not np.allclose(_parameters(load_model(out / "mill1" / "X.gbm"))["k"],
+                           _parameters(load_model(out / "mill2" / "X.gbm"))["k"])
+
+    log = plant / "mill2" / "a.csv"
+    os.utime(log, ns=(log.stat().st_atime_ns, log.stat().st_mtime_ns + 10**9))  # mill2's log changed
+    status, printed, _ = _main(capsys, argv)
+    assert status == 2 and "1 trained, 1 skipped" in printed and "mill1/X: 2 log(s)" in printed
+    modified = (out / "mill1" / "X.gbm").stat().st_mtime_ns
+    status, printed, _ = _main(capsys, argv + ["--force"])
+    assert status == 2 and "2 trained, 0 skipped" in printed
+    assert (out / "mill1" / "X.gbm").stat().st_mtime_ns > modified
+
+
+def test_each_log_is_predicted_with_its_machines_model(plant, tmp_path, capsys):
+    models = tmp_path / "models"
+    assert _main(capsys, ["train", *QUICK, "--train", plant / "mill1", plant / "mill2" / "*.csv", "--per-machine",
+                          "--out", models, "--workers", "2"])[0] == 0
+    out = tmp_path / "results"
+    status, printed, _ = _main(capsys, ["predict", models, plant / "mill1", plant / "mill2", "--out", out,
+                                        "--workers", "2", "--quiet"])
+    assert status == 0 and "3 predicted" in printed
+    entries = json.loads((out / MANIFEST).read_text())["logs"]
+    used = {Path(entry["log"]).parent.name: entry["model"] for entry in entries}
+    assert used == {"mill1": str(models / "mill1" / "X.gbm"), "mill2": str(models / "mill2" / "X.gbm")}
+    single = tmp_path / "single.parquet"
+    assert _main(capsys, ["predict", models / "mill2" / "X.gbm", plant / "mill2" / "a.csv", "--out", single,
+                          "--quiet"])[0] == 0
+    part = pd.read_parquet(out / "machine=mill2" / "axis=X" / "log=a" / "part-0.parquet")
+    pd.testing.assert_frame_equal(part, pd.read_parquet(single))
+    status, _, error = _main(capsys, ["predict", models, plant, "--out", tmp_path / "r2"])
+    assert status == 2 and "no trained model of machine mill3" in error and "\n" not in error.strip()
+
+
+def test_several_axes_a_model_each_and_one_axis_per_machine(tmp_path):
+    (tmp_path / "mill1").mkdir()
+    (tmp_path / "mixed").mkdir()
+    x, y = make_dataset("X", "A", 4, duration_s=10), make_dataset("Y", "A", 4, duration_s=10)
+    write_log([x, y], tmp_path / "mill1" / "both.mcap")
+    write_log(x, tmp_path / "mixed" / "x.mcap")
+    write_log(y, tmp_path / "mixed" / "y.mcap")
+    out = tmp_path / "models"
+    jobs = train_jobs(expand_logs([str(tmp_path / "mill1")]), CoulombModel(), str(out), axes=["X", "Y"])
+    assert [(job.machine, job.read["axis"]) for job in jobs] == [("mill1", "X"), ("mill1", "Y")]
+    for job, log in zip(jobs, (x, y)):
+        entry = train_model(job)
+        assert entry["status"] == "ok" and entry["output"] == f"mill1/{log.axis}.gbm"
+        alone = CoulombModel().fit(prepare([log]))
+        np.testing.assert_allclose(load_model(out / entry["output"]).coulomb_pos_, alone.coulomb_pos_, rtol=1e-12)
+    (mixed,) = train_jobs(expand_logs([str(tmp_path / "mixed")]), CoulombModel(), str(out))
+    entry = train_model(mixed)
+    assert entry["status"] == "failed" and "machine mixed: its logs are of several axes, X (x.mcap), Y (y.mcap)" \
+        in entry["error"]
+
+
+def test_fleet_training_options_are_checked(plant, tmp_path, capsys):
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "file.gbm").write_text("")
+    base = ["train", "--model", "coulomb", "--train"]
+    for argv, message in (
+            ([plant, "--out", tmp_path / "m"], "--train " + str(plant) + ": a directory or pattern"),
+            ([plant / "mill1" / "a.mcap", "--out", tmp_path / "m.gbm", "--workers", "2"],
+             "--scheduler and --workers apply with --per-machine"),
+            ([plant, "--per-machine", "--out", tmp_path / "m", "--stage2", plant / "mill2" / "a.csv"],
+             "--stage2 does not apply with --per-machine"),
+            ([plant, "--per-machine", "--out", tmp_path / "m", "--machine", "m.toml"],
+             "--machine does not apply with --per-machine"),
+            ([tmp_path / "empty", "--per-machine", "--out", tmp_path / "m"], "empty: no log file"),
+            ([plant, "--per-machine", "--out", tmp_path / "file.gbm"], "exists and is not a directory"),
+            ([plant, "--per-machine", "--out", plant], "is one of the inputs"),
+            ([plant, "--per-machine", "--out", tmp_path / "m", "--axes", "X", "--columns", "position_mm=p"],
+             "--columns does not apply with --axes"),
+            ([plant, "--per-machine", "--out", tmp_path / "m", "--elements", "3"],
+             "option --elements does not apply to the coulomb model")):
+        status, _, error = _main(capsys, base + argv)
+        assert status == 2 and message in error and "\n" not in error.strip(), (argv, error)
