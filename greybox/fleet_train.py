@@ -1,6 +1,7 @@
 """``greybox train --per-machine``: one model per machine and axis of a plant's logs, trained on dask.distributed.
 
-The machine of a log is the name of its folder (as in the ``machine=`` partition of a fleet prediction).
+The machine of a log is the name of its folder (as in the ``machine=`` partition of a fleet prediction;
+folders of one name in different places are one machine).
 Each machine's model of an axis is fitted on all that machine's logs, one Dask task per (machine, axis),
 on the engine of every fleet run (:func:`greybox.fleet.run_tasks`: a local cluster or a scheduler
 address, failures reported while the rest go on, complete models skipped on a re-run). The output
