@@ -169,8 +169,8 @@ def _canonical(value) -> str:
     return json.dumps(value, sort_keys=True)
 
 
-def read_manifest(directory: str | os.PathLike, fmt: str) -> dict:
-    """The manifest of ``fmt`` in ``directory``, or ``{}`` when there is none, it is unreadable or of another format."""
+def _load_manifest(directory: str | os.PathLike) -> dict:
+    """The manifest in ``directory`` of any format, or ``{}`` when there is none or it is unreadable."""
     path = Path(directory) / MANIFEST
     if not path.is_file():
         return {}
@@ -178,7 +178,13 @@ def read_manifest(directory: str | os.PathLike, fmt: str) -> dict:
         document = json.loads(path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, ValueError, RecursionError):
         return {}
-    return document if isinstance(document, dict) and document.get("format") == fmt else {}
+    return document if isinstance(document, dict) else {}
+
+
+def read_manifest(directory: str | os.PathLike, fmt: str) -> dict:
+    """The manifest of ``fmt`` in ``directory``, or ``{}`` when there is none, it is unreadable or of another format."""
+    document = _load_manifest(directory)
+    return document if document.get("format") == fmt else {}
 
 
 def _complete(document: dict, items: str, out_dir: Path, fields: Sequence[str]) -> dict:
@@ -244,9 +250,13 @@ def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, o
     Raises
     ------
     GreyboxError
-        When the scheduler cannot be reached.
+        When ``out_dir`` holds the manifest of another kind of fleet run, or the scheduler cannot be reached.
     """
     out_dir = Path(out_dir)
+    other = _load_manifest(out_dir).get("format", header["format"])
+    if other != header["format"]:
+        raise GreyboxError(f"{out_dir}: holds the {MANIFEST} of another kind of run ({other}); choose another "
+                           "output directory")
     out_dir.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
     fields = list(fingerprints[0]) if fingerprints else []

@@ -133,6 +133,8 @@ def test_several_axes_a_model_each_and_one_axis_per_machine(tmp_path):
 def test_fleet_training_options_are_checked(plant, tmp_path, capsys):
     (tmp_path / "empty").mkdir()
     (tmp_path / "file.gbm").write_text("")
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / MANIFEST).write_text('{"format": "greybox-fleet"}')  # a fleet prediction's output
     base = ["train", "--model", "coulomb", "--train"]
     for argv, message in (
             ([plant, "--out", tmp_path / "m"], "--train " + str(plant) + ": a directory or pattern"),
@@ -145,6 +147,7 @@ def test_fleet_training_options_are_checked(plant, tmp_path, capsys):
             ([tmp_path / "empty", "--per-machine", "--out", tmp_path / "m"], "empty: no log file"),
             ([plant, "--per-machine", "--out", tmp_path / "file.gbm"], "exists and is not a directory"),
             ([plant, "--per-machine", "--out", plant], "is one of the inputs"),
+            ([plant, "--per-machine", "--out", tmp_path / "results"], "_manifest.json of another kind of run"),
             ([plant, "--per-machine", "--out", tmp_path / "m", "--axes", "X", "--columns", "position_mm=p"],
              "--columns does not apply with --axes"),
             ([plant, "--per-machine", "--out", tmp_path / "m", "--elements", "3"],
