@@ -383,6 +383,36 @@ class CurrentModel(ModelProtocol):
             lies outside the range of the training runs (kernel models add ``"inputs"``, their input
             space). Empty for a model loaded from a file that predates the record of the ranges.
         """
+        flags, _ = self.outside_training_chunk(log, self.region_state(), sample_time=log.sample_time)
+        return flags
+
+    def region_state(self):
+        """State carried by :meth:`outside_training_chunk` from chunk to chunk of a run, at its start.
+
+        None here: whether a sample lies in the training region depends on that sample alone.
+        Kernel models on the states of a dynamic model carry that model's state.
+        """
+        return None
+
+    def outside_training_chunk(self, log: AxisLog, state, *, sample_time: float):
+        """:meth:`outside_training` of one chunk of a run, from the state the previous chunk ended in.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared chunk: consecutive samples of one run.
+        state : object
+            :meth:`region_state` at the start of the run, else what the previous chunk returned.
+        sample_time : float
+            Step [s] of the whole run.
+
+        Returns
+        -------
+        flags : dict of str to ndarray of bool
+            As :meth:`outside_training` for the chunk's samples.
+        state : object
+            The state after the chunk: the ``state`` of the next chunk.
+        """
         check_is_fitted(self)
         out = {}
         for name, channel in _REGION_CHANNELS.items():
@@ -390,7 +420,7 @@ class CurrentModel(ModelProtocol):
             if bounds is not None:
                 values = getattr(log, channel)
                 out[channel] = (values < bounds[0]) | (values > bounds[1])
-        return out
+        return out, state
 
     def _check_predict_runs(self, logs) -> list[AxisLog]:
         check_is_fitted(self)

@@ -107,10 +107,16 @@ def test_a_model_file_without_a_region_still_predicts_and_says_so(logs, tmp_path
     assert "outside_training" not in result.columns()
 
 
-def test_gms_svr_reads_its_inputs_in_chunks_equal_to_the_whole_run(logs):
+def test_gms_svr_flags_its_inputs_in_chunks_equal_to_the_whole_run(logs):
     model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=60), **SMALL_SVR).fit(logs["A"])
     long_log = prepare([make_dataset("X", "C", seed=35, duration_s=130)])[0]
-    chunks = list(model._input_chunks(long_log))
-    assert len(chunks) >= 2  # the GMS state is carried across a chunk boundary
     whole = model._inputs(long_log, model.initial_state(), long_log.sample_time)[0]
-    np.testing.assert_array_equal(np.concatenate(chunks), whole)
+    expected = np.any((whole < model.input_range_[0]) | (whole > model.input_range_[1]), axis=1)
+    assert 0 < np.count_nonzero(expected) < len(expected)  # a test that can tell
+    np.testing.assert_array_equal(model.outside_training(long_log)["inputs"], expected)  # 60 s chunks inside
+    state, parts = model.region_state(), []
+    for samples in (slice(0, 1234), slice(1234, 40_000), slice(40_000, None)):  # the GMS state carried across
+        flags, state = model.outside_training_chunk(long_log.select(samples), state,
+                                                    sample_time=long_log.sample_time)
+        parts.append(flags["inputs"])
+    np.testing.assert_array_equal(np.concatenate(parts), expected)

@@ -54,8 +54,8 @@ table (e.g. the cutting force along the axis) is its opposite.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
@@ -63,11 +63,12 @@ from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog, as_log_list
 from ..data.quantities import MOTIONS, Motion
 from ..errors import GreyboxError
-from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, iter_chunks, samples_per_chunk
+from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from ..registry import model_kind
 from .interval import ProcessInterval
 
-__all__ = ["EXTRAPOLATION_WARNING_SHARE", "ProcessResult", "extrapolation_summary", "predict_process"]
+__all__ = ["EXTRAPOLATION_WARNING_SHARE", "ProcessResult", "ProcessTally", "check_process_inputs",
+           "extrapolation_summary", "join_results", "predict_process", "process_attrs", "process_blocks"]
 
 
 @dataclass(frozen=True)
@@ -195,13 +196,16 @@ class ProcessResult:
 EXTRAPOLATION_WARNING_SHARE = 0.05
 
 
-def extrapolation_summary(regions: dict, n_samples: int) -> dict:
+def extrapolation_summary(counts: dict, n_outside: int | None, n_samples: int) -> dict:
     """JSON-able shares of samples outside the training region, overall and per quantity.
 
     Parameters
     ----------
-    regions : dict of str to ndarray of bool
-        :meth:`~greybox.estimator.CurrentModel.outside_training` of the log.
+    counts : dict of str to int
+        Samples outside the training region per quantity (of
+        :meth:`~greybox.estimator.CurrentModel.outside_training`); empty for a model without the record.
+    n_outside : int or None
+        Samples outside in any quantity (None without the record).
     n_samples : int
         Samples of the log.
 
@@ -211,13 +215,222 @@ def extrapolation_summary(regions: dict, n_samples: int) -> dict:
         ``{"share": float or None, "by": {quantity: share}, "warn_above": float}``; ``share`` is None
         (with a ``"reason"``) when the model carries no training region.
     """
-    if not regions:
+    if not counts:
         return {"share": None, "by": {}, "warn_above": EXTRAPOLATION_WARNING_SHARE,
                 "reason": "the model file predates the record of its training region; retrain to get one"}
-    outside = np.logical_or.reduce(list(regions.values()))
-    return {"share": float(np.count_nonzero(outside)) / n_samples,
-            "by": {name: float(np.count_nonzero(mask)) / n_samples for name, mask in regions.items()},
+    return {"share": n_outside / n_samples, "by": {name: count / n_samples for name, count in counts.items()},
             "warn_above": EXTRAPOLATION_WARNING_SHARE}
+
+
+@dataclass
+class ProcessTally:
+    """Running figures of a process result given block by block: what ``greybox predict`` reports.
+
+    :meth:`add` each block (or the whole result once); the figures are those of all samples added.
+
+    Attributes
+    ----------
+    n_samples : int
+        Samples added.
+    sum_squares : dict of str to float
+        Sums of squares of ``measured``, ``model``, ``process`` and ``load`` (A^2, N^2 or Nm^2).
+    largest : dict of str to float
+        Largest ``|process|`` and ``|load|``.
+    half_width_sum : float
+        Sum of the interval half-widths (0 without an interval).
+    outside_counts : dict of str to int
+        Samples outside the training region per quantity.
+    n_outside : int
+        Samples outside in any quantity.
+    """
+
+    n_samples: int = 0
+    sum_squares: dict = field(default_factory=lambda: dict.fromkeys(("measured", "model", "process", "load"), 0.0))
+    largest: dict = field(default_factory=lambda: dict.fromkeys(("process", "load"), 0.0))
+    half_width_sum: float = 0.0
+    outside_counts: dict = field(default_factory=dict)
+    n_outside: int = 0
+    _regions: bool = False
+
+    def add(self, result: ProcessResult, regions: dict | None = None) -> None:
+        """Count in one block (or a whole result) and its training-region flags per quantity."""
+        self.n_samples += len(result.time)
+        values = {"measured": result.measured, "model": result.model, "process": result.process,
+                  "load": result.load}
+        for name, array in values.items():
+            if array is not None and len(array):
+                self.sum_squares[name] += float(array @ array)
+                if name in self.largest:
+                    self.largest[name] = max(self.largest[name], float(np.max(np.abs(array))))
+        if result.half_width is not None:
+            self.half_width_sum += float(np.sum(result.half_width))
+        if regions:
+            self._regions = True
+            for name, flags in regions.items():
+                self.outside_counts[name] = self.outside_counts.get(name, 0) + int(np.count_nonzero(flags))
+            self.n_outside += int(np.count_nonzero(np.logical_or.reduce(list(regions.values()))))
+
+    def rms(self, name: str) -> float:
+        """Root mean square of ``measured``, ``model``, ``process`` or ``load`` over the samples added."""
+        return float(np.sqrt(self.sum_squares[name] / self.n_samples))
+
+    def extrapolation(self) -> dict:
+        """:func:`extrapolation_summary` of the samples added."""
+        return extrapolation_summary(self.outside_counts if self._regions else {},
+                                     self.n_outside if self._regions else None, self.n_samples)
+
+
+def check_process_inputs(model, runs: Sequence[AxisLog], axis_config: AxisConfig | None) -> None:
+    """Refuse runs of mixed effort units, axis metadata with a load log, or of the other kind of axis.
+
+    Raises
+    ------
+    GreyboxError
+        See :func:`predict_process`.
+    """
+    unit = runs[0].effort_unit
+    units = runs[0].units
+    name = runs[0].source or "<in-memory log>"
+    for run in runs:
+        if run.effort_unit != unit:
+            raise GreyboxError(f"{run.source or '<in-memory log>'}: the runs mix effort units")
+    if unit != "A" and axis_config is not None:
+        raise GreyboxError(f"{name}: the log carries {units.load} in {unit} already; "
+                           "axis metadata convert a current and do not apply")
+    if axis_config is not None and axis_config.motion != runs[0].motion:
+        raise GreyboxError(f"{name}: the log is of a {runs[0].motion} axis ({units.length}), the axis file "
+                           f"{axis_config.source or '(in memory)'} describes a {axis_config.motion} one")
+
+
+def process_attrs(model, *, axis_config: AxisConfig | None, interval: ProcessInterval | None, chunk_s: float,
+                  motion: str, effort_unit: str, tally: ProcessTally, runs: list | None = None) -> dict:
+    """The JSON-able description of a process result (``ProcessResult.attrs``).
+
+    Parameters
+    ----------
+    model : CurrentModel
+        The model.
+    axis_config : AxisConfig, optional
+        Drive-train constants used.
+    interval : ProcessInterval, optional
+        Calibrated interval used.
+    chunk_s : float
+        Chunk length [s].
+    motion, effort_unit : str
+        Kind of axis and effort unit of the log.
+    tally : ProcessTally
+        The figures of the whole result (for the extrapolation summary).
+    runs : list of dict, optional
+        ``{"start_s", "samples"}`` of each run of a log split at gaps.
+    """
+    attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s)}
+    if runs is not None and len(runs) > 1:
+        attrs["runs"] = runs
+    if effort_unit == "A" and axis_config is not None:
+        units = MOTIONS[motion]
+        per_ampere = f"{units.load_unit}_per_A"
+        factors = axis_config.load_constants
+        constants = {key: value for key, value in axis_config.to_dict().items() if key not in ("name", "channels")}
+        attrs["axis_config"] = {"source": axis_config.source, **constants,
+                                f"{units.load}_constant_driving_{per_ampere}": factors[0],
+                                f"{units.load}_constant_backdriven_{per_ampere}": factors[1]}
+    attrs["extrapolation"] = tally.extrapolation()
+    if interval is not None:
+        attrs["interval"] = interval.to_dict()
+    return attrs
+
+
+def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
+                   axis_config: AxisConfig | None = None, interval: ProcessInterval | None = None,
+                   chunk_s: float = DEFAULT_CHUNK_S, tally: ProcessTally | None = None,
+                   progress: Callable[[float], None] | None = None) -> Iterator[ProcessResult]:
+    """The process result of one run given block by block, one block at a time.
+
+    The model runs over each block in chunks of ``chunk_s``, carrying its state (and the state of its
+    training-region check) from chunk to chunk and block to block, so that the blocks of a run give
+    what the run gives whole.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        A fitted model (trained on air cuts) of a registered kind.
+    blocks : iterable of AxisLog
+        Consecutive prepared blocks of one run.
+    sample_time : float
+        Step [s] of the whole run (its median step).
+    axis_config : AxisConfig, optional
+        Drive-train constants; gives ``load`` for a current log.
+    interval : ProcessInterval, optional
+        Calibrated half-widths; gives the bounds.
+    chunk_s : float, default 60.0
+        Chunk length [s].
+    tally : ProcessTally, optional
+        Counts in every block with its training-region flags.
+    progress : callable, optional
+        Called after each chunk with the log time [s] reached.
+
+    Yields
+    ------
+    ProcessResult
+        One per block, ``attrs`` empty.
+    """
+    state = model.initial_state()
+    region = model.region_state()
+    for block in blocks:
+        predicted = np.empty(len(block))
+        parts = []
+        for samples in chunk_slices(len(block), samples_per_chunk(sample_time, chunk_s)):
+            chunk = block.select(samples)
+            predicted[samples], state = model.predict_chunk(chunk, state, sample_time=sample_time)
+            flags, region = model.outside_training_chunk(chunk, region, sample_time=sample_time)
+            parts.append(flags)
+            if progress is not None:
+                progress(float(block.time[samples.stop - 1]))
+        regions = {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
+        result = _block_result(block, predicted, regions, axis_config, interval)
+        if tally is not None:
+            tally.add(result, regions)
+        yield result
+
+
+def _block_result(block: AxisLog, predicted: np.ndarray, regions: dict, axis_config: AxisConfig | None,
+                  interval: ProcessInterval | None) -> ProcessResult:
+    """The process result of one prepared block from its prediction and training-region flags."""
+    process = block.effort - predicted
+    load = factors = load_bounds = half_width = None
+    if block.effort_unit != "A":
+        load = process
+    elif axis_config is not None:
+        load = axis_config.process_load(process, block.velocity)
+        factors = axis_config.load_constants
+    if interval is not None:
+        half_width = interval.half_widths(block)
+        if factors is not None:
+            load_bounds = (axis_config.process_load(process - half_width, block.velocity),
+                           axis_config.process_load(process + half_width, block.velocity))
+    outside = np.logical_or.reduce(list(regions.values())) if regions else None
+    return ProcessResult(time=block.time, position=block.position, velocity=block.velocity, measured=block.effort,
+                         model=predicted, load=load, effort_unit=block.effort_unit, motion=block.motion,
+                         load_constants=factors,
+                         axis=block.axis or (axis_config.name if axis_config is not None else ""),
+                         source=block.source, dataset=block.dataset or "", half_width=half_width,
+                         load_bounds=load_bounds, outside=outside)
+
+
+def join_results(parts: Sequence[ProcessResult], attrs: dict) -> ProcessResult:
+    """One result of consecutive block results (of one or several runs), with ``attrs``."""
+    first = parts[0]
+
+    def joined(name):
+        values = [getattr(part, name) for part in parts]
+        return None if values[0] is None else np.concatenate(values)
+
+    bounds = None
+    if first.load_bounds is not None:
+        bounds = tuple(np.concatenate([part.load_bounds[k] for part in parts]) for k in (0, 1))
+    return replace(first, time=joined("time"), position=joined("position"), velocity=joined("velocity"),
+                   measured=joined("measured"), model=joined("model"), load=joined("load"),
+                   half_width=joined("half_width"), outside=joined("outside"), load_bounds=bounds, attrs=attrs)
 
 
 def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: AxisConfig | None = None,
@@ -256,66 +469,20 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
         or axis metadata of a linear axis with a rotary log (or the other way round).
     """
     runs = as_log_list(log)
-    unit = runs[0].effort_unit
-    units = runs[0].units
-    name = runs[0].source or "<in-memory log>"
-    for run in runs:
-        if run.effort_unit != unit:
-            raise GreyboxError(f"{run.source or '<in-memory log>'}: the runs mix effort units")
-    if unit != "A" and axis_config is not None:
-        raise GreyboxError(f"{name}: the log carries {units.load} in {unit} already; "
-                           "axis metadata convert a current and do not apply")
-    if axis_config is not None and axis_config.motion != runs[0].motion:
-        raise GreyboxError(f"{name}: the log is of a {runs[0].motion} axis ({units.length}), the axis file "
-                           f"{axis_config.source or '(in memory)'} describes a {axis_config.motion} one")
+    check_process_inputs(model, runs, axis_config)
     n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, chunk_s))) for run in runs)
-    done = 0
-    predicted = []
-    for run in runs:
-        out = np.empty(len(run))
-        for samples, current in iter_chunks(model, run, chunk_s=chunk_s):
-            out[samples] = current
-            done += 1
-            if progress is not None:
-                progress(done, n_chunks, float(run.time[samples.stop - 1]))
-        predicted.append(out)
+    done = [0]
 
-    def joined(values):
-        return np.concatenate(values)
+    def step(time_s: float) -> None:
+        done[0] += 1
+        progress(done[0], n_chunks, time_s)
 
-    time, position, velocity, effort = (joined([getattr(run, name) for run in runs])
-                                        for name in ("time", "position", "velocity", "effort"))
-    model_current = joined(predicted)
-    process = effort - model_current
-    load = factors = None
-    attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s)}
-    if len(runs) > 1:
-        attrs["runs"] = [{"start_s": float(run.time[0]), "samples": len(run)} for run in runs]
-    if unit != "A":
-        load = process
-    elif axis_config is not None:
-        load = axis_config.process_load(process, velocity)
-        factors = axis_config.load_constants
-        per_ampere = f"{units.load_unit}_per_A"
-        constants = {key: value for key, value in axis_config.to_dict().items() if key not in ("name", "channels")}
-        attrs["axis_config"] = {"source": axis_config.source, **constants,
-                                f"{units.load}_constant_driving_{per_ampere}": factors[0],
-                                f"{units.load}_constant_backdriven_{per_ampere}": factors[1]}
-    per_run = [model.outside_training(run) for run in runs]
-    regions = {name: joined([flags[name] for flags in per_run]) for name in per_run[0]}
-    outside = np.logical_or.reduce(list(regions.values())) if regions else None
-    attrs["extrapolation"] = extrapolation_summary(regions, len(time))
-    half_width = load_bounds = None
-    if interval is not None:
-        half_width = joined([interval.half_widths(run) for run in runs])
-        attrs["interval"] = interval.to_dict()
-        if factors is not None:
-            load_bounds = (axis_config.process_load(process - half_width, velocity),
-                            axis_config.process_load(process + half_width, velocity))
-    first = runs[0]
-    return ProcessResult(time=time, position=position, velocity=velocity, measured=effort,
-                         model=model_current, load=load, effort_unit=unit, motion=runs[0].motion,
-                         load_constants=factors,
-                         axis=first.axis or (axis_config.name if axis_config is not None else ""),
-                         source=first.source, attrs=attrs, dataset=first.dataset or "", half_width=half_width,
-                         load_bounds=load_bounds, outside=outside)
+    tally = ProcessTally()
+    parts = [part for run in runs
+             for part in process_blocks(model, [run], sample_time=run.sample_time, axis_config=axis_config,
+                                        interval=interval, chunk_s=chunk_s, tally=tally,
+                                        progress=None if progress is None else step)]
+    attrs = process_attrs(model, axis_config=axis_config, interval=interval, chunk_s=chunk_s,
+                          motion=runs[0].motion, effort_unit=runs[0].effort_unit, tally=tally,
+                          runs=[{"start_s": float(run.time[0]), "samples": len(run)} for run in runs])
+    return join_results(parts, attrs)

@@ -27,17 +27,20 @@ back given a column mapping for the effort, e.g.
 from __future__ import annotations
 
 import json
+import os
+import tempfile
 from pathlib import Path
+from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
 from ..atomic import atomic_output, check_output_path
 from ..data.file_metadata import sidecar_path, sidecar_text
 from ..errors import GreyboxError
-from .process import ProcessResult
+from .process import ProcessResult, join_results
 
 __all__ = ["OUTPUT_FORMATS", "PROCESS_SCHEMA_NAME", "output_format", "output_paths", "check_output_path",
-           "write_process"]
+           "write_process", "write_process_blocks"]
 
 #: Output formats by file extension.
 OUTPUT_FORMATS = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet", ".mcap": "mcap"}
@@ -92,23 +95,63 @@ def _metadata(result: ProcessResult) -> dict:
     return {"axis": result.axis, "dataset": result.dataset, "effort_unit": result.effort_unit, "attrs": result.attrs}
 
 
-def _write_csv(result: ProcessResult, path) -> None:
-    columns = result.columns()
+def _csv_rows(columns: dict, stream) -> None:
+    text = [values.tolist() for values in columns.values()]
+    template = ",".join(["%r"] * len(columns)) + "\n"
+    for row in zip(*text):
+        stream.write(template % row)
+
+
+def _write_csv(results: Iterable[ProcessResult], path) -> ProcessResult | None:
+    """Write the blocks as one CSV table; return the last block (None for none)."""
+    last = None
     with open(path, "w", encoding="utf-8", newline="") as stream:
-        stream.write(",".join(columns) + "\n")
-        text = [values.tolist() for values in columns.values()]
-        template = ",".join(["%r"] * len(columns)) + "\n"
-        for row in zip(*text):
-            stream.write(template % row)
+        for last in results:
+            columns = last.columns()
+            if stream.tell() == 0:
+                stream.write(",".join(columns) + "\n")
+            _csv_rows(columns, stream)
+    return last
 
 
-def _write_parquet(result: ProcessResult, path) -> None:
+def _arrow_table(result: ProcessResult, metadata: dict | None = None):
     import pyarrow as pa
+
+    return pa.table({name: np.asarray(values, dtype=np.float64) for name, values in result.columns().items()},
+                    metadata=None if metadata is None else {b"greybox": json.dumps(metadata).encode()})
+
+
+def _write_parquet(results: Iterable[ProcessResult], path, metadata: Callable[[], dict]) -> None:
+    """Write the blocks as row groups; the metadata (known once every block is through) in the schema.
+
+    The schema metadata of a Parquet file is fixed when its writer starts, so the blocks go to a
+    hidden temporary file first and are then copied row group by row group into ``path`` under the
+    complete schema.
+    """
     import pyarrow.parquet as pq
 
-    table = pa.table({name: np.asarray(values, dtype=np.float64) for name, values in result.columns().items()},
-                     metadata={b"greybox": json.dumps(_metadata(result)).encode()})
-    pq.write_table(table, path, compression="zstd")
+    handle, staging = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(path)), prefix=".blocks.", suffix=".tmp")
+    os.close(handle)
+    try:
+        writer = None
+        try:
+            for result in results:
+                table = _arrow_table(result)
+                if writer is None:
+                    writer = pq.ParquetWriter(staging, table.schema, compression="zstd")
+                writer.write_table(table)
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            raise GreyboxError(f"{path}: nothing to write")
+        source = pq.ParquetFile(staging)
+        schema = source.schema_arrow.with_metadata({b"greybox": json.dumps(metadata()).encode()})
+        with pq.ParquetWriter(str(path), schema, compression="zstd") as final:
+            for index in range(source.num_row_groups):
+                final.write_table(source.read_row_group(index).replace_schema_metadata(schema.metadata))
+    finally:
+        os.unlink(staging)
 
 
 def _schema(fields) -> dict:
@@ -123,9 +166,15 @@ def _schema(fields) -> dict:
     }
 
 
-def _write_mcap(result: ProcessResult, path) -> None:
+def _write_mcap(results: Iterable[ProcessResult], path, metadata: Callable[[], dict]) -> None:
+    """Write the result as MCAP; the channel's metadata come first, so the blocks are joined first."""
     from mcap.writer import CompressionType, Writer
 
+    parts = list(results)
+    if not parts:
+        raise GreyboxError(f"{path}: nothing to write")
+    described = metadata()
+    result = join_results(parts, described["attrs"]) if len(parts) > 1 else parts[0]
     columns = result.columns()
     time = columns.pop("time_s")
     if time.size and time.min() < 0:
@@ -133,7 +182,6 @@ def _write_mcap(result: ProcessResult, path) -> None:
     template = "{" + ",".join(json.dumps(name).replace("%", "%%") + ":%r" for name in columns) + "}"
     rows = zip(*(values.tolist() for values in columns.values()))
     stamps = np.rint(time * 1e9).astype(np.uint64).tolist()
-    metadata = _metadata(result)
     with open(path, "wb") as stream:
         writer = Writer(stream, compression=CompressionType.ZSTD)
         writer.start(profile="", library="greybox")
@@ -142,13 +190,10 @@ def _write_mcap(result: ProcessResult, path) -> None:
         channel_id = writer.register_channel(
             f"/process/{result.axis}" if result.axis else "/process", "json", schema_id,
             {"axis": result.axis, "dataset": result.dataset, "effort_unit": result.effort_unit,
-             "attrs": json.dumps(metadata["attrs"])})
+             "attrs": json.dumps(described["attrs"])})
         for stamp, row in zip(stamps, rows):
             writer.add_message(channel_id, stamp, (template % row).encode(), stamp)
         writer.finish()
-
-
-_WRITERS = {"csv": _write_csv, "parquet": _write_parquet, "mcap": _write_mcap}
 
 
 def write_process(result: ProcessResult, path, *, overwrite: bool = False, protect=()) -> Path:
@@ -173,22 +218,61 @@ def write_process(result: ProcessResult, path, *, overwrite: bool = False, prote
     Raises
     ------
     GreyboxError
-        For an unknown extension, non-finite values, an existing file (or
-        sidecar) without ``overwrite``, a protected file, or a missing directory.
+        See :func:`write_process_blocks`.
+    """
+    return write_process_blocks([result], path, metadata=lambda: _metadata(result), overwrite=overwrite,
+                                protect=protect)
+
+
+def write_process_blocks(results: Iterable[ProcessResult], path, *, metadata: Callable[[], dict],
+                         overwrite: bool = False, protect=()) -> Path:
+    """Write a process table given block by block, atomically, holding one block at a time (CSV, Parquet).
+
+    Parameters
+    ----------
+    results : iterable of ProcessResult
+        Consecutive blocks of one result (:func:`greybox.evaluate.process.process_blocks`); taken one at
+        a time, so that a generator computes each block as it is written.
+    path : str or path-like
+        Output file (.csv, .parquet/.pq or .mcap; an MCAP file is written once all blocks are in).
+    metadata : callable
+        ``metadata()`` gives ``{"axis", "dataset", "effort_unit", "attrs"}`` once every block is through.
+    overwrite, protect
+        As :func:`write_process`.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    GreyboxError
+        For an unknown extension, non-finite values, an existing file (or sidecar) without ``overwrite``,
+        a protected file, or a missing directory; nothing is left behind then, and an older ``path`` is kept.
     """
     path = Path(path)
     fmt = output_format(path)
     for target in output_paths(path):
         check_output_path(target, overwrite=overwrite, protect=protect)
-    for name, values in result.columns().items():
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raise GreyboxError(f"{path}: column '{name}' is not finite at sample {bad[0]}")
+    checked = _finite(results, path)
     if fmt == "csv":
         with atomic_output(path) as temporary, atomic_output(sidecar_path(path)) as side:
-            _write_csv(result, str(temporary))
-            side.write_text(sidecar_text(_metadata(result)), encoding="utf-8")
+            if _write_csv(checked, str(temporary)) is None:
+                raise GreyboxError(f"{path}: nothing to write")
+            side.write_text(sidecar_text(metadata()), encoding="utf-8")
         return path
     with atomic_output(path) as temporary:
-        _WRITERS[fmt](result, str(temporary))
+        (_write_parquet if fmt == "parquet" else _write_mcap)(checked, str(temporary), metadata)
     return path
+
+
+def _finite(results: Iterable[ProcessResult], path) -> Iterator[ProcessResult]:
+    """The blocks, each checked for non-finite values (the message counts samples from the first block)."""
+    offset = 0
+    for result in results:
+        for name, values in result.columns().items():
+            bad = np.flatnonzero(~np.isfinite(values))
+            if bad.size:
+                raise GreyboxError(f"{path}: column '{name}' is not finite at sample {offset + bad[0]}")
+        offset += len(result.time)
+        yield result

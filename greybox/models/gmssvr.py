@@ -53,7 +53,6 @@ from ..errors import LogError, ParameterError
 from ..estimator import check_runs
 from ..friction.gms import GMSModel
 from ..identify.progress import make_progress
-from .chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from .svr import KernelRegressionModel
 
 __all__ = ["GMSSVRModel", "TARGETS"]
@@ -289,12 +288,12 @@ class GMSSVRModel(KernelRegressionModel):
         gms_current, z, _, end = self.gms_.trajectory(run, state, sample_time=sample_time)
         return np.column_stack((run.position, gms_current, z)), end
 
-    def _input_chunks(self, run: AxisLog):
-        """The inputs chunk by chunk (the GMS state carried across), so that memory stays bounded."""
-        state = self.initial_state()
-        for samples in chunk_slices(len(run), samples_per_chunk(run.sample_time, DEFAULT_CHUNK_S)):
-            X, state = self._inputs(run.select(samples), state, run.sample_time)
-            yield X
+    def _inputs_chunk(self, run: AxisLog, state, sample_time: float):
+        return self._inputs(run, state, sample_time)
+
+    def region_state(self):
+        """The GMS stage's state at the start of a run: the SVR inputs hold its element deflections."""
+        return self.gms_.initial_state()
 
     def initial_state(self):
         """State of the frozen GMS stage at the start of a run (all elements at rest)."""

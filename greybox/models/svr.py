@@ -44,6 +44,7 @@ from ..identify.cv import blocked_folds
 from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_seed
 from ..identify.progress import ProgressEvent
+from .chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from .rbf import rbf_expansion
 from .subset import coverage_subset
 
@@ -367,7 +368,7 @@ class KernelRegressionModel(CurrentModel):
     ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_``,
     ``n_train_`` and ``input_range_`` (the lowest and highest value of each
     input over the training data, shape (2, n_features)), and evaluates it.
-    A subclass gives the inputs of a whole run by ``_input_chunks(run)``.
+    A subclass gives the inputs of a chunk of a run by ``_inputs_chunk(run, state, sample_time)``.
     """
 
     def _check_params(self) -> None:
@@ -411,19 +412,28 @@ class KernelRegressionModel(CurrentModel):
         self.n_train_ = fit.n_train
         self.input_range_ = np.vstack((np.min(X, axis=0), np.max(X, axis=0)))
 
-    def _input_chunks(self, run: AxisLog):  # pragma: no cover - abstract
-        """Raw SVR inputs of one whole run, in consecutive chunks of shape (n_chunk, n_features)."""
+    def _inputs_chunk(self, run: AxisLog, state, sample_time: float):  # pragma: no cover - abstract
+        """Raw SVR inputs of a chunk of a run, shape (n, n_features), and the state after it."""
         raise NotImplementedError
 
     def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
         """As :meth:`CurrentModel.outside_training <greybox.estimator.CurrentModel.outside_training>`, with
-        ``"inputs"``: True where any SVR input lies outside its range over the training data."""
-        out = super().outside_training(log)
+        ``"inputs"``: True where any SVR input lies outside its range over the training data. Computed
+        in chunks, so that the inputs of a long run need not be held at once."""
+        state, parts = self.region_state(), []
+        for samples in chunk_slices(len(log), samples_per_chunk(log.sample_time, DEFAULT_CHUNK_S)):
+            flags, state = self.outside_training_chunk(log.select(samples), state, sample_time=log.sample_time)
+            parts.append(flags)
+        return {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
+
+    def outside_training_chunk(self, log: AxisLog, state, *, sample_time: float):
+        out, _ = super().outside_training_chunk(log, state, sample_time=sample_time)
         ranges = getattr(self, "input_range_", None)  # None: a file that predates the record
-        if ranges is not None:
-            out["inputs"] = np.concatenate([np.any((X < ranges[0]) | (X > ranges[1]), axis=1)
-                                            for X in self._input_chunks(log)])
-        return out
+        if ranges is None:
+            return out, state
+        X, state = self._inputs_chunk(log, state, sample_time)
+        out["inputs"] = np.any((X < ranges[0]) | (X > ranges[1]), axis=1)
+        return out, state
 
     def _kernel_predict(self, X) -> np.ndarray:
         """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
@@ -558,8 +568,8 @@ class SVRCurrentModel(KernelRegressionModel):
     def _inputs(self, run: AxisLog) -> np.ndarray:
         return np.column_stack((run.position, run.velocity))
 
-    def _input_chunks(self, run: AxisLog):
-        yield self._inputs(run)
+    def _inputs_chunk(self, run: AxisLog, state, sample_time: float):
+        return self._inputs(run), state
 
     def _fit_runs(self, runs, progress) -> None:
         self.J_, self.offset_ = inertia_offset_proxy(runs, self.inertia)
