@@ -154,21 +154,29 @@ def _interval(args: argparse.Namespace, model, read):
 
 def _print_result(result, args: argparse.Namespace, interval, axis_file: str | None) -> None:
     """The console lines of one axis's result: effort, load, extrapolation and interval."""
-    unit = result.effort_unit
-    units = result.units
+    from ..evaluate.process import ProcessTally
+
+    tally = ProcessTally()
+    tally.add(result)
+    _print_figures(tally, result.effort_unit, result.units, result.load_constants, result.attrs["extrapolation"],
+                   args, interval, axis_file)
+
+
+def _print_figures(tally, unit: str, units, load_constants, extrapolation: dict, args: argparse.Namespace,
+                   interval, axis_file: str | None) -> None:
+    """The console lines of one axis's figures (a :class:`~greybox.evaluate.process.ProcessTally`)."""
     noun = "current" if unit == "A" else units.load
-    process = result.process
-    print(f"  {noun:<8} rms measured {_rms(result.measured):.4g} {unit}, model {_rms(result.model):.4g} "
-          f"{unit}, process {_rms(process):.4g} {unit}, largest |process| {np.max(np.abs(process)):.4g} {unit}")
-    if unit == "A" and result.load is not None:
-        driving, backdriven = result.load_constants
+    print(f"  {noun:<8} rms measured {tally.rms('measured'):.4g} {unit}, model {tally.rms('model'):.4g} "
+          f"{unit}, process {tally.rms('process'):.4g} {unit}, largest |process| {tally.largest['process']:.4g} {unit}")
+    if unit == "A" and load_constants is not None:
+        driving, backdriven = load_constants
         per_ampere = f"{units.load_unit}/A"
         factors = (f"{driving:.6g} {per_ampere}" if driving == backdriven
                    else f"{driving:.6g} {per_ampere} driving, {backdriven:.6g} {per_ampere} back-driven")
-        print(f"  {units.load:<8} rms process {_rms(result.load):.4g} {units.load_unit}, "
-              f"largest |process| {np.max(np.abs(result.load)):.4g} {units.load_unit} "
+        print(f"  {units.load:<8} rms process {tally.rms('load'):.4g} {units.load_unit}, "
+              f"largest |process| {tally.largest['load']:.4g} {units.load_unit} "
               f"({factors} from {axis_file})")
-    _report_extrapolation(result.attrs["extrapolation"], Path(args.log).name)
+    _report_extrapolation(extrapolation, Path(args.log).name)
     if interval is not None:
         from ..evaluate.interval import MIN_CLASS_SAMPLES
 
@@ -178,7 +186,7 @@ def _print_result(result, args: argparse.Namespace, interval, axis_file: str | N
                            for name, value in interval.half_width_A.items())
         print(f"  interval {100 * interval.coverage:g} % (split conformal per regime on "
               f"{sum(interval.samples.values())} air-cut samples of {len(args.calibration)} log(s)): "
-              f"half-width [{unit}] {widths}; mean {np.mean(result.half_width):.3g} {unit}")
+              f"half-width [{unit}] {widths}; mean {tally.half_width_sum / tally.n_samples:.3g} {unit}")
 
 
 def _is_fleet(args: argparse.Namespace) -> bool:
@@ -210,6 +218,9 @@ def run(args: argparse.Namespace) -> int:
     out = _check_outputs(args, inputs)
     config = read_axis_config(args.axis_config) if args.axis_config else None
     model = load_model(args.model)
+    streamed = _streamed_log(args, config)
+    if streamed is not None:
+        return _run_streamed(args, model, streamed, config, out, inputs, run_started)
     runs = _read_runs(args, config.channels if config else {})
     log_time = np.concatenate([run.time for run in runs])
     window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
@@ -229,6 +240,54 @@ def run(args: argparse.Namespace) -> int:
     from ..evaluate.process_plot import plot_process
 
     _write_outputs(args, result, out, inputs, window, plot_process)
+    print(f"done in {time.perf_counter() - run_started:.2f} s wall (model {elapsed:.2f} s)")
+    return 0
+
+
+def _streamed_log(args: argparse.Namespace, config):
+    """The cutting log as a :class:`~greybox.data.stream.ParquetLog` when it is predicted block by block, else None.
+
+    A Parquet log of a linear axis with a time column, without --resample and --plot, is streamed: its
+    length then does not bound the memory (:mod:`greybox.data.stream`).
+    """
+    from ..data.stream import ParquetLog, can_stream
+
+    if args.plot or args.topic or not can_stream(args.log, sample_time=args.sample_time, resample=args.resample):
+        return None
+    from ..data.io import parse_column_mapping
+
+    columns = dict(config.channels if config else {})
+    if args.columns:
+        columns.update(parse_column_mapping(args.columns))
+    log = ParquetLog(args.log, columns=columns or None, axis=args.axis)
+    return log if log.motion == "linear" else None
+
+
+def _run_streamed(args: argparse.Namespace, model, log, config, out: Path, inputs: list, run_started: float) -> int:
+    """``greybox predict`` of a log read, predicted and written block by block."""
+    from ..data.quantities import MOTIONS
+    from ..evaluate.process_stream import stream_process
+
+    interval = _interval(args, model, lambda path: _read_runs(args, config.channels if config else {}, path))
+    started = time.perf_counter()
+    span = log.time_span()
+    done = stream_process(model, log, out, axis_config=config, interval=interval, chunk_s=args.chunk_s,
+                          tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz,
+                          attrs={"model_file": str(args.model), "log_file": str(args.log)},
+                          overwrite=args.force, protect=inputs, progress=_progress(span[1], args.quiet))
+    elapsed = time.perf_counter() - started
+    attrs = done.metadata["attrs"]
+    dataset = done.metadata["dataset"]
+    print(f"predicted {Path(args.log).name} with the {attrs['model_kind']} model {Path(args.model).name}: "
+          f"{done.tally.n_samples} samples, {done.duration:.1f} s, {done.n_chunks} chunk(s) of {args.chunk_s:g} s"
+          + (f", dataset {dataset}" if dataset else "") + ", read and written block by block")
+    load_constants = config.load_constants if config is not None and done.metadata["effort_unit"] == "A" else None
+    _print_figures(done.tally, done.metadata["effort_unit"], MOTIONS[done.motion], load_constants,
+                   attrs["extrapolation"], args, interval, Path(args.axis_config).name if args.axis_config else None)
+    from ..evaluate.process_io import output_paths
+
+    for target in output_paths(out):
+        print(f"wrote {target}")
     print(f"done in {time.perf_counter() - run_started:.2f} s wall (model {elapsed:.2f} s)")
     return 0
 

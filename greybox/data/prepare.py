@@ -30,7 +30,8 @@ from ..errors import LogError
 from .log import AxisLog, as_log_list
 from .validate import check_finite, check_increasing, check_time, check_velocity_units
 
-__all__ = ["MAX_GAP_STEPS", "default_cutoff", "derive", "resample", "split_at_gaps", "trim", "prepare"]
+__all__ = ["MAX_GAP_STEPS", "default_cutoff", "derivative_filter", "derivative_margin", "derive", "resample",
+           "split_at_gaps", "trim", "prepare"]
 
 #: Default cut-off of the derivative filter for fast logs [Hz].
 DEFAULT_CUTOFF_HZ = 50.0
@@ -47,7 +48,71 @@ def _lowpass(values: np.ndarray, sos: np.ndarray) -> np.ndarray:
     return sosfiltfilt(sos, values)
 
 
-def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4, tolerance: float = 0.25) -> AxisLog:
+def derivative_filter(sample_time: float, *, cutoff_hz: float | None = None, order: int = 4,
+                      source=None) -> tuple[np.ndarray, float]:
+    """The low-pass of :func:`derive`: Butterworth second-order sections and the cut-off [Hz].
+
+    Parameters
+    ----------
+    sample_time : float
+        Nominal sample time [s].
+    cutoff_hz : float, optional
+        Cut-off [Hz]; default :func:`default_cutoff`.
+    order : int, default 4
+        Butterworth order.
+    source : str, optional
+        Log named in the error message.
+
+    Raises
+    ------
+    LogError
+        For a cut-off not between 0 and the Nyquist frequency.
+    """
+    from scipy.signal import butter
+
+    nyquist = 0.5 / sample_time
+    cutoff = default_cutoff(sample_time) if cutoff_hz is None else float(cutoff_hz)
+    if not 0.0 < cutoff < nyquist:
+        raise LogError(source, f"filter cut-off {cutoff:g} Hz must lie between 0 and the Nyquist frequency "
+                               f"{nyquist:g} Hz")
+    if int(order) != order or order < 1:
+        raise ValueError(f"filter order must be a positive integer, got {order!r}")
+    return butter(int(order), cutoff, fs=1.0 / sample_time, output="sos"), cutoff
+
+
+#: Relative size below which the edge transient of the derivative filter counts as gone.
+_SETTLED = 1e-18
+
+
+def derivative_margin(sample_time: float, *, cutoff_hz: float | None = None, order: int = 4) -> int:
+    """Samples on each side of a stretch of a log that make :func:`derive` inside it the whole log's result.
+
+    The forward-backward filter starts from the values at the ends of what it is given; the transient
+    of that start decays with the slowest pole ``r`` of the filter as ``r^k`` over ``k`` samples. With
+    this many samples beyond each end of the stretch (or the log's own end), it has decayed below
+    ``1e-18`` of the signal by the time it reaches the stretch (plus the two samples of the central
+    differences).
+
+    Parameters
+    ----------
+    sample_time : float
+        Nominal sample time [s].
+    cutoff_hz : float, optional
+        Cut-off [Hz]; default :func:`default_cutoff`.
+    order : int, default 4
+        Butterworth order.
+
+    Returns
+    -------
+    int
+    """
+    sos, _ = derivative_filter(sample_time, cutoff_hz=cutoff_hz, order=order)
+    slowest = max(float(np.max(np.abs(np.roots(section[3:])))) for section in sos)
+    return int(np.ceil(np.log(_SETTLED) / np.log(slowest))) + 2
+
+
+def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4, tolerance: float = 0.25,
+           sample_time: float | None = None) -> AxisLog:
     """Fill in velocity and acceleration where the log lacks them.
 
     Without logged velocity, the position is low-pass filtered (zero-phase
@@ -67,6 +132,9 @@ def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4, tole
         Butterworth order (the forward-backward run doubles the attenuation).
     tolerance : float, default 0.25
         Time-step tolerance of the uniformity check (see :func:`check_time`).
+    sample_time : float, optional
+        Nominal step [s] of the whole log when ``log`` is a stretch of it whose time steps have been
+        checked already (:mod:`greybox.data.stream`); default: checked here, the median step.
 
     Returns
     -------
@@ -82,18 +150,10 @@ def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4, tole
     """
     if log.is_prepared:
         return log
-    from scipy.signal import butter
-
     source = log.source or None
-    sample_time = check_time(log.time, source=source, tolerance=tolerance)
-    nyquist = 0.5 / sample_time
-    cutoff = default_cutoff(sample_time) if cutoff_hz is None else float(cutoff_hz)
-    if not 0.0 < cutoff < nyquist:
-        raise LogError(source, f"filter cut-off {cutoff:g} Hz must lie between 0 and the Nyquist frequency "
-                               f"{nyquist:g} Hz")
-    if int(order) != order or order < 1:
-        raise ValueError(f"filter order must be a positive integer, got {order!r}")
-    sos = butter(int(order), cutoff, fs=1.0 / sample_time, output="sos")
+    if sample_time is None:
+        sample_time = check_time(log.time, source=source, tolerance=tolerance)
+    sos, cutoff = derivative_filter(sample_time, cutoff_hz=cutoff_hz, order=order, source=source)
     needed = 3 * (2 * sos.shape[0] + 1) + 1
     if len(log) < needed:
         raise LogError(source, f"the log has {len(log)} samples; the {order}th-order filter needs at least {needed}")

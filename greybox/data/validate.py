@@ -38,7 +38,7 @@ UNIT_SLIPS = {"linear": _LINEAR_SLIPS, "rotary": _ROTARY_SLIPS}
 _SLIP_TOLERANCE = 0.15
 
 
-def check_time(time, *, source=None, tolerance: float = 0.25) -> float:
+def check_time(time, *, source=None, tolerance: float = 0.25, nominal: float | None = None, start: int = 0) -> float:
     """Check that sample times are finite, strictly increasing and uniform.
 
     Parameters
@@ -50,11 +50,15 @@ def check_time(time, *, source=None, tolerance: float = 0.25) -> float:
     tolerance : float, default 0.25
         Allowed deviation of a time step from the nominal (median) step, as a
         fraction of it. A longer step is reported as a gap, a shorter one as jitter.
+    nominal : float, optional
+        Nominal step [s] of a whole log of which ``time`` is a stretch (default: the median step of ``time``).
+    start : int, default 0
+        Index in the whole log of ``time[0]``, for the sample numbers in the messages.
 
     Returns
     -------
     float
-        Nominal sample time [s]: the median time step.
+        Nominal sample time [s]: the median time step (or ``nominal``).
 
     Raises
     ------
@@ -66,8 +70,8 @@ def check_time(time, *, source=None, tolerance: float = 0.25) -> float:
     if not 0.0 < tolerance < 1.0:
         raise ValueError(f"tolerance must lie in (0, 1), got {tolerance!r}")
     time = np.asarray(time, dtype=np.float64)
-    steps = check_increasing(time, source=source)
-    nominal = float(np.median(steps))
+    steps = check_increasing(time, source=source, start=start)
+    nominal = float(np.median(steps)) if nominal is None else float(nominal)
     off = np.flatnonzero(np.abs(steps - nominal) > tolerance * nominal)
     if off.size:
         k = int(off[0])
@@ -87,7 +91,7 @@ def check_time(time, *, source=None, tolerance: float = 0.25) -> float:
     return nominal
 
 
-def check_increasing(time, *, source=None) -> np.ndarray:
+def check_increasing(time, *, source=None, start: int = 0) -> np.ndarray:
     """Check that there are at least 2 sample times, finite and strictly increasing; return the steps [s].
 
     Parameters
@@ -96,6 +100,8 @@ def check_increasing(time, *, source=None) -> np.ndarray:
         Sample times [s].
     source : str or path-like, optional
         File the times came from, named in the error message.
+    start : int, default 0
+        Index in the whole log of ``time[0]``, for the sample numbers in the messages.
 
     Returns
     -------
@@ -114,24 +120,28 @@ def check_increasing(time, *, source=None) -> np.ndarray:
     bad = np.flatnonzero(~np.isfinite(time))
     if bad.size:
         k = int(bad[0])
-        raise LogError(source, f"time holds {time[k]} at sample {k}")
+        raise LogError(source, f"time holds {time[k]} at sample {k + start}")
     steps = np.diff(time)
     nonpositive = np.flatnonzero(steps <= 0.0)
     if nonpositive.size:
         k = int(nonpositive[0]) + 1
         if steps[k - 1] == 0.0:
-            raise LogError(source, f"time repeats at sample {k}: t = {time[k]:.9g} s twice")
-        raise LogError(source, f"time goes backwards at sample {k}: t = {time[k]:.9g} s after {time[k - 1]:.9g} s")
+            raise LogError(source, f"time repeats at sample {k + start}: t = {time[k]:.9g} s twice")
+        raise LogError(source, f"time goes backwards at sample {k + start}: t = {time[k]:.9g} s after "
+                               f"{time[k - 1]:.9g} s")
     return steps
 
 
-def check_finite(log: AxisLog) -> None:
+def check_finite(log: AxisLog, *, start: int | None = None) -> None:
     """Check that every channel of a log holds finite values only.
 
     Parameters
     ----------
     log : AxisLog
         The log to check (time is checked by :func:`check_time`).
+    start : int, optional
+        When ``log`` is a stretch of a longer log read block by block: the index of its first sample
+        there (for the sample number in the message, which then counts the bad values of the stretch).
 
     Raises
     ------
@@ -143,10 +153,11 @@ def check_finite(log: AxisLog) -> None:
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             k = int(bad[0])
+            where = "in all" if start is None else f"in samples {start} to {start + len(log) - 1}"
             raise LogError(
                 log.source or None,
-                f"channel '{name}' holds {values[k]} at t = {log.time[k]:.9g} s (sample {k}; "
-                f"{bad.size} non-finite value{'s' if bad.size != 1 else ''} in all)",
+                f"channel '{name}' holds {values[k]} at t = {log.time[k]:.9g} s (sample {k + (start or 0)}; "
+                f"{bad.size} non-finite value{'s' if bad.size != 1 else ''} {where})",
             )
 
 

@@ -1,0 +1,339 @@
+"""Logs of any length, read and prepared block by block in bounded memory.
+
+A log of an hour at 500 Hz holds 1.8 million samples; a plant keeps logs of a shift or a day. For a
+Parquet log of one linear axis with a time column, :func:`prepared_blocks` gives the same prepared run
+as :func:`greybox.data.io.read_log` followed by :func:`greybox.data.prepare.prepare`, in consecutive
+blocks, while holding only a few blocks at a time. It reads the file three times:
+
+1. the time column: finite and strictly increasing (the error names the sample), and the time steps
+   counted by the upper 32 bits of their floating-point pattern (for positive numbers the order of the
+   patterns is the order of the numbers);
+2. the time column again: the steps in the one or two counts that hold the middle of the sorted steps,
+   counted by value, which gives the exact median step, the nominal sample time that the whole-log
+   preparation takes (:attr:`greybox.data.log.AxisLog.sample_time`);
+3. every column, block by block: steps within the tolerance of the nominal step, finite values, the
+   velocity's unit (:func:`~greybox.data.validate.check_velocity_units`, block by block), and the
+   derivatives of :func:`~greybox.data.prepare.derive` over the block with
+   :func:`~greybox.data.prepare.derivative_margin` samples of its neighbours on each side, so that the
+   forward-backward filter sees enough of the log to give, inside the block, the whole-log result.
+
+Other logs (CSV, MCAP, TDMS, MATLAB, rotary axes, logs without a time column, logs to be resampled)
+are read whole: :func:`can_stream` says which are streamed.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Iterable, Iterator, Mapping
+
+import numpy as np
+
+from ..errors import LogError
+from .file_metadata import metadata_fields, parse_metadata
+from .log import AxisLog
+from .prepare import derivative_margin, derive
+from .units import log_from_columns, resolve_columns, select_axis
+from .validate import check_finite, check_increasing, check_time, check_velocity_units
+
+__all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "can_stream", "concatenate", "median_step",
+           "prepared_blocks"]
+
+#: Samples per block (4 min 22 s at 2 ms).
+DEFAULT_BLOCK_SAMPLES = 1 << 15
+
+#: File extensions of the logs read block by block.
+STREAM_SUFFIXES = (".parquet", ".pq")
+
+_METADATA_KEY = b"greybox"
+
+#: Bytes read from the file at a time.
+_READ_BUFFER_BYTES = 1 << 20
+
+
+def can_stream(path, *, sample_time: float | None = None, resample: float | None = None) -> bool:
+    """Whether :class:`ParquetLog` reads ``path`` block by block with these read options.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Log file.
+    sample_time : float, optional
+        The ``--sample-time`` of a log without time column (then the log is read whole).
+    resample : float, optional
+        The ``--resample`` step (then the log is read whole).
+    """
+    return (os.path.splitext(os.fspath(path))[1].lower() in STREAM_SUFFIXES and sample_time is None
+            and resample is None)
+
+
+def concatenate(blocks: Iterable[AxisLog]) -> AxisLog:
+    """One log of consecutive blocks of the same log (channels joined; names and attrs of the first).
+
+    Raises
+    ------
+    ValueError
+        For no block at all.
+    """
+    blocks = list(blocks)
+    if not blocks:
+        raise ValueError("no block to join")
+    if len(blocks) == 1:
+        return blocks[0]
+    first = blocks[0]
+
+    def joined(name):
+        values = [getattr(block, name) for block in blocks]
+        return None if values[0] is None else np.concatenate(values)
+
+    return first.replace(time=joined("time"), position=joined("position"), effort=joined("effort"),
+                         velocity=joined("velocity"), acceleration=joined("acceleration"),
+                         extras={name: np.concatenate([block.extras[name] for block in blocks])
+                                 for name in first.extras})
+
+
+class ParquetLog:
+    """A Parquet axis log read in blocks of rows, converted as :func:`greybox.data.io.read_log` converts it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Parquet file with a time column.
+    columns : mapping of str to str, optional
+        ``{canonical_name: column}`` for columns not named by the convention.
+    axis : str, optional
+        Axis to read from a file holding several (columns ``<axis>_<quantity>_<unit>``).
+    block_samples : int, default :data:`DEFAULT_BLOCK_SAMPLES`
+        Rows per block.
+
+    Attributes
+    ----------
+    n_samples : int
+        Rows in the file.
+    motion : str
+        "linear" or "rotary", from the units of the columns.
+
+    Raises
+    ------
+    LogError
+        For a file that is not Parquet, holds no rows, lacks required columns or a time column.
+    """
+
+    def __init__(self, path, *, columns: Mapping[str, str] | None = None, axis: str | None = None,
+                 block_samples: int = DEFAULT_BLOCK_SAMPLES):
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        self.path = os.fspath(path)
+        self.columns = dict(columns) if columns else None
+        self.axis = axis
+        self.block_samples = int(block_samples)
+        try:
+            # column chunks read through a small buffer: a row group need not fit in memory at once
+            self._file = pq.ParquetFile(self.path, pre_buffer=False, buffer_size=_READ_BUFFER_BYTES)
+        except (pa.ArrowException, OSError) as exc:
+            raise LogError(self.path, f"not a readable Parquet file ({str(exc).strip().splitlines()[0]})") from None
+        self.n_samples = self._file.metadata.num_rows
+        if self.n_samples == 0:
+            raise LogError(self.path, "no data rows")
+        raw = (self._file.schema_arrow.metadata or {}).get(_METADATA_KEY)
+        self._metadata = metadata_fields(parse_metadata(raw, self.path, "the greybox schema metadata")
+                                         if raw else {}, axis)
+        names = self._file.schema_arrow.names
+        shapes = {name: np.empty(0) for name in names}
+        selected = select_axis(shapes, axis, source=self.path, columns=self.columns) if axis is not None else shapes
+        found, self.motion = resolve_columns(
+            [name for name in selected if name and not str(name).startswith("Unnamed: ")], source=self.path,
+            columns=self.columns, effort_unit=self._metadata.get("effort_unit"))
+        if "time" not in found:
+            raise LogError(self.path, "no time column (time_s or time_ms, or map one with columns={'time_s': ...}); "
+                                      "for logs without time stamps give the sample time (--sample-time)")
+        self._time_column, self._time_factor = found["time"]
+
+    def times(self) -> Iterator[np.ndarray]:
+        """The time column [s], block by block."""
+        for batch in self._file.iter_batches(batch_size=self.block_samples, columns=[self._time_column]):
+            values = np.asarray(batch.column(0).to_numpy(zero_copy_only=False), dtype=np.float64)
+            yield values * self._time_factor if self._time_factor != 1.0 else values
+
+    def blocks(self, block_samples: int | None = None) -> Iterator[AxisLog]:
+        """The log, block by block (the last may be shorter), converted but not validated.
+
+        Parameters
+        ----------
+        block_samples : int, optional
+            Samples per block; default :attr:`block_samples`.
+        """
+        size = self.block_samples if block_samples is None else int(block_samples)
+        pending: list[AxisLog] = []
+        held = 0
+        ready = None  # a full block held back: a last piece of one sample joins it
+        for batch in self._file.iter_batches(batch_size=size):
+            pending.append(self._convert(batch))
+            held += len(pending[-1])
+            while held >= size:
+                whole = concatenate(pending)
+                if ready is not None:
+                    yield ready
+                ready = whole.select(slice(0, size))
+                rest = whole.select(slice(size, None))
+                pending, held = ([rest], len(rest)) if len(rest) else ([], 0)
+        rest = concatenate(pending) if held else None
+        if ready is not None and rest is not None and len(rest) < 2:
+            ready, rest = concatenate([ready, rest]), None
+        if ready is not None:
+            yield ready
+        if rest is not None:
+            yield rest
+
+    def time_span(self) -> tuple[float, float]:
+        """Times of the first and the last sample [s]."""
+        groups = self._file.metadata.num_row_groups
+        first = self._file.read_row_group(0, columns=[self._time_column]).column(0)
+        last = self._file.read_row_group(groups - 1, columns=[self._time_column]).column(0)
+        return (float(first[0].as_py()) * self._time_factor, float(last[-1].as_py()) * self._time_factor)
+
+    def _convert(self, batch) -> AxisLog:
+        import pyarrow as pa
+
+        arrays = {}
+        for name, column in zip(batch.schema.names, batch.columns):
+            kind = column.type
+            numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
+            arrays[name] = (column.to_numpy(zero_copy_only=False) if numeric
+                            else column.to_numpy(zero_copy_only=False).astype(object))
+        return log_from_columns(arrays, source=self.path, columns=self.columns, select=self.axis, **self._metadata)
+
+
+def _steps(times: Iterable[np.ndarray], source) -> Iterator[np.ndarray]:
+    """The time steps [s] of consecutive blocks of time stamps, checked strictly increasing and finite."""
+    last = None
+    index = 0
+    for time in times:
+        joined = time if last is None else np.concatenate(([last], time))
+        start = index if last is None else index - 1
+        if len(joined) < 2 and last is None:
+            last, index = (float(time[-1]) if len(time) else None), index + len(time)
+            continue
+        yield check_increasing(joined, source=source, start=start)
+        last = float(joined[-1])
+        index += len(time)
+    if index < 2:
+        check_increasing(np.full(index, 0.0), source=source)  # the message for a log of 0 or 1 samples
+
+
+def _add_counts(keys, counts, values):
+    """``keys`` and ``counts`` with the distinct ``values`` counted in."""
+    new_keys, new_counts = np.unique(values, return_counts=True)
+    if keys is None:
+        return new_keys, new_counts
+    merged, inverse = np.unique(np.concatenate((keys, new_keys)), return_inverse=True)
+    return merged, np.bincount(inverse, weights=np.concatenate((counts, new_counts))).astype(np.int64)
+
+
+def _value_at(keys, counts, rank: int):
+    """The ``rank``-th (0-based) of the sorted values counted in ``keys``/``counts``; and its bucket start."""
+    ends = np.cumsum(counts)
+    position = int(np.searchsorted(ends, rank, side="right"))
+    before = int(ends[position - 1]) if position else 0
+    return keys[position], rank - before
+
+
+def median_step(times, source=None) -> float:
+    """The median of the time steps of a log given block by block, exactly as :func:`numpy.median` gives it.
+
+    Parameters
+    ----------
+    times : callable
+        ``times()`` gives an iterator over the time stamps [s] block by block; it is called twice.
+    source : str, optional
+        Log named in error messages.
+
+    Returns
+    -------
+    float
+        Median step [s].
+
+    Raises
+    ------
+    LogError
+        For fewer than 2 samples, or times not finite and strictly increasing (the message names the sample).
+    """
+    keys = counts = None
+    n_steps = 0
+    for steps in _steps(times(), source):
+        keys, counts = _add_counts(keys, counts, steps.view(np.uint64) >> np.uint64(32))
+        n_steps += steps.size
+    middle = sorted({(n_steps - 1) // 2, n_steps // 2})
+    buckets = [_value_at(keys, counts, rank) for rank in middle]
+    wanted = np.array(sorted({bucket for bucket, _ in buckets}), dtype=np.uint64)
+    exact_keys = exact_counts = None
+    for steps in _steps(times(), source):
+        inside = steps[np.isin(steps.view(np.uint64) >> np.uint64(32), wanted)]
+        if inside.size:
+            exact_keys, exact_counts = _add_counts(exact_keys, exact_counts, inside)
+    # ranks inside the buckets, counted from the first wanted bucket
+    first = int(np.searchsorted(keys, wanted[0]))
+    offset = int(np.sum(counts[:first]))
+    values = [_value_at(exact_keys, exact_counts, rank - offset)[0] for rank in middle]
+    return float(values[0]) if len(values) == 1 else float(np.mean(values))
+
+
+def prepared_blocks(log: ParquetLog, *, tolerance: float = 0.25, cutoff_hz: float | None = None,
+                    sample_time: float | None = None, block_samples: int | None = None) -> Iterator[AxisLog]:
+    """The prepared run of a log, block by block: what :func:`greybox.data.prepare.prepare` gives for it whole.
+
+    Parameters
+    ----------
+    log : ParquetLog
+        The log.
+    tolerance : float, default 0.25
+        Time-step tolerance (see :func:`~greybox.data.validate.check_time`).
+    cutoff_hz : float, optional
+        Derivative-filter cut-off [Hz]; default :func:`~greybox.data.prepare.default_cutoff`.
+    sample_time : float, optional
+        The log's median step [s] if known (:func:`median_step`); computed otherwise.
+    block_samples : int, optional
+        Samples per block (default the log's); at least the filter's margin on each side.
+
+    Yields
+    ------
+    AxisLog
+        Consecutive prepared blocks (velocity and acceleration present).
+
+    Raises
+    ------
+    LogError
+        As :func:`greybox.data.io.read_log` and :func:`greybox.data.prepare.prepare` would for the whole log.
+    """
+    source = log.path
+    nominal = median_step(log.times, source) if sample_time is None else float(sample_time)
+    margin = derivative_margin(nominal, cutoff_hz=cutoff_hz)
+    tail: AxisLog | None = None  # the last `margin` samples before the current block
+    current: AxisLog | None = None
+    read = 0  # samples read before `block`
+    for block in log.blocks(max(log.block_samples if block_samples is None else block_samples, margin)):
+        if read:  # the step from the previous block's last sample counts too
+            check_time(np.concatenate(([current.time[-1]], block.time)), source=source, tolerance=tolerance,
+                       nominal=nominal, start=read - 1)
+        elif len(block) >= 2:
+            check_time(block.time, source=source, tolerance=tolerance, nominal=nominal)
+        check_finite(block, start=read)
+        check_velocity_units(block)
+        if current is not None:
+            yield _prepared(current, tail, block, margin, nominal, tolerance, cutoff_hz)
+            tail = concatenate([tail, current] if tail is not None else [current])
+            tail = tail.select(slice(max(0, len(tail) - margin), None))
+        current = block
+        read += len(block)
+    yield _prepared(current, tail, None, margin, nominal, tolerance, cutoff_hz)
+
+
+def _prepared(block: AxisLog, before: AxisLog | None, after: AxisLog | None, margin: int, nominal: float,
+              tolerance: float, cutoff_hz) -> AxisLog:
+    """``block`` prepared with up to ``margin`` samples of the log on each side."""
+    pieces = ([before] if before is not None else []) + [block]
+    if after is not None:
+        pieces.append(after.select(slice(0, margin)))
+    window = derive(concatenate(pieces), cutoff_hz=cutoff_hz, tolerance=tolerance, sample_time=nominal)
+    first = len(before) if before is not None else 0
+    return window.select(slice(first, first + len(block)))

@@ -1,0 +1,196 @@
+"""Logs read, prepared, predicted and written block by block equal the whole-log path."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+import greybox.cli as cli
+from greybox.data.io import read_log, write_log
+from greybox.data.prepare import derivative_margin, prepare
+from greybox.data.stream import ParquetLog, concatenate, median_step, prepared_blocks
+from greybox.errors import LogError
+from greybox.friction import GMSModel
+from greybox.models.gmssvr import GMSSVRModel
+from greybox.persistence import save_model
+from greybox.twin import make_dataset
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
+
+
+def _blocks_of(values: np.ndarray, size: int):
+    return lambda: (values[k:k + size] for k in range(0, len(values), size))
+
+
+@pytest.mark.parametrize("size", [1, 2, 7, 1000, 10_000])
+@pytest.mark.parametrize("kind", ["uniform", "jitter", "ns", "odd"])
+def test_median_step_is_numpys_median_of_the_steps(kind, size):
+    rng = np.random.default_rng(len(kind) + size)
+    n = {"uniform": 5000, "jitter": 5001, "ns": 4000, "odd": 3}[kind]
+    if kind == "uniform":
+        time = 12.5 + np.arange(n) * 0.002
+    elif kind == "jitter":
+        time = np.cumsum(0.002 * (1.0 + 0.2 * rng.uniform(-1, 1, n)))
+    elif kind == "ns":
+        time = np.cumsum(rng.integers(1_990_000, 2_010_000, n)) * 1e-9
+    else:
+        time = np.array([0.0, 0.5, 0.75])
+    assert median_step(_blocks_of(time, size)) == np.median(np.diff(time))
+
+
+def test_median_step_names_the_sample_where_time_goes_back():
+    time = np.arange(100) * 0.01
+    time[61] = time[60]
+    with pytest.raises(LogError, match="time repeats at sample 61"):
+        median_step(_blocks_of(time, 7), "log.parquet")
+    with pytest.raises(LogError, match="has 1 sample"):
+        median_step(_blocks_of(np.array([3.0]), 5))
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    root = tmp_path_factory.mktemp("stream")
+    cut = make_dataset("X", "C", seed=3, duration_s=40, cutting=True)  # logged velocity: acceleration derived
+    without_velocity = cut.replace(velocity=None)  # both derived from the position
+    paths = {"cut": root / "cut.parquet", "position_only": root / "position_only.parquet"}
+    write_log(cut, paths["cut"])
+    write_log(without_velocity, paths["position_only"])
+    return paths
+
+
+@pytest.mark.parametrize("name", ["cut", "position_only"])
+@pytest.mark.parametrize("cutoff_hz", [None, 2.0])
+def test_prepared_blocks_join_into_the_prepared_whole_log(logs, name, cutoff_hz):
+    path = logs[name]
+    (whole,) = prepare([read_log(path)], cutoff_hz=cutoff_hz)
+    stream = ParquetLog(path, block_samples=997)  # blocks end where the row groups do not
+    blocks = list(prepared_blocks(stream, cutoff_hz=cutoff_hz))
+    margin = derivative_margin(whole.sample_time, cutoff_hz=cutoff_hz)
+    assert len(blocks) == -(-len(whole) // max(997, margin))  # the margin of a low cut-off widens the blocks
+    joined = concatenate(blocks)
+    logged = ("time", "position", "effort") + (("velocity",) if name == "cut" else ())
+    for channel in logged:
+        np.testing.assert_array_equal(getattr(joined, channel), getattr(whole, channel))
+    # derived channels: the filter's rounding differs with where it starts (a low cut-off amplifies it),
+    # its result does not; without the margins the difference is 1e-3 of the scale (the test below)
+    for channel in ("velocity", "acceleration"):
+        scale = np.max(np.abs(getattr(whole, channel)))
+        assert np.max(np.abs(getattr(joined, channel) - getattr(whole, channel))) <= 1e-9 * scale
+    assert joined.extras.keys() == whole.extras.keys()
+    assert joined.attrs["derivative_filter"] == whole.attrs["derivative_filter"]
+
+
+def test_a_block_too_short_for_the_filter_margin_would_differ(logs):
+    """The margin matters: without it the blocks' derivatives differ from the whole log's near the seams."""
+    (whole,) = prepare([read_log(logs["cut"])])
+    from greybox.data.prepare import derive
+
+    stream = ParquetLog(logs["cut"], block_samples=997)
+    naive = concatenate([derive(block, sample_time=whole.sample_time) for block in stream.blocks()])
+    assert np.max(np.abs(naive.acceleration - whole.acceleration)) > 1e-3 * np.max(np.abs(whole.acceleration))
+
+
+def test_a_last_piece_of_one_sample_joins_the_block_before(tmp_path):
+    log = make_dataset("X", "A", seed=4, duration_s=6)
+    path = tmp_path / "odd.parquet"
+    write_log(log.select(slice(0, 2001)), path)
+    sizes = [len(block) for block in ParquetLog(path, block_samples=1000).blocks()]
+    assert sizes == [1000, 1001]
+
+
+@pytest.mark.parametrize(("damage", "message"), [
+    ("gap", "gap of"), ("nan", r"holds nan at t = .* \(sample 1500; 1 non-finite value in samples 1000 to 1999"),
+    ("backwards", "time goes backwards at sample 1000"),
+])
+def test_errors_name_the_sample_of_the_whole_log(tmp_path, damage, message):
+    log = make_dataset("X", "A", seed=5, duration_s=10)
+    time, effort = log.time.copy(), log.effort.copy()
+    if damage == "gap":
+        time[1500:] += 0.5
+    elif damage == "nan":
+        effort[1500] = np.nan
+    else:
+        time[1000] = time[998]
+    path = tmp_path / "damaged.parquet"
+    write_log(log.replace(time=time, effort=effort), path)
+    with pytest.raises(LogError, match=message):
+        list(prepared_blocks(ParquetLog(path, block_samples=1000)))
+
+
+# ------------------------------------------------------------------ greybox predict, streamed
+
+
+@pytest.fixture(autouse=True)
+def predict_registered(monkeypatch):
+    if "predict" not in cli.COMMANDS:
+        monkeypatch.setattr(cli, "COMMANDS", tuple(cli.COMMANDS) + ("predict",))
+
+
+@pytest.fixture(scope="module")
+def models(tmp_path_factory):
+    root = tmp_path_factory.mktemp("stream_models")
+    train = prepare([make_dataset("X", "A", seed=11, duration_s=30)])
+    gms = GMSModel(n_starts=1, max_iter=80).fit(train)
+    gmssvr = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=80), optimize=False, C=0.5, epsilon=0.02, gamma=3.0,
+                         n_subset=400).fit(train)
+    paths = {"gms": root / "gms.gbm", "gmssvr": root / "gmssvr.gbm"}
+    save_model(gms, paths["gms"])
+    save_model(gmssvr, paths["gmssvr"])
+    return paths
+
+
+def _table(path: Path):
+    if path.suffix == ".csv":
+        return pd.read_csv(path), json.loads(Path(str(path) + ".json").read_text())
+    return pd.read_parquet(path), json.loads(pq.read_schema(path).metadata[b"greybox"])
+
+
+@pytest.mark.parametrize("kind", ["gms", "gmssvr"])
+@pytest.mark.parametrize("suffix", [".parquet", ".csv"])
+def test_streamed_predict_writes_what_the_whole_log_gives(tmp_path, capsys, logs, models, kind, suffix):
+    """The same cutting log as Parquet (streamed) and as MCAP (read whole): equal tables and metadata."""
+    whole_log = tmp_path / "cut.mcap"
+    write_log(read_log(logs["cut"]), whole_log)
+    calibration = tmp_path / "air.mcap"
+    write_log(make_dataset("X", "C", seed=21, duration_s=20), calibration)
+    outputs = {}
+    for name, log in (("streamed", logs["cut"]), ("whole", whole_log)):
+        out = tmp_path / f"{name}{suffix}"
+        status = cli.main(["predict", str(models[kind]), str(log), "--out", str(out), "--axis-config", str(EXAMPLE),
+                           "--calibration", str(calibration), "--chunk-s", "7", "--quiet"])
+        printed = capsys.readouterr().out
+        assert status == 0
+        assert ("read and written block by block" in printed) == (name == "streamed")
+        outputs[name] = (_table(out), printed)
+    (streamed, streamed_meta), streamed_text = outputs["streamed"]
+    (whole, whole_meta), whole_text = outputs["whole"]
+    assert list(streamed.columns) == list(whole.columns)
+    assert "force_process_upper_N" in streamed.columns and "outside_training" in streamed.columns
+    for column in whole.columns:
+        np.testing.assert_allclose(streamed[column], whole[column], rtol=0, atol=1e-9)
+    for meta in (streamed_meta, whole_meta):
+        meta["attrs"].pop("log_file")
+    assert streamed_meta == whole_meta
+    figures = [line for line in whole_text.splitlines() if line.startswith("  ")]
+    assert figures and figures == [line for line in streamed_text.splitlines() if line.startswith("  ")]
+
+
+def test_streamed_predict_leaves_no_output_on_a_damaged_log(tmp_path, capsys, models):
+    log = make_dataset("X", "C", seed=6, duration_s=30, cutting=True)
+    effort = log.effort.copy()
+    effort[-10] = np.inf  # found in the last block, after earlier blocks were written
+    path = tmp_path / "late_damage.parquet"
+    write_log(log.replace(effort=effort), path)
+    out = tmp_path / "out.parquet"
+    out.write_text("an older output")
+    status = cli.main(["predict", str(models["gms"]), str(path), "--out", str(out), "--force", "--quiet"])
+    captured = capsys.readouterr()
+    assert status == 2
+    assert "late_damage.parquet" in captured.err and "inf" in captured.err and "Traceback" not in captured.err
+    assert out.read_text() == "an older output"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["late_damage.parquet", "out.parquet"]
