@@ -1,0 +1,207 @@
+"""GMS+SVR against GMS alone on a one-hour log: prediction, kernel sums and training, in one run.
+
+Usage::
+
+    python benchmarks/bench_predict_hour.py [--json] [--duration 3600] [--out DIR]
+
+Steps, all on this machine in one run (its cores stated; ratios carry over, absolutes do not):
+
+1. a one-hour 500 Hz cutting log of the twin's X axis (dataset A, seed 21), written as MCAP and as Parquet;
+   reading each with :func:`greybox.data.read_log` [samples/s];
+2. GMS and GMS+SVR trained with their defaults (as ``greybox train``) on the shipped ``data/X_A`` + ``X_B``:
+   the GMS stage's time, the SVR stage's time and the ratio of the whole GMS+SVR training to the GMS stage;
+   then the GMS+SVR training again with the kernel sums of the code before this benchmark was written
+   (every support vector for every sample, one matrix product per block, :func:`dense_expansion` below),
+   with its time and the test RE of both on ``data/X_C``;
+3. ``greybox predict MODEL LOG --out OUT.parquet`` in a fresh process for each model: wall time and peak
+   resident memory (``ru_maxrss`` of that process), and the ratio GMS+SVR / GMS;
+4. the kernel sums of the hour's SVR inputs by :func:`greybox.models.rbf.rbf_expansion` (1 and all
+   threads) and by :func:`dense_expansion`, with the largest difference.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from greybox.data.io import read_log, write_log
+from greybox.data.prepare import prepare
+from greybox.friction.gms import GMSModel
+from greybox.metrics import relative_error
+from greybox.models import svr as svr_module
+from greybox.models.gmssvr import GMSSVRModel
+from greybox.models.rbf import rbf_expansion
+from greybox.persistence import save_model
+from greybox.twin import make_dataset
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+def dense_expansion(X, support_vectors, dual_coef, intercept=0.0, gamma=1.0, *, chunk_elements=1 << 16):
+    """The kernel sums as greybox computed them before the compiled kernel: all terms, matrix products.
+
+    Kept here as the baseline of this benchmark only.
+    """
+    X = np.asarray(X, dtype=np.float64)
+    sv = np.asarray(support_vectors, dtype=np.float64)
+    alpha = np.asarray(dual_coef, dtype=np.float64).ravel()
+    n_samples, n_features = X.shape
+    out = np.full(n_samples, float(intercept))
+    if not sv.shape[0] or not n_samples:
+        return out
+    centre = sv.mean(axis=0)
+    sv_c = sv - centre
+    right = np.empty((sv.shape[0], n_features + 2))
+    right[:, :n_features] = (2.0 * gamma) * sv_c
+    right[:, n_features] = 1.0
+    right[:, n_features + 1] = -gamma * np.einsum("ij,ij->i", sv_c, sv_c)
+    right_t = np.ascontiguousarray(right.T)
+    rows = max(1, chunk_elements // sv.shape[0])
+    left = np.empty((min(rows, n_samples), n_features + 2))
+    left[:, n_features + 1] = 1.0
+    for start in range(0, n_samples, rows):
+        stop = min(start + rows, n_samples)
+        m = stop - start
+        x_c = left[:m, :n_features]
+        np.subtract(X[start:stop], centre, out=x_c)
+        left[:m, n_features] = -gamma * np.einsum("ij,ij->i", x_c, x_c)
+        k = np.minimum(left[:m] @ right_t, 0.0)
+        out[start:stop] += np.exp(k) @ alpha
+    return out
+
+
+def timed(function, *args, **kwargs):
+    """``(result, seconds)`` of one call."""
+    started = time.perf_counter()
+    result = function(*args, **kwargs)
+    return result, time.perf_counter() - started
+
+
+def read_rates(root: Path, duration_s: float) -> dict:
+    """Write the hour as MCAP and Parquet; samples per second read by :func:`read_log`."""
+    log = make_dataset("X", "A", 21, duration_s=duration_s, cutting=True)
+    rates = {}
+    for suffix in ("mcap", "parquet"):
+        path = root / f"hour.{suffix}"
+        write_log(log, path)
+        read_log(path)  # imports and compiled readers warm
+        read, seconds = timed(read_log, path)
+        rates[suffix] = {"samples": len(read), "seconds": seconds, "samples_per_s": len(read) / seconds}
+    return rates
+
+
+def train(root: Path) -> dict:
+    """GMS and GMS+SVR with their defaults on X_A + X_B, then GMS+SVR again with the former kernel sums."""
+    runs = prepare([read_log(DATA / "X_A.mcap"), read_log(DATA / "X_B.mcap")])
+    (test,) = prepare([read_log(DATA / "X_C.mcap")])
+    gms, gms_s = timed(GMSModel().fit, runs)
+    model = GMSSVRModel()
+    _, stage1_s = timed(model.fit_gms, runs)
+    _, stage2_s = timed(model.fit_svr, runs)
+    save_model(gms, root / "gms.gbm")
+    save_model(model, root / "gmssvr.gbm")
+    former = GMSSVRModel()
+    former.fit_gms(runs)
+    svr_module.rbf_expansion = dense_expansion
+    try:
+        _, former_stage2_s = timed(former.fit_svr, runs)
+    finally:
+        svr_module.rbf_expansion = rbf_expansion
+    return {
+        "gms_fit_s": gms_s, "gmssvr_gms_stage_s": stage1_s, "gmssvr_svr_stage_s": stage2_s,
+        "gmssvr_over_gms_stage": (stage1_s + stage2_s) / stage1_s,
+        "former_svr_stage_s": former_stage2_s, "svr_stage_speedup": former_stage2_s / stage2_s,
+        "n_support": int(model.dual_coef_.size),
+        "test_re_percent": relative_error(test.effort, model.predict(test)),
+        "former_test_re_percent": relative_error(test.effort, former.predict(test)),
+    }
+
+
+def predict_cli(model: Path, log: Path, out: Path) -> dict:
+    """``greybox predict MODEL LOG --out OUT --quiet`` in a fresh process: wall time and peak memory."""
+    out.unlink(missing_ok=True)
+    started = time.perf_counter()
+    process = subprocess.Popen([sys.executable, "-m", "greybox", "predict", str(model), str(log), "--out", str(out),
+                                "--quiet"], stdout=subprocess.DEVNULL)
+    _, status, usage = os.wait4(process.pid, 0)
+    seconds = time.perf_counter() - started
+    process.returncode = os.waitstatus_to_exitcode(status)
+    if process.returncode:
+        raise SystemExit(f"greybox predict {model.name} failed with status {process.returncode}")
+    return {"seconds": seconds, "peak_rss_mb": usage.ru_maxrss / 1024}
+
+
+def kernel_sums(root: Path) -> dict:
+    """The hour's SVR inputs summed by the compiled kernel (1 and all threads) and by the former code."""
+    from greybox.persistence import load_model
+
+    model = load_model(root / "gmssvr.gbm")
+    (log,) = prepare([read_log(root / "hour.parquet")])
+    X = np.concatenate(list(model._input_chunks(log)))
+    scaled = (X - model.input_mean_) / model.input_scale_
+    args = (scaled, model.support_vectors_, model.dual_coef_, model.intercept_, model.gamma_)
+    rbf_expansion(*(a[:1000] if i == 0 else a for i, a in enumerate(args)))  # compile
+    one, one_s = timed(rbf_expansion, *args, threads=1)
+    threaded, threaded_s = timed(rbf_expansion, *args)
+    former, former_s = timed(dense_expansion, *args)
+    return {"samples": len(scaled), "n_support": int(model.dual_coef_.size), "former_s": former_s,
+            "compiled_1_thread_s": one_s, "compiled_threads_s": threaded_s,
+            "speedup_1_thread": former_s / one_s, "speedup_threads": former_s / threaded_s,
+            "max_abs_difference_A": float(max(np.max(np.abs(one - former)), np.max(np.abs(threaded - former))))}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=3600.0, help="length of the predicted log [s]")
+    parser.add_argument("--out", help="keep the log, models and outputs in this directory (default: temporary)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args()
+    root = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="bench_predict_"))
+    root.mkdir(parents=True, exist_ok=True)
+    try:
+        reading = read_rates(root, args.duration)
+        training = train(root)
+        predicting = {kind: predict_cli(root / f"{kind}.gbm", root / "hour.mcap", root / f"{kind}.parquet")
+                      for kind in ("gms", "gmssvr")}
+        predicting["ratio"] = predicting["gmssvr"]["seconds"] / predicting["gms"]["seconds"]
+        kernel = kernel_sums(root)
+    finally:
+        if not args.out:
+            shutil.rmtree(root, ignore_errors=True)
+    result = {"cores": len(os.sched_getaffinity(0)), "duration_s": args.duration, "read": reading,
+              "train": training, "predict": predicting, "kernel": kernel}
+    if args.json:
+        print(json.dumps(result))
+        return
+    print(f"one log of {args.duration:g} s, {result['cores']} cores")
+    for fmt, rate in reading.items():
+        print(f"  read {fmt}: {rate['samples']} samples in {rate['seconds']:.2f} s, "
+              f"{rate['samples_per_s'] / 1e6:.2f} M samples/s")
+    t = training
+    print(f"  train GMS {t['gms_fit_s']:.1f} s; GMS+SVR: GMS stage {t['gmssvr_gms_stage_s']:.1f} s + SVR stage "
+          f"{t['gmssvr_svr_stage_s']:.1f} s = {t['gmssvr_over_gms_stage']:.2f}x the GMS stage "
+          f"({t['n_support']} support vectors); SVR stage with the former kernel sums {t['former_svr_stage_s']:.1f} s "
+          f"({t['svr_stage_speedup']:.2f}x); test RE on X_C {t['test_re_percent']:.2f} % "
+          f"(former {t['former_test_re_percent']:.2f} %)")
+    for kind in ("gms", "gmssvr"):
+        p = predicting[kind]
+        print(f"  greybox predict {kind} -> Parquet: {p['seconds']:.2f} s wall, peak {p['peak_rss_mb']:.0f} MB")
+    print(f"  ratio GMS+SVR / GMS: {predicting['ratio']:.2f}")
+    k = kernel
+    print(f"  kernel sums, {k['samples']} samples x {k['n_support']} support vectors: former {k['former_s']:.2f} s, "
+          f"compiled {k['compiled_1_thread_s']:.2f} s on 1 thread ({k['speedup_1_thread']:.2f}x), "
+          f"{k['compiled_threads_s']:.2f} s on all ({k['speedup_threads']:.2f}x); largest difference "
+          f"{k['max_abs_difference_A']:.2g} A")
+
+
+if __name__ == "__main__":
+    main()
