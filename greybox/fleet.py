@@ -14,12 +14,13 @@ the plant::
 
 (``pyarrow.dataset.dataset(OUT, partitioning="hive")`` reads it whole, with the partition columns).
 The manifest records what ran: every log with its status (``ok``, ``skipped``, ``failed`` with its
-one-line error), output, samples, seconds and the worker's peak memory, its model file and the
-file's SHA-256, the versions of greybox and its libraries, the cluster and the wall time. A re-run
-skips every log whose output is complete: listed ``ok`` in the manifest for the same model file (hash)
-and the same log file (size and modification time), its output still there. Every file is written
-atomically. The model is one model file, or a directory of models written by ``greybox train
---per-machine``, from which each log gets its machine's model (:func:`machine_models`).
+one-line error), output, samples, seconds and the worker's peak memory, its model file and the file's
+SHA-256, the versions of greybox and its libraries, the cluster and the wall time. A re-run skips every
+log whose output is complete: listed ``ok`` in the manifest for the same model file (hash) and the same
+log file (size and modification time), its output still there, also after a run that was killed (the
+manifest is saved while the fleet runs). Every file is written atomically. The model is one model file,
+or a directory of models written by ``greybox train --per-machine``, from which each log gets its
+machine's model (:func:`machine_models`).
 """
 
 from __future__ import annotations
@@ -37,9 +38,9 @@ from typing import Callable, Iterator, Mapping, Sequence
 from .atomic import write_text_atomic
 from .errors import GreyboxError
 
-__all__ = ["LOG_SUFFIXES", "MANIFEST", "MODELS_FORMAT", "FleetJob", "attempt", "expand_logs", "fleet_jobs",
-           "log_stamp", "machine_models", "machine_of", "out_dir_of", "partition", "predict_log", "read_manifest",
-           "read_prepared", "run_fleet", "run_tasks"]
+__all__ = ["LOG_SUFFIXES", "MANIFEST", "MODELS_FORMAT", "SAVE_EVERY_S", "FleetJob", "attempt", "expand_logs",
+           "fleet_jobs", "log_stamp", "machine_models", "machine_of", "out_dir_of", "partition", "predict_log",
+           "read_manifest", "read_prepared", "run_fleet", "run_tasks"]
 
 #: File extensions taken as logs when a directory is given.
 LOG_SUFFIXES = (".csv", ".parquet", ".pq", ".mcap", ".mat", ".tdms")
@@ -52,6 +53,10 @@ MODELS_FORMAT = "greybox-fleet-models"
 
 #: ``format`` of the manifest of a fleet prediction.
 PREDICT_FORMAT = "greybox-fleet"
+
+#: Least time between two saves of the manifest while a fleet runs [s]: the jobs finished so far are kept
+#: for a re-run when a run is killed.
+SAVE_EVERY_S = 10.0
 
 _GLOB_CHARACTERS = set("*?[")
 
@@ -241,6 +246,9 @@ def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, o
     progress : callable, optional
         ``progress(done, total, entry)`` after each job.
 
+    While the jobs run, the manifest lists those finished, saved at most every :data:`SAVE_EVERY_S`
+    seconds, so that a re-run after the run was killed skips them.
+
     Returns
     -------
     dict
@@ -262,12 +270,15 @@ def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, o
     fields = list(fingerprints[0]) if fingerprints else []
     previous = {} if force else _complete(read_manifest(out_dir, header["format"]), items, out_dir, fields)
     entries: list[dict | None] = [None] * len(jobs)
-    done = 0
+    done, saved = 0, time.perf_counter()
 
     def finish(index: int, entry: dict) -> None:
-        nonlocal done
+        nonlocal done, saved
         entries[index] = {**entry, **fingerprints[index]}
         done += 1
+        if time.perf_counter() - saved >= SAVE_EVERY_S:  # a run killed later keeps what is done
+            _write_manifest(out_dir, {**header, items: [entry for entry in entries if entry is not None]})
+            saved = time.perf_counter()
         if progress is not None:
             progress(done, len(jobs), entries[index])
 
@@ -283,8 +294,13 @@ def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, o
                 "counts": {status: sum(entry["status"] == status for entry in entries)
                            for status in ("ok", "skipped", "failed")},
                 items: entries}
-    write_text_atomic(out_dir / MANIFEST, json.dumps(manifest, indent=1) + "\n")
+    _write_manifest(out_dir, manifest)
     return manifest
+
+
+def _write_manifest(out_dir: Path, manifest: dict) -> None:
+    """Write ``out_dir/_manifest.json`` atomically."""
+    write_text_atomic(out_dir / MANIFEST, json.dumps(manifest, indent=1) + "\n")
 
 
 def out_dir_of(jobs: Sequence, nothing: str) -> str:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -47,18 +48,23 @@ def _parameters(model) -> dict:
     return {row.name: np.asarray(row.value, dtype=float) for row in model.parameter_table()}
 
 
-def test_a_model_per_machine_as_plain_training_gives_then_skips_and_retrains(plant, tmp_path, capsys):
-    out = tmp_path / "models"
+@pytest.fixture(scope="module")
+def trained(plant, tmp_path_factory):
+    """The plant's fleet trained once on 2 workers: (command line, exit status, models directory)."""
+    out = tmp_path_factory.mktemp("trained") / "models"
     argv = ["train", *QUICK, "--train", plant, "--per-machine", "--out", out, "--workers", "2"]
-    status, printed, _ = _main(capsys, argv)
+    return argv, cli.main([str(item) for item in argv]), out
+
+
+def test_a_model_per_machine_equals_plain_training_on_its_logs(plant, trained, tmp_path, capsys):
+    _, status, out = trained
     assert status == 2  # mill3 fails, mill1 and mill2 are trained
-    assert "2 trained, 0 skipped" in printed and "1 failed of 3 models" in printed and "on 2 worker(s)" in printed
-    assert "failed: mill3: " in printed and "broken.csv: missing required column" in printed
     manifest = json.loads((out / MANIFEST).read_text())
     assert manifest["format"] == "greybox-fleet-models" and manifest["cluster"]["workers"] == 2
     assert manifest["versions"]["distributed"] and manifest["counts"] == {"ok": 2, "skipped": 0, "failed": 1}
     entries = {entry["machine"]: entry for entry in manifest["models"]}
     assert entries["mill3"]["status"] == "failed" and not (out / "mill3").exists()
+    assert "broken.csv: missing required column" in entries["mill3"]["error"]
     assert [Path(log["path"]).name for log in entries["mill1"]["logs"]] == ["a.mcap", "b.parquet"]
     assert entries["mill1"]["logs"][1]["size"] == (plant / "mill1" / "b.parquet").stat().st_size
     assert entries["mill1"]["model"]["params"]["n_starts"] == 1 and entries["mill1"]["peak_rss_mb"] > 0
@@ -79,20 +85,25 @@ def test_a_model_per_machine_as_plain_training_gives_then_skips_and_retrains(pla
     assert not np.allclose(_parameters(load_model(out / "mill1" / "X.gbm"))["k"],
                            _parameters(load_model(out / "mill2" / "X.gbm"))["k"])
 
+
+def test_a_rerun_skips_complete_models_and_force_retrains(plant, trained, tmp_path, capsys):
+    argv, _, trained_out = trained
+    out = tmp_path / "models"
+    shutil.copytree(trained_out, out)  # the manifest names its models relative to the directory
+    argv = [out if item == trained_out else item for item in argv]
     log = plant / "mill2" / "a.csv"
     os.utime(log, ns=(log.stat().st_atime_ns, log.stat().st_mtime_ns + 10**9))  # mill2's log changed
     status, printed, _ = _main(capsys, argv)
-    assert status == 2 and "1 trained, 1 skipped" in printed and "mill1/X: 2 log(s)" in printed
+    assert status == 2 and "1 trained, 1 skipped" in printed and "1 failed of 3 models" in printed
+    assert "mill1/X: 2 log(s)" in printed and "(skipped)" in printed and "failed: mill3: " in printed
     modified = (out / "mill1" / "X.gbm").stat().st_mtime_ns
     status, printed, _ = _main(capsys, argv + ["--force"])
     assert status == 2 and "2 trained, 0 skipped" in printed
     assert (out / "mill1" / "X.gbm").stat().st_mtime_ns > modified
 
 
-def test_each_log_is_predicted_with_its_machines_model(plant, tmp_path, capsys):
-    models = tmp_path / "models"
-    assert _main(capsys, ["train", *QUICK, "--train", plant / "mill1", plant / "mill2" / "*.csv", "--per-machine",
-                          "--out", models, "--workers", "2"])[0] == 0
+def test_each_log_is_predicted_with_its_machines_model(plant, trained, tmp_path, capsys):
+    models = trained[2]
     out = tmp_path / "results"
     status, printed, _ = _main(capsys, ["predict", models, plant / "mill1", plant / "mill2", "--out", out,
                                         "--workers", "2", "--quiet"])
@@ -107,6 +118,29 @@ def test_each_log_is_predicted_with_its_machines_model(plant, tmp_path, capsys):
     pd.testing.assert_frame_equal(part, pd.read_parquet(single))
     status, _, error = _main(capsys, ["predict", models, plant, "--out", tmp_path / "r2"])
     assert status == 2 and "no trained model of machine mill3" in error and "\n" not in error.strip()
+
+
+def test_a_run_stopped_midway_keeps_the_models_it_finished(plant, tmp_path, capsys, monkeypatch):
+    import greybox.cli._fleet as cli_fleet
+    import greybox.fleet as fleet
+
+    def stop_after_the_first(noun, quiet, label):
+        def show(done, total, entry):
+            raise KeyboardInterrupt  # Ctrl-C while the second model trains
+
+        return show
+
+    monkeypatch.setattr(fleet, "SAVE_EVERY_S", 0.0)
+    monkeypatch.setattr(cli_fleet, "fleet_progress", stop_after_the_first)
+    out = tmp_path / "models"
+    argv = ["train", *QUICK, "--train", plant / "mill1", plant / "mill2", "--per-machine", "--out", out,
+            "--workers", "2"]
+    assert _main(capsys, argv)[0] == 130
+    (finished,) = json.loads((out / MANIFEST).read_text())["models"]
+    assert finished["status"] == "ok" and (out / finished["output"]).is_file()
+    monkeypatch.undo()
+    status, printed, _ = _main(capsys, argv)
+    assert status == 0 and "1 trained, 1 skipped" in printed and f"{finished['machine']}/X: " in printed
 
 
 def test_several_axes_a_model_each_and_one_axis_per_machine(tmp_path):
