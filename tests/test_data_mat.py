@@ -67,3 +67,13 @@ def test_emps_variables_without_a_mapping_read_as_the_benchmark(tmp_path, log):
                    "vir": np.full((n, 1), 0.5), "gtau": np.array([[30.0]])})
     read = read_log(path)
     assert read.effort_unit == "N" and np.allclose(read.effort, 15.0) and read.attrs["gtau"] == 30.0
+
+
+@pytest.mark.parametrize("size", [1, 20, 100])
+def test_a_mat_file_cut_inside_its_header_is_one_clear_error(tmp_path, log, size):
+    whole = tmp_path / "whole.mat"
+    savemat(whole, {"time_s": log.time, "position_mm": log.position, "current_A": log.effort})
+    cut = tmp_path / "cut.mat"
+    cut.write_bytes(whole.read_bytes()[:size])
+    with pytest.raises(LogError, match="cut.mat: not a readable MATLAB .mat file"):
+        read_log(cut)

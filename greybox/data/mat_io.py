@@ -76,6 +76,8 @@ def load_mat_variables(path) -> dict[str, np.ndarray]:
         return _load_hdf5(path)
     try:
         variables = loadmat(path)
+    except IndexError:  # scipy runs off the end of a header cut short
+        raise LogError(path, "not a readable MATLAB .mat file (it ends inside its header)") from None
     except (MatReadError, ValueError, TypeError, NotImplementedError, OSError, EOFError) as exc:
         raise LogError(path, f"not a readable MATLAB .mat file ({exc})") from None
     return {name: value for name, value in variables.items() if not name.startswith("__")}
