@@ -11,9 +11,10 @@ import pyarrow.parquet as pq
 import pytest
 
 import greybox.cli as cli
+from greybox.data.blocks import concatenate
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import derivative_margin, prepare
-from greybox.data.stream import ParquetLog, concatenate, median_step, prepared_blocks
+from greybox.data.stream import ParquetLog, median_step, prepared_blocks
 from greybox.errors import LogError
 from greybox.friction import GMSModel
 from greybox.models.gmssvr import GMSSVRModel

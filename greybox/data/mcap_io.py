@@ -23,8 +23,9 @@ message, and so that a damaged file gives a :class:`~greybox.errors.LogError`.
 from __future__ import annotations
 
 import json
+import os
 import zlib
-from typing import Iterable, Iterator, Mapping, Sequence
+from typing import Iterator, Mapping, Sequence
 
 import numpy as np
 from numba import njit
@@ -68,6 +69,7 @@ _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x04, 0x05, 0x06, 0x0F
 _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time u64
 _BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
 _BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
+_WINDOW_BYTES = 8 << 20  # file bytes scanned at a time
 
 
 def topic_for(axis: str) -> str:
@@ -298,11 +300,18 @@ class _MessageCollector:
         self.pending_rows = 0
         self.batches: list[tuple[int, dict]] = []
 
-    def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray) -> None:
+    @property
+    def rows(self) -> int:
+        """Messages collected so far (since the last :meth:`columns`)."""
+        return sum(stamps.size for stamps in self.stamps)
+
+    def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, stamps_only: bool = False) -> None:
         if not offsets.size:
             return
         header = buf[offsets[:, None] + np.arange(6, 14)]
         self.stamps.append(np.ascontiguousarray(header).view("<u8").ravel().copy())
+        if stamps_only:
+            return
         text = join_slices(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER, 10)
         self.pending.append(text)
         self.pending_bytes += text.size
@@ -394,23 +403,50 @@ def _choose(channels: Mapping[int, _Channel], topic: str | None, path) -> _Chann
     raise LogError(path, f"no channel with topic '{topic}'; topics in the file: {topics}")
 
 
-def _walk(data: bytes, path) -> Iterable[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """Yield (buffer, opcodes, offsets, lengths) for the data section, chunk by chunk."""
-    if len(data) < 2 * len(_MAGIC) or data[: len(_MAGIC)] != _MAGIC:
-        raise LogError(path, "not an MCAP file (the file does not start with the MCAP magic bytes)")
-    if data[-len(_MAGIC):] != _MAGIC:
-        raise LogError(path, "truncated MCAP file: it does not end with the MCAP magic bytes "
-                             "(was the logger stopped before closing it?)")
-    buf = np.frombuffer(data, np.uint8)
-    stop = len(data) - len(_MAGIC)
-    opcodes, offsets, lengths, end = scan_records(buf, len(_MAGIC), stop)
-    if end != stop:
-        raise LogError(path, f"corrupt or truncated MCAP file: the record at byte {end} runs past the end of the file")
-    data_end = np.flatnonzero(opcodes == _OP_DATA_END)
-    if not data_end.size:
-        raise LogError(path, "corrupt MCAP file: no data-end record")
-    last = int(data_end[0])
-    opcodes, offsets, lengths = opcodes[:last], offsets[:last], lengths[:last]
+def _walk(path) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """Yield (buffer, opcodes, offsets, lengths) for the data section, a window of the file or a chunk at a time.
+
+    The file is scanned :data:`_WINDOW_BYTES` at a time (a record longer than that is read whole), up to
+    the data-end record, so that the memory held does not grow with the file.
+    """
+    size = os.path.getsize(path)
+    with open(path, "rb") as stream:
+        if size < 2 * len(_MAGIC) or stream.read(len(_MAGIC)) != _MAGIC:
+            raise LogError(path, "not an MCAP file (the file does not start with the MCAP magic bytes)")
+        stream.seek(size - len(_MAGIC))
+        if stream.read(len(_MAGIC)) != _MAGIC:
+            raise LogError(path, "truncated MCAP file: it does not end with the MCAP magic bytes "
+                                 "(was the logger stopped before closing it?)")
+        stop = size - len(_MAGIC)
+        stream.seek(len(_MAGIC))
+        start = len(_MAGIC)  # file offset of the first byte not yet scanned
+        carry = b""
+        while True:
+            unread = stop - start - len(carry)
+            wanted = _WINDOW_BYTES
+            if len(carry) >= 9:  # the record that did not fit: read it whole
+                missing = 9 + int.from_bytes(carry[1:9], "little") - len(carry)
+                if missing > unread:
+                    unread = 0
+                wanted = max(wanted, missing)
+            if not unread:
+                if carry:
+                    raise LogError(path, f"corrupt or truncated MCAP file: the record at byte {start} runs past "
+                                         "the end of the file")
+                raise LogError(path, "corrupt MCAP file: no data-end record")
+            data = carry + stream.read(min(wanted, unread))
+            buf = np.frombuffer(data, np.uint8)
+            opcodes, offsets, lengths, end = scan_records(buf, 0, buf.size)
+            ends = np.flatnonzero(opcodes == _OP_DATA_END)
+            last = int(ends[0]) if ends.size else opcodes.size
+            yield from _expand(buf, data, opcodes[:last], offsets[:last], lengths[:last], path)
+            if ends.size:
+                return
+            carry, start = data[end:], start + end
+
+
+def _expand(buf, data: bytes, opcodes, offsets, lengths, path):
+    """The records of a scanned stretch of the file, each chunk record replaced by the records it holds."""
     chunks = np.flatnonzero(opcodes == _OP_CHUNK)
     begin = 0
     for index in list(chunks) + [opcodes.size]:
@@ -428,11 +464,18 @@ def _walk(data: bytes, path) -> Iterable[tuple[np.ndarray, np.ndarray, np.ndarra
 
 def _collect(path, topic: str | None) -> tuple[dict[int, _Channel], _MessageCollector]:
     """Walk the file once: every channel record, and the messages of the channel to read."""
-    with open(path, "rb") as stream:
-        data = stream.read()
     channels: dict[int, _Channel] = {}
     collector = _MessageCollector(path)
-    for buf, opcodes, offsets, lengths in _walk(data, path):
+    for _ in _messages(path, topic, channels, collector):
+        pass
+    return channels, collector
+
+
+def _messages(path, topic: str | None, channels: dict[int, _Channel], collector: _MessageCollector,
+              stamps_only: bool = False) -> Iterator[int]:
+    """Walk the file, adding channel records to ``channels`` and the chosen channel's messages to ``collector``
+    (their time stamps only with ``stamps_only``); yield the messages collected after each stretch."""
+    for buf, opcodes, offsets, lengths in _walk(path):
         for k in np.flatnonzero(opcodes == _OP_CHANNEL):
             channel = _Channel(buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), path)
             channels.setdefault(channel.id, channel)
@@ -445,8 +488,8 @@ def _collect(path, topic: str | None) -> tuple[dict[int, _Channel], _MessageColl
             raise LogError(path, "corrupt MCAP file: a message record is shorter than its header")
         ids = buf[offs].astype(np.uint16) | (buf[offs + 1].astype(np.uint16) << 8)
         mine = ids == chosen.id
-        collector.add(buf, offs[mine], lens[mine])
-    return channels, collector
+        collector.add(buf, offs[mine], lens[mine], stamps_only=stamps_only)
+        yield collector.rows
 
 
 def read_mcap(

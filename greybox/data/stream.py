@@ -29,14 +29,14 @@ from typing import Iterable, Iterator, Mapping
 import numpy as np
 
 from ..errors import LogError
+from .blocks import concatenate, reblock
 from .file_metadata import metadata_fields, parse_metadata
 from .log import AxisLog
 from .prepare import derivative_margin, derive
 from .units import log_from_columns, resolve_columns, select_axis
 from .validate import check_finite, check_increasing, check_time, check_velocity_units
 
-__all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "can_stream", "concatenate", "median_step",
-           "prepared_blocks"]
+__all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "can_stream", "median_step", "prepared_blocks"]
 
 #: Samples per block (4 min 22 s at 2 ms).
 DEFAULT_BLOCK_SAMPLES = 1 << 15
@@ -64,31 +64,6 @@ def can_stream(path, *, sample_time: float | None = None, resample: float | None
     """
     return (os.path.splitext(os.fspath(path))[1].lower() in STREAM_SUFFIXES and sample_time is None
             and resample is None)
-
-
-def concatenate(blocks: Iterable[AxisLog]) -> AxisLog:
-    """One log of consecutive blocks of the same log (channels joined; names and attrs of the first).
-
-    Raises
-    ------
-    ValueError
-        For no block at all.
-    """
-    blocks = list(blocks)
-    if not blocks:
-        raise ValueError("no block to join")
-    if len(blocks) == 1:
-        return blocks[0]
-    first = blocks[0]
-
-    def joined(name):
-        values = [getattr(block, name) for block in blocks]
-        return None if values[0] is None else np.concatenate(values)
-
-    return first.replace(time=joined("time"), position=joined("position"), effort=joined("effort"),
-                         velocity=joined("velocity"), acceleration=joined("acceleration"),
-                         extras={name: np.concatenate([block.extras[name] for block in blocks])
-                                 for name in first.extras})
 
 
 class ParquetLog:
@@ -164,26 +139,7 @@ class ParquetLog:
             Samples per block; default :attr:`block_samples`.
         """
         size = self.block_samples if block_samples is None else int(block_samples)
-        pending: list[AxisLog] = []
-        held = 0
-        ready = None  # a full block held back: a last piece of one sample joins it
-        for batch in self._file.iter_batches(batch_size=size):
-            pending.append(self._convert(batch))
-            held += len(pending[-1])
-            while held >= size:
-                whole = concatenate(pending)
-                if ready is not None:
-                    yield ready
-                ready = whole.select(slice(0, size))
-                rest = whole.select(slice(size, None))
-                pending, held = ([rest], len(rest)) if len(rest) else ([], 0)
-        rest = concatenate(pending) if held else None
-        if ready is not None and rest is not None and len(rest) < 2:
-            ready, rest = concatenate([ready, rest]), None
-        if ready is not None:
-            yield ready
-        if rest is not None:
-            yield rest
+        yield from reblock((self._convert(batch) for batch in self._file.iter_batches(batch_size=size)), size)
 
     def time_span(self) -> tuple[float, float]:
         """Times of the first and the last sample [s]."""
