@@ -11,10 +11,11 @@ import pyarrow.parquet as pq
 import pytest
 
 import greybox.cli as cli
-from greybox.data.blocks import concatenate
+from greybox.data.blocks import CannotStream, concatenate
 from greybox.data.io import read_log, write_log
+from greybox.data.mcap_io import McapLog
 from greybox.data.prepare import derivative_margin, prepare
-from greybox.data.stream import ParquetLog, median_step, prepared_blocks
+from greybox.data.stream import ParquetLog, median_step, open_stream, prepared_blocks
 from greybox.errors import LogError
 from greybox.friction import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
@@ -58,18 +59,22 @@ def logs(tmp_path_factory):
     root = tmp_path_factory.mktemp("stream")
     cut = make_dataset("X", "C", seed=3, duration_s=40, cutting=True)  # logged velocity: acceleration derived
     without_velocity = cut.replace(velocity=None)  # both derived from the position
-    paths = {"cut": root / "cut.parquet", "position_only": root / "position_only.parquet"}
-    write_log(cut, paths["cut"])
-    write_log(without_velocity, paths["position_only"])
+    paths = {}
+    for suffix in (".parquet", ".mcap"):
+        paths["cut" + suffix] = root / f"cut{suffix}"
+        paths["position_only" + suffix] = root / f"position_only{suffix}"
+        write_log(cut, paths["cut" + suffix])
+        write_log(without_velocity, paths["position_only" + suffix])
     return paths
 
 
+@pytest.mark.parametrize("suffix", [".parquet", ".mcap"])
 @pytest.mark.parametrize("name", ["cut", "position_only"])
 @pytest.mark.parametrize("cutoff_hz", [None, 2.0])
-def test_prepared_blocks_join_into_the_prepared_whole_log(logs, name, cutoff_hz):
-    path = logs[name]
+def test_prepared_blocks_join_into_the_prepared_whole_log(logs, name, cutoff_hz, suffix):
+    path = logs[name + suffix]
     (whole,) = prepare([read_log(path)], cutoff_hz=cutoff_hz)
-    stream = ParquetLog(path, block_samples=997)  # blocks end where the row groups do not
+    stream = open_stream(path, block_samples=997)  # blocks end where the row groups (MCAP chunks) do not
     blocks = list(prepared_blocks(stream, cutoff_hz=cutoff_hz))
     margin = derivative_margin(whole.sample_time, cutoff_hz=cutoff_hz)
     assert len(blocks) == -(-len(whole) // max(997, margin))  # the margin of a low cut-off widens the blocks
@@ -88,10 +93,10 @@ def test_prepared_blocks_join_into_the_prepared_whole_log(logs, name, cutoff_hz)
 
 def test_a_block_too_short_for_the_filter_margin_would_differ(logs):
     """The margin matters: without it the blocks' derivatives differ from the whole log's near the seams."""
-    (whole,) = prepare([read_log(logs["cut"])])
+    (whole,) = prepare([read_log(logs["cut.parquet"])])
     from greybox.data.prepare import derive
 
-    stream = ParquetLog(logs["cut"], block_samples=997)
+    stream = ParquetLog(logs["cut.parquet"], block_samples=997)
     naive = concatenate([derive(block, sample_time=whole.sample_time) for block in stream.blocks()])
     assert np.max(np.abs(naive.acceleration - whole.acceleration)) > 1e-3 * np.max(np.abs(whole.acceleration))
 
@@ -152,15 +157,16 @@ def _table(path: Path):
 
 
 @pytest.mark.parametrize("kind", ["gms", "gmssvr"])
-@pytest.mark.parametrize("suffix", [".parquet", ".csv"])
-def test_streamed_predict_writes_what_the_whole_log_gives(tmp_path, capsys, logs, models, kind, suffix):
-    """The same cutting log as Parquet (streamed) and as MCAP (read whole): equal tables and metadata."""
-    whole_log = tmp_path / "cut.mcap"
-    write_log(read_log(logs["cut"]), whole_log)
+@pytest.mark.parametrize(("log_suffix", "suffix"), [(".parquet", ".parquet"), (".parquet", ".csv"),
+                                                     (".mcap", ".parquet")])
+def test_streamed_predict_writes_what_the_whole_log_gives(tmp_path, capsys, logs, models, kind, log_suffix, suffix):
+    """The same cutting log as Parquet or MCAP (streamed) and as CSV (read whole): equal tables and metadata."""
+    whole_log = tmp_path / "cut.csv"
+    write_log(read_log(logs["cut.parquet"]), whole_log)
     calibration = tmp_path / "air.mcap"
     write_log(make_dataset("X", "C", seed=21, duration_s=20), calibration)
     outputs = {}
-    for name, log in (("streamed", logs["cut"]), ("whole", whole_log)):
+    for name, log in (("streamed", logs["cut" + log_suffix]), ("whole", whole_log)):
         out = tmp_path / f"{name}{suffix}"
         status = cli.main(["predict", str(models[kind]), str(log), "--out", str(out), "--axis-config", str(EXAMPLE),
                            "--calibration", str(calibration), "--chunk-s", "7", "--quiet"])
@@ -177,6 +183,7 @@ def test_streamed_predict_writes_what_the_whole_log_gives(tmp_path, capsys, logs
     for meta in (streamed_meta, whole_meta):
         meta["attrs"].pop("log_file")
     assert streamed_meta == whole_meta
+    assert streamed_meta["dataset"] == "C" and streamed_meta["axis"] == "X"
     figures = [line for line in whole_text.splitlines() if line.startswith("  ")]
     assert figures and figures == [line for line in streamed_text.splitlines() if line.startswith("  ")]
 
@@ -195,3 +202,30 @@ def test_streamed_predict_leaves_no_output_on_a_damaged_log(tmp_path, capsys, mo
     assert "late_damage.parquet" in captured.err and "inf" in captured.err and "Traceback" not in captured.err
     assert out.read_text() == "an older output"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["late_damage.parquet", "out.parquet"]
+
+
+def test_mcap_messages_out_of_time_order_are_read_whole(tmp_path, capsys, models):
+    """A logger may store chunks out of time order: the stream says so and predict reads the log whole."""
+    from mcap.writer import Writer
+
+    log = make_dataset("X", "C", seed=8, duration_s=12, cutting=True)
+    path = tmp_path / "shuffled.mcap"
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        writer.start()
+        schema = writer.register_schema("greybox.AxisSample", "jsonschema", b"{}")
+        channel = writer.register_channel("/axis/X", "json", schema, {"axis": "X"})
+        order = np.concatenate([np.arange(3000, len(log)), np.arange(3000)])  # the first seconds come last
+        for k in order:
+            stamp = int(round(log.time[k] * 1e9))
+            message = json.dumps({"position_mm": log.position[k], "velocity_mm_s": log.velocity[k],
+                                  "current_A": log.effort[k]}).encode()
+            writer.add_message(channel, stamp, message, stamp)
+        writer.finish()
+    with pytest.raises(CannotStream, match="time order"):
+        median_step(McapLog(path, block_samples=1000).times)
+    out = tmp_path / "out.parquet"
+    assert cli.main(["predict", str(models["gms"]), str(path), "--out", str(out), "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    assert "block by block" not in printed
+    np.testing.assert_array_equal(pd.read_parquet(out)["time_s"], prepare([read_log(path)])[0].time)

@@ -219,8 +219,9 @@ def run(args: argparse.Namespace) -> int:
     config = read_axis_config(args.axis_config) if args.axis_config else None
     model = load_model(args.model)
     streamed = _streamed_log(args, config)
-    if streamed is not None:
-        return _run_streamed(args, model, streamed, config, out, inputs, run_started)
+    status = None if streamed is None else _run_streamed(args, model, streamed, config, out, inputs, run_started)
+    if status is not None:
+        return status
     runs = _read_runs(args, config.channels if config else {})
     log_time = np.concatenate([run.time for run in runs])
     window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
@@ -245,36 +246,46 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _streamed_log(args: argparse.Namespace, config):
-    """The cutting log as a :class:`~greybox.data.stream.ParquetLog` when it is predicted block by block, else None.
+    """The cutting log opened block by block (:func:`~greybox.data.stream.open_stream`), or None to read it whole.
 
-    A Parquet log of a linear axis with a time column, without --resample and --plot, is streamed: its
+    A Parquet or MCAP log of a linear axis, without --resample, --sample-time and --plot, is streamed: its
     length then does not bound the memory (:mod:`greybox.data.stream`).
     """
-    from ..data.stream import ParquetLog, can_stream
+    from ..data.stream import can_stream, open_stream
 
-    if args.plot or args.topic or not can_stream(args.log, sample_time=args.sample_time, resample=args.resample):
+    if args.plot or not can_stream(args.log, sample_time=args.sample_time, resample=args.resample, topic=args.topic):
         return None
     from ..data.io import parse_column_mapping
 
     columns = dict(config.channels if config else {})
     if args.columns:
         columns.update(parse_column_mapping(args.columns))
-    log = ParquetLog(args.log, columns=columns or None, axis=args.axis)
+    log = open_stream(args.log, columns=columns or None, topic=args.topic, axis=args.axis)
     return log if log.motion == "linear" else None
 
 
-def _run_streamed(args: argparse.Namespace, model, log, config, out: Path, inputs: list, run_started: float) -> int:
-    """``greybox predict`` of a log read, predicted and written block by block."""
+def _run_streamed(args: argparse.Namespace, model, log, config, out: Path, inputs: list, run_started: float):
+    """``greybox predict`` of a log read, predicted and written block by block; None if it cannot be streamed."""
+    from ..data.blocks import CannotStream
     from ..data.quantities import MOTIONS
     from ..evaluate.process_stream import stream_process
 
     interval = _interval(args, model, lambda path: _read_runs(args, config.channels if config else {}, path))
     started = time.perf_counter()
-    span = log.time_span()
-    done = stream_process(model, log, out, axis_config=config, interval=interval, chunk_s=args.chunk_s,
-                          tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz,
-                          attrs={"model_file": str(args.model), "log_file": str(args.log)},
-                          overwrite=args.force, protect=inputs, progress=_progress(span[1], args.quiet))
+    shown = []
+
+    def progress(done: int, chunks: int, time_s: float) -> None:
+        if not shown:  # the log's end is known once the time stamps have been read
+            shown.append(_progress(log.time_span()[1], False))
+        shown[0](done, chunks, time_s)
+
+    try:
+        done = stream_process(model, log, out, axis_config=config, interval=interval, chunk_s=args.chunk_s,
+                              tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz,
+                              attrs={"model_file": str(args.model), "log_file": str(args.log)},
+                              overwrite=args.force, protect=inputs, progress=None if args.quiet else progress)
+    except CannotStream:
+        return None
     elapsed = time.perf_counter() - started
     attrs = done.metadata["attrs"]
     dataset = done.metadata["dataset"]

@@ -8,7 +8,11 @@ import numpy as np
 
 from .log import AxisLog
 
-__all__ = ["concatenate", "reblock"]
+__all__ = ["CannotStream", "concatenate", "reblock"]
+
+
+class CannotStream(Exception):
+    """A log that cannot be read block by block (e.g. MCAP messages stored out of time order): read it whole."""
 
 
 def concatenate(blocks: Iterable[AxisLog]) -> AxisLog:

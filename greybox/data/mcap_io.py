@@ -31,10 +31,11 @@ import numpy as np
 from numba import njit
 
 from ..errors import LogError
+from .blocks import CannotStream, reblock
 from .log import AxisLog
 from .units import log_from_columns
 
-__all__ = ["AXIS_SAMPLE_SCHEMA", "SCHEMA_NAME", "read_mcap", "write_mcap", "topic_for"]
+__all__ = ["AXIS_SAMPLE_SCHEMA", "SCHEMA_NAME", "McapLog", "read_mcap", "write_mcap", "topic_for"]
 
 #: Name of the message schema written by greybox.
 SCHEMA_NAME = "greybox.AxisSample"
@@ -492,6 +493,30 @@ def _messages(path, topic: str | None, channels: dict[int, _Channel], collector:
         yield collector.rows
 
 
+def _resolve_channel(channels: Mapping[int, _Channel], topic: str | None, axis: str | None,
+                     path) -> tuple[_Channel, str | None]:
+    """The channel to read, and the axis whose prefixed fields to select in it (None: the whole channel).
+
+    An axis without a topic is the channel ``/axis/<axis>``, or the fields ``<axis>_...`` of the file's one
+    channel.
+    """
+    select = None
+    if axis is not None and topic is None:
+        topic = topic_for(axis)
+        if not any(channel.topic == topic for channel in channels.values()):
+            if len(channels) > 1:
+                listed = ", ".join(sorted(channel.topic for channel in channels.values()))
+                raise LogError(path, f"no channel of axis '{axis}' ({topic}); the channels in the file: {listed}")
+            topic, select = None, axis
+    channel = _choose(channels, topic, path)
+    if channel.message_encoding != "json":
+        raise LogError(
+            path,
+            f"channel '{channel.topic}' has message encoding '{channel.message_encoding}'; greybox reads JSON messages",
+        )
+    return channel, select
+
+
 def read_mcap(
     path,
     *,
@@ -530,40 +555,118 @@ def read_mcap(
         For a file that is not MCAP, truncated or corrupt, an ambiguous or
         unknown topic, non-JSON messages, or missing fields.
     """
-    select = None
-    if axis is not None and topic is None:
-        topic = topic_for(axis)
-        channels, collector = _collect(path, topic)
-        if not any(channel.topic == topic for channel in channels.values()):
-            if len(channels) > 1:
-                listed = ", ".join(sorted(channel.topic for channel in channels.values()))
-                raise LogError(path, f"no channel of axis '{axis}' ({topic}); the channels in the file: {listed}")
-            topic, select = None, axis
-            channels, collector = _collect(path, None)
-    else:
-        channels, collector = _collect(path, topic)
-    channel = _choose(channels, topic, path)
-    if channel.message_encoding != "json":
-        raise LogError(
-            path,
-            f"channel '{channel.topic}' has message encoding '{channel.message_encoding}'; greybox reads JSON messages",
-        )
+    channels, collector = _collect(path, topic_for(axis) if axis is not None and topic is None else topic)
+    channel, select = _resolve_channel(channels, topic, axis, path)
+    if select is not None:  # the axis's fields in the one channel: collect that channel's messages
+        channels, collector = _collect(path, None)
     stamps, table = collector.columns()
     if not stamps.size:
         raise LogError(path, f"channel '{channel.topic}' has no messages")
+    return log_from_columns(table, source=path, columns=columns, time=stamps * 1e-9, select=select,
+                            **_channel_fields(channel, path))
+
+
+def _channel_fields(channel: _Channel, path) -> dict:
+    """The log's effort unit, axis, dataset and attrs from a channel's metadata."""
     metadata = channel.metadata
     try:
         attrs = json.loads(metadata.get("attrs", "{}"))
     except (ValueError, RecursionError):
         raise LogError(path, f"channel '{channel.topic}': metadata 'attrs' is not JSON text") from None
-    return log_from_columns(
-        table,
-        source=path,
-        columns=columns,
-        time=stamps * 1e-9,
-        effort_unit=metadata.get("effort_unit"),
-        axis=metadata.get("axis", channel.topic.rstrip("/").rsplit("/", 1)[-1]),
-        dataset=metadata.get("dataset", ""),
-        attrs=attrs if isinstance(attrs, dict) else {"attrs": attrs},
-        select=select,
-    )
+    return {"effort_unit": metadata.get("effort_unit"),
+            "axis": metadata.get("axis", channel.topic.rstrip("/").rsplit("/", 1)[-1]),
+            "dataset": metadata.get("dataset", ""), "attrs": attrs if isinstance(attrs, dict) else {"attrs": attrs}}
+
+
+class McapLog:
+    """An MCAP axis log read block by block, converted as :func:`read_mcap` converts it.
+
+    The channel is chosen as :func:`read_mcap` chooses it, from a first walk over the file's records.
+    Its messages must be stored in time order (:meth:`times` raises
+    :class:`~greybox.data.blocks.CannotStream` otherwise; :func:`read_mcap` sorts them).
+
+    Parameters
+    ----------
+    path : str or path-like
+        MCAP file with JSON messages.
+    columns : mapping of str to str, optional
+        ``{canonical_name: message_field}`` for fields not named by the convention.
+    topic : str, optional
+        Channel to read.
+    axis : str, optional
+        Axis to read (see :func:`read_mcap`).
+    block_samples : int
+        Samples per block.
+
+    Attributes
+    ----------
+    n_samples : int or None
+        Messages of the channel (known after the first pass of :meth:`times`).
+    motion : str
+        "linear" or "rotary", from the fields of the first messages.
+
+    Raises
+    ------
+    LogError
+        As :func:`read_mcap`.
+    """
+
+    def __init__(self, path, *, columns: Mapping[str, str] | None = None, topic: str | None = None,
+                 axis: str | None = None, block_samples: int):
+        self.path = os.fspath(path)
+        self.columns = dict(columns) if columns else None
+        self.block_samples = int(block_samples)
+        channels: dict[int, _Channel] = {}
+        for _buf, opcodes, offsets, lengths in _walk(self.path):
+            for k in np.flatnonzero(opcodes == _OP_CHANNEL):
+                channel = _Channel(_buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), self.path)
+                channels.setdefault(channel.id, channel)
+        self._channel, self._select = _resolve_channel(channels, topic, axis, self.path)
+        self._topic = self._channel.topic if self._select is None else None
+        self._fields = _channel_fields(self._channel, self.path)
+        self.n_samples = None
+        self._span = None
+        first = next(self.blocks(2), None)
+        if first is None:
+            raise LogError(self.path, f"channel '{self._channel.topic}' has no messages")
+        self.motion = first.motion
+
+    def times(self) -> Iterator[np.ndarray]:
+        """The message times [s] of the channel, as they come in the file (messages not parsed)."""
+        collector = _MessageCollector(self.path)
+        count, first, last = 0, None, None
+        for rows in _messages(self.path, self._topic, {}, collector, stamps_only=True):
+            if rows:
+                stamps = np.concatenate(collector.stamps)
+                collector.stamps = []
+                if np.any(stamps[1:] < stamps[:-1]) or (last is not None and stamps[0] < last):
+                    raise CannotStream(f"{self.path}: messages not stored in time order")
+                first = stamps[0] if first is None else first
+                last = stamps[-1]
+                count += stamps.size
+                yield stamps * 1e-9
+        self.n_samples, self._span = count, (None if first is None else (first * 1e-9, last * 1e-9))
+
+    def time_span(self) -> tuple[float, float]:
+        """Times of the first and the last sample [s] (after a pass of :meth:`times`)."""
+        if self._span is None:
+            for _ in self.times():
+                pass
+        return self._span
+
+    def blocks(self, block_samples: int | None = None) -> Iterator[AxisLog]:
+        """The log, block by block (the last may be shorter), converted but not validated."""
+        size = self.block_samples if block_samples is None else int(block_samples)
+        yield from reblock(self._pieces(size), size)
+
+    def _pieces(self, size: int) -> Iterator[AxisLog]:
+        collector = _MessageCollector(self.path)
+        for rows in _messages(self.path, self._topic, {}, collector):
+            if rows >= size:
+                yield self._convert(*collector.columns())
+        if collector.rows:
+            yield self._convert(*collector.columns())
+
+    def _convert(self, stamps: np.ndarray, table: dict) -> AxisLog:
+        return log_from_columns(table, source=self.path, columns=self.columns, time=stamps * 1e-9,
+                                select=self._select, **self._fields)

@@ -36,13 +36,14 @@ from .prepare import derivative_margin, derive
 from .units import log_from_columns, resolve_columns, select_axis
 from .validate import check_finite, check_increasing, check_time, check_velocity_units
 
-__all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "can_stream", "median_step", "prepared_blocks"]
+__all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "can_stream", "median_step", "open_stream",
+           "prepared_blocks"]
 
 #: Samples per block (4 min 22 s at 2 ms).
 DEFAULT_BLOCK_SAMPLES = 1 << 15
 
 #: File extensions of the logs read block by block.
-STREAM_SUFFIXES = (".parquet", ".pq")
+STREAM_SUFFIXES = (".parquet", ".pq", ".mcap")
 
 _METADATA_KEY = b"greybox"
 
@@ -50,8 +51,9 @@ _METADATA_KEY = b"greybox"
 _READ_BUFFER_BYTES = 1 << 20
 
 
-def can_stream(path, *, sample_time: float | None = None, resample: float | None = None) -> bool:
-    """Whether :class:`ParquetLog` reads ``path`` block by block with these read options.
+def can_stream(path, *, sample_time: float | None = None, resample: float | None = None,
+               topic: str | None = None) -> bool:
+    """Whether :func:`open_stream` reads ``path`` block by block with these read options.
 
     Parameters
     ----------
@@ -61,9 +63,41 @@ def can_stream(path, *, sample_time: float | None = None, resample: float | None
         The ``--sample-time`` of a log without time column (then the log is read whole).
     resample : float, optional
         The ``--resample`` step (then the log is read whole).
+    topic : str, optional
+        The ``--topic`` of an MCAP log (a Parquet log with a topic is read whole, to be refused there).
     """
-    return (os.path.splitext(os.fspath(path))[1].lower() in STREAM_SUFFIXES and sample_time is None
-            and resample is None)
+    suffix = os.path.splitext(os.fspath(path))[1].lower()
+    return (suffix in STREAM_SUFFIXES and sample_time is None and resample is None
+            and (topic is None or suffix == ".mcap"))
+
+
+def open_stream(path, *, columns: Mapping[str, str] | None = None, topic: str | None = None,
+                axis: str | None = None, block_samples: int = DEFAULT_BLOCK_SAMPLES):
+    """A :class:`ParquetLog` or :class:`~greybox.data.mcap_io.McapLog` of a log that :func:`can_stream` accepts.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Parquet or MCAP log.
+    columns : mapping of str to str, optional
+        Column (field) mapping.
+    topic : str, optional
+        MCAP channel.
+    axis : str, optional
+        Axis to read from a log of several.
+    block_samples : int, default :data:`DEFAULT_BLOCK_SAMPLES`
+        Samples per block.
+
+    Raises
+    ------
+    LogError
+        For a file that cannot be read as the log it claims to be.
+    """
+    if os.path.splitext(os.fspath(path))[1].lower() == ".mcap":
+        from .mcap_io import McapLog
+
+        return McapLog(path, columns=columns, topic=topic, axis=axis, block_samples=block_samples)
+    return ParquetLog(path, columns=columns, axis=axis, block_samples=block_samples)
 
 
 class ParquetLog:
@@ -234,14 +268,14 @@ def median_step(times, source=None) -> float:
     return float(values[0]) if len(values) == 1 else float(np.mean(values))
 
 
-def prepared_blocks(log: ParquetLog, *, tolerance: float = 0.25, cutoff_hz: float | None = None,
+def prepared_blocks(log, *, tolerance: float = 0.25, cutoff_hz: float | None = None,
                     sample_time: float | None = None, block_samples: int | None = None) -> Iterator[AxisLog]:
     """The prepared run of a log, block by block: what :func:`greybox.data.prepare.prepare` gives for it whole.
 
     Parameters
     ----------
-    log : ParquetLog
-        The log.
+    log : ParquetLog or McapLog
+        The log (:func:`open_stream`).
     tolerance : float, default 0.25
         Time-step tolerance (see :func:`~greybox.data.validate.check_time`).
     cutoff_hz : float, optional

@@ -1,6 +1,6 @@
 """The process table of a log of any length, read, predicted and written block by block.
 
-:func:`stream_process` does for a log that :class:`greybox.data.stream.ParquetLog` reads block by block
+:func:`stream_process` does for a log that :func:`greybox.data.stream.open_stream` reads block by block
 what :func:`~greybox.evaluate.process.predict_process` followed by
 :func:`~greybox.evaluate.process_io.write_process` does for a log in memory, with the same table and
 metadata, while holding a few blocks of the log at a time: the log is prepared block by block
@@ -17,7 +17,7 @@ from itertools import chain
 from typing import Callable
 
 from ..data.axis_config import AxisConfig
-from ..data.stream import ParquetLog, median_step, prepared_blocks
+from ..data.stream import median_step, prepared_blocks
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from .interval import ProcessInterval
 from .process import ProcessTally, check_process_inputs, process_attrs, process_blocks
@@ -60,7 +60,7 @@ class StreamedProcess:
         return self.stop_s - self.start_s
 
 
-def stream_process(model, log: ParquetLog, out, *, axis_config: AxisConfig | None = None,
+def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
                    interval: ProcessInterval | None = None, chunk_s: float = DEFAULT_CHUNK_S,
                    tolerance: float = 0.25, cutoff_hz: float | None = None, attrs: dict | None = None,
                    overwrite: bool = False, protect=(),
@@ -71,8 +71,8 @@ def stream_process(model, log: ParquetLog, out, *, axis_config: AxisConfig | Non
     ----------
     model : CurrentModel
         A fitted model (trained on air cuts) of a registered kind.
-    log : ParquetLog
-        The cutting log.
+    log : ParquetLog or McapLog
+        The cutting log (:func:`greybox.data.stream.open_stream`).
     out : str or path-like
         Output table; see :func:`~greybox.evaluate.process_io.write_process_blocks`.
     axis_config : AxisConfig, optional
@@ -103,7 +103,7 @@ def stream_process(model, log: ParquetLog, out, *, axis_config: AxisConfig | Non
     LogError, GreyboxError
         As reading, preparing, predicting and writing the log whole would; no output is left then.
     """
-    nominal = median_step(log.times, log.path)
+    nominal = median_step(log.times, log.path)  # before anything is written: CannotStream falls back here
     start_s, stop_s = log.time_span()
     n_chunks = len(chunk_slices(log.n_samples, samples_per_chunk(nominal, chunk_s)))
     blocks = prepared_blocks(log, tolerance=tolerance, cutoff_hz=cutoff_hz, sample_time=nominal,
