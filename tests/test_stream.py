@@ -45,6 +45,26 @@ def test_median_step_is_numpys_median_of_the_steps(kind, size):
     assert median_step(_blocks_of(time, size)) == np.median(np.diff(time))
 
 
+@pytest.mark.parametrize("limit", [1, 10, 1 << 16])
+def test_median_step_reads_a_uniform_log_once_and_an_irregular_one_twice(monkeypatch, limit):
+    from greybox.data import stream
+
+    monkeypatch.setattr(stream, "_MAX_DISTINCT_STEPS", limit)
+    rng = np.random.default_rng(limit)
+    for time, irregular in ((np.arange(4001) * 0.002, False),
+                            (np.cumsum(0.002 * (1.0 + 0.2 * rng.uniform(-1, 1, 4000))), True)):
+        passes = []
+
+        def times(time=time):
+            passes.append(1)
+            return _blocks_of(time, 333)()
+
+        assert median_step(times) == np.median(np.diff(time))
+        distinct = np.unique(np.diff(time)).size
+        assert len(passes) == (2 if distinct > limit else 1)
+        assert irregular == (distinct > 100)
+
+
 def test_median_step_names_the_sample_where_time_goes_back():
     time = np.arange(100) * 0.01
     time[61] = time[60]

@@ -47,6 +47,9 @@ STREAM_SUFFIXES = (".parquet", ".pq", ".mcap")
 
 _METADATA_KEY = b"greybox"
 
+#: Distinct time steps counted one by one; beyond, the steps are counted by their upper bits (two passes).
+_MAX_DISTINCT_STEPS = 1 << 16
+
 #: Bytes read from the file at a time.
 _READ_BUFFER_BYTES = 1 << 20
 
@@ -231,10 +234,14 @@ def _value_at(keys, counts, rank: int):
 def median_step(times, source=None) -> float:
     """The median of the time steps of a log given block by block, exactly as :func:`numpy.median` gives it.
 
+    The steps are counted by value while they take few distinct values (a uniform log: one pass over the
+    time stamps); otherwise by the upper 32 bits of their floating-point pattern, and a second pass counts
+    by value the steps of the one or two counts that hold the middle of the sorted steps.
+
     Parameters
     ----------
     times : callable
-        ``times()`` gives an iterator over the time stamps [s] block by block; it is called twice.
+        ``times()`` gives an iterator over the time stamps [s] block by block; it is called once or twice.
     source : str, optional
         Log named in error messages.
 
@@ -250,20 +257,25 @@ def median_step(times, source=None) -> float:
     """
     keys = counts = None
     n_steps = 0
+    shift = np.uint64(0)  # 0: counted by value; 32: by the upper bits
     for steps in _steps(times(), source):
-        keys, counts = _add_counts(keys, counts, steps.view(np.uint64) >> np.uint64(32))
+        keys, counts = _add_counts(keys, counts, steps.view(np.uint64) >> shift)
         n_steps += steps.size
+        if not shift and keys.size > _MAX_DISTINCT_STEPS:
+            shift = np.uint64(32)
+            keys, counts = _add_counts(None, None, np.repeat(keys >> shift, counts))
     middle = sorted({(n_steps - 1) // 2, n_steps // 2})
+    if not shift:
+        values = [_value_at(keys, counts, rank)[0].view(np.float64) for rank in middle]
+        return float(values[0]) if len(values) == 1 else float(np.mean(values))
     buckets = [_value_at(keys, counts, rank) for rank in middle]
     wanted = np.array(sorted({bucket for bucket, _ in buckets}), dtype=np.uint64)
     exact_keys = exact_counts = None
     for steps in _steps(times(), source):
-        inside = steps[np.isin(steps.view(np.uint64) >> np.uint64(32), wanted)]
+        inside = steps[np.isin(steps.view(np.uint64) >> shift, wanted)]
         if inside.size:
             exact_keys, exact_counts = _add_counts(exact_keys, exact_counts, inside)
-    # ranks inside the buckets, counted from the first wanted bucket
-    first = int(np.searchsorted(keys, wanted[0]))
-    offset = int(np.sum(counts[:first]))
+    offset = int(np.sum(counts[:int(np.searchsorted(keys, wanted[0]))]))  # steps below the first wanted count
     values = [_value_at(exact_keys, exact_counts, rank - offset)[0] for rank in middle]
     return float(values[0]) if len(values) == 1 else float(np.mean(values))
 

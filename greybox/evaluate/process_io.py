@@ -138,7 +138,7 @@ def _write_parquet(results: Iterable[ProcessResult], path, metadata: Callable[[]
             for result in results:
                 table = _arrow_table(result)
                 if writer is None:
-                    writer = pq.ParquetWriter(staging, table.schema, compression="zstd")
+                    writer = pq.ParquetWriter(staging, table.schema, compression="none")  # read back at once
                 writer.write_table(table)
         finally:
             if writer is not None:
