@@ -479,20 +479,57 @@ def predict_log(job: FleetJob) -> dict:
 
 
 def _predict_and_write(job: FleetJob) -> dict:
+    """The table ``greybox predict`` writes for the job's log, streamed where ``predict`` streams it."""
     from .data.axis_config import read_axis_config
     from .evaluate.process import predict_process
     from .evaluate.process_io import write_process
     from .persistence import load_model
 
     config = read_axis_config(job.axis_config) if job.axis_config else None
+    model = load_model(job.model)
+    attrs = {"model_file": job.model, "log_file": job.log}
+    streamed = _stream_and_write(job, model, config, attrs)
+    if streamed is not None:
+        return streamed
     runs = read_prepared(job.log, job.read, columns=config.channels if config else None)
-    result = predict_process(load_model(job.model), runs, axis_config=config, chunk_s=job.chunk_s)
-    result.attrs.update({"model_file": job.model, "log_file": job.log})
-    axis = partition(result.axis or "-")
-    target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={axis}" / f"log={partition(Path(job.log).stem)}"
+    result = predict_process(model, runs, axis_config=config, chunk_s=job.chunk_s)
+    result.attrs.update(attrs)
+    target = _partition(job, result.axis)
+    path = write_process(result, target, overwrite=True)  # the table `predict` writes
+    return {"output": str(path), "axis": target.parent.parent.name.split("=", 1)[1], "samples": len(result.time)}
+
+
+def _partition(job: FleetJob, axis: str) -> Path:
+    """The job's table in the dataset, its directory made."""
+    target = (Path(job.out_dir) / f"machine={job.machine}" / f"axis={partition(axis or '-')}"
+              / f"log={partition(Path(job.log).stem)}")
     target.mkdir(parents=True, exist_ok=True)
-    path = write_process(result, target / "part-0.parquet", overwrite=True)  # the table `predict` writes
-    return {"output": str(path), "axis": axis, "samples": len(result.time)}
+    return target / "part-0.parquet"
+
+
+def _stream_and_write(job: FleetJob, model, config, attrs: dict) -> dict | None:
+    """Predict and write the log block by block (:mod:`greybox.data.stream`); None if it is to be read whole."""
+    from .data.blocks import CannotStream
+    from .data.stream import can_stream, open_stream
+    from .evaluate.process_stream import stream_process
+
+    read = job.read
+    if not can_stream(job.log, sample_time=read.get("sample_time"), resample=read.get("resample"),
+                      topic=read.get("topic")):
+        return None
+    columns = {**(config.channels if config else {}), **(read.get("columns") or {})} or None
+    log = open_stream(job.log, columns=columns, topic=read.get("topic"), axis=read.get("axis"))
+    if log.motion != "linear":
+        return None
+    target = _partition(job, log.axis or (config.name if config is not None else ""))
+    try:
+        done = stream_process(model, log, target, axis_config=config, chunk_s=job.chunk_s,
+                              tolerance=read.get("time_tolerance", 0.25), cutoff_hz=read.get("cutoff_hz"),
+                              attrs=attrs, overwrite=True)
+    except CannotStream:
+        return None
+    return {"output": str(target), "axis": target.parent.parent.name.split("=", 1)[1],
+            "samples": done.tally.n_samples}
 
 
 def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers: int | None = None,

@@ -604,6 +604,8 @@ class McapLog:
         Messages of the channel (known after the first pass of :meth:`times`).
     motion : str
         "linear" or "rotary", from the fields of the first messages.
+    axis : str
+        The log's axis name (the ``axis`` read, else the channel's).
 
     Raises
     ------
@@ -624,6 +626,7 @@ class McapLog:
         self._channel, self._select = _resolve_channel(channels, topic, axis, self.path)
         self._topic = self._channel.topic if self._select is None else None
         self._fields = _channel_fields(self._channel, self.path)
+        self.axis = self._select if self._select is not None else self._fields["axis"]
         self.n_samples = None
         self._span = None
         first = next(self.blocks(2), None)

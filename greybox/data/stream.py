@@ -123,6 +123,8 @@ class ParquetLog:
         Rows in the file.
     motion : str
         "linear" or "rotary", from the units of the columns.
+    axis : str
+        The log's axis name (the ``axis`` read, else the file's metadata; "" if neither names one).
 
     Raises
     ------
@@ -137,7 +139,7 @@ class ParquetLog:
 
         self.path = os.fspath(path)
         self.columns = dict(columns) if columns else None
-        self.axis = axis
+        self._select = axis
         self.block_samples = int(block_samples)
         try:
             # column chunks read through a small buffer: a row group need not fit in memory at once
@@ -160,6 +162,7 @@ class ParquetLog:
             raise LogError(self.path, "no time column (time_s or time_ms, or map one with columns={'time_s': ...}); "
                                       "for logs without time stamps give the sample time (--sample-time)")
         self._time_column, self._time_factor = found["time"]
+        self.axis = axis if axis is not None else str(self._metadata.get("axis", ""))
 
     def times(self) -> Iterator[np.ndarray]:
         """The time column [s], block by block."""
@@ -194,7 +197,7 @@ class ParquetLog:
             numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
             arrays[name] = (column.to_numpy(zero_copy_only=False) if numeric
                             else column.to_numpy(zero_copy_only=False).astype(object))
-        return log_from_columns(arrays, source=self.path, columns=self.columns, select=self.axis, **self._metadata)
+        return log_from_columns(arrays, source=self.path, columns=self.columns, select=self._select, **self._metadata)
 
 
 def _steps(times: Iterable[np.ndarray], source) -> Iterator[np.ndarray]:
