@@ -13,9 +13,11 @@ Steps, all on this machine in one run (its cores stated; ratios carry over, abso
    then the GMS+SVR training again with the kernel sums of the code before this benchmark was written
    (every support vector for every sample, one matrix product per block, :func:`dense_expansion` below),
    with its time and the test RE of both on ``data/X_C``;
-3. ``greybox predict MODEL LOG --out OUT.parquet`` in a fresh process for each model: wall time and peak
-   resident memory (``ru_maxrss`` of that process), and the ratio GMS+SVR / GMS;
-4. the kernel sums of the hour's SVR inputs by :func:`greybox.models.rbf.rbf_expansion` (1 and all
+3. ``greybox predict MODEL LOG --out OUT.parquet`` in a fresh process for each model and each log format
+   (both read, predicted and written block by block): wall time and peak resident memory (``VmHWM`` of
+   that process), and the ratio GMS+SVR / GMS;
+4. the same GMS+SVR prediction on a Parquet log ``--long`` times as long: its peak memory against the hour's;
+5. the kernel sums of the hour's SVR inputs by :func:`greybox.models.rbf.rbf_expansion` (1 and all
    threads) and by :func:`dense_expansion`, with the largest difference.
 """
 
@@ -87,7 +89,7 @@ def timed(function, *args, **kwargs):
 
 
 def read_rates(root: Path, duration_s: float) -> dict:
-    """Write the hour as MCAP and Parquet; samples per second read by :func:`read_log`."""
+    """Write the hour as MCAP and Parquet; samples per second read whole by :func:`read_log`."""
     log = make_dataset("X", "A", 21, duration_s=duration_s, cutting=True)
     rates = {}
     for suffix in ("mcap", "parquet"):
@@ -126,18 +128,32 @@ def train(root: Path) -> dict:
     }
 
 
+#: Runs ``greybox`` in the child and writes its peak resident memory [kB] (``VmHWM``, Linux) to argv[1] at exit;
+#: the ``ru_maxrss`` of a child counts the memory of the parent it was forked from.
+_CHILD = r"""
+import runpy, sys
+report = sys.argv.pop(1)
+try:
+    runpy.run_module("greybox", run_name="__main__", alter_sys=True)
+finally:
+    with open("/proc/self/status") as status:
+        peak = next(int(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+    with open(report, "w") as stream:
+        stream.write(str(peak))
+"""
+
+
 def predict_cli(model: Path, log: Path, out: Path) -> dict:
     """``greybox predict MODEL LOG --out OUT --quiet`` in a fresh process: wall time and peak memory."""
     out.unlink(missing_ok=True)
+    report = out.with_suffix(".peak")
     started = time.perf_counter()
-    process = subprocess.Popen([sys.executable, "-m", "greybox", "predict", str(model), str(log), "--out", str(out),
-                                "--quiet"], stdout=subprocess.DEVNULL)
-    _, status, usage = os.wait4(process.pid, 0)
+    status = subprocess.run([sys.executable, "-c", _CHILD, str(report), "predict", str(model), str(log), "--out",
+                             str(out), "--quiet"], stdout=subprocess.DEVNULL).returncode
     seconds = time.perf_counter() - started
-    process.returncode = os.waitstatus_to_exitcode(status)
-    if process.returncode:
-        raise SystemExit(f"greybox predict {model.name} failed with status {process.returncode}")
-    return {"seconds": seconds, "peak_rss_mb": usage.ru_maxrss / 1024}
+    if status:
+        raise SystemExit(f"greybox predict {model.name} {log.name} failed with status {status}")
+    return {"seconds": seconds, "peak_rss_mb": int(report.read_text()) / 1024}
 
 
 def kernel_sums(root: Path) -> dict:
@@ -146,7 +162,7 @@ def kernel_sums(root: Path) -> dict:
 
     model = load_model(root / "gmssvr.gbm")
     (log,) = prepare([read_log(root / "hour.parquet")])
-    X = np.concatenate(list(model._input_chunks(log)))
+    X, _ = model._inputs_chunk(log, model.region_state(), log.sample_time)
     scaled = (X - model.input_mean_) / model.input_scale_
     args = (scaled, model.support_vectors_, model.dual_coef_, model.intercept_, model.gamma_)
     rbf_expansion(*(a[:1000] if i == 0 else a for i, a in enumerate(args)))  # compile
@@ -163,6 +179,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=3600.0, help="length of the predicted log [s]")
     parser.add_argument("--out", help="keep the log, models and outputs in this directory (default: temporary)")
+    parser.add_argument("--long", type=float, default=3.0, help="length of the long log, in --duration (default 3)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args()
     root = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="bench_predict_"))
@@ -170,15 +187,19 @@ def main() -> None:
     try:
         reading = read_rates(root, args.duration)
         training = train(root)
-        predicting = {kind: predict_cli(root / f"{kind}.gbm", root / "hour.mcap", root / f"{kind}.parquet")
-                      for kind in ("gms", "gmssvr")}
-        predicting["ratio"] = predicting["gmssvr"]["seconds"] / predicting["gms"]["seconds"]
+        predicting = {fmt: {kind: predict_cli(root / f"{kind}.gbm", root / f"hour.{fmt}", root / f"{kind}.parquet")
+                            for kind in ("gms", "gmssvr")} for fmt in ("mcap", "parquet")}
+        for runs in predicting.values():
+            runs["ratio"] = runs["gmssvr"]["seconds"] / runs["gms"]["seconds"]
+        write_log(make_dataset("X", "A", 22, duration_s=args.long * args.duration, cutting=True), root / "long.parquet")
+        longer = predict_cli(root / "gmssvr.gbm", root / "long.parquet", root / "long_out.parquet")
+        longer["memory_ratio"] = longer["peak_rss_mb"] / predicting["parquet"]["gmssvr"]["peak_rss_mb"]
         kernel = kernel_sums(root)
     finally:
         if not args.out:
             shutil.rmtree(root, ignore_errors=True)
     result = {"cores": len(os.sched_getaffinity(0)), "duration_s": args.duration, "read": reading,
-              "train": training, "predict": predicting, "kernel": kernel}
+              "train": training, "predict": predicting, "long": longer, "kernel": kernel}
     if args.json:
         print(json.dumps(result))
         return
@@ -192,10 +213,14 @@ def main() -> None:
           f"({t['n_support']} support vectors); SVR stage with the former kernel sums {t['former_svr_stage_s']:.1f} s "
           f"({t['svr_stage_speedup']:.2f}x); test RE on X_C {t['test_re_percent']:.2f} % "
           f"(former {t['former_test_re_percent']:.2f} %)")
-    for kind in ("gms", "gmssvr"):
-        p = predicting[kind]
-        print(f"  greybox predict {kind} -> Parquet: {p['seconds']:.2f} s wall, peak {p['peak_rss_mb']:.0f} MB")
-    print(f"  ratio GMS+SVR / GMS: {predicting['ratio']:.2f}")
+    for fmt, runs in predicting.items():
+        for kind in ("gms", "gmssvr"):
+            p = runs[kind]
+            print(f"  greybox predict {kind}, {fmt} -> Parquet: {p['seconds']:.2f} s wall, "
+                  f"peak {p['peak_rss_mb']:.0f} MB")
+        print(f"  ratio GMS+SVR / GMS ({fmt}): {runs['ratio']:.2f}")
+    print(f"  greybox predict gmssvr, Parquet {args.long:g}x as long: {longer['seconds']:.2f} s wall, peak "
+          f"{longer['peak_rss_mb']:.0f} MB ({longer['memory_ratio']:.2f}x the hour's)")
     k = kernel
     print(f"  kernel sums, {k['samples']} samples x {k['n_support']} support vectors: former {k['former_s']:.2f} s, "
           f"compiled {k['compiled_1_thread_s']:.2f} s on 1 thread ({k['speedup_1_thread']:.2f}x), "

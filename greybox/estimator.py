@@ -200,6 +200,34 @@ class CurrentModel(ModelProtocol):
         """
         return self._effort(*self._chunk_arguments(log, state, sample_time))
 
+    def predict_flag_chunk(self, log: AxisLog, state, region, *, sample_time: float):
+        """:meth:`predict_chunk` and :meth:`outside_training_chunk` of one chunk of a run, together.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared chunk: consecutive samples of one run.
+        state, region : object
+            The model's state and the state of its training-region check before the chunk
+            (:meth:`initial_state` and :meth:`region_state` at the start of a run).
+        sample_time : float
+            Step [s] of the whole run.
+
+        Returns
+        -------
+        current : ndarray, shape (n,)
+            Predicted effort [A, or N].
+        state : object
+            The model's state after the chunk.
+        flags : dict of str to ndarray of bool
+            As :meth:`outside_training`.
+        region : object
+            The region check's state after the chunk.
+        """
+        current, state = self.predict_chunk(log, state, sample_time=sample_time)
+        flags, region = self.outside_training_chunk(log, region, sample_time=sample_time)
+        return current, state, flags, region
+
     def friction_chunk(self, log: AxisLog, state=None, *, sample_time: float | None = None):
         """Friction of one chunk of a run from a given state (no inertia, no offset) [A, or N].
 

@@ -120,3 +120,22 @@ def test_gms_svr_flags_its_inputs_in_chunks_equal_to_the_whole_run(logs):
                                                     sample_time=long_log.sample_time)
         parts.append(flags["inputs"])
     np.testing.assert_array_equal(np.concatenate(parts), expected)
+
+
+def test_gms_svr_predicts_and_flags_a_chunk_with_one_gms_pass_as_it_does_apart(logs):
+    model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=60), **SMALL_SVR).fit(logs["A"])
+    run = prepare([make_dataset("X", "C", seed=36, duration_s=20)])[0]
+    first, rest = run.select(slice(0, 3000)), run.select(slice(3000, None))
+    state = region = model.initial_state()
+    for chunk in (first, rest):  # the second chunk starts from the states the first ended in
+        current, state_together, flags, region_together = model.predict_flag_chunk(
+            chunk, state, region, sample_time=run.sample_time)
+        expected, state = model.predict_chunk(chunk, state, sample_time=run.sample_time)
+        expected_flags, region = model.outside_training_chunk(chunk, region, sample_time=run.sample_time)
+        np.testing.assert_array_equal(current, expected)
+        assert flags.keys() == expected_flags.keys() and "inputs" in flags
+        for name in flags:
+            np.testing.assert_array_equal(flags[name], expected_flags[name])
+        for ours, theirs in ((state_together, state), (region_together, region)):
+            for a, b in zip(ours, theirs):
+                np.testing.assert_array_equal(a, b)

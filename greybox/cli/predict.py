@@ -32,7 +32,9 @@ def add_parser(subparsers) -> None:
         "sample, the measured current, the model current (inertia + friction) and the process current "
         "= measured - model; with --axis-config also the process force in N (torque in Nm for a rotary "
         "axis). The model runs over chunks "
-        "of --chunk-s seconds carrying its state, so long logs need little working memory.",
+        "of --chunk-s seconds carrying its state; a Parquet or MCAP log of a linear axis (without --plot, "
+        "--resample, --sample-time) is read, prepared and written block by block, so its length does not "
+        "bound the memory.",
     )
     parser.add_argument("model", metavar="MODEL",
                         help="model file written by 'greybox train' (.gbm), or a machine model directory "

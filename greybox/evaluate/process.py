@@ -58,6 +58,7 @@ from dataclasses import dataclass, field, replace
 from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog, as_log_list
@@ -259,7 +260,7 @@ class ProcessTally:
                   "load": result.load}
         for name, array in values.items():
             if array is not None and len(array):
-                self.sum_squares[name] += float(array @ array)
+                self.sum_squares[name] += float(np.einsum("i,i->", array, array))  # no BLAS: its threads spin
                 if name in self.largest:
                     self.largest[name] = max(self.largest[name], float(np.max(np.abs(array))))
         if result.half_width is not None:
@@ -380,9 +381,8 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
         predicted = np.empty(len(block))
         parts = []
         for samples in chunk_slices(len(block), samples_per_chunk(sample_time, chunk_s)):
-            chunk = block.select(samples)
-            predicted[samples], state = model.predict_chunk(chunk, state, sample_time=sample_time)
-            flags, region = model.outside_training_chunk(chunk, region, sample_time=sample_time)
+            predicted[samples], state, flags, region = model.predict_flag_chunk(
+                block.select(samples), state, region, sample_time=sample_time)
             parts.append(flags)
             if progress is not None:
                 progress(float(block.time[samples.stop - 1]))
@@ -478,10 +478,11 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
         progress(done[0], n_chunks, time_s)
 
     tally = ProcessTally()
-    parts = [part for run in runs
-             for part in process_blocks(model, [run], sample_time=run.sample_time, axis_config=axis_config,
-                                        interval=interval, chunk_s=chunk_s, tally=tally,
-                                        progress=None if progress is None else step)]
+    with threadpool_limits(limits=1, user_api="blas"):  # idle BLAS threads spin, taking the kernels' cores
+        parts = [part for run in runs
+                 for part in process_blocks(model, [run], sample_time=run.sample_time, axis_config=axis_config,
+                                            interval=interval, chunk_s=chunk_s, tally=tally,
+                                            progress=None if progress is None else step)]
     attrs = process_attrs(model, axis_config=axis_config, interval=interval, chunk_s=chunk_s,
                           motion=runs[0].motion, effort_unit=runs[0].effort_unit, tally=tally,
                           runs=[{"start_s": float(run.time[0]), "samples": len(run)} for run in runs])

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 from itertools import chain
 from typing import Callable
 
+from threadpoolctl import threadpool_limits
+
 from ..data.axis_config import AxisConfig
 from ..data.stream import median_step, prepared_blocks
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
@@ -130,7 +132,9 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
                           "dataset": first.dataset or "", "effort_unit": first.effort_unit, "attrs": table_attrs})
         return described
 
-    write_process_blocks(results, out, metadata=metadata, overwrite=overwrite, protect=protect)
+    # one BLAS thread: its idle threads spin, taking the cores from the kernel sums' own threads
+    with threadpool_limits(limits=1, user_api="blas"):
+        write_process_blocks(results, out, metadata=metadata, overwrite=overwrite, protect=protect)
     return StreamedProcess(tally=tally, metadata=described, motion=first.motion, sample_time=nominal,
                            start_s=start_s, stop_s=stop_s, n_chunks=n_chunks)
 

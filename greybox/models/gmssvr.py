@@ -301,10 +301,22 @@ class GMSSVRModel(KernelRegressionModel):
 
     def _simulate(self, run: AxisLog, state, sample_time):
         inputs, end = self._inputs(run, state, sample_time)
+        return self._friction_of(run, inputs), end
+
+    def _friction_of(self, run: AxisLog, inputs) -> np.ndarray:
+        """Friction [A] of a chunk whose SVR inputs are ``inputs``: the prediction less inertia and offset."""
         current = self._kernel_predict(inputs)
         if self.target == "residual":
             current = current + inputs[:, 1]
-        return current - self.J_ * run.acceleration - self.offset_, end
+        return current - self.J_ * run.acceleration - self.offset_
+
+    def predict_flag_chunk(self, log: AxisLog, state, region, *, sample_time: float):
+        """As :meth:`CurrentModel.predict_flag_chunk <greybox.estimator.CurrentModel.predict_flag_chunk>`, the
+        GMS stage simulated once for both: the region check carries the same GMS state as the prediction."""
+        run, start, step = self._chunk_arguments(log, state, sample_time)
+        inputs, end = self._inputs(run, start, step)
+        current = self.J_ * run.acceleration + self._friction_of(run, inputs) + self.offset_
+        return current, end, self._flags(run, inputs, step), end
 
     def _n_params(self) -> int:
         return int(self.dual_coef_.size) + 1 + self.gms_.n_params

@@ -40,6 +40,8 @@ compiled kernel releases the GIL. Working memory: a few rows of
 from __future__ import annotations
 
 import math
+import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 
 import numba
@@ -84,8 +86,8 @@ def _exp_neg(t):
 
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath={"reassoc", "contract"})
-def _expansion_blocks(X, support_t, alpha, gamma, cutoff, block, first_block, stop_block, out):
-    """Add the kernel sums of the samples of blocks ``[first_block, stop_block)`` to ``out``.
+def _expansion_blocks(X, support_t, alpha, gamma, cutoff, block, first_block, stride, out):
+    """Add the kernel sums of the samples of every ``stride``-th block from ``first_block`` on to ``out``.
 
     ``support_t`` holds the support vectors column-wise, shape (n_features, n_support).
     """
@@ -97,7 +99,8 @@ def _expansion_blocks(X, support_t, alpha, gamma, cutoff, block, first_block, st
     low = np.empty(n_features)
     high = np.empty(n_features)
     reach = cutoff / gamma  # squared distance beyond which a term is left out
-    for b in range(first_block, stop_block):
+    n_blocks = (n_samples + block - 1) // block
+    for b in range(first_block, n_blocks, stride):
         start = b * block
         stop = min(start + block, n_samples)
         for f in range(n_features):
@@ -209,13 +212,25 @@ def rbf_expansion(
     support_t = np.ascontiguousarray(sv.T)
     n_blocks = -(-n_samples // BLOCK_SAMPLES)
     threads = min(threads, max(1, n_blocks // _MIN_BLOCKS_PER_THREAD))
-    bounds = np.linspace(0, n_blocks, threads + 1).astype(np.int64)
     if threads == 1:
-        _expansion_blocks(X, support_t, alpha, float(gamma), cutoff, BLOCK_SAMPLES, 0, n_blocks, out)
+        _expansion_blocks(X, support_t, alpha, float(gamma), cutoff, BLOCK_SAMPLES, 0, 1, out)
         return out
-    with ThreadPoolExecutor(max_workers=threads) as pool:
-        parts = [pool.submit(_expansion_blocks, X, support_t, alpha, float(gamma), cutoff, BLOCK_SAMPLES,
-                             int(bounds[k]), int(bounds[k + 1]), out) for k in range(threads)]
-        for part in parts:
-            part.result()
+    # blocks dealt out in turn: the work per block varies along a log, neighbouring blocks alike
+    parts = [_pool(threads).submit(_expansion_blocks, X, support_t, alpha, float(gamma), cutoff, BLOCK_SAMPLES, k,
+                                   threads, out) for k in range(threads)]
+    for part in parts:
+        part.result()
     return out
+
+
+_POOLS: dict[tuple[int, int], ThreadPoolExecutor] = {}
+_POOLS_LOCK = threading.Lock()
+
+
+def _pool(threads: int) -> ThreadPoolExecutor:
+    """A thread pool of ``threads`` workers, made once per process (a long log is summed chunk after chunk)."""
+    key = (os.getpid(), threads)  # a forked process makes its own
+    with _POOLS_LOCK:
+        if key not in _POOLS:
+            _POOLS[key] = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="greybox-rbf")
+        return _POOLS[key]

@@ -427,13 +427,17 @@ class KernelRegressionModel(CurrentModel):
         return {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
 
     def outside_training_chunk(self, log: AxisLog, state, *, sample_time: float):
-        out, _ = super().outside_training_chunk(log, state, sample_time=sample_time)
-        ranges = getattr(self, "input_range_", None)  # None: a file that predates the record
-        if ranges is None:
-            return out, state
+        if getattr(self, "input_range_", None) is None:  # a file that predates the record
+            return super().outside_training_chunk(log, state, sample_time=sample_time)
         X, state = self._inputs_chunk(log, state, sample_time)
-        out["inputs"] = np.any((X < ranges[0]) | (X > ranges[1]), axis=1)
-        return out, state
+        return self._flags(log, X, sample_time), state
+
+    def _flags(self, log: AxisLog, X, sample_time: float) -> dict[str, np.ndarray]:
+        """The training-region flags of a chunk whose SVR inputs are ``X``."""
+        out, _ = super().outside_training_chunk(log, None, sample_time=sample_time)
+        if getattr(self, "input_range_", None) is not None:
+            out["inputs"] = np.any((X < self.input_range_[0]) | (X > self.input_range_[1]), axis=1)
+        return out
 
     def _kernel_predict(self, X) -> np.ndarray:
         """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
