@@ -249,3 +249,32 @@ def test_mcap_messages_out_of_time_order_are_read_whole(tmp_path, capsys, models
     printed = capsys.readouterr().out
     assert "block by block" not in printed
     np.testing.assert_array_equal(pd.read_parquet(out)["time_s"], prepare([read_log(path)])[0].time)
+
+
+@pytest.mark.parametrize("repeat_channels", [True, False])
+def test_mcap_channels_come_from_the_summary_or_from_the_records(tmp_path, repeat_channels):
+    """Without channels in the summary section, the data section's channel records choose the channel."""
+    from mcap.writer import Writer
+
+    x, y = (make_dataset(axis, "A", seed=9, duration_s=6) for axis in ("X", "Y"))
+    path = tmp_path / "two.mcap"
+    with open(path, "wb") as stream:
+        writer = Writer(stream, repeat_channels=repeat_channels)
+        writer.start()
+        schema = writer.register_schema("greybox.AxisSample", "jsonschema", b"{}")
+        channels = {log.axis: writer.register_channel(f"/axis/{log.axis}", "json", schema, {"axis": log.axis})
+                    for log in (x, y)}
+        n = min(len(x), len(y))
+        for k in range(n):
+            for log in (x, y):
+                stamp = int(round(log.time[k] * 1e9))
+                message = {"position_mm": log.position[k], "current_A": log.effort[k]}
+                writer.add_message(channels[log.axis], stamp, json.dumps(message).encode(), stamp)
+        writer.finish()
+    streamed = concatenate(McapLog(path, axis="Y", block_samples=500).blocks())
+    whole = read_log(path, axis="Y")
+    assert streamed.axis == whole.axis == "Y"
+    np.testing.assert_array_equal(streamed.position, whole.position)
+    np.testing.assert_array_equal(streamed.position, y.position[:n])
+    with pytest.raises(LogError, match="several channels"):
+        McapLog(path, block_samples=500)

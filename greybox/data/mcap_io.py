@@ -66,7 +66,7 @@ AXIS_SAMPLE_SCHEMA = {
 }
 
 _MAGIC = b"\x89MCAP0\r\n"
-_OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x04, 0x05, 0x06, 0x0F
+_OP_FOOTER, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x02, 0x04, 0x05, 0x06, 0x0F
 _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time u64
 _BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
 _BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
@@ -477,9 +477,7 @@ def _messages(path, topic: str | None, channels: dict[int, _Channel], collector:
     """Walk the file, adding channel records to ``channels`` and the chosen channel's messages to ``collector``
     (their time stamps only with ``stamps_only``); yield the messages collected after each stretch."""
     for buf, opcodes, offsets, lengths in _walk(path):
-        for k in np.flatnonzero(opcodes == _OP_CHANNEL):
-            channel = _Channel(buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), path)
-            channels.setdefault(channel.id, channel)
+        _add_channels(channels, buf, opcodes, offsets, lengths, path)
         chosen = _match(channels, topic)
         is_message = opcodes == _OP_MESSAGE
         if chosen is None or not is_message.any():
@@ -578,6 +576,44 @@ def _channel_fields(channel: _Channel, path) -> dict:
             "dataset": metadata.get("dataset", ""), "attrs": attrs if isinstance(attrs, dict) else {"attrs": attrs}}
 
 
+def _add_channels(channels: dict[int, _Channel], buf: np.ndarray, opcodes, offsets, lengths, path) -> None:
+    for k in np.flatnonzero(opcodes == _OP_CHANNEL):
+        channel = _Channel(buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), path)
+        channels.setdefault(channel.id, channel)
+
+
+def _walked_channels(path) -> dict[int, _Channel]:
+    """The channel records of the data section (a walk over the whole file)."""
+    channels: dict[int, _Channel] = {}
+    for buf, opcodes, offsets, lengths in _walk(path):
+        _add_channels(channels, buf, opcodes, offsets, lengths, path)
+    return channels
+
+
+def _summary_channels(path) -> dict[int, _Channel]:
+    """The channel records of the summary section that the footer points to; empty if there are none."""
+    size = os.path.getsize(path)
+    footer = 1 + 8 + 20  # opcode, length, summary start u64, summary offset start u64, summary CRC u32
+    if size < 2 * len(_MAGIC) + footer:
+        return {}
+    with open(path, "rb") as stream:
+        stream.seek(size - len(_MAGIC) - footer)
+        record = stream.read(footer)
+        if record[0] != _OP_FOOTER or int.from_bytes(record[1:9], "little") != 20:
+            return {}
+        start = int.from_bytes(record[9:17], "little")
+        stop = int.from_bytes(record[17:25], "little") or size - len(_MAGIC) - footer
+        if not len(_MAGIC) <= start < stop <= size - len(_MAGIC) - footer or stop - start > _WINDOW_BYTES:
+            return {}
+        stream.seek(start)
+        data = stream.read(stop - start)
+    buf = np.frombuffer(data, np.uint8)
+    opcodes, offsets, lengths, _ = scan_records(buf, 0, buf.size)
+    channels: dict[int, _Channel] = {}
+    _add_channels(channels, buf, opcodes, offsets, lengths, path)
+    return channels
+
+
 class McapLog:
     """An MCAP axis log read block by block, converted as :func:`read_mcap` converts it.
 
@@ -618,11 +654,7 @@ class McapLog:
         self.path = os.fspath(path)
         self.columns = dict(columns) if columns else None
         self.block_samples = int(block_samples)
-        channels: dict[int, _Channel] = {}
-        for _buf, opcodes, offsets, lengths in _walk(self.path):
-            for k in np.flatnonzero(opcodes == _OP_CHANNEL):
-                channel = _Channel(_buf[offsets[k]:offsets[k] + lengths[k]].tobytes(), self.path)
-                channels.setdefault(channel.id, channel)
+        channels = _summary_channels(self.path) or _walked_channels(self.path)
         self._channel, self._select = _resolve_channel(channels, topic, axis, self.path)
         self._topic = self._channel.topic if self._select is None else None
         self._fields = _channel_fields(self._channel, self.path)
