@@ -55,7 +55,7 @@ def test_median_step_reads_a_uniform_log_once_and_an_irregular_one_twice(monkeyp
                             (np.cumsum(0.002 * (1.0 + 0.2 * rng.uniform(-1, 1, 4000))), True)):
         passes = []
 
-        def times(time=time):
+        def times(time=time, passes=passes):
             passes.append(1)
             return _blocks_of(time, 333)()
 
