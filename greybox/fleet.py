@@ -161,7 +161,16 @@ def attempt(label: str, work: Callable[[], dict]) -> dict:
 
 
 def _peak_rss_mb() -> float | None:
-    """Peak resident memory of this (worker) process so far [MB]; None where the OS does not say."""
+    """Peak resident memory of this (worker) process so far [MB]; None where the OS does not say.
+
+    On Linux ``VmHWM`` of ``/proc/self/status``: ``ru_maxrss`` keeps across ``exec`` the peak of the
+    process the worker was forked from (a large parent would be counted as the worker's own).
+    """
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            return next(int(line.split()[1]) for line in status if line.startswith("VmHWM:")) / 1024.0
+    except (OSError, StopIteration, ValueError, IndexError):
+        pass
     try:
         import resource
     except ImportError:  # not on Windows
