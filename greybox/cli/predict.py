@@ -37,8 +37,9 @@ def add_parser(subparsers) -> None:
         "bound the memory.",
     )
     parser.add_argument("model", metavar="MODEL",
-                        help="model file written by 'greybox train' (.gbm), or a machine model directory "
-                        "('greybox train --axes')")
+                        help="model file written by 'greybox train' (.gbm), a machine model directory "
+                        "('greybox train --axes'), or for a fleet run the models directory of 'greybox train "
+                        "--per-machine' (each log predicted with its machine's model)")
     parser.add_argument("logs", nargs="+", metavar="LOG",
                         help="cutting log (CSV, Parquet, MCAP, TDMS or MATLAB .mat); several logs, directories "
                         "(searched recursively) or glob patterns make a fleet run: one task per log on Dask, "
