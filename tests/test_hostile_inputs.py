@@ -256,8 +256,36 @@ def test_a_run_stopped_mid_write_keeps_the_previous_output(long_prediction, tmp_
     assert out.read_text() == "previous output\n"  # never a partial table under the output's name
     left = [name for name in os.listdir(tmp_path) if name != "process.csv"]
     if stop == signal.SIGTERM:
-        assert process.returncode == 143 and "terminated (SIGTERM)" in error and "Traceback" not in error
+        assert process.returncode == 143 and "terminated (SIGTERM)" in error and "Traceback" not in error, error
         assert left == []  # the temporary file is removed on the way out
     else:
         assert process.returncode == -signal.SIGKILL
         assert all(name.startswith(".process.csv.") and name.endswith(".tmp") for name in left)
+
+
+@pytest.mark.parametrize(("stop", "status", "said"), [("Terminated", 143, "terminated (SIGTERM)"),
+                                                      ("KeyboardInterrupt", 130, "interrupted")])
+def test_a_signal_caught_inside_compiled_code_still_stops_the_command_cleanly(monkeypatch, capsys, stop, status,
+                                                                              said):
+    """numba turns an exception raised in a callback (its cache loading) into a SystemError caused by it."""
+    import greybox.cli as cli
+    import greybox.cli.info as info
+
+    signal_error = cli.Terminated() if stop == "Terminated" else KeyboardInterrupt()
+
+    def run(args):
+        try:
+            raise signal_error
+        except KeyboardInterrupt as error:
+            raise SystemError("<function _numba_unpickle> returned a result with an exception set") from error
+
+    monkeypatch.setattr(info, "run", run)
+    assert cli.main(["info", "any.gbm"]) == status
+    assert said in capsys.readouterr().err
+
+    def broken(args):
+        raise SystemError("a real one")
+
+    monkeypatch.setattr(info, "run", broken)
+    with pytest.raises(SystemError, match="a real one"):
+        cli.main(["info", "any.gbm"])

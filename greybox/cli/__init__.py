@@ -59,6 +59,30 @@ def _terminate(signum, frame):
     raise Terminated()
 
 
+def _signal_behind(error: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C or SIGTERM in the causes of ``error``, if any.
+
+    A signal's handler raises where the interpreter happens to be; inside a Python callback of compiled
+    code (numba loading a cached function) the exception comes out as a ``SystemError`` caused by it.
+    """
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
+def _stopped(stop: KeyboardInterrupt, command: str) -> int:
+    """Say how the command was stopped; the exit status (143 for SIGTERM, 130 for Ctrl-C)."""
+    if isinstance(stop, Terminated):
+        print(f"greybox {command}: terminated (SIGTERM); no output was left half-written", file=sys.stderr)
+        return 143
+    print(f"greybox {command}: interrupted", file=sys.stderr)
+    return 130
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the ``greybox`` command and return its exit status.
 
@@ -75,12 +99,13 @@ def main(argv: list[str] | None = None) -> int:
     except GreyboxError as error:
         print(f"greybox {args.command}: error: {error_message(error, args)}", file=sys.stderr)
         return 2
-    except Terminated:
-        print(f"greybox {args.command}: terminated (SIGTERM); no output was left half-written", file=sys.stderr)
-        return 143
-    except KeyboardInterrupt:
-        print(f"greybox {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as stop:  # Ctrl-C, or SIGTERM (Terminated)
+        return _stopped(stop, args.command)
+    except SystemError as error:  # a signal handled inside a callback of compiled code comes out wrapped
+        stop = _signal_behind(error)
+        if stop is None:
+            raise
+        return _stopped(stop, args.command)
     except BrokenPipeError:  # the reader of the output went away (``greybox ... | head``): stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
