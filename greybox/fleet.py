@@ -427,6 +427,18 @@ def machine_models(directory: str | os.PathLike) -> dict[str, dict[str, str]]:
     return table
 
 
+def model_of_log(directory: str | os.PathLike, log: str | os.PathLike, axis: str | None = None) -> str:
+    """The model file of ``log``'s machine (the name of its folder) in a directory of ``greybox train --per-machine``.
+
+    Raises
+    ------
+    GreyboxError
+        For a directory without that manifest, a machine without a model, or (without ``axis``) a machine
+        with models of several axes.
+    """
+    return _model_for(Path(log), machine_of(Path(log)), machine_models(directory), str(directory), axis)
+
+
 def _model_for(log: Path, machine: str, models: dict[str, dict[str, str]], directory: str, axis: str | None) -> str:
     """The model file of ``log``'s machine in a models directory (of ``axis`` where it has several)."""
     by_axis = models.get(machine)

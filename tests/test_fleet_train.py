@@ -116,6 +116,11 @@ def test_each_log_is_predicted_with_its_machines_model(plant, trained, tmp_path,
                           "--quiet"])[0] == 0
     part = pd.read_parquet(out / "machine=mill2" / "axis=X" / "log=a" / "part-0.parquet")
     pd.testing.assert_frame_equal(part, pd.read_parquet(single))
+    from_directory = tmp_path / "from_directory.parquet"  # one log, the models directory: its machine's model
+    status, printed, _ = _main(capsys, ["predict", models, plant / "mill2" / "a.csv", "--out", from_directory,
+                                        "--quiet"])
+    assert status == 0 and str(models / "mill2" / "X.gbm") in printed
+    pd.testing.assert_frame_equal(pd.read_parquet(from_directory), pd.read_parquet(single))
     status, _, error = _main(capsys, ["predict", models, plant, "--out", tmp_path / "r2"])
     assert status == 2 and "no trained model of machine mill3" in error and "\n" not in error.strip()
 

@@ -208,6 +208,11 @@ def run(args: argparse.Namespace) -> int:
     args.log = args.logs[0]
     if is_machine_model(args.model):
         return _run_machine(args)
+    if os.path.isdir(args.model):  # the models of 'greybox train --per-machine': the one of this log's machine
+        from ..fleet import model_of_log
+
+        args.model = model_of_log(args.model, args.log, args.axis)
+        print(f"model of machine {Path(args.log).resolve().parent.name}: {args.model}")
     run_started = time.perf_counter()
     from ..data.axis_config import read_axis_config
     from ..evaluate.process import predict_process
