@@ -515,42 +515,39 @@ def _predict_and_write(job: FleetJob) -> dict:
     runs = read_prepared(job.log, job.read, columns=config.channels if config else None)
     result = predict_process(model, runs, axis_config=config, chunk_s=job.chunk_s)
     result.attrs.update(attrs)
-    target = _partition(job, result.axis)
+    target, axis = _partition(job, result.axis)
     path = write_process(result, target, overwrite=True)  # the table `predict` writes
-    return {"output": str(path), "axis": target.parent.parent.name.split("=", 1)[1], "samples": len(result.time)}
+    return {"output": str(path), "axis": axis, "samples": len(result.time)}
 
 
-def _partition(job: FleetJob, axis: str) -> Path:
-    """The job's table in the dataset, its directory made."""
-    target = (Path(job.out_dir) / f"machine={job.machine}" / f"axis={partition(axis or '-')}"
-              / f"log={partition(Path(job.log).stem)}")
+def _partition(job: FleetJob, axis: str) -> tuple[Path, str]:
+    """The job's table in the dataset (its directory made), and the name of its axis partition."""
+    name = partition(axis or "-")
+    target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={name}" / f"log={partition(Path(job.log).stem)}"
     target.mkdir(parents=True, exist_ok=True)
-    return target / "part-0.parquet"
+    return target / "part-0.parquet", name
 
 
 def _stream_and_write(job: FleetJob, model, config, attrs: dict) -> dict | None:
     """Predict and write the log block by block (:mod:`greybox.data.stream`); None if it is to be read whole."""
     from .data.blocks import CannotStream
-    from .data.stream import can_stream, open_stream
+    from .data.stream import open_stream
     from .evaluate.process_stream import stream_process
 
     read = job.read
-    if not can_stream(job.log, sample_time=read.get("sample_time"), resample=read.get("resample"),
-                      topic=read.get("topic")):
-        return None
     columns = {**(config.channels if config else {}), **(read.get("columns") or {})} or None
-    log = open_stream(job.log, columns=columns, topic=read.get("topic"), axis=read.get("axis"))
-    if log.motion != "linear":
+    log = open_stream(job.log, columns=columns, topic=read.get("topic"), axis=read.get("axis"),
+                      sample_time=read.get("sample_time"), resample=read.get("resample"))
+    if log is None:
         return None
-    target = _partition(job, log.axis or (config.name if config is not None else ""))
+    target, axis = _partition(job, log.axis or (config.name if config is not None else ""))
     try:
         done = stream_process(model, log, target, axis_config=config, chunk_s=job.chunk_s,
                               tolerance=read.get("time_tolerance", 0.25), cutoff_hz=read.get("cutoff_hz"),
                               attrs=attrs, overwrite=True)
     except CannotStream:
         return None
-    return {"output": str(target), "axis": target.parent.parent.name.split("=", 1)[1],
-            "samples": done.tally.n_samples}
+    return {"output": str(target), "axis": axis, "samples": done.tally.n_samples}
 
 
 def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers: int | None = None,

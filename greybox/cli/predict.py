@@ -259,17 +259,16 @@ def _streamed_log(args: argparse.Namespace, config):
     A Parquet or MCAP log of a linear axis, without --resample, --sample-time and --plot, is streamed: its
     length then does not bound the memory (:mod:`greybox.data.stream`).
     """
-    from ..data.stream import can_stream, open_stream
-
-    if args.plot or not can_stream(args.log, sample_time=args.sample_time, resample=args.resample, topic=args.topic):
-        return None
     from ..data.io import parse_column_mapping
+    from ..data.stream import open_stream
 
+    if args.plot:
+        return None
     columns = dict(config.channels if config else {})
     if args.columns:
         columns.update(parse_column_mapping(args.columns))
-    log = open_stream(args.log, columns=columns or None, topic=args.topic, axis=args.axis)
-    return log if log.motion == "linear" else None
+    return open_stream(args.log, columns=columns or None, topic=args.topic, axis=args.axis,
+                       sample_time=args.sample_time, resample=args.resample)
 
 
 def _run_streamed(args: argparse.Namespace, model, log, config, out: Path, inputs: list, run_started: float):

@@ -57,19 +57,35 @@ def read_parquet(path, *, columns: Mapping[str, str] | None = None, sample_time:
     try:
         table = pq.read_table(path)
     except (pa.ArrowException, OSError) as exc:
-        raise LogError(path, f"not a readable Parquet file ({str(exc).strip().splitlines()[0]})") from None
+        raise unreadable(path, exc) from None
     if table.num_rows == 0:
         raise LogError(path, "no data rows")
-    raw = (table.schema.metadata or {}).get(_METADATA_KEY)
-    metadata = parse_metadata(raw, path, "the greybox schema metadata") if raw else {}
+    return log_from_columns(column_arrays(table.column_names, table.columns), source=path, columns=columns,
+                            sample_time=sample_time, select=axis, **schema_fields(table.schema, path, axis))
+
+
+def unreadable(path, error: Exception) -> LogError:
+    """The error of a file pyarrow cannot open as Parquet."""
+    return LogError(path, f"not a readable Parquet file ({str(error).strip().splitlines()[0]})")
+
+
+def schema_fields(schema, path, axis: str | None = None) -> dict:
+    """The log's axis, dataset, effort unit and attrs from the greybox metadata of an Arrow schema."""
+    raw = (schema.metadata or {}).get(_METADATA_KEY)
+    return metadata_fields(parse_metadata(raw, path, "the greybox schema metadata") if raw else {}, axis)
+
+
+def column_arrays(names, columns) -> dict[str, np.ndarray]:
+    """Arrow columns (of a table or a record batch) as arrays: numeric ones as numbers, others as objects."""
+    import pyarrow as pa
+
     arrays = {}
-    for name in table.column_names:
-        column = table.column(name)
+    for name, column in zip(names, columns):
         kind = column.type
         numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
-        arrays[name] = column.to_numpy() if numeric else column.to_numpy(zero_copy_only=False).astype(object)
-    return log_from_columns(arrays, source=path, columns=columns, sample_time=sample_time, select=axis,
-                            **metadata_fields(metadata, axis))
+        arrays[name] = (column.to_numpy(zero_copy_only=False) if numeric
+                        else column.to_numpy(zero_copy_only=False).astype(object))
+    return arrays
 
 
 def write_parquet(log: AxisLog | Sequence[AxisLog], path) -> None:

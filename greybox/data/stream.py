@@ -18,7 +18,7 @@ blocks, while holding only a few blocks at a time. It reads the file three times
    forward-backward filter sees enough of the log to give, inside the block, the whole-log result.
 
 Other logs (CSV, MCAP, TDMS, MATLAB, rotary axes, logs without a time column, logs to be resampled)
-are read whole: :func:`can_stream` says which are streamed.
+are read whole: :func:`open_stream` says which are streamed.
 """
 
 from __future__ import annotations
@@ -30,13 +30,13 @@ import numpy as np
 
 from ..errors import LogError
 from .blocks import concatenate, reblock
-from .file_metadata import metadata_fields, parse_metadata
 from .log import AxisLog
+from .parquet_io import column_arrays, schema_fields, unreadable
 from .prepare import derivative_margin, derive
 from .units import log_from_columns, resolve_columns, select_axis
 from .validate import check_finite, check_increasing, check_time, check_velocity_units
 
-__all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "can_stream", "median_step", "open_stream",
+__all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "median_step", "open_stream",
            "prepared_blocks"]
 
 #: Samples per block (4 min 22 s at 2 ms).
@@ -45,8 +45,6 @@ DEFAULT_BLOCK_SAMPLES = 1 << 15
 #: File extensions of the logs read block by block.
 STREAM_SUFFIXES = (".parquet", ".pq", ".mcap")
 
-_METADATA_KEY = b"greybox"
-
 #: Distinct time steps counted one by one; beyond, the steps are counted by their upper bits (two passes).
 _MAX_DISTINCT_STEPS = 1 << 16
 
@@ -54,40 +52,30 @@ _MAX_DISTINCT_STEPS = 1 << 16
 _READ_BUFFER_BYTES = 1 << 20
 
 
-def can_stream(path, *, sample_time: float | None = None, resample: float | None = None,
-               topic: str | None = None) -> bool:
-    """Whether :func:`open_stream` reads ``path`` block by block with these read options.
+def open_stream(path, *, columns: Mapping[str, str] | None = None, topic: str | None = None,
+                axis: str | None = None, sample_time: float | None = None, resample: float | None = None,
+                block_samples: int = DEFAULT_BLOCK_SAMPLES):
+    """A :class:`ParquetLog` or :class:`~greybox.data.mcap_io.McapLog` of a log read block by block; None when
+    the log is to be read whole.
+
+    Read whole: formats other than Parquet and MCAP, logs to be given a sample time or resampled, a
+    Parquet log with a topic (to be refused where it is read), and rotary axes (a modulo axis is unwrapped
+    over the whole log).
 
     Parameters
     ----------
     path : str or path-like
         Log file.
-    sample_time : float, optional
-        The ``--sample-time`` of a log without time column (then the log is read whole).
-    resample : float, optional
-        The ``--resample`` step (then the log is read whole).
-    topic : str, optional
-        The ``--topic`` of an MCAP log (a Parquet log with a topic is read whole, to be refused there).
-    """
-    suffix = os.path.splitext(os.fspath(path))[1].lower()
-    return (suffix in STREAM_SUFFIXES and sample_time is None and resample is None
-            and (topic is None or suffix == ".mcap"))
-
-
-def open_stream(path, *, columns: Mapping[str, str] | None = None, topic: str | None = None,
-                axis: str | None = None, block_samples: int = DEFAULT_BLOCK_SAMPLES):
-    """A :class:`ParquetLog` or :class:`~greybox.data.mcap_io.McapLog` of a log that :func:`can_stream` accepts.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Parquet or MCAP log.
     columns : mapping of str to str, optional
         Column (field) mapping.
     topic : str, optional
         MCAP channel.
     axis : str, optional
         Axis to read from a log of several.
+    sample_time : float, optional
+        The ``--sample-time`` of a log without time column.
+    resample : float, optional
+        The ``--resample`` step.
     block_samples : int, default :data:`DEFAULT_BLOCK_SAMPLES`
         Samples per block.
 
@@ -96,11 +84,17 @@ def open_stream(path, *, columns: Mapping[str, str] | None = None, topic: str | 
     LogError
         For a file that cannot be read as the log it claims to be.
     """
-    if os.path.splitext(os.fspath(path))[1].lower() == ".mcap":
+    suffix = os.path.splitext(os.fspath(path))[1].lower()
+    if suffix not in STREAM_SUFFIXES or sample_time is not None or resample is not None or \
+            (topic is not None and suffix != ".mcap"):
+        return None
+    if suffix == ".mcap":
         from .mcap_io import McapLog
 
-        return McapLog(path, columns=columns, topic=topic, axis=axis, block_samples=block_samples)
-    return ParquetLog(path, columns=columns, axis=axis, block_samples=block_samples)
+        log = McapLog(path, columns=columns, topic=topic, axis=axis, block_samples=block_samples)
+    else:
+        log = ParquetLog(path, columns=columns, axis=axis, block_samples=block_samples)
+    return log if log.motion == "linear" else None
 
 
 class ParquetLog:
@@ -145,13 +139,11 @@ class ParquetLog:
             # column chunks read through a small buffer: a row group need not fit in memory at once
             self._file = pq.ParquetFile(self.path, pre_buffer=False, buffer_size=_READ_BUFFER_BYTES)
         except (pa.ArrowException, OSError) as exc:
-            raise LogError(self.path, f"not a readable Parquet file ({str(exc).strip().splitlines()[0]})") from None
+            raise unreadable(self.path, exc) from None
         self.n_samples = self._file.metadata.num_rows
         if self.n_samples == 0:
             raise LogError(self.path, "no data rows")
-        raw = (self._file.schema_arrow.metadata or {}).get(_METADATA_KEY)
-        self._metadata = metadata_fields(parse_metadata(raw, self.path, "the greybox schema metadata")
-                                         if raw else {}, axis)
+        self._metadata = schema_fields(self._file.schema_arrow, self.path, axis)
         names = self._file.schema_arrow.names
         shapes = {name: np.empty(0) for name in names}
         selected = select_axis(shapes, axis, source=self.path, columns=self.columns) if axis is not None else shapes
@@ -189,15 +181,9 @@ class ParquetLog:
         return (float(first[0].as_py()) * self._time_factor, float(last[-1].as_py()) * self._time_factor)
 
     def _convert(self, batch) -> AxisLog:
-        import pyarrow as pa
+        return log_from_columns(column_arrays(batch.schema.names, batch.columns), source=self.path,
+                                columns=self.columns, select=self._select, **self._metadata)
 
-        arrays = {}
-        for name, column in zip(batch.schema.names, batch.columns):
-            kind = column.type
-            numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
-            arrays[name] = (column.to_numpy(zero_copy_only=False) if numeric
-                            else column.to_numpy(zero_copy_only=False).astype(object))
-        return log_from_columns(arrays, source=self.path, columns=self.columns, select=self._select, **self._metadata)
 
 
 def _steps(times: Iterable[np.ndarray], source) -> Iterator[np.ndarray]:
