@@ -33,3 +33,34 @@ def test_failure_keeps_old_content_and_removes_temporary(tmp_path):
 def test_missing_directory_is_named(tmp_path):
     with pytest.raises(FileNotFoundError, match="does not exist"):
         write_text_atomic(tmp_path / "nowhere" / "x.txt", "x")
+
+
+def test_a_signal_while_the_temporary_file_is_made_leaves_no_file(tmp_path, monkeypatch):
+    """SIGTERM right after the temporary file exists (before the block that removes it) is held back."""
+    import signal
+    import tempfile
+
+    from greybox.atomic import atomic_output
+
+    class Stop(Exception):
+        pass
+
+    def stop(signum, frame):
+        raise Stop()
+
+    made = tempfile.mkstemp
+
+    def mkstemp_then_signal(*args, **kwargs):
+        result = made(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGTERM)  # arrives here unless held back
+        return result
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp_then_signal)
+    try:
+        with pytest.raises(Stop):
+            with atomic_output(tmp_path / "out.csv") as temporary:
+                temporary.write_text("never finished")
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert list(tmp_path.iterdir()) == []
