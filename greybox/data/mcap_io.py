@@ -16,8 +16,11 @@ Layout written by :func:`write_mcap` (documented for logger authors in
 :func:`read_mcap` reads any MCAP file whose channel carries JSON messages: the
 field names follow the same rules as CSV columns (unit suffixes, ``columns=``
 mapping). It walks the records itself, so that a file of millions of messages
-is decoded in bulk (one JSON parse per batch of chunks) rather than message by
-message, and so that a damaged file gives a :class:`~greybox.errors.LogError`.
+is decoded in bulk rather than message by message, and so that a damaged file
+gives a :class:`~greybox.errors.LogError`: chunks are decompressed ahead on a
+worker thread; each chunk's messages are parsed by the compiled reader of flat
+objects of numbers (:mod:`greybox.data.json_numbers`), or, when they are not all
+such objects, by pyarrow's JSON reader in batches of chunks.
 """
 
 from __future__ import annotations
@@ -25,13 +28,16 @@ from __future__ import annotations
 import json
 import os
 import zlib
+from collections import deque
 from typing import Iterator, Mapping, Sequence
 
 import numpy as np
 from numba import njit
 
 from ..errors import LogError
+from ..threads import shared_pool
 from .blocks import CannotStream, reblock
+from .json_numbers import parse_flat_objects
 from .log import AxisLog
 from .units import log_from_columns
 
@@ -71,6 +77,7 @@ _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time
 _BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
 _BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
 _WINDOW_BYTES = 8 << 20  # file bytes scanned at a time
+_CHUNKS_AHEAD = 2  # chunks decompressed ahead of the one being read
 
 
 def topic_for(axis: str) -> str:
@@ -291,27 +298,29 @@ def _decompress(content: bytes, path) -> bytes:
 
 
 class _MessageCollector:
-    """Gathers the messages of one channel, parsing their JSON in batches."""
+    """Gathers the messages of one channel: each chunk's by the compiled reader, else in batches by pyarrow's."""
 
     def __init__(self, path):
         self.path = path
         self.stamps: list[np.ndarray] = []
+        self.rows = 0  # messages collected since the last :meth:`columns` or :meth:`take_stamps`
         self.pending: list[np.ndarray] = []
         self.pending_bytes = 0
         self.pending_rows = 0
         self.batches: list[tuple[int, dict]] = []
-
-    @property
-    def rows(self) -> int:
-        """Messages collected so far (since the last :meth:`columns`)."""
-        return sum(stamps.size for stamps in self.stamps)
 
     def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, stamps_only: bool = False) -> None:
         if not offsets.size:
             return
         header = buf[offsets[:, None] + np.arange(6, 14)]
         self.stamps.append(np.ascontiguousarray(header).view("<u8").ravel().copy())
+        self.rows += offsets.size
         if stamps_only:
+            return
+        columns = parse_flat_objects(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER)
+        if columns is not None:
+            self.flush()
+            self.batches.append((offsets.size, columns))
             return
         text = join_slices(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER, 10)
         self.pending.append(text)
@@ -347,11 +356,16 @@ class _MessageCollector:
                                       "each message must hold one object")
         self.batches.append((rows, {name: _as_array(table.column(name)) for name in table.column_names}))
 
+    def take_stamps(self) -> np.ndarray:
+        """The time stamps [ns] collected since the last call (or :meth:`columns`), as they came."""
+        stamps = np.concatenate(self.stamps) if self.stamps else np.empty(0, np.uint64)
+        self.stamps, self.rows = [], 0
+        return stamps
+
     def columns(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Time stamps [ns] and field columns, in log_time order (missing values NaN)."""
         self.flush()
-        stamps = np.concatenate(self.stamps) if self.stamps else np.empty(0, np.uint64)
-        self.stamps = []
+        stamps = self.take_stamps()
         names = list(dict.fromkeys(name for _, batch in self.batches for name in batch))
         table = {}
         for name in names:
@@ -447,20 +461,35 @@ def _walk(path) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
 
 
 def _expand(buf, data: bytes, opcodes, offsets, lengths, path):
-    """The records of a scanned stretch of the file, each chunk record replaced by the records it holds."""
-    chunks = np.flatnonzero(opcodes == _OP_CHUNK)
+    """The records of a scanned stretch of the file, each chunk record replaced by the records it holds.
+
+    Chunks are decompressed :data:`_CHUNKS_AHEAD` ahead on a worker thread, while the caller works on
+    the records already given.
+    """
+    chunks = np.flatnonzero(opcodes == _OP_CHUNK).tolist()
+    pool = shared_pool(1, "decompress")
+    pending = deque(pool.submit(_decompress, data[offsets[k]:offsets[k] + lengths[k]], path)
+                    for k in chunks[:_CHUNKS_AHEAD])
     begin = 0
-    for index in list(chunks) + [opcodes.size]:
-        if index > begin:
-            yield buf, opcodes[begin:index], offsets[begin:index], lengths[begin:index]
-        if index < opcodes.size:
-            raw = _decompress(data[offsets[index]:offsets[index] + lengths[index]], path)
-            inner = np.frombuffer(raw, np.uint8)
-            ops, offs, lens, end = scan_records(inner, 0, inner.size)
-            if end != inner.size:
-                raise LogError(path, "corrupt MCAP file: a chunk holds a partial record")
-            yield inner, ops, offs, lens
-        begin = index + 1
+    try:
+        for number, index in enumerate(chunks + [opcodes.size]):
+            if index > begin:
+                yield buf, opcodes[begin:index], offsets[begin:index], lengths[begin:index]
+            if index < opcodes.size:
+                raw = pending.popleft().result()
+                if number + _CHUNKS_AHEAD < len(chunks):
+                    ahead = chunks[number + _CHUNKS_AHEAD]
+                    pending.append(pool.submit(_decompress, data[offsets[ahead]:offsets[ahead] + lengths[ahead]],
+                                               path))
+                inner = np.frombuffer(raw, np.uint8)
+                ops, offs, lens, end = scan_records(inner, 0, inner.size)
+                if end != inner.size:
+                    raise LogError(path, "corrupt MCAP file: a chunk holds a partial record")
+                yield inner, ops, offs, lens
+            begin = index + 1
+    finally:
+        for future in pending:
+            future.cancel()
 
 
 def _collect(path, topic: str | None) -> tuple[dict[int, _Channel], _MessageCollector]:
@@ -672,8 +701,7 @@ class McapLog:
         count, first, last = 0, None, None
         for rows in _messages(self.path, self._topic, {}, collector, stamps_only=True):
             if rows:
-                stamps = np.concatenate(collector.stamps)
-                collector.stamps = []
+                stamps = collector.take_stamps()
                 if np.any(stamps[1:] < stamps[:-1]) or (last is not None and stamps[0] < last):
                     raise CannotStream(f"{self.path}: messages not stored in time order")
                 first = stamps[0] if first is None else first

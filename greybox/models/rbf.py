@@ -40,13 +40,12 @@ compiled kernel releases the GIL. Working memory: a few rows of
 from __future__ import annotations
 
 import math
-import os
-import threading
-from concurrent.futures import ThreadPoolExecutor
 
 import numba
 import numpy as np
 from numba import njit
+
+from ..threads import shared_pool
 
 __all__ = ["rbf_expansion", "DEFAULT_TOLERANCE", "BLOCK_SAMPLES", "EXP_RELATIVE_ERROR", "MAX_CUTOFF"]
 
@@ -216,21 +215,8 @@ def rbf_expansion(
         _expansion_blocks(X, support_t, alpha, float(gamma), cutoff, BLOCK_SAMPLES, 0, 1, out)
         return out
     # blocks dealt out in turn: the work per block varies along a log, neighbouring blocks alike
-    parts = [_pool(threads).submit(_expansion_blocks, X, support_t, alpha, float(gamma), cutoff, BLOCK_SAMPLES, k,
-                                   threads, out) for k in range(threads)]
+    parts = [shared_pool(threads).submit(_expansion_blocks, X, support_t, alpha, float(gamma), cutoff,
+                                         BLOCK_SAMPLES, k, threads, out) for k in range(threads)]
     for part in parts:
         part.result()
     return out
-
-
-_POOLS: dict[tuple[int, int], ThreadPoolExecutor] = {}
-_POOLS_LOCK = threading.Lock()
-
-
-def _pool(threads: int) -> ThreadPoolExecutor:
-    """A thread pool of ``threads`` workers, made once per process (a long log is summed chunk after chunk)."""
-    key = (os.getpid(), threads)  # a forked process makes its own
-    with _POOLS_LOCK:
-        if key not in _POOLS:
-            _POOLS[key] = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="greybox-rbf")
-        return _POOLS[key]

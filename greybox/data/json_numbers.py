@@ -1,0 +1,409 @@
+"""Compiled reading of JSON messages that are flat objects of numbers, correctly rounded.
+
+An MCAP axis log carries one JSON object per sample, e.g.
+``{"position_mm":-250.0,"velocity_mm_s":0.0,"current_A":0.027}``, the same keys in
+the same order in every message. :func:`parse_flat_objects` reads a batch of such
+messages straight from the decompressed chunk (no copy of the text) into one
+float64 column per key. It accepts strict JSON only: an object whose values are
+numbers or ``null`` (read as NaN), with the keys of the batch's first message in
+the same order in every message. For anything else (strings, nesting, other
+keys, escapes in keys, invalid JSON) it returns ``None`` and the caller parses
+the batch with a general JSON reader, which gives the same columns or the error.
+
+Numbers are converted to the nearest double (ties to even), as Python's
+``float`` converts them:
+
+* a decimal mantissa ``w`` of at most 19 significant digits with a power of ten
+  ``q`` is exact in doubles when ``w <= 2**53`` and ``|q| <= 22`` (Clinger's
+  fast path: one correctly rounded multiplication or division);
+* otherwise ``w * 10**q`` is rounded from its product with a 128-bit truncated
+  power of five (the Eisel-Lemire algorithm; D. Lemire, "Number parsing at a
+  gigabyte per second", Software: Practice and Experience 51, 2021), which
+  either gives the correctly rounded result or reports that it cannot decide;
+* the few numbers left (more than 19 significant digits, undecided products,
+  results outside the normal range of doubles) are converted by ``float`` on
+  their text, at most :data:`MAX_SLOW_NUMBERS` per batch.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numba import njit
+
+from ..threads import shared_pool
+
+__all__ = ["parse_flat_objects", "MAX_KEYS", "MAX_SLOW_NUMBERS", "MIN_MESSAGES_PER_THREAD"]
+
+#: Keys a message may have (beyond: the batch goes to the general reader).
+MAX_KEYS = 1024
+
+#: Numbers per batch that may be handed to Python's ``float`` (beyond: the batch goes to the general reader).
+MAX_SLOW_NUMBERS = 4096
+
+#: Fewest messages worth a thread of their own.
+MIN_MESSAGES_PER_THREAD = 1024
+
+_SMALLEST_POWER, _LARGEST_POWER = -342, 308  # decimal exponents of the table of powers of five
+
+
+def _powers_of_five() -> np.ndarray:
+    """``5**q`` for q in [-342, 308], normalised to 128 bits (top bit set), as (high, low) uint64 words.
+
+    Non-negative powers are truncated; negative ones are the reciprocal rounded up (then truncated where
+    it needs more than 128 bits), so that the product with a mantissa never undershoots.
+    """
+    table = np.empty((_LARGEST_POWER - _SMALLEST_POWER + 1, 2), np.uint64)
+    for index, q in enumerate(range(_SMALLEST_POWER, _LARGEST_POWER + 1)):
+        if q >= 0:
+            value = 5 ** q
+            bits = value.bit_length()
+            value = value << (128 - bits) if bits < 128 else value >> (bits - 128)
+        else:
+            power = 5 ** -q
+            width = power.bit_length()
+            value = (1 << (width + 127 if q >= -27 else 2 * width + 128)) // power + 1
+            value >>= max(value.bit_length() - 128, 0)
+        table[index] = (value >> 64, value & ((1 << 64) - 1))
+    return table
+
+
+_POWERS_OF_FIVE = _powers_of_five()
+_EXACT_POWERS_OF_TEN = np.array([10.0 ** k for k in range(23)])
+
+_MASK32 = np.uint64(0xFFFFFFFF)
+_ALL_ONES = np.uint64(0xFFFFFFFFFFFFFFFF)
+_TWO_TO_53 = np.uint64(1 << 53)
+
+# status of a parsed number
+_EXACT, _SLOW, _INVALID = 0, 1, 2
+
+
+@njit(cache=True, nogil=True)
+def _multiply(a, b):
+    """The 128-bit product of two uint64 values, as (high, low) words."""
+    shift = np.uint64(32)
+    a_low, a_high = a & _MASK32, a >> shift
+    b_low, b_high = b & _MASK32, b >> shift
+    low_low = a_low * b_low
+    low_high = a_low * b_high
+    high_low = a_high * b_low
+    middle = (low_low >> shift) + (low_high & _MASK32) + high_low
+    high = a_high * b_high + (middle >> shift) + (low_high >> shift)
+    low = (middle << shift) | (low_low & _MASK32)
+    return high, low
+
+
+@njit(cache=True, nogil=True)
+def _leading_zeros(w):
+    """Leading zero bits of a non-zero uint64."""
+    count = 0
+    for width in (32, 16, 8, 4, 2, 1):
+        if w >> np.uint64(64 - width) == np.uint64(0):
+            w = w << np.uint64(width)
+            count += width
+    return count
+
+
+@njit(cache=True, nogil=True)
+def _eisel_lemire(w, q, powers):
+    """``w * 10**q`` rounded to the nearest double, for a non-zero uint64 ``w``.
+
+    Returns
+    -------
+    value : float
+    decided : bool
+        False when the result cannot be decided from 128 bits or is not a normal double.
+    """
+    if q < _SMALLEST_POWER or q > _LARGEST_POWER:
+        return 0.0, False
+    zeros = _leading_zeros(w)
+    w = w << np.uint64(zeros)
+    index = q - _SMALLEST_POWER
+    high, low = _multiply(w, powers[index, 0])
+    precision_mask = _ALL_ONES >> np.uint64(55)  # 52 mantissa bits, the hidden bit, a rounding bit, one spare
+    if high & precision_mask == precision_mask:
+        second_high, _ = _multiply(w, powers[index, 1])
+        low = low + second_high
+        if second_high > low:
+            high = high + np.uint64(1)
+    if low == _ALL_ONES and (q < -27 or q > 55):
+        return 0.0, False
+    upper_bit = np.int64(high >> np.uint64(63))
+    shift = np.uint64(upper_bit + 9)
+    mantissa = high >> shift
+    power2 = (((q * (152170 + 65536)) >> 16) + 63) + upper_bit - zeros + 1023
+    if power2 <= 0:
+        return 0.0, False
+    if (low <= np.uint64(1) and -4 <= q <= 23 and mantissa & np.uint64(3) == np.uint64(1)
+            and (mantissa << shift) == high):
+        mantissa = mantissa & ~np.uint64(1)  # exactly halfway: round to even, down
+    mantissa = (mantissa + (mantissa & np.uint64(1))) >> np.uint64(1)
+    if mantissa >= np.uint64(2) << np.uint64(52):
+        mantissa = np.uint64(1) << np.uint64(52)
+        power2 += 1
+    if power2 >= 0x7FF:
+        return 0.0, False
+    return math.ldexp(float(mantissa), power2 - 1075), True
+
+
+@njit(cache=True, nogil=True)
+def _is_digit(byte):
+    return 48 <= byte <= 57
+
+
+@njit(cache=True, nogil=True)
+def _number(buf, pos, stop, powers, exact_tens):
+    """Parse the JSON number at ``buf[pos]``.
+
+    Returns
+    -------
+    value : float
+    end : int
+        Position after the number.
+    status : int
+        ``_EXACT`` (value correctly rounded), ``_SLOW`` (valid, but to be converted by ``float``) or
+        ``_INVALID`` (not a JSON number).
+    """
+    negative = buf[pos] == 45  # '-'
+    if negative:
+        pos += 1
+    if pos >= stop or not _is_digit(buf[pos]):
+        return 0.0, pos, _INVALID
+    w = np.uint64(0)
+    digits = 0  # significant digits in w
+    too_long = False
+    if buf[pos] == 48:  # '0' alone before the point
+        pos += 1
+        if pos < stop and _is_digit(buf[pos]):
+            return 0.0, pos, _INVALID
+    else:
+        while pos < stop and _is_digit(buf[pos]):
+            if digits < 19:
+                w = w * np.uint64(10) + np.uint64(buf[pos] - 48)
+                digits += 1
+            else:
+                too_long = True
+            pos += 1
+    exponent = 0
+    if pos < stop and buf[pos] == 46:  # '.'
+        pos += 1
+        if pos >= stop or not _is_digit(buf[pos]):
+            return 0.0, pos, _INVALID
+        while pos < stop and _is_digit(buf[pos]):
+            digit = buf[pos] - 48
+            if w == 0 and digit == 0:
+                exponent -= 1
+            elif digits < 19:
+                w = w * np.uint64(10) + np.uint64(digit)
+                digits += 1
+                exponent -= 1
+            else:
+                too_long = True
+            pos += 1
+    if pos < stop and (buf[pos] == 101 or buf[pos] == 69):  # 'e' or 'E'
+        pos += 1
+        sign = 1
+        if pos < stop and (buf[pos] == 43 or buf[pos] == 45):
+            sign = -1 if buf[pos] == 45 else 1
+            pos += 1
+        if pos >= stop or not _is_digit(buf[pos]):
+            return 0.0, pos, _INVALID
+        power = 0
+        while pos < stop and _is_digit(buf[pos]):
+            if power < 100000:
+                power = power * 10 + (buf[pos] - 48)
+            pos += 1
+        exponent += sign * power
+    if too_long:
+        return 0.0, pos, _SLOW
+    if w == 0:
+        return (-0.0 if negative else 0.0), pos, _EXACT
+    if w <= _TWO_TO_53 and -22 <= exponent <= 22:
+        value = float(w)
+        value = value * exact_tens[exponent] if exponent >= 0 else value / exact_tens[-exponent]
+    else:
+        value, decided = _eisel_lemire(w, exponent, powers)
+        if not decided:
+            return 0.0, pos, _SLOW
+    return (-value if negative else value), pos, _EXACT
+
+
+@njit(cache=True, nogil=True)
+def _skip_space(buf, pos, stop):
+    while pos < stop and (buf[pos] == 32 or buf[pos] == 10 or buf[pos] == 13 or buf[pos] == 9):
+        pos += 1
+    return pos
+
+
+@njit(cache=True, nogil=True)
+def _keys(buf, start, stop, max_keys):
+    """Start and length of each key of the flat object ``buf[start:stop]``; -1 keys if it is not one.
+
+    A key holding a backslash (an escape) or a value that is not a number or null also gives -1.
+    """
+    starts = np.empty(max_keys, np.int64)
+    lengths = np.empty(max_keys, np.int64)
+    pos = _skip_space(buf, start, stop)
+    if pos >= stop or buf[pos] != 123:  # '{'
+        return starts, lengths, -1
+    pos = _skip_space(buf, pos + 1, stop)
+    count = 0
+    if pos < stop and buf[pos] == 125:  # '}': no keys
+        return starts, lengths, -1
+    while True:
+        if count == max_keys or pos >= stop or buf[pos] != 34:  # '"'
+            return starts, lengths, -1
+        pos += 1
+        first = pos
+        while pos < stop and buf[pos] != 34:
+            if buf[pos] == 92 or buf[pos] < 32:  # '\' or a control character
+                return starts, lengths, -1
+            pos += 1
+        if pos >= stop:
+            return starts, lengths, -1
+        starts[count], lengths[count] = first, pos - first
+        count += 1
+        pos = _skip_space(buf, pos + 1, stop)
+        if pos >= stop or buf[pos] != 58:  # ':'
+            return starts, lengths, -1
+        pos = _skip_space(buf, pos + 1, stop)
+        pos = _value_end(buf, pos, stop)
+        if pos < 0:
+            return starts, lengths, -1
+        pos = _skip_space(buf, pos, stop)
+        if pos < stop and buf[pos] == 44:  # ','
+            pos = _skip_space(buf, pos + 1, stop)
+            continue
+        if pos < stop and buf[pos] == 125 and _skip_space(buf, pos + 1, stop) == stop:
+            return starts, lengths, count
+        return starts, lengths, -1
+
+
+@njit(cache=True, nogil=True)
+def _value_end(buf, pos, stop):
+    """End of the number or null at ``pos`` (its characters only, not its syntax); -1 if there is none."""
+    first = pos
+    if pos + 4 <= stop and buf[pos] == 110 and buf[pos + 1] == 117 and buf[pos + 2] == 108 and buf[pos + 3] == 108:
+        return pos + 4
+    while pos < stop and (_is_digit(buf[pos]) or buf[pos] == 45 or buf[pos] == 43 or buf[pos] == 46
+                          or buf[pos] == 101 or buf[pos] == 69):
+        pos += 1
+    return pos if pos > first else -1
+
+
+@njit(cache=True, nogil=True)
+def _objects(buf, offsets, lengths, key_bytes, key_ends, powers, exact_tens, out, slow):
+    """Parse message ``row`` into ``out[:, row]``; numbers to convert slowly go to ``slow`` (row, key, start, end).
+
+    Returns
+    -------
+    slow_count : int
+        Numbers recorded in ``slow``; -1 if a message is not an object of the template's keys, in order, with
+        number or null values, or if there are more slow numbers than rows of ``slow``.
+    """
+    n_keys = key_ends.shape[0]
+    slow_count = 0
+    for row in range(offsets.shape[0]):
+        start = offsets[row]
+        stop = start + lengths[row]
+        pos = _skip_space(buf, start, stop)
+        if pos >= stop or buf[pos] != 123:
+            return -1
+        for key in range(n_keys):
+            pos = _skip_space(buf, pos + 1, stop)
+            first = 0 if key == 0 else key_ends[key - 1]
+            size = key_ends[key] - first
+            if pos + size + 2 > stop or buf[pos] != 34 or buf[pos + size + 1] != 34:
+                return -1
+            for k in range(size):
+                if buf[pos + 1 + k] != key_bytes[first + k]:
+                    return -1
+            pos = _skip_space(buf, pos + size + 2, stop)
+            if pos >= stop or buf[pos] != 58:
+                return -1
+            pos = _skip_space(buf, pos + 1, stop)
+            if pos >= stop:
+                return -1
+            if buf[pos] == 110:  # null
+                if pos + 4 > stop or buf[pos + 1] != 117 or buf[pos + 2] != 108 or buf[pos + 3] != 108:
+                    return -1
+                out[key, row] = np.nan
+                pos += 4
+            else:
+                value, end, status = _number(buf, pos, stop, powers, exact_tens)
+                if status == _INVALID:
+                    return -1
+                if status == _SLOW:
+                    if slow_count == slow.shape[0]:
+                        return -1
+                    slow[slow_count, 0], slow[slow_count, 1] = row, key
+                    slow[slow_count, 2], slow[slow_count, 3] = pos, end
+                    slow_count += 1
+                out[key, row] = value
+                pos = end
+            pos = _skip_space(buf, pos, stop)
+            if pos >= stop or buf[pos] != (125 if key == n_keys - 1 else 44):  # '}' after the last, ',' before
+                return -1
+        if _skip_space(buf, pos + 1, stop) != stop:
+            return -1
+    return slow_count
+
+
+def parse_flat_objects(buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, *,
+                       threads: int | None = None) -> dict[str, np.ndarray] | None:
+    """Read messages that are flat JSON objects of numbers, the same keys in the same order, into columns.
+
+    Parameters
+    ----------
+    buf : ndarray of uint8
+        Bytes holding the messages.
+    offsets, lengths : ndarray of int64
+        Where each message's JSON text starts in ``buf``, and its length [bytes].
+    threads : int, optional
+        Threads sharing the messages (in contiguous parts of at least :data:`MIN_MESSAGES_PER_THREAD`);
+        default :func:`numba.get_num_threads`.
+
+    Returns
+    -------
+    dict of str to ndarray of float64, or None
+        One column per key, in the messages' order (``null`` read as NaN); None when a message is not such an
+        object (then parse the batch with a general JSON reader).
+    """
+    if not offsets.size:
+        return None
+    offsets = np.ascontiguousarray(offsets, np.int64)
+    lengths = np.ascontiguousarray(lengths, np.int64)
+    starts, sizes, count = _keys(buf, offsets[0], offsets[0] + lengths[0], MAX_KEYS)
+    if count <= 0:
+        return None
+    spans = list(zip(starts[:count].tolist(), sizes[:count].tolist()))
+    try:
+        names = [bytes(buf[start:start + size]).decode("utf-8") for start, size in spans]
+    except UnicodeDecodeError:
+        return None
+    if len(set(names)) != count:
+        return None
+    key_bytes = np.concatenate([buf[start:start + size] for start, size in spans])
+    key_ends = np.cumsum(sizes[:count])
+    out = np.empty((count, offsets.size), np.float64)
+    threads = numba.get_num_threads() if threads is None else threads
+    parts = max(1, min(threads, offsets.size // MIN_MESSAGES_PER_THREAD))
+    bounds = np.linspace(0, offsets.size, parts + 1).astype(np.int64)
+    slow = np.empty((parts, MAX_SLOW_NUMBERS // parts, 4), np.int64)
+
+    def part(k: int) -> int:
+        rows = slice(bounds[k], bounds[k + 1])
+        return _objects(buf, offsets[rows], lengths[rows], key_bytes, key_ends, _POWERS_OF_FIVE,
+                        _EXACT_POWERS_OF_TEN, out[:, rows], slow[k])
+
+    others = [shared_pool(parts - 1).submit(part, k) for k in range(1, parts)] if parts > 1 else []
+    slow_counts = [part(0)] + [other.result() for other in others]  # the first part on this thread
+    if min(slow_counts) < 0:
+        return None
+    for k, slow_count in enumerate(slow_counts):
+        for row, key, start, end in slow[k, :slow_count].tolist():
+            out[key, bounds[k] + row] = float(bytes(buf[start:end]))
+    return dict(zip(names, out))
