@@ -573,9 +573,11 @@ def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers
         When the scheduler cannot be reached or the jobs disagree on the output directory.
     """
     out_dir = out_dir_of(jobs, "no log to predict")
-    hashes = {model: _file_hash(model) for model in {job.model for job in jobs}}
-    fingerprints = [{"log": job.log, "model": job.model, "model_sha256": hashes[job.model], **log_stamp(job.log)}
-                    for job in jobs]
+    files = {job.model for job in jobs} | {job.axis_config for job in jobs if job.axis_config}
+    hashes = {path: _file_hash(path) for path in files}
+    fingerprints = [{"log": job.log, "model": job.model, "model_sha256": hashes[job.model], **log_stamp(job.log),
+                     "axis_config_sha256": hashes.get(job.axis_config), "read": job.read, "chunk_s": job.chunk_s}
+                    for job in jobs]  # an option or axis file changed: the log is predicted again
     header = {"format": PREDICT_FORMAT, "format_version": 2, "axis_config": jobs[0].axis_config,
               "read": jobs[0].read, "chunk_s": jobs[0].chunk_s}
     return run_tasks(predict_log, jobs, fingerprints, out_dir=out_dir, header=header, items="logs",

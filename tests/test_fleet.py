@@ -79,6 +79,18 @@ def test_a_fleet_run_writes_a_partitioned_dataset_and_a_manifest(plant, tmp_path
     assert "1 predicted, 2 skipped" in capsys.readouterr().out
     assert cli.main(argv + ["--force"]) == 2
     assert "3 predicted, 0 skipped" in capsys.readouterr().out
+    assert cli.main(argv + ["--cutoff-hz", "40"]) == 2  # another read option: predicted again
+    assert "3 predicted, 0 skipped" in capsys.readouterr().out
+    assert cli.main(argv + ["--cutoff-hz", "40"]) == 2
+    assert "0 predicted, 3 skipped" in capsys.readouterr().out
+    axis_file = tmp_path / "axis.toml"  # the same axis file elsewhere: skipped; its content changed: predicted
+    axis_file.write_text(EXAMPLE.read_text())
+    moved = [str(axis_file) if part == str(EXAMPLE) else part for part in argv] + ["--cutoff-hz", "40"]
+    assert cli.main(moved) == 2
+    assert "0 predicted, 3 skipped" in capsys.readouterr().out
+    axis_file.write_text(EXAMPLE.read_text().replace("screw_lead_mm = 10.0", "screw_lead_mm = 12.0"))
+    assert cli.main(moved) == 2
+    assert "3 predicted, 0 skipped" in capsys.readouterr().out
 
 
 def test_a_fleet_runs_on_a_scheduler_address(plant, tmp_path, capsys):
