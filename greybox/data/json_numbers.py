@@ -126,12 +126,15 @@ def _eisel_lemire(w, q, powers):
     precision_mask = _ALL_ONES >> np.uint64(55)  # 52 mantissa bits, the hidden bit, a rounding bit, one spare
     if high & precision_mask == precision_mask:
         second_high, _ = _multiply(w, powers[index, 1])
-        low = low + second_high
-        if second_high > low:
+        room = _ALL_ONES - low  # add to the low word, carrying into the high one (without wrapping around)
+        if second_high > room:
+            low = second_high - room - np.uint64(1)
             high = high + np.uint64(1)
+        else:
+            low = low + second_high
     if low == _ALL_ONES and (q < -27 or q > 55):
         return 0.0, False
-    upper_bit = np.int64(high >> np.uint64(63))
+    upper_bit = int(high >> np.uint64(63))
     shift = np.uint64(upper_bit + 9)
     mantissa = high >> shift
     power2 = (((q * (152170 + 65536)) >> 16) + 63) + upper_bit - zeros + 1023
@@ -214,7 +217,7 @@ def _number(buf, pos, stop, powers, exact_tens):
         power = 0
         while pos < stop and _is_digit(buf[pos]):
             if power < 100000:
-                power = power * 10 + (buf[pos] - 48)
+                power = power * 10 + (int(buf[pos]) - 48)
             pos += 1
         exponent += sign * power
     if too_long:
