@@ -14,7 +14,14 @@ __all__ = ["check_out_dir", "fleet_progress", "read_options", "report_fleet"]
 
 
 def read_options(args: argparse.Namespace) -> dict:
-    """The options of reading and preparing logs (:func:`greybox.fleet.read_prepared`) as given on the command line."""
+    """The options of reading and preparing logs (:func:`greybox.fleet.read_prepared`) as given on the command line.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed command-line arguments with the log-reading options (``columns``, ``topic``, ``axis``,
+        ``sample_time``, ``time_tolerance``, ``cutoff_hz``, ``resample``, ``max_gap``).
+    """
     from ..data.io import parse_column_mapping
 
     return {"columns": parse_column_mapping(args.columns) if args.columns else None, "topic": args.topic,
@@ -23,7 +30,14 @@ def read_options(args: argparse.Namespace) -> dict:
 
 
 def check_out_dir(out: str, inputs=()) -> Path:
-    """``--out`` of a fleet run: a directory (created if missing), none of the ``inputs``; return it resolved.
+    """``--out`` of a fleet run: a directory or a path not yet taken, none of the ``inputs``; return it resolved.
+
+    Parameters
+    ----------
+    out : str
+        The ``--out`` path given on the command line.
+    inputs : iterable of str or Path, default ()
+        Input paths of the run; the output directory must not be one of them.
 
     Raises
     ------

@@ -49,6 +49,11 @@ def _color(model: str, k: int) -> str:
 def effort_name(runs: Sequence[AxisLog]) -> tuple[str, str]:
     """What the runs' effort is and its unit: ``("current", "A")``, ``("force", "N")`` or ``("torque", "Nm")``.
 
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Runs whose ``effort_unit`` is read; all must carry the same one.
+
     Raises
     ------
     ValueError
@@ -62,6 +67,14 @@ def effort_name(runs: Sequence[AxisLog]) -> tuple[str, str]:
 
 def split_runs(runs: Sequence[AxisLog], prediction) -> list[np.ndarray]:
     """Split a prediction of concatenated runs into one array per run (a list passes through).
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        The runs the prediction is of; their lengths set the split.
+    prediction : ndarray, shape (n,), or sequence of array_like
+        Prediction of the runs concatenated (``n`` the total number of samples), or one array per run
+        (checked against the runs' lengths and returned as float arrays).
 
     Raises
     ------
@@ -207,6 +220,13 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
         ``{model: prediction}`` (concatenated or per run) [A] (or [N]).
     path : path-like
         PNG file to write.
+    n_bins : int, default 40
+        Number of equal-width position bins of the mean-residual lines.
+    max_points : int, default 20000
+        Most samples drawn per panel: each direction's samples are thinned to at most half of it
+        (a stride of their count divided by ``max_points // 2``, rounded up).
+    title : str, default "Residual against position, by direction of motion"
+        Figure title.
 
     Returns
     -------
@@ -232,7 +252,7 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
         residual = measured - np.concatenate(split_runs(runs, prediction))
         for _, mask, color, _ in directions:
             index = np.flatnonzero(mask)
-            shown = index[:: max(1, index.size // max_points)]
+            shown = index[:: max(1, -(-index.size // max(1, max_points // 2)))]  # half the points each
             ax.plot(position[shown], residual[shown], ".", ms=1, color=color, alpha=0.3)
         for label, mask, _, color in directions:
             index = np.flatnonzero(mask)
