@@ -118,12 +118,28 @@ def check_output_path(path: str | os.PathLike, *, overwrite: bool = False, prote
 
 
 def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically and return the path."""
+    """Write ``data`` to ``path`` atomically and return the path.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; its directory must exist. An existing file is replaced.
+    data : bytes
+        The complete file content.
+    """
     with atomic_output(path) as temporary:
         temporary.write_bytes(data)
     return Path(path)
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
-    """Write UTF-8 ``text`` to ``path`` atomically and return the path."""
+    """Write UTF-8 ``text`` to ``path`` atomically and return the path.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; its directory must exist. An existing file is replaced.
+    text : str
+        The complete file content, encoded as UTF-8.
+    """
     return write_bytes_atomic(path, text.encode("utf-8"))

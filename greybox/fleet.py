@@ -67,6 +67,16 @@ def expand_logs(items: Sequence[str]) -> list[Path]:
     Directories and patterns yield the files with a log extension (:data:`LOG_SUFFIXES`), so that a CSV
     log's metadata sidecar or a manifest beside the logs is not taken for a log.
 
+    Parameters
+    ----------
+    items : sequence of str
+        Log files, directories and glob patterns (``**`` matches across directories).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The logs, resolved to absolute paths, in the order found; a file named twice appears once.
+
     Raises
     ------
     GreyboxError
@@ -97,17 +107,35 @@ def expand_logs(items: Sequence[str]) -> list[Path]:
 
 
 def partition(value: str) -> str:
-    """A partition value safe in a path: letters, digits, ``-``, ``_`` and ``.``."""
+    """A partition value safe in a path: letters, digits, ``-``, ``_`` and ``.``.
+
+    Parameters
+    ----------
+    value : str
+        Name to make safe; every other character becomes ``_``, and an empty name ``_``.
+    """
     return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in value) or "_"
 
 
 def machine_of(log: str | os.PathLike) -> str:
-    """The machine a log belongs to: the name of its folder, made safe for a path (:func:`partition`)."""
+    """The machine a log belongs to: the name of its folder, made safe for a path (:func:`partition`).
+
+    Parameters
+    ----------
+    log : str or path-like
+        Log file.
+    """
     return partition(Path(log).parent.name)
 
 
 def log_stamp(path: str | os.PathLike) -> dict:
-    """``size`` [bytes] and ``mtime_ns`` [ns] of a file: a log changed since a run differs in one of them."""
+    """``size`` [bytes] and ``mtime_ns`` [ns] of a file: a log changed since a run differs in one of them.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An existing file.
+    """
     stat = os.stat(path)
     return {"size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
 
@@ -141,6 +169,14 @@ def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None
 
 def attempt(label: str, work: Callable[[], dict]) -> dict:
     """Run one task's ``work`` on a worker and say how it went; never raises for bad input.
+
+    Parameters
+    ----------
+    label : str
+        What the task works on (e.g. the log file), named in the error of a failure that is a bug.
+    work : callable
+        ``work() -> dict``: does the task and returns the fields of its entry; a
+        :class:`GreyboxError` it raises is reported as the failure.
 
     Returns
     -------
@@ -196,7 +232,15 @@ def _load_manifest(directory: str | os.PathLike) -> dict:
 
 
 def read_manifest(directory: str | os.PathLike, fmt: str) -> dict:
-    """The manifest of ``fmt`` in ``directory``, or ``{}`` when there is none, it is unreadable or of another format."""
+    """The manifest of ``fmt`` in ``directory``, or ``{}`` when there is none, it is unreadable or of another format.
+
+    Parameters
+    ----------
+    directory : str or path-like
+        Output directory holding :data:`MANIFEST`.
+    fmt : str
+        The ``format`` the manifest must have (:data:`MODELS_FORMAT`, or that of a fleet prediction).
+    """
     document = _load_manifest(directory)
     return document if document.get("format") == fmt else {}
 
@@ -315,6 +359,13 @@ def _write_manifest(out_dir: Path, manifest: dict) -> None:
 def out_dir_of(jobs: Sequence, nothing: str) -> str:
     """The one output directory of a fleet's jobs (their ``out_dir``).
 
+    Parameters
+    ----------
+    jobs : sequence
+        Jobs with an ``out_dir`` attribute (:class:`FleetJob`, or those of ``greybox train --per-machine``).
+    nothing : str
+        Error message for no job at all.
+
     Raises
     ------
     GreyboxError
@@ -409,6 +460,11 @@ def machine_models(directory: str | os.PathLike) -> dict[str, dict[str, str]]:
 
     Only the models its manifest lists as trained (``ok`` or ``skipped``) whose file is there count.
 
+    Parameters
+    ----------
+    directory : str or path-like
+        Output directory of ``greybox train --per-machine``, with its manifest.
+
     Raises
     ------
     GreyboxError
@@ -463,6 +519,22 @@ def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: s
     ``model`` is one model file for every log, or a directory written by ``greybox train --per-machine``:
     each log then gets its machine's model (of ``read["axis"]`` where the machine has several).
 
+    Parameters
+    ----------
+    logs : sequence of path-like
+        Log files (:func:`expand_logs`); each one's folder names its machine.
+    model : str
+        Model file, or directory of models of ``greybox train --per-machine``.
+    out_dir : str
+        Root of the Parquet dataset the jobs write.
+    axis_config : str, optional
+        Axis file (force or torque) used for every log.
+    read : dict, optional
+        Options of reading and preparing the logs (:func:`read_prepared`); its ``axis`` also picks the
+        model in a models directory.
+    chunk_s : float, default 60.0
+        Chunk length of the prediction [s].
+
     Raises
     ------
     GreyboxError
@@ -488,6 +560,11 @@ def _file_hash(path: str) -> str:
 
 def predict_log(job: FleetJob) -> dict:
     """Predict one log and write its process table; the task each worker runs.
+
+    Parameters
+    ----------
+    job : FleetJob
+        The log, its model and options, and the dataset it is written to.
 
     Returns
     -------

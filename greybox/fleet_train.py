@@ -134,6 +134,11 @@ def _fit_and_save(job: TrainJob) -> dict:
 def train_model(job: TrainJob) -> dict:
     """Train and save one model of the fleet; the task each worker runs.
 
+    Parameters
+    ----------
+    job : TrainJob
+        The machine's logs, the axis to read, the unfitted model and the output directory.
+
     Returns
     -------
     dict

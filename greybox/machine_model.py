@@ -55,6 +55,9 @@ class MachineModel:
         One fitted model per axis, in the machine's axis order.
     name : str, default ""
         Machine name.
+    source : str, default ""
+        Directory the machine model was loaded from (:func:`load_machine`); empty when built in memory.
+        Not compared in equality.
     """
 
     models: Mapping[str, object]
@@ -68,7 +71,13 @@ class MachineModel:
 
 
 def is_machine_model(path: str | PathLike) -> bool:
-    """True when ``path`` is a directory holding a machine manifest."""
+    """True when ``path`` is a directory holding a machine manifest.
+
+    Parameters
+    ----------
+    path : str or path-like
+        File or directory to test.
+    """
     path = Path(path)
     return path.is_dir() and (path / MANIFEST).is_file()
 

@@ -151,7 +151,15 @@ def relerr(y, y_hat) -> float:
 
 
 def max_error(y, y_hat) -> float:
-    """Largest absolute error, in the unit of ``y`` (A or N); nan for ``n == 0``."""
+    """Largest absolute error, in the unit of ``y`` (A or N); nan for ``n == 0``.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        Measured effort [A or N].
+    y_hat : array_like, shape (n,)
+        Modelled effort, same unit.
+    """
     y, y_hat = _pair(y, y_hat)
     if y.size == 0:
         return float("nan")

@@ -49,7 +49,13 @@ def provenance() -> dict:
 
 
 def provenance_line(info: dict | None = None) -> str:
-    """One line for text and Markdown reports, e.g. ``greybox 0.1.0, Python 3.11.7, 2 cores, numpy 2.4.6, ...``."""
+    """One line for text and Markdown reports, e.g. ``greybox 0.1.0, Python 3.11.7, 2 cores, numpy 2.4.6, ...``.
+
+    Parameters
+    ----------
+    info : dict, optional
+        What :func:`provenance` returns; default measured now.
+    """
     info = provenance() if info is None else info
     libraries = ", ".join(f"{name} {version}" for name, version in info["libraries"].items())
     return (f"greybox {info['greybox']}, Python {info['python']}, {info['platform']}, {info['cpu_count']} cores; "

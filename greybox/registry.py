@@ -42,6 +42,11 @@ def _file_kinds() -> dict[str, type]:
 def model_class(kind: str) -> type:
     """Return the class registered under ``kind``.
 
+    Parameters
+    ----------
+    kind : str
+        A key of :data:`MODEL_CLASSES` or :data:`DERIVED_MODEL_CLASSES`, as stored in a model file.
+
     Raises
     ------
     KeyError
@@ -55,6 +60,11 @@ def model_class(kind: str) -> type:
 
 def model_kind(model) -> str:
     """Return the registered kind of ``model`` (its exact class, not a subclass).
+
+    Parameters
+    ----------
+    model : object
+        A current model (fitted or not).
 
     Raises
     ------

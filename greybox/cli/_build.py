@@ -70,6 +70,14 @@ def build_model(kind: str, args: argparse.Namespace):
     ``--elements``, ``--offset`` of gmssvr) is set on the first stage.
     ``--backlash`` wraps the model in a :class:`BacklashModel`.
 
+    Parameters
+    ----------
+    kind : str
+        Registered model kind (e.g. ``"gms"``, ``"svr"``, ``"gmssvr"``), as in :func:`greybox.registry.model_class`.
+    args : argparse.Namespace
+        Parsed command-line arguments; the model options (``offset``, ``asymmetric``, ``elements``,
+        ``model_seed``, ``set``, ``backlash``) are read from it, and those it lacks count as not given.
+
     Raises
     ------
     GreyboxError
@@ -111,7 +119,13 @@ _CONSTANTS = {"true": True, "false": False, "null": None, "none": None}
 
 def parse_setting(text: str):
     """The value of ``--set NAME=VALUE``: a JSON value; ``true``/``false``/``null`` in any case
-    (``False`` and ``None`` too); anything else as text (the model's checks refuse a wrong type)."""
+    (``False`` and ``None`` too); anything else as text (the model's checks refuse a wrong type).
+
+    Parameters
+    ----------
+    text : str
+        The ``VALUE`` part of the option, after the first ``=``.
+    """
     stripped = text.strip()
     if stripped.lower() in _CONSTANTS:
         return _CONSTANTS[stripped.lower()]

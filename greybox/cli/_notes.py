@@ -153,7 +153,16 @@ def reader_words(text: str) -> str:
 
 
 def error_message(error: BaseException, args: argparse.Namespace) -> str:
-    """The text of a user-facing error of a command, hyperparameters spelt as options, on one line."""
+    """The text of a user-facing error of a command, hyperparameters spelt as options, on one line.
+
+    Parameters
+    ----------
+    error : BaseException
+        The error the command raised. A :class:`CommandLineError` is shown as is, a log-reading error
+        in the reader's option words, any other with model hyperparameters spelt as options.
+    args : argparse.Namespace
+        The parsed command line (whether it offers ``--set``).
+    """
     if isinstance(error, CommandLineError):
         return _one_line(error)
     if isinstance(error, LogError):

@@ -93,7 +93,13 @@ class NumberRange:
         return f"a {noun} in {'(' if self.low_open else '['}{low:g}, {high:g}{')' if self.high_open else ']'}"
 
     def contains(self, value) -> bool:
-        """Whether ``value`` lies in the range (and is finite)."""
+        """Whether ``value`` lies in the range (and is finite).
+
+        Parameters
+        ----------
+        value : int or float
+            Number to test against the bounds.
+        """
         if not math.isfinite(value):
             return False
         if self.low is not None and (value <= self.low if self.low_open else value < self.low):
@@ -150,12 +156,24 @@ SEED = NumberRange(int, low=0, high=MAX_SEED)
 
 
 def positive(unit: str) -> NumberRange:
-    """A number > 0 of ``unit`` (e.g. ``"seconds"``), named so in the message."""
+    """A number > 0 of ``unit`` (e.g. ``"seconds"``), named so in the message.
+
+    Parameters
+    ----------
+    unit : str
+        Unit in words, appended to the range's description.
+    """
     return NumberRange(float, low=0, low_open=True, unit=unit)
 
 
 def non_negative(unit: str) -> NumberRange:
-    """A number >= 0 of ``unit`` (e.g. ``"seconds"``), named so in the message."""
+    """A number >= 0 of ``unit`` (e.g. ``"seconds"``), named so in the message.
+
+    Parameters
+    ----------
+    unit : str
+        Unit in words, appended to the range's description.
+    """
     return NumberRange(float, low=0, unit=unit)
 
 

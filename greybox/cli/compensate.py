@@ -20,6 +20,13 @@ STROKE_REFERENCES = ("low", "high")
 
 
 def add_parser(subparsers) -> None:
+    """Add the ``compensate`` sub-command and its options.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-command registry of the ``greybox`` parser (from ``add_subparsers``).
+    """
     from ..control.references import STROKES_MM
     from ..registry import MODEL_CLASSES
 
@@ -238,6 +245,18 @@ def _check_output(args) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``greybox compensate``: simulate the loop with each feed-forward, print the table, write the report.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of the sub-command.
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+    """
     from ..control.report import comparison_rows, write_report
     from ..control.workflow import compensation_study
 

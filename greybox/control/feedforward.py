@@ -52,11 +52,33 @@ class InertiaFeedForward:
         self.name = name
 
     def friction(self, reference: Reference) -> np.ndarray:
-        """Friction part of the feed-forward [A]: zero."""
+        """Friction part of the feed-forward [A]: zero.
+
+        Parameters
+        ----------
+        reference : Reference
+            Position reference; only its length is used.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            Zeros, one per reference sample.
+        """
         return np.zeros(len(reference))
 
     def current(self, reference: Reference) -> np.ndarray:
-        """Feed-forward current [A] at every reference sample."""
+        """Feed-forward current [A] at every reference sample.
+
+        Parameters
+        ----------
+        reference : Reference
+            Position reference; its acceleration [mm/s^2] is scaled by the inertia.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            ``J_ff a_ref`` [A].
+        """
         return self.inertia_A_s2_mm * reference.acceleration
 
     def describe(self) -> dict:
@@ -94,12 +116,34 @@ class ModelFeedForward:
         self.effort_unit = model.effort_unit_
 
     def friction(self, reference: Reference) -> np.ndarray:
-        """Friction current of the model along the reference, plus its offset [A]."""
+        """Friction current of the model along the reference, plus its offset [A].
+
+        Parameters
+        ----------
+        reference : Reference
+            Position reference; the model is simulated along its motion from rest.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            ``F_model(ref) + I_0`` [A] at every reference sample.
+        """
         log = reference.to_log(motion=self.model.units_.name, effort_unit=self.effort_unit)
         return self.model.friction(log) + self.model.offset_
 
     def current(self, reference: Reference) -> np.ndarray:
-        """Feed-forward current [A] at every reference sample."""
+        """Feed-forward current [A] at every reference sample.
+
+        Parameters
+        ----------
+        reference : Reference
+            Position reference the feed-forward is computed from.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            ``J_ff a_ref + F_model(ref) + I_0`` [A].
+        """
         return self.inertia_A_s2_mm * reference.acceleration + self.friction(reference)
 
     def describe(self) -> dict:

@@ -95,7 +95,24 @@ class ControllerSettings(NamedTuple):
     @classmethod
     def from_gains(cls, gains: PIDGains, period_s: float, current_limit_A: float,
                    resolution_mm: float) -> "ControllerSettings":
-        """Discretise ``gains`` at the controller period ``period_s`` [s]."""
+        """Discretise ``gains`` at the controller period ``period_s`` [s].
+
+        Parameters
+        ----------
+        gains : PIDGains
+            Continuous-time gains of the controller.
+        period_s : float
+            Controller period ``T`` [s], > 0.
+        current_limit_A : float
+            Saturation of the motor current [A], > 0.
+        resolution_mm : float
+            Position measurement resolution [mm], >= 0 (0: exact measurement).
+
+        Raises
+        ------
+        ParameterError
+            If the period, the current limit or the resolution is out of range.
+        """
         if not (np.isfinite(period_s) and period_s > 0.0):
             raise ParameterError(f"controller period must be positive, got {period_s} s")
         if not (np.isfinite(current_limit_A) and current_limit_A > 0.0):
@@ -109,7 +126,15 @@ class ControllerSettings(NamedTuple):
 
 @njit(cache=True)
 def measure(position_mm, resolution_mm):
-    """Encoder reading of a position [mm]: rounded to the resolution (unchanged when it is 0)."""
+    """Encoder reading of a position [mm]: rounded to the resolution (unchanged when it is 0).
+
+    Parameters
+    ----------
+    position_mm : float
+        True position [mm].
+    resolution_mm : float
+        Encoder resolution [mm]; 0 for an ideal encoder.
+    """
     if resolution_mm > 0.0:
         return np.round(position_mm / resolution_mm) * resolution_mm
     return position_mm

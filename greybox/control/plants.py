@@ -98,7 +98,20 @@ class PlantTrace(NamedTuple):
 
 
 def fine_stride(period_s: float, max_step_s: float) -> int:
-    """Number of internal steps per period [s]: the fewest with a step <= ``max_step_s`` [s]."""
+    """Number of internal steps per period [s]: the fewest with a step <= ``max_step_s`` [s].
+
+    Parameters
+    ----------
+    period_s : float
+        Controller period [s], > 0.
+    max_step_s : float
+        Largest internal step allowed [s], > 0.
+
+    Raises
+    ------
+    GreyboxError
+        If ``period_s`` is not positive and finite.
+    """
     if not (np.isfinite(period_s) and period_s > 0.0):
         raise GreyboxError(f"period must be positive, got {period_s} s")
     return max(1, int(math.ceil(period_s / max_step_s * (1.0 - 1e-9))))
@@ -252,7 +265,15 @@ class TwinPlant:
 
     @classmethod
     def for_axis(cls, axis: str, *, friction: bool = True) -> "TwinPlant":
-        """Default truth plant of axis ``"X"``, ``"Y"`` or ``"C"`` (rotary, deg), named ``twin-X`` / ...."""
+        """Default truth plant of axis ``"X"``, ``"Y"`` or ``"C"`` (rotary, deg), named ``twin-X`` / ....
+
+        Parameters
+        ----------
+        axis : str
+            Axis of the synthetic machine, ``"X"``, ``"Y"`` or ``"C"`` (case and surrounding spaces ignored).
+        friction : bool, default True
+            With ``False`` the plant is the axis's inertia alone.
+        """
         key = str(axis).strip().upper()
         suffix = "" if friction else " (no friction)"
         return cls(default_plant_parameters(key), friction=friction, name=f"twin-{key}{suffix}", axis=key)
@@ -278,7 +299,19 @@ class TwinPlant:
 
     def run(self, reference, feedforward_A, disturbance_A, settings: ControllerSettings, periods: int
             ) -> PlantTrace:
-        """Run the loop (see :func:`position_loop` for the arguments) and return the recorded trace."""
+        """Run the loop (see :func:`position_loop` for the arguments) and return the recorded trace.
+
+        Parameters
+        ----------
+        reference : Reference
+            Position reference [mm, or deg on a rotary axis]; the loop starts at rest at its first position.
+        feedforward_A, disturbance_A : array_like, shape (n,)
+            Feed-forward and disturbance current [A] at every reference sample.
+        settings : ControllerSettings
+            Discretised controller.
+        periods : int
+            Controller periods per reference sample.
+        """
         return run_law(self.plant_law(), self.params.internal_step_s, reference, feedforward_A, disturbance_A,
                        settings, periods)
 
@@ -346,5 +379,17 @@ class ModelPlant:
 
     def run(self, reference, feedforward_A, disturbance_A, settings: ControllerSettings, periods: int
             ) -> PlantTrace:
-        """Run the loop (see :func:`position_loop` for the arguments) and return the recorded trace."""
+        """Run the loop (see :func:`position_loop` for the arguments) and return the recorded trace.
+
+        Parameters
+        ----------
+        reference : Reference
+            Position reference [mm, or deg on a rotary axis]; the loop starts at rest at its first position.
+        feedforward_A, disturbance_A : array_like, shape (n,)
+            Feed-forward and disturbance current [A] at every reference sample.
+        settings : ControllerSettings
+            Discretised controller.
+        periods : int
+            Controller periods per reference sample.
+        """
         return run_law(self.law, self.max_step_s, reference, feedforward_A, disturbance_A, settings, periods)

@@ -53,7 +53,15 @@ def _plot_name(reference_name: str) -> str:
 
 
 def report_paths(reference_names, out_dir) -> list[Path]:
-    """Every file :func:`write_report` writes for these references into ``out_dir``."""
+    """Every file :func:`write_report` writes for these references into ``out_dir``.
+
+    Parameters
+    ----------
+    reference_names : iterable of str
+        Names of the references, one tracking-error plot each.
+    out_dir : path-like
+        Output directory of the report.
+    """
     out = Path(out_dir)
     return [out / name for name in REPORT_FILES] + [out / _plot_name(name) for name in reference_names]
 
@@ -63,7 +71,13 @@ def _reference_names(results) -> list[str]:
 
 
 def comparison_rows(results: list[LoopResult]) -> list[dict]:
-    """Rows of the comparison: :meth:`LoopResult.summary` plus ``rms_vs_none`` (RMS / RMS of "none", or NaN)."""
+    """Rows of the comparison: :meth:`LoopResult.summary` plus ``rms_vs_none`` (RMS / RMS of "none", or NaN).
+
+    Parameters
+    ----------
+    results : list of LoopResult
+        Runs of a comparison, grouped by reference in the order their references first appear.
+    """
     rows = []
     for name in _reference_names(results):
         group = [result for result in results if result.reference.name == name]
@@ -76,7 +90,13 @@ def comparison_rows(results: list[LoopResult]) -> list[dict]:
 
 
 def format_tables(results: list[LoopResult]) -> str:
-    """Markdown tables of RMS and peak tracking error [um, or mdeg for a rotary axis], one per reference."""
+    """Markdown tables of RMS and peak tracking error [um, or mdeg for a rotary axis], one per reference.
+
+    Parameters
+    ----------
+    results : list of LoopResult
+        Runs of a comparison; one table per reference they ran on.
+    """
     lines = []
     for name in _reference_names(results):
         group = [result for result in results if result.reference.name == name]

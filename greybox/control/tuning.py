@@ -35,7 +35,18 @@ DERIVATIVE_FILTER_RATIO = 10.0
 
 
 def default_bandwidth_hz(sample_time_s: float) -> float:
-    """Default closed-loop bandwidth [Hz] for a controller period [s]: ``omega = 0.1 / T``."""
+    """Default closed-loop bandwidth [Hz] for a controller period [s]: ``omega = 0.1 / T``.
+
+    Parameters
+    ----------
+    sample_time_s : float
+        Controller period ``T`` [s], > 0.
+
+    Raises
+    ------
+    ParameterError
+        If ``sample_time_s`` is not positive and finite.
+    """
     if not (np.isfinite(sample_time_s) and sample_time_s > 0.0):
         raise ParameterError(f"controller period must be positive, got {sample_time_s} s")
     return BANDWIDTH_TIMES_PERIOD / sample_time_s / (2.0 * math.pi)

@@ -58,6 +58,15 @@ class CompensationResult:
 def twin_training_runs(plant: TwinPlant, *, seed: int = 0, duration_s: float = 60.0) -> list[AxisLog]:
     """Prepared synthetic training runs (datasets A and P) of a twin plant's axis.
 
+    Parameters
+    ----------
+    plant : TwinPlant
+        Twin plant of a named axis (``plant.axis`` set, e.g. by :meth:`TwinPlant.for_axis`).
+    seed : int, default 0
+        Master seed of the synthetic datasets.
+    duration_s : float, default 60.0
+        Length [s] of each dataset.
+
     Raises
     ------
     GreyboxError

@@ -238,6 +238,13 @@ def _check_values(values: Mapping[str, object], where: str, names: Mapping[str, 
 def check_channels(table, where: str) -> dict[str, str]:
     """A ``[channels]`` table checked: ``{canonical_name: name_in_log}``, each quantity mapped once.
 
+    Parameters
+    ----------
+    table : object
+        The parsed ``[channels]`` value; valid when a dict of canonical column name to the log's name.
+    where : str
+        What is being read (file name, and axis table), prefixed to error messages.
+
     Raises
     ------
     GreyboxError

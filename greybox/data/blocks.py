@@ -18,6 +18,11 @@ class CannotStream(Exception):
 def concatenate(blocks: Iterable[AxisLog]) -> AxisLog:
     """One log of consecutive blocks of the same log (channels joined; names and attrs of the first).
 
+    Parameters
+    ----------
+    blocks : iterable of AxisLog
+        Consecutive blocks of one log, in time order, all with the same channels.
+
     Raises
     ------
     ValueError

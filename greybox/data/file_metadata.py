@@ -27,12 +27,24 @@ SIDECAR_SUFFIX = ".json"
 
 
 def log_metadata(log: AxisLog) -> dict[str, object]:
-    """The metadata object written with a log (JSON-able)."""
+    """The metadata object written with a log (JSON-able).
+
+    Parameters
+    ----------
+    log : AxisLog
+        The log whose axis, dataset, effort unit and attrs are taken.
+    """
     return {"axis": log.axis, "dataset": log.dataset, "effort_unit": log.effort_unit, "attrs": log.attrs}
 
 
 def logs_metadata(logs) -> dict[str, object]:
-    """The metadata object written with one log, or with several axes in one table: ``{"axes": {axis: ...}}``."""
+    """The metadata object written with one log, or with several axes in one table: ``{"axes": {axis: ...}}``.
+
+    Parameters
+    ----------
+    logs : iterable of AxisLog
+        The logs written to one file: one, or several axes on the same time stamps.
+    """
     logs = list(logs)
     if len(logs) == 1:
         return log_metadata(logs[0])
@@ -41,6 +53,15 @@ def logs_metadata(logs) -> dict[str, object]:
 
 def parse_metadata(text: str | bytes, source, what: str = "greybox metadata") -> dict:
     """The metadata object of JSON ``text``.
+
+    Parameters
+    ----------
+    text : str or bytes
+        The JSON text (bytes are decoded as UTF-8).
+    source : str or path-like or None
+        The file it was read from, for error messages.
+    what : str, default "greybox metadata"
+        What the text is, for error messages ("metadata file").
 
     Raises
     ------
@@ -90,13 +111,24 @@ def sidecar_path(path: str | os.PathLike) -> Path:
     The whole name is kept, rather than the extension replaced, so that the
     sidecar never collides with a JSON file of the same stem (``metrics.csv``
     and ``metrics.json`` of a report, ``x.csv`` and ``x.json`` of a user).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The CSV file.
     """
     path = Path(path)
     return path.with_name(path.name + SIDECAR_SUFFIX)
 
 
 def sidecar_text(metadata: Mapping[str, object]) -> str:
-    """The text of a sidecar file: the metadata object as indented JSON."""
+    """The text of a sidecar file: the metadata object as indented JSON.
+
+    Parameters
+    ----------
+    metadata : mapping
+        The metadata object (:func:`log_metadata` or :func:`logs_metadata`); must be JSON-able.
+    """
     return json.dumps(dict(metadata), indent=1) + "\n"
 
 

@@ -49,6 +49,13 @@ _HANDLERS = {
 def format_of(path, fmt: str | None = None) -> str:
     """Return the format name of a file: ``fmt`` if given, else from the extension.
 
+    Parameters
+    ----------
+    path : str or path-like
+        Log file; its extension (case-insensitive) gives the format.
+    fmt : str, optional
+        Format name (a key of :data:`FORMATS`), overriding the extension.
+
     Raises
     ------
     LogError

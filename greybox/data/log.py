@@ -164,6 +164,11 @@ class AxisLog:
 
         A selection that is not contiguous joins separate stretches of time;
         call :func:`greybox.data.prepare.trim` for time windows instead.
+
+        Parameters
+        ----------
+        index : slice or ndarray of bool or int
+            Applied to every channel alike: a slice, a boolean mask of shape ``(n,)``, or sample indices.
         """
 
         def pick(a):
@@ -213,6 +218,11 @@ class AxisLog:
 
 def as_log_list(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
     """Return ``logs`` as a list of runs, accepting a single :class:`AxisLog`.
+
+    Parameters
+    ----------
+    logs : AxisLog or iterable of AxisLog
+        One log, or several.
 
     Raises
     ------

@@ -92,6 +92,11 @@ class MachineConfig:
     def axis(self, name: str) -> MachineAxis:
         """The axis called ``name``.
 
+        Parameters
+        ----------
+        name : str
+            Axis name as in the machine file's ``[axes.NAME]`` table (e.g. ``"X"``).
+
         Raises
         ------
         GreyboxError

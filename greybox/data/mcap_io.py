@@ -81,7 +81,13 @@ _CHUNKS_AHEAD = 2  # chunks decompressed ahead of the one being read
 
 
 def topic_for(axis: str) -> str:
-    """Topic of an axis channel: ``/axis/<axis>``, or ``/axis`` for an unnamed axis."""
+    """Topic of an axis channel: ``/axis/<axis>``, or ``/axis`` for an unnamed axis.
+
+    Parameters
+    ----------
+    axis : str
+        Axis name; empty for an unnamed axis.
+    """
     return f"/axis/{axis}" if axis else "/axis"
 
 
@@ -718,7 +724,13 @@ class McapLog:
         return self._span
 
     def blocks(self, block_samples: int | None = None) -> Iterator[AxisLog]:
-        """The log, block by block (the last may be shorter), converted but not validated."""
+        """The log, block by block (the last may be shorter), converted but not validated.
+
+        Parameters
+        ----------
+        block_samples : int, optional
+            Samples per block; default :attr:`block_samples`.
+        """
         size = self.block_samples if block_samples is None else int(block_samples)
         yield from reblock(self._pieces(size), size)
 

@@ -38,7 +38,13 @@ DEFAULT_CUTOFF_HZ = 50.0
 
 
 def default_cutoff(sample_time: float) -> float:
-    """Default derivative-filter cut-off [Hz] for a sample time [s]: ``min(50, 0.4 * Nyquist)``."""
+    """Default derivative-filter cut-off [Hz] for a sample time [s]: ``min(50, 0.4 * Nyquist)``.
+
+    Parameters
+    ----------
+    sample_time : float
+        Nominal sample time [s], positive.
+    """
     return min(DEFAULT_CUTOFF_HZ, 0.4 * 0.5 / sample_time)
 
 
@@ -218,6 +224,15 @@ def resample(log: AxisLog, sample_time: float) -> AxisLog:
 
 def trim(log: AxisLog, start_s: float | None = None, stop_s: float | None = None) -> AxisLog:
     """Keep the samples with ``start_s <= time <= stop_s`` (times in s; None = open end).
+
+    Parameters
+    ----------
+    log : AxisLog
+        Log with increasing time.
+    start_s : float, optional
+        Start of the window on the log's time axis [s]; None keeps from the first sample.
+    stop_s : float, optional
+        End of the window on the log's time axis [s], inclusive; None keeps to the last sample.
 
     Raises
     ------

@@ -88,7 +88,13 @@ class Motion:
         return ("A", self.load_unit)
 
     def effort_column(self, effort_unit: str) -> str:
-        """Canonical column of an effort in ``effort_unit``: ``"current_A"`` or the load column."""
+        """Canonical column of an effort in ``effort_unit``: ``"current_A"`` or the load column.
+
+        Parameters
+        ----------
+        effort_unit : str
+            ``"A"`` for a motor current; any other unit gives the load column.
+        """
         return "current_A" if effort_unit == "A" else self.load_column
 
     def relabel(self, text: str) -> str:
@@ -97,11 +103,22 @@ class Motion:
         Names of effect parameters and labels that the package writes in mm (``"period_mm"``,
         ``"slope_A_per_mm"``, ``"velocity [mm/s]"``) read ``"period_deg"``, ``"slope_A_per_deg"``,
         ``"velocity [deg/s]"`` for a rotary axis; a linear axis's text is returned as is.
+
+        Parameters
+        ----------
+        text : str
+            Name or label written for a linear axis; each ``mm`` that stands as a word is replaced.
         """
         return text if self.length == "mm" else _MM.sub(self.length, text)
 
     def effort_label(self, effort_unit: str) -> str:
-        """Axis label of an effort, e.g. ``"motor current [A]"`` or ``"torque [Nm]"``."""
+        """Axis label of an effort, e.g. ``"motor current [A]"`` or ``"torque [Nm]"``.
+
+        Parameters
+        ----------
+        effort_unit : str
+            ``"A"`` for a motor current; any other unit gives the load's label.
+        """
         return "motor current [A]" if effort_unit == "A" else f"{self.load} [{self.load_unit}]"
 
 
@@ -120,6 +137,11 @@ MOTIONS = {motion.name: motion for motion in (LINEAR, ROTARY)}
 
 def motion_named(name: str) -> Motion:
     """Return the :class:`Motion` called ``name`` (``"linear"`` or ``"rotary"``).
+
+    Parameters
+    ----------
+    name : str
+        ``"linear"`` or ``"rotary"``.
 
     Raises
     ------

@@ -113,7 +113,13 @@ def parse_column_name(name: str) -> tuple[str, str | None] | None:
 
 
 def known_column(name: str) -> bool:
-    """True when ``name`` is a quantity with a supported unit, e.g. ``"position_deg"`` (a valid mapping key)."""
+    """True when ``name`` is a quantity with a supported unit, e.g. ``"position_deg"`` (a valid mapping key).
+
+    Parameters
+    ----------
+    name : str
+        Column name, ``<quantity>_<unit>``.
+    """
     parsed = parse_column_name(name)
     return parsed is not None and parsed[1] in UNIT_FACTORS[parsed[0]]
 

@@ -353,6 +353,11 @@ class AugmentedModel(CurrentModel):
 
         The effect columns of :meth:`linear_part` and of the discovery's
         scores are built from such runs (friction effects scale the base's friction).
+
+        Parameters
+        ----------
+        logs : AxisLog or iterable of AxisLog
+            Prepared runs, of the effort unit and kind of axis the model was fitted on.
         """
         runs = self._check_predict_runs(logs)
         shape_base = getattr(self, "friction_shape_base_", None)
@@ -407,6 +412,11 @@ class AugmentedModel(CurrentModel):
     def term_currents(self, logs: AxisLog | Iterable[AxisLog]) -> dict[str, np.ndarray]:
         """The current of each term over the runs, concatenated [A, or N].
 
+        Parameters
+        ----------
+        logs : AxisLog or iterable of AxisLog
+            Prepared runs to evaluate the terms on.
+
         Returns
         -------
         dict
@@ -423,6 +433,11 @@ class AugmentedModel(CurrentModel):
 
         Columns: the base's linear parameters, then every term's columns
         (named ``"<effect>.<column>"``).
+
+        Parameters
+        ----------
+        logs : AxisLog or sequence of AxisLog
+            Prepared runs; unlike the base class's single run, several are stacked in order.
         """
         runs = self.with_base_friction(logs)
         part = _joined([self.base_.linear_part(run) for run in runs])
@@ -442,7 +457,13 @@ class AugmentedModel(CurrentModel):
         return np.concatenate([self.base_.linear_coefficients()] + [e["coefficients"] for e in self.effects_])
 
     def set_linear_coefficients(self, values) -> None:
-        """Write ``values`` (order of :meth:`linear_coefficients`) into the base model and the terms."""
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the base model and the terms.
+
+        Parameters
+        ----------
+        values : array_like, shape (p,)
+            The base's linear parameters followed by every term's coefficients, as in the base class.
+        """
         check_is_fitted(self, "effects_")
         x = np.asarray(values, dtype=float)
         n_base = self.base_.linear_coefficients().size

@@ -77,6 +77,11 @@ def default_velocity_scale(runs: Sequence[AxisLog]) -> float:
 
     1 % of the 99th percentile of ``|v|`` over all runs: small against the
     feed speeds, large against velocity noise at rest.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs; their velocities [mm/s] are pooled.
     """
     speed = np.concatenate([np.abs(run.velocity) for run in runs])
     scale = 0.01 * float(np.percentile(speed, 99.0))
@@ -120,7 +125,15 @@ class EffectContext:
 
     @classmethod
     def from_runs(cls, runs: Sequence[AxisLog], velocity_scale_mm_s: float | None = None) -> "EffectContext":
-        """Context of prepared training runs (``v_e`` by :func:`default_velocity_scale` unless given)."""
+        """Context of prepared training runs (``v_e`` by :func:`default_velocity_scale` unless given).
+
+        Parameters
+        ----------
+        runs : sequence of AxisLog
+            Prepared training runs; their lowest and highest position [mm] give ``position_range_mm``.
+        velocity_scale_mm_s : float, optional
+            ``v_e`` [mm/s]; None: :func:`default_velocity_scale` of ``runs``.
+        """
         low = float(min(np.min(run.position) for run in runs))
         high = float(max(np.max(run.position) for run in runs))
         if not high > low:
@@ -131,11 +144,23 @@ class EffectContext:
         return cls(scale, (low, high))
 
     def direction(self, run: AxisLog) -> np.ndarray:
-        """Smoothed direction of motion ``tanh(v / v_e)`` (-1 ... 1)."""
+        """Smoothed direction of motion ``tanh(v / v_e)`` (-1 ... 1).
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run.
+        """
         return np.tanh(run.velocity / self.velocity_scale_mm_s)
 
     def friction_shape(self, run: AxisLog) -> np.ndarray:
-        """What friction effects scale: the base's friction less its viscous part over its level, or ``d``."""
+        """What friction effects scale: the base's friction less its viscous part over its level, or ``d``.
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run; with a ``friction_level`` it must carry the :data:`BASE_FRICTION` channel.
+        """
         if self.friction_level is None:
             return self.direction(run)
         if BASE_FRICTION not in run.extras:
@@ -144,12 +169,24 @@ class EffectContext:
         return run.extras[BASE_FRICTION] / self.friction_level
 
     def elapsed(self, run: AxisLog) -> np.ndarray:
-        """Time since the start of the run [s] (see ``run_start_s``)."""
+        """Time since the start of the run [s] (see ``run_start_s``).
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run, or a chunk of one.
+        """
         start = run.time[0] if self.run_start_s is None else self.run_start_s
         return run.time - start
 
     def unit_position(self, run: AxisLog) -> np.ndarray:
-        """Position scaled to ``u`` in [-1, 1] over the context's range, held at -1 / +1 beyond it."""
+        """Position scaled to ``u`` in [-1, 1] over the context's range, held at -1 / +1 beyond it.
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run.
+        """
         low, high = self.position_range_mm
         return np.clip((2.0 * run.position - low - high) / (high - low), -1.0, 1.0)
 
@@ -211,7 +248,14 @@ class Effect:
         return len(self.column_names)
 
     def check_shape(self, shape: float | None) -> float | None:
-        """Return ``shape`` as a float (None for effects without one), or raise :class:`GreyboxError`."""
+        """Return ``shape`` as a float (None for effects without one), or raise :class:`GreyboxError`.
+
+        Parameters
+        ----------
+        shape : float or None
+            Value of the shape parameter, in its unit (period [mm], time constant [s] or
+            Stribeck velocity [mm/s]); must be positive, or None for an effect without one.
+        """
         if self.shape is None:
             if shape is not None:
                 raise GreyboxError(f"effect {self.name!r} has no shape parameter, got {shape!r}")
@@ -221,26 +265,76 @@ class Effect:
         return float(shape)
 
     def columns(self, run: AxisLog, context: EffectContext, shape: float | None = None) -> np.ndarray:
-        """Regressor columns of one prepared run, shape ``(n, n_columns)``."""
+        """Regressor columns of one prepared run, shape ``(n, n_columns)``.
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run.
+        context : EffectContext
+            Scales of the regressors.
+        shape : float, optional
+            Value of the shape parameter in its unit; None for an effect without one.
+        """
         columns = self.build(run, context, self.check_shape(shape))
         return np.asarray(columns, dtype=float).reshape(len(run), self.n_columns)
 
     def current(self, run: AxisLog, context: EffectContext, coefficients, shape: float | None = None
                 ) -> np.ndarray:
-        """The effect's current ``columns @ coefficients`` over one run [A, or N]."""
+        """The effect's current ``columns @ coefficients`` over one run [A, or N].
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run.
+        context : EffectContext
+            Scales of the regressors.
+        coefficients : array_like, shape (n_columns,)
+            Linear coefficients of the columns.
+        shape : float, optional
+            Value of the shape parameter in its unit; None for an effect without one.
+        """
         return self.columns(run, context, shape) @ np.asarray(coefficients, dtype=float)
 
     def parameters(self, coefficients, context: EffectContext, shape: float | None = None,
                    unit: str = "A") -> dict[str, float]:
-        """Physical parameters from fitted coefficients; names end in their unit (``unit`` = A or N)."""
+        """Physical parameters from fitted coefficients; names end in their unit (``unit`` = A or N).
+
+        Parameters
+        ----------
+        coefficients : array_like, shape (n_columns,)
+            Fitted linear coefficients of the columns.
+        context : EffectContext
+            Scales the columns were built with.
+        shape : float, optional
+            Value of the shape parameter in its unit; None for an effect without one.
+        unit : str, default "A"
+            Effort unit of the coefficients, "A" or "N"; used in the parameter names.
+        """
         return self.describe(np.asarray(coefficients, dtype=float), context, self.check_shape(shape), unit)
 
     def shape_grid(self, runs: Sequence[AxisLog], context: EffectContext) -> np.ndarray | None:
-        """Values of the shape parameter a scan tries (None without one)."""
+        """Values of the shape parameter a scan tries (None without one).
+
+        Parameters
+        ----------
+        runs : sequence of AxisLog
+            Prepared training runs.
+        context : EffectContext
+            Scales of the regressors.
+        """
         return None if self.shape is None else self.shape.grid(runs, context)
 
     def shape_bracket(self, shape: float, grid: np.ndarray) -> tuple[float, float]:
-        """Interval around ``shape`` one grid step wide on either side (in the grid's own scale), inside the grid."""
+        """Interval around ``shape`` one grid step wide on either side (in the grid's own scale), inside the grid.
+
+        Parameters
+        ----------
+        shape : float
+            Centre of the interval, in the shape parameter's unit.
+        grid : ndarray, shape (m,)
+            Scanned values of the shape parameter (:meth:`shape_grid`).
+        """
         if self.shape.scale == "frequency":
             frequencies = 1.0 / grid
             step = float(np.max(np.abs(np.diff(frequencies)))) if grid.size > 1 else 0.5 / shape
@@ -262,6 +356,13 @@ def period_scan(runs: Sequence[AxisLog], context: EffectContext) -> tuple[float,
     ``1 / P_min``, ``P_min`` giving 4 samples per period at the median moving
     speed, but at most 4000 periods (``P_min >= R / 1000``). Periods come
     longest first.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared training runs; their position steps give the median moving speed per sample.
+    context : EffectContext
+        Its ``position_range_mm`` is ``R``.
     """
     low, high = context.position_range_mm
     span = high - low
@@ -279,6 +380,15 @@ def scan_periods(runs: Sequence[AxisLog], context: EffectContext, excluded: Sequ
     """:func:`period_scan` without the periods within :data:`PERIOD_SEPARATION_STEPS` steps of ``excluded`` [mm].
 
     Those periods are in the model already (a periodic effect named again takes another period).
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared training runs.
+    context : EffectContext
+        Scales of the regressors.
+    excluded : sequence of float, default ()
+        Periods already in the model [mm].
     """
     step, grid = period_scan(runs, context)
     if len(excluded):
@@ -288,7 +398,15 @@ def scan_periods(runs: Sequence[AxisLog], context: EffectContext, excluded: Sequ
 
 
 def period_grid(runs: Sequence[AxisLog], context: EffectContext) -> np.ndarray:
-    """Periods [mm] scanned for the position-periodic effects (see :func:`period_scan`)."""
+    """Periods [mm] scanned for the position-periodic effects (see :func:`period_scan`).
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared training runs.
+    context : EffectContext
+        Scales of the regressors.
+    """
     return period_scan(runs, context)[1]
 
 
@@ -441,6 +559,13 @@ PRESLIDING_WIDTHS_MM = (0.001, 0.003, 0.01, 0.03, 0.1)
 def presliding_states(run: AxisLog, context: EffectContext) -> tuple[np.ndarray, tuple]:
     """States of the pre-sliding refinement's play operators over a run, and where they end.
 
+    Parameters
+    ----------
+    run : AxisLog
+        One prepared run, or a chunk of one.
+    context : EffectContext
+        Its ``presliding_start`` gives the states before the first sample.
+
     Returns
     -------
     states : ndarray, shape (n, len(PRESLIDING_WIDTHS_MM))
@@ -508,6 +633,11 @@ VELOCITY_ONLY = ("viscous_friction", "stribeck")
 
 def effect(name: str) -> Effect:
     """Return the library effect or base refinement (:data:`REFINEMENTS`) ``name``.
+
+    Parameters
+    ----------
+    name : str
+        Name of a library effect (:data:`EFFECT_NAMES`) or of a refinement.
 
     Raises
     ------

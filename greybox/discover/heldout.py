@@ -259,7 +259,15 @@ class HeldOutTest:
         return None, term.shape_grid(self.runs, self.context)
 
     def best_shape(self, term: Effect, excluded_periods: Sequence[float] = ()) -> float:
-        """The shape of ``term`` that explains most of the residual over all training data (as a step's scan)."""
+        """The shape of ``term`` that explains most of the residual over all training data (as a step's scan).
+
+        Parameters
+        ----------
+        term : Effect
+            An effect with a shape parameter (period, time constant or Stribeck velocity).
+        excluded_periods : sequence of float, default ()
+            Periodic effects: periods [mm] in the model already, left out of the scan (:func:`scan_periods`).
+        """
         step, grid = self._grid(term, excluded_periods)
         nuisance = Nuisance(self.columns)
         everything = np.ones(self.target.size, dtype=bool)

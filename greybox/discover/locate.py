@@ -96,6 +96,21 @@ def structure_basis(runs: Sequence[AxisLog], thresholds: RegimeThresholds | None
         in bins from 10 ms to 1 s, per state: transients after reversals,
         starts and stops (pre-sliding, frictional memory at rest).
 
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs.
+    thresholds : RegimeThresholds, optional
+        Regime thresholds, of which the standstill speed [mm/s] is used; from the runs by default.
+    n_velocity_bins : int, default 16
+        Quantile bins of the velocity (fewer when quantiles coincide).
+    n_position_bins : int, default 12
+        Bins of the position range per direction of motion.
+    n_time_bins : int, default 10
+        Bins of the time since the start of the run.
+    n_acceleration_bins : int, default 10
+        Quantile bins of the acceleration (fewer when quantiles coincide).
+
     Returns
     -------
     dict of str to scipy.sparse.csr_matrix
@@ -198,6 +213,17 @@ def _binned_mean(values: np.ndarray, residual: np.ndarray, edges: np.ndarray) ->
 def residual_profiles(runs: Sequence[AxisLog], residual, thresholds: RegimeThresholds | None = None,
                       n_bins: int = 60) -> dict[str, dict]:
     """Binned mean residual along position (per direction), velocity, time and time since reversal.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs.
+    residual : ndarray, shape (n_samples,)
+        Measured minus modelled effort over the runs, concatenated [A, or N].
+    thresholds : RegimeThresholds, optional
+        Regime thresholds, of which the standstill speed [mm/s] is used; from the runs by default.
+    n_bins : int, default 60
+        Number of bins of each profile.
 
     Returns
     -------

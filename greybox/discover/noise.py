@@ -146,7 +146,15 @@ class ResidualNoise:
         return float(_ar_autocorrelation(self.ar, 1)[1])
 
     def draw_coefficients(self, n_replicates: int, rng: np.random.Generator) -> np.ndarray:
-        """AR coefficients of each replicate, shape ``(n_replicates, p)``: stationary draws around ``ar``."""
+        """AR coefficients of each replicate, shape ``(n_replicates, p)``: stationary draws around ``ar``.
+
+        Parameters
+        ----------
+        n_replicates : int
+            Number of coefficient sets to draw.
+        rng : numpy.random.Generator
+            Source of the draws (not used when ``ar_covariance`` is None or the order is 0).
+        """
         if self.ar_covariance is None or self.ar.size == 0:
             return np.tile(self.ar, (n_replicates, 1))
         draws = np.empty((n_replicates, self.ar.size))
@@ -166,6 +174,13 @@ class ResidualNoise:
 
         Each replicate has its own coefficients (:meth:`draw_coefficients`),
         the same in every run, and unit variance before the level is applied.
+
+        Parameters
+        ----------
+        n_replicates : int
+            Number of independent noise series per run.
+        rng : numpy.random.Generator
+            Source of the coefficients and innovations.
         """
         coefficients = self.draw_coefficients(n_replicates, rng)
         burn_in = 10 * self.ar.size + 200

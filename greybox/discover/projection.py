@@ -59,11 +59,23 @@ class Nuisance:
         return self.basis.shape[1]
 
     def project(self, values: np.ndarray) -> np.ndarray:
-        """``(I - P) values``: the part of each column outside the nuisance span."""
+        """``(I - P) values``: the part of each column outside the nuisance span.
+
+        Parameters
+        ----------
+        values : ndarray, shape (n, m)
+            Columns to project, with one row per row of the nuisance columns (or shape (n,)).
+        """
         return values - self.basis @ (self.basis.T @ values)
 
     def coordinates(self, values) -> np.ndarray:
-        """``basis' values`` (dense result) for dense or sparse ``values``."""
+        """``basis' values`` (dense result) for dense or sparse ``values``.
+
+        Parameters
+        ----------
+        values : ndarray or scipy.sparse matrix, shape (n, m)
+            Columns with one row per row of the nuisance columns.
+        """
         if scipy.sparse.issparse(values):
             return np.asarray((values.T @ self.basis).T)
         return self.basis.T @ values

@@ -38,7 +38,13 @@ _MAX_POINTS = 20_000
 
 
 def jsonable(value):
-    """``value`` with NumPy types turned into Python ones and non-finite floats into None."""
+    """``value`` with NumPy types turned into Python ones and non-finite floats into None.
+
+    Parameters
+    ----------
+    value : object
+        A scalar, array, or dict / list / tuple nesting them (dict keys become str); other objects pass unchanged.
+    """
     if isinstance(value, dict):
         return {str(key): jsonable(item) for key, item in value.items()}
     if isinstance(value, (list, tuple)):
@@ -55,7 +61,15 @@ def jsonable(value):
 
 
 def write_json(document: dict, path: str | os.PathLike) -> Path:
-    """Write ``document`` as indented strict JSON, atomically; return the path."""
+    """Write ``document`` as indented strict JSON, atomically; return the path.
+
+    Parameters
+    ----------
+    document : dict
+        Content to write, passed through :func:`jsonable` first.
+    path : str or os.PathLike
+        Target file.
+    """
     return write_text_atomic(path, json.dumps(jsonable(document), indent=1, allow_nan=False) + "\n")
 
 
@@ -72,7 +86,17 @@ def _profile(ax, before: dict, after: dict, xlabel: str, title: str, log_x: bool
 
 
 def plot_residuals(result: DiscoveryResult, which: str, path) -> Path:
-    """Residual figure of the training (``which="train"``) or test (``"test"``) runs; return the path."""
+    """Residual figure of the training (``which="train"``) or test (``"test"``) runs; return the path.
+
+    Parameters
+    ----------
+    result : DiscoveryResult
+        Outcome of a discovery run, holding the residuals before and after.
+    which : {"train", "test"}
+        Which runs' residuals to draw; must be a key of ``result.residuals``.
+    path : path-like
+        Image file to write; the format follows its extension.
+    """
     plt = import_pyplot(path)
     data = result.residuals[which]
     gap = result.train if which == "train" else result.test
@@ -125,7 +149,15 @@ def plot_residuals(result: DiscoveryResult, which: str, path) -> Path:
 
 
 def plot_evidence(result: DiscoveryResult, path) -> Path:
-    """Evidence figure: candidates of every step against their thresholds, and period scans."""
+    """Evidence figure: candidates of every step against their thresholds, and period scans.
+
+    Parameters
+    ----------
+    result : DiscoveryResult
+        Outcome of a discovery run, with its steps' candidate scores.
+    path : path-like
+        Image file to write; the format follows its extension.
+    """
     plt = import_pyplot(path)
     n_steps = len(result.steps)
     figure, axes = plt.subplots(1, n_steps + 1, figsize=(4.5 * (n_steps + 1), 5), layout="constrained",
@@ -167,6 +199,15 @@ def write_report(result: DiscoveryResult, directory, document: dict | None = Non
     """Write ``discovery.json`` and the figures into ``directory`` (created if missing); return the paths.
 
     ``document`` replaces :meth:`DiscoveryResult.to_dict` as the JSON content if given.
+
+    Parameters
+    ----------
+    result : DiscoveryResult
+        Outcome of a discovery run.
+    directory : path-like
+        Folder to write :data:`REPORT_FILES` into (``residual_test.png`` only when there are test runs).
+    document : dict, optional
+        JSON content to write instead of ``result.to_dict()``.
     """
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)

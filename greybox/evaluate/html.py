@@ -103,7 +103,23 @@ def render_html(*, title: str, tables: Sequence[Table] = (), figures: Sequence[t
 
 def write_html(path: str | os.PathLike, *, title: str, tables: Sequence[Table] = (),
                figures: Sequence[tuple[str, str | os.PathLike]] = (), intro: str = "", embed: bool = True) -> Path:
-    """Write :func:`render_html` to ``path`` atomically and return the path."""
+    """Write :func:`render_html` to ``path`` atomically and return the path.
+
+    Parameters
+    ----------
+    path : path-like
+        HTML file to write; its directory is the page directory for relative image paths.
+    title : str
+        Page heading (and window title).
+    tables : sequence of Table
+        Shown first, in order.
+    figures : sequence of (caption, path)
+        PNG files, shown after the tables.
+    intro : str
+        First paragraph (plain text; blank lines separate paragraphs).
+    embed : bool, default True
+        Embed the images as base64 instead of linking them relative to the page.
+    """
     path = Path(path)
     text = render_html(title=title, tables=tables, figures=figures, intro=intro, page_dir=path.parent, embed=embed)
     return write_text_atomic(path, text)

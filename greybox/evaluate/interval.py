@@ -46,7 +46,20 @@ MIN_CLASS_SAMPLES = 200
 
 
 def interval_classes(log: AxisLog, thresholds: RegimeThresholds) -> np.ndarray:
-    """Index into :data:`INTERVAL_CLASSES` of every sample of one prepared run."""
+    """Index into :data:`INTERVAL_CLASSES` of every sample of one prepared run.
+
+    Parameters
+    ----------
+    log : AxisLog
+        Prepared run.
+    thresholds : RegimeThresholds
+        Regime thresholds (those of the calibration logs) that define the classes.
+
+    Returns
+    -------
+    ndarray of int64, shape (n,)
+        Class index of every sample; a sample in several regimes takes the first class listed.
+    """
     masks = regime_masks(log, thresholds)
     out = np.full(len(log), len(INTERVAL_CLASSES) - 1, dtype=np.int64)
     for index in reversed(range(len(INTERVAL_CLASSES) - 1)):  # the first class listed wins
@@ -90,7 +103,18 @@ class ProcessInterval:
     motion: str = "linear"
 
     def half_widths(self, log: AxisLog) -> np.ndarray:
-        """Half-width [A] at every sample of one prepared run."""
+        """Half-width [A] at every sample of one prepared run.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared run; its samples are classed with the calibration thresholds.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            Half-width [A] (or [N] for a force log) of the class of every sample.
+        """
         table = np.array([self.half_width_A[name] for name in INTERVAL_CLASSES])
         return table[interval_classes(log, self.thresholds)]
 

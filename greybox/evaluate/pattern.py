@@ -108,7 +108,13 @@ def paper_pattern(records: Sequence[Mapping]) -> list[dict]:
 
 
 def paper_pattern_table(records: Sequence[Mapping]) -> Table:
-    """:func:`paper_pattern` as a table."""
+    """:func:`paper_pattern` as a table.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records of experiments 1 and 2, as for :func:`paper_pattern`.
+    """
     rows = [[c["check"], c["axis"], c["paper"], c["ours"], c["target"], "yes" if c["met"] else "no"]
             for c in paper_pattern(records)]
     notes = ["The synthetic axes are calibrated to behave like the paper's machine, not to give its numbers; "

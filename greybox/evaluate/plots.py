@@ -112,7 +112,13 @@ def envelope(time, values, max_points: int = ENVELOPE_POINTS) -> tuple[np.ndarra
 
 
 def window_title(window: tuple[float, float] | None) -> str:
-    """Suffix of a figure title naming a time window [s] (empty without one)."""
+    """Suffix of a figure title naming a time window [s] (empty without one).
+
+    Parameters
+    ----------
+    window : (float, float) or None
+        Start and stop time [s] of the window, or None for the whole log.
+    """
     return "" if window is None else f", {window[0]:g} to {window[1]:g} s"
 
 
@@ -135,7 +141,15 @@ def import_pyplot(path: str | os.PathLike | None):
 
 
 def finish_figure(figure, path: str | os.PathLike | None):
-    """Return ``figure`` when ``path`` is None, else write it with :func:`save_figure` and return the path."""
+    """Return ``figure`` when ``path`` is None, else write it with :func:`save_figure` and return the path.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        Figure to return or save.
+    path : path-like or None
+        Target file (written atomically, the figure then closed), or None to return the figure open.
+    """
     if path is None:
         return figure
     return save_figure(figure, path)

@@ -243,6 +243,9 @@ class ProcessTally:
         Samples outside the training region per quantity.
     n_outside : int
         Samples outside in any quantity.
+    _regions : bool, default False
+        Whether any block came with training-region flags (internal: set by :meth:`add`; without it
+        :meth:`extrapolation` reports no training region).
     """
 
     n_samples: int = 0
@@ -254,7 +257,17 @@ class ProcessTally:
     _regions: bool = False
 
     def add(self, result: ProcessResult, regions: dict | None = None) -> None:
-        """Count in one block (or a whole result) and its training-region flags per quantity."""
+        """Count in one block (or a whole result) and its training-region flags per quantity.
+
+        Parameters
+        ----------
+        result : ProcessResult
+            The block (or whole result) to count in.
+        regions : dict of str to ndarray of bool, optional
+            Per quantity, True at the samples of the block outside the training region
+            (:meth:`~greybox.estimator.CurrentModel.outside_training`); None or empty when the model
+            carries no training region.
+        """
         self.n_samples += len(result.time)
         values = {"measured": result.measured, "model": result.model, "process": result.process,
                   "load": result.load}
@@ -272,7 +285,13 @@ class ProcessTally:
             self.n_outside += int(np.count_nonzero(np.logical_or.reduce(list(regions.values()))))
 
     def rms(self, name: str) -> float:
-        """Root mean square of ``measured``, ``model``, ``process`` or ``load`` over the samples added."""
+        """Root mean square of ``measured``, ``model``, ``process`` or ``load`` over the samples added.
+
+        Parameters
+        ----------
+        name : {"measured", "model", "process", "load"}
+            Which signal [A] (or [N], [Nm]).
+        """
         return float(np.sqrt(self.sum_squares[name] / self.n_samples))
 
     def extrapolation(self) -> dict:
@@ -283,6 +302,15 @@ class ProcessTally:
 
 def check_process_inputs(model, runs: Sequence[AxisLog], axis_config: AxisConfig | None) -> None:
     """Refuse runs of mixed effort units, axis metadata with a load log, or of the other kind of axis.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        The model the runs are for (not examined by the checks).
+    runs : sequence of AxisLog
+        Prepared runs of one log; the first sets the effort unit and the kind of axis.
+    axis_config : AxisConfig or None
+        Drive-train constants to be applied, if any.
 
     Raises
     ------
@@ -418,7 +446,15 @@ def _block_result(block: AxisLog, predicted: np.ndarray, regions: dict, axis_con
 
 
 def join_results(parts: Sequence[ProcessResult], attrs: dict) -> ProcessResult:
-    """One result of consecutive block results (of one or several runs), with ``attrs``."""
+    """One result of consecutive block results (of one or several runs), with ``attrs``.
+
+    Parameters
+    ----------
+    parts : sequence of ProcessResult
+        Consecutive block results, in time order; the first gives the fields that are not per sample.
+    attrs : dict
+        JSON-able description of the whole result (e.g. from :func:`process_attrs`).
+    """
     first = parts[0]
 
     def joined(name):

@@ -68,6 +68,11 @@ _DESCRIPTIONS = {
 def output_format(path) -> str:
     """Format name of an output file from its extension.
 
+    Parameters
+    ----------
+    path : path-like
+        Output file; only its extension (case-insensitive) is read.
+
     Raises
     ------
     GreyboxError
@@ -81,6 +86,11 @@ def output_format(path) -> str:
 
 def output_paths(path) -> list[Path]:
     """Every file :func:`write_process` writes for ``path``: the table, and for CSV its metadata sidecar.
+
+    Parameters
+    ----------
+    path : path-like
+        Output file of the process table (.csv, .parquet, .pq or .mcap).
 
     Raises
     ------

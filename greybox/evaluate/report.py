@@ -99,6 +99,13 @@ def check_output_dir(out_dir: str | os.PathLike, *, force: bool = False) -> Path
 
     Called before any work, so that a long run never ends in a refusal.
 
+    Parameters
+    ----------
+    out_dir : path-like
+        Report directory; it need not exist, but its parent must.
+    force : bool, default False
+        Accept a directory that already holds files (the report then overwrites its own files there).
+
     Returns
     -------
     pathlib.Path
@@ -122,7 +129,14 @@ def check_output_dir(out_dir: str | os.PathLike, *, force: bool = False) -> Path
 
 
 def json_ready(value):
-    """Replace non-finite floats by None, recursively (strict JSON has no NaN)."""
+    """Replace non-finite floats by None, recursively (strict JSON has no NaN).
+
+    Parameters
+    ----------
+    value : object
+        A float, dict, list, tuple, NumPy scalar or anything else; dicts keep their keys, lists and
+        tuples become lists, NumPy scalars become Python numbers, other values pass through.
+    """
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):
@@ -135,12 +149,25 @@ def json_ready(value):
 
 
 def records_json(records: Sequence[Mapping]) -> str:
-    """Metric records as strict JSON text (non-finite numbers as null), one key per line."""
+    """Metric records as strict JSON text (non-finite numbers as null), one key per line.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records.
+    """
     return json.dumps(json_ready(list(records)), indent=1, allow_nan=False) + "\n"
 
 
 def write_metrics(records: Sequence[Mapping], out_dir: str | os.PathLike) -> tuple[Path, Path]:
     """Write ``metrics.json`` and ``metrics.csv`` into ``out_dir``.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records; the CSV keeps the keys of :data:`CSV_COLUMNS` only.
+    out_dir : path-like
+        Existing directory.
 
     Returns
     -------
@@ -269,6 +296,13 @@ def hyperparameter_table(rows: Sequence[Mapping]) -> Table:
 def noise_floor_ratios(records: Sequence[Mapping], model: str = "gmssvr") -> list[dict]:
     """Test RE of ``model`` over the test RE of the noise-free current, per experiment and axis.
 
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records, including the ``noise_floor`` test records.
+    model : str, default "gmssvr"
+        Model kind compared with the noise floor.
+
     Returns
     -------
     list of dict
@@ -290,7 +324,17 @@ def noise_floor_ratios(records: Sequence[Mapping], model: str = "gmssvr") -> lis
 
 
 def noise_floor_table(records: Sequence[Mapping], model: str = "gmssvr", target: float = 1.5) -> Table:
-    """:func:`noise_floor_ratios` as a table, with the target ratio."""
+    """:func:`noise_floor_ratios` as a table, with the target ratio.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records, including the ``noise_floor`` test records.
+    model : str, default "gmssvr"
+        Model kind compared with the noise floor.
+    target : float, default 1.5
+        Ratio of test RE to noise-floor RE at or below which a row is marked as within target.
+    """
     rows = [[str(r["experiment"]), r["axis"], _number(r["re"], 2), _number(r["noise_re"], 2),
              _number(r["ratio"], 2), "yes" if r["ratio"] <= target else "no"]
             for r in noise_floor_ratios(records, model)]
@@ -308,6 +352,13 @@ def svr_generalisation(records: Sequence[Mapping], model: str = "svr") -> list[d
     travel) although it fitted its training data well: overfitting. This
     compares, per experiment and axis, the training RE with the RE on every
     test log.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records; a test record's ``per_log`` gives the RE of each test log.
+    model : str, default "svr"
+        Model kind to examine.
 
     Returns
     -------
@@ -334,7 +385,15 @@ def svr_generalisation(records: Sequence[Mapping], model: str = "svr") -> list[d
 
 
 def svr_generalisation_table(records: Sequence[Mapping], model: str = "svr") -> Table:
-    """:func:`svr_generalisation` as a table: one row per experiment, axis and test log."""
+    """:func:`svr_generalisation` as a table: one row per experiment, axis and test log.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records.
+    model : str, default "svr"
+        Model kind to examine.
+    """
     rows = []
     for entry in svr_generalisation(records, model):
         for log, re in entry["test_re"].items():
@@ -353,6 +412,12 @@ def timing_table(timings: Sequence[Mapping]) -> Table:
 
     ``notes`` are the warnings a fit issued (e.g. a hyperparameter that ended
     at the end of its search interval).
+
+    Parameters
+    ----------
+    timings : sequence of dict
+        One entry per fit with those keys; ``fit_seconds`` [s] of 0 marks a fit shared with an earlier one,
+        ``trained_on`` and ``notes`` are optional.
     """
     rows = [[str(t["experiment"]), t["axis"], _label(t["model"]), t.get("trained_on", ""),
              "shared with an earlier fit" if t["fit_seconds"] == 0 else f"{t['fit_seconds']:.1f}",
@@ -413,6 +478,13 @@ def regime_table(records: Sequence[Mapping], title: str = "RE per operating regi
 
     The regimes are those of :mod:`greybox.evaluate.regimes`; the header
     gives each regime's share of the samples.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records; those without ``regimes`` are left out, and the first with them gives the shares.
+    title : str, default "RE per operating regime [%]"
+        Table title.
     """
     from .regimes import REGIME_NAMES
 
@@ -477,7 +549,17 @@ def report_tables(records: Sequence[Mapping], hyperparameters: Sequence[Mapping]
 
 
 def tables_markdown(tables: Sequence[Table], title: str = "greybox report", intro: str = "") -> str:
-    """All tables as one Markdown document."""
+    """All tables as one Markdown document.
+
+    Parameters
+    ----------
+    tables : sequence of Table
+        Tables in the order they appear.
+    title : str, default "greybox report"
+        Top-level heading.
+    intro : str, default ""
+        Text between the heading and the tables (left out when empty).
+    """
     parts = [f"# {title}\n"]
     if intro:
         parts.append(intro.rstrip() + "\n")

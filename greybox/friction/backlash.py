@@ -117,7 +117,13 @@ def _start_gap(position, width, state) -> tuple[float, float]:
 
 
 def stroke(runs) -> float:
-    """Median over the runs of the distance between the smallest and the largest position [mm]."""
+    """Median over the runs of the distance between the smallest and the largest position [mm].
+
+    Parameters
+    ----------
+    runs : iterable of AxisLog
+        Runs with at least one sample each.
+    """
     return float(np.median([np.ptp(run.position) for run in runs]))
 
 

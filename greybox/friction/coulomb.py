@@ -104,7 +104,13 @@ class CoulombModel(CurrentModel):
 
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:
-        """Columns ``a, sgn v, v (, 1)``, or ``a, [v>0], -[v<0], v [v>0], v [v<0]`` if asymmetric."""
+        """Columns ``a, sgn v, v (, 1)``, or ``a, [v>0], -[v<0], v [v>0], v [v<0]`` if asymmetric.
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run (velocity and acceleration present), as in the base class.
+        """
         v, a = run.velocity, run.acceleration
         if self.asymmetric:
             positive, negative = (v > 0.0).astype(float), (v < 0.0).astype(float)
@@ -123,7 +129,13 @@ class CoulombModel(CurrentModel):
         return np.array([self.J_, self.coulomb_pos_, self.viscous_pos_] + ([self.offset_] if self.fit_offset else []))
 
     def set_linear_coefficients(self, values) -> None:
-        """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model."""
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model.
+
+        Parameters
+        ----------
+        values : array_like, shape (p,)
+            Values of the linear parameters, in the order of :meth:`linear_coefficients`.
+        """
         x = [float(value) for value in np.asarray(values, dtype=float)]
         if self.asymmetric:
             self.J_, self.coulomb_pos_, self.coulomb_neg_, self.viscous_pos_, self.viscous_neg_ = x

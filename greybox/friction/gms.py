@@ -77,7 +77,13 @@ class GMSState(NamedTuple):
 
     @classmethod
     def at_rest(cls, n_elements: int) -> "GMSState":
-        """All elements relaxed (``z = 0``) and sticking."""
+        """All elements relaxed (``z = 0``) and sticking.
+
+        Parameters
+        ----------
+        n_elements : int
+            Number ``N`` of GMS elements.
+        """
         return cls(np.zeros(n_elements), np.zeros(n_elements, dtype=np.int8))
 
 
@@ -631,6 +637,11 @@ class GMSModel(CurrentModel):
         """Columns ``z_1..z_N, w, v, a (, 1)`` at the fitted element shape (``w = sum_i alpha_i dz_i/dt``).
 
         ``v`` is the two columns ``v [v > 0]``, ``v [v < 0]`` when ``asymmetric``.
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run (velocity and acceleration present), as in the base class.
         """
         p = self._parameters()
         z, _, w, _, _ = gms_trajectory(run.velocity, run.sample_time, alpha=p["alpha"], C=p["C"], s_0=p["s_0"],
@@ -650,7 +661,13 @@ class GMSModel(CurrentModel):
         return np.concatenate((self.k_, [self.sigma_], viscous, [self.J_], [self.offset_] if self.fit_offset else []))
 
     def set_linear_coefficients(self, values) -> None:
-        """Write ``values`` (order of :meth:`linear_coefficients`) into the model (``alpha_`` must be set)."""
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the model (``alpha_`` must be set).
+
+        Parameters
+        ----------
+        values : array_like, shape (p,)
+            Values of the linear parameters, in the order of :meth:`linear_coefficients`.
+        """
         x = [float(value) for value in np.asarray(values, dtype=float)]
         n = len(self.alpha_)
         self.k_ = np.array(x[:n])

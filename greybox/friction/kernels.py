@@ -155,7 +155,15 @@ def gms_sample(v, sample_time, curves):
 
 @njit(cache=True, error_model="numpy")
 def viscous_at(v, viscous):
-    """Viscous friction ``mu(v) v`` [A] with ``viscous = (mu+, mu-)`` [A s/mm] for positive / negative motion."""
+    """Viscous friction ``mu(v) v`` [A], with the coefficient of the direction of motion.
+
+    Parameters
+    ----------
+    v : float
+        Velocity [mm/s].
+    viscous : ndarray, shape (2,)
+        ``(mu+, mu-)`` [A s/mm] for positive and negative motion.
+    """
     return (viscous[1] if v < 0.0 else viscous[0]) * v
 
 

@@ -385,6 +385,11 @@ class LuGreModel(CurrentModel):
         """Columns ``dz/dt, v, a (, 1)`` at the fitted bristle law; ``sigma0 z`` is the fixed part.
 
         ``v`` is the two columns ``v [v > 0]``, ``v [v < 0]`` when ``asymmetric``.
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run (velocity and acceleration present), as in the base class.
         """
         law = self._law()
         v = np.ascontiguousarray(run.velocity, dtype=float)
@@ -405,7 +410,13 @@ class LuGreModel(CurrentModel):
         return np.array([self.sigma1_] + viscous + [self.J_] + ([self.offset_] if self.fit_offset else []))
 
     def set_linear_coefficients(self, values) -> None:
-        """Write ``values`` (order of :meth:`linear_coefficients`) into the model."""
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the model.
+
+        Parameters
+        ----------
+        values : array_like, shape (p,)
+            Values of the linear parameters, in the order of :meth:`linear_coefficients`.
+        """
         x = [float(value) for value in np.asarray(values, dtype=float)]
         self.sigma1_, self.viscous_ = x[:2]
         if self.asymmetric:

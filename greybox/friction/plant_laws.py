@@ -87,7 +87,19 @@ def stable_step(inertia: float, stiffness: float, damping: float) -> float:
 # ------------------------------------------------------------------ GMS
 @njit(cache=True, error_model="numpy")
 def gms_plant_friction(parameters, state, position_mm, velocity_mm_s):
-    """GMS friction [A] ``mu(v) v + sigma w + sum_i k_i z_i`` of the present state (layout in the module doc)."""
+    """GMS friction [A] ``mu(v) v + sigma w + sum_i k_i z_i`` of the present state (layout in the module doc).
+
+    Parameters
+    ----------
+    parameters : ndarray of float64
+        The law's parameters, in the layout of the module doc (GMS).
+    state : ndarray of float64
+        The law's state, in the layout of the module doc (GMS).
+    position_mm : float
+        Present position [mm].
+    velocity_mm_s : float
+        Present velocity [mm/s].
+    """
     n = (parameters.shape[0] - _GMS_HEAD) // 2
     force = viscous_at(velocity_mm_s, parameters[0:2]) + parameters[2] * state[0]
     for i in range(n):
@@ -101,6 +113,17 @@ def gms_plant_advance(parameters, state, velocity_mm_s, step_s):
 
     Every element takes :func:`greybox.friction.kernels.gms_element_step`;
     ``state[0]`` receives ``sum_i alpha_i dz_i/dt`` over the step [mm/s].
+
+    Parameters
+    ----------
+    parameters : ndarray of float64
+        The law's parameters, in the layout of the module doc (GMS).
+    state : ndarray of float64
+        The law's state, in the layout of the module doc (GMS) (updated in place).
+    velocity_mm_s : float
+        Velocity over the step [mm/s].
+    step_s : float
+        Internal step [s].
     """
     n = (parameters.shape[0] - _GMS_HEAD) // 2
     s, inv_s, d, v_dt = gms_sample(velocity_mm_s, step_s, parameters[4:_GMS_HEAD].reshape((2, 3)))
@@ -162,7 +185,19 @@ def gms_plant_law(*, alpha, k, sigma, s_0, s_inf, v_s, c, mu, inertia, offset) -
 # ------------------------------------------------------------------ LuGre
 @njit(cache=True, error_model="numpy")
 def lugre_plant_friction(parameters, state, position_mm, velocity_mm_s):
-    """LuGre friction [A] ``sigma0 z + sigma1 dz/dt + sigma2(v) v`` of the present state (layout in the module doc)."""
+    """LuGre friction [A] ``sigma0 z + sigma1 dz/dt + sigma2(v) v`` of the present state (layout in the module doc).
+
+    Parameters
+    ----------
+    parameters : ndarray of float64
+        The law's parameters, in the layout of the module doc (LuGre).
+    state : ndarray of float64
+        The law's state, in the layout of the module doc (LuGre).
+    position_mm : float
+        Present position [mm].
+    velocity_mm_s : float
+        Present velocity [mm/s].
+    """
     return parameters[0] * state[0] + parameters[1] * state[1] + viscous_at(velocity_mm_s, parameters[2:4])
 
 
@@ -172,6 +207,17 @@ def lugre_plant_advance(parameters, state, velocity_mm_s, step_s):
 
     The exact step :func:`greybox.friction.kernels.lugre_exact_step`;
     ``state[1]`` receives ``dz/dt`` over the step [mm/s].
+
+    Parameters
+    ----------
+    parameters : ndarray of float64
+        The law's parameters, in the layout of the module doc (LuGre).
+    state : ndarray of float64
+        The law's state, in the layout of the module doc (LuGre) (updated in place).
+    velocity_mm_s : float
+        Velocity over the step [mm/s].
+    step_s : float
+        Internal step [s].
     """
     z = state[0]
     rate = lugre_decay_rate(velocity_mm_s, parameters[0], parameters[4:10].reshape((2, 3)))

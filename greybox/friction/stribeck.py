@@ -143,6 +143,11 @@ class StribeckModel(CurrentModel):
         ``a, sgn v (1 - e), sgn v e, v (, 1)`` with ``e = exp(-|v|/v_s)``; if
         asymmetric ``a, [v>0] (1 - e+), [v>0] e+, -[v<0] (1 - e-), -[v<0] e-,
         v [v>0], v [v<0]`` with ``e+``, ``e-`` of ``v_s+``, ``v_s-``.
+
+        Parameters
+        ----------
+        run : AxisLog
+            One prepared run (velocity and acceleration present), as in the base class.
         """
         matrix = stribeck_regressors(run.velocity, run.acceleration, self._stribeck_velocities(), self.fit_offset)
         if self.asymmetric:
@@ -164,7 +169,13 @@ class StribeckModel(CurrentModel):
                         + ([self.offset_] if self.fit_offset else []))
 
     def set_linear_coefficients(self, values) -> None:
-        """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model."""
+        """Write ``values`` (order of :meth:`linear_coefficients`) into the fitted model.
+
+        Parameters
+        ----------
+        values : array_like, shape (p,)
+            Values of the linear parameters, in the order of :meth:`linear_coefficients`.
+        """
         x = [float(value) for value in np.asarray(values, dtype=float)]
         if self.asymmetric:
             (self.J_, self.coulomb_, self.static_, self.coulomb_neg_, self.static_neg_,

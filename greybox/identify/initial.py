@@ -38,7 +38,13 @@ _MIN_SLIDING_SAMPLES = 50
 
 
 def check_motion(runs: Sequence[AxisLog]) -> None:
-    """Raise :class:`LogError` if no run moves (velocity zero throughout)."""
+    """Raise :class:`LogError` if no run moves (velocity zero throughout).
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs, at least one; the error names the first one's source.
+    """
     if not any(np.any(run.velocity != 0.0) for run in runs):
         raise LogError(runs[0].source or None,
                        "the velocity is zero throughout: friction cannot be identified from a standing axis")
@@ -52,6 +58,18 @@ def _stack(runs, masks):
 
 def samples_at_speed(runs: Sequence[AxisLog], min_speed: float = 0.0):
     """Velocity [mm/s], acceleration [mm/s^2] and effort [A] of the samples with ``|v| >= min_speed``.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs, at least one.
+    min_speed : float, default 0.0
+        Least speed ``|v|`` of a sample kept [mm/s]; 0 keeps every sample.
+
+    Returns
+    -------
+    tuple of ndarray
+        Velocity, acceleration and effort of the kept samples, the runs concatenated.
 
     Raises
     ------
@@ -68,6 +86,15 @@ def motion_direction(velocity: np.ndarray) -> np.ndarray:
     """Direction of motion per sample (+1/-1), zeros of the velocity take the previous direction.
 
     Samples before the first non-zero velocity get 0.
+
+    Parameters
+    ----------
+    velocity : ndarray, shape (n,)
+        Velocity [mm/s].
+
+    Returns
+    -------
+    ndarray of int8, shape (n,)
     """
     sign = np.sign(velocity).astype(np.int8)
     last_moving = np.maximum.accumulate(np.where(sign != 0, np.arange(sign.size), 0))
@@ -107,7 +134,19 @@ def distance_since_reversal(time: np.ndarray, velocity: np.ndarray) -> np.ndarra
 
 
 def sliding_mask(run: AxisLog, min_distance: float = SLIDING_DISTANCE_MM) -> np.ndarray:
-    """Samples of a prepared run that are moving and at least ``min_distance`` [mm] past a reversal."""
+    """Samples of a prepared run that are moving and at least ``min_distance`` [mm] past a reversal.
+
+    Parameters
+    ----------
+    run : AxisLog
+        One prepared run.
+    min_distance : float, default :data:`SLIDING_DISTANCE_MM`
+        Travel since the last reversal from which a sample counts as sliding [mm].
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+    """
     return (run.velocity != 0.0) & (distance_since_reversal(run.time, run.velocity) >= min_distance)
 
 

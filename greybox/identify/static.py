@@ -44,6 +44,13 @@ def check_direction_settings(asymmetric: bool, fit_offset: bool) -> None:
 
     An offset shifts the mean of the two directions' sliding levels, which
     the two levels already set: the three are not separately identifiable.
+
+    Parameters
+    ----------
+    asymmetric : bool
+        Whether the model has separate friction levels for the two directions of motion.
+    fit_offset : bool
+        Whether the model fits a constant offset [A].
     """
     if asymmetric and fit_offset:
         raise ParameterError("an offset and direction-dependent friction levels are not separately "
@@ -55,6 +62,21 @@ def velocity_range(velocity: np.ndarray) -> tuple[float, float]:
 
     From 1e-3 to 1 times the largest speed in the data (the 99.9th percentile
     of ``|v|``, robust to single outliers; the maximum if fewer samples move).
+
+    Parameters
+    ----------
+    velocity : ndarray, shape (n,)
+        Velocity [mm/s].
+
+    Returns
+    -------
+    (float, float)
+        Lower and upper end of the range [mm/s].
+
+    Raises
+    ------
+    ValueError
+        If the velocity is zero throughout.
     """
     speed = np.abs(velocity)
     v_max = float(np.percentile(speed, 99.9)) or float(np.max(speed, initial=0.0))

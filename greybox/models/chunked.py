@@ -67,6 +67,13 @@ def chunk_slices(n_samples: int, chunk_samples: int) -> list[slice]:
 def samples_per_chunk(sample_time: float, chunk_s: float) -> int:
     """Samples in a chunk of ``chunk_s`` seconds at step ``sample_time`` [s] (nearest whole number, at least 2).
 
+    Parameters
+    ----------
+    sample_time : float
+        Sample time of the run [s], positive.
+    chunk_s : float
+        Chunk length [s].
+
     Raises
     ------
     ParameterError

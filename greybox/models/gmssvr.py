@@ -312,7 +312,20 @@ class GMSSVRModel(KernelRegressionModel):
 
     def predict_flag_chunk(self, log: AxisLog, state, region, *, sample_time: float):
         """As :meth:`CurrentModel.predict_flag_chunk <greybox.estimator.CurrentModel.predict_flag_chunk>`, the
-        GMS stage simulated once for both: the region check carries the same GMS state as the prediction."""
+        GMS stage simulated once for both: the region check carries the same GMS state as the prediction.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared chunk: consecutive samples of one run.
+        state : object
+            GMS state before the chunk (:meth:`initial_state` at the start of a run); used for both the
+            prediction and the region check.
+        region : object
+            State of the region check before the chunk; not used, since it equals ``state`` here.
+        sample_time : float
+            Step [s] of the whole run.
+        """
         run, start, step = self._chunk_arguments(log, state, sample_time)
         inputs, end = self._inputs(run, start, step)
         current = self.J_ * run.acceleration + self._friction_of(run, inputs) + self.offset_
@@ -331,12 +344,23 @@ class GMSSVRModel(KernelRegressionModel):
         return stage + self._kernel_parameters()
 
     def gms_predict(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
-        """Current of the frozen GMS stage alone [A], the runs concatenated."""
+        """Current of the frozen GMS stage alone [A], the runs concatenated.
+
+        Parameters
+        ----------
+        logs : AxisLog or iterable of AxisLog
+            Prepared runs.
+        """
         check_is_fitted(self, "gms_")
         return self.gms_.predict(logs)
 
     def states(self, logs: AxisLog | Iterable[AxisLog]) -> tuple[np.ndarray, np.ndarray]:
         """GMS element deflections and stick flags (see :meth:`greybox.friction.GMSModel.states`).
+
+        Parameters
+        ----------
+        logs : AxisLog or iterable of AxisLog
+            Prepared runs; the rows of the results are their samples, concatenated.
 
         Returns
         -------

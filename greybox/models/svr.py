@@ -419,7 +419,13 @@ class KernelRegressionModel(CurrentModel):
     def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
         """As :meth:`CurrentModel.outside_training <greybox.estimator.CurrentModel.outside_training>`, with
         ``"inputs"``: True where any SVR input lies outside its range over the training data. Computed
-        in chunks, so that the inputs of a long run need not be held at once."""
+        in chunks, so that the inputs of a long run need not be held at once.
+
+        Parameters
+        ----------
+        log : AxisLog
+            One prepared run.
+        """
         state, parts = self.region_state(), []
         for samples in chunk_slices(len(log), samples_per_chunk(log.sample_time, DEFAULT_CHUNK_S)):
             flags, state = self.outside_training_chunk(log.select(samples), state, sample_time=log.sample_time)
@@ -427,6 +433,24 @@ class KernelRegressionModel(CurrentModel):
         return {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
 
     def outside_training_chunk(self, log: AxisLog, state, *, sample_time: float):
+        """As in the base class, with ``"inputs"`` flagged where an SVR input lies outside its training range.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared chunk: consecutive samples of one run.
+        state : object
+            :meth:`region_state` at the start of the run, else what the previous chunk returned.
+        sample_time : float
+            Step [s] of the whole run.
+
+        Returns
+        -------
+        flags : dict of str to ndarray of bool
+            As :meth:`outside_training` for the chunk's samples.
+        state : object
+            The state after the chunk: the ``state`` of the next chunk.
+        """
         if getattr(self, "input_range_", None) is None:  # a file that predates the record
             return super().outside_training_chunk(log, state, sample_time=sample_time)
         X, state = self._inputs_chunk(log, state, sample_time)

@@ -227,6 +227,11 @@ def parse_program(text: str, *, source: str = "") -> Program:
 def read_program(path) -> Program:
     """Read a G-code program file (``.mpf``, ``.nc``, ``.gcode``, any text).
 
+    Parameters
+    ----------
+    path : str or path-like
+        Program file, UTF-8 or Latin-1 text.
+
     Raises
     ------
     GreyboxError

@@ -217,7 +217,13 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None, *
 
 # ---------------------------------------------------------------- outputs
 def markdown_table(results: dict) -> str:
-    """Markdown summary: RE and relerr per model on the pooled training and test files, then RE per file."""
+    """Markdown summary: RE and relerr per model on the pooled training and test files, then RE per file.
+
+    Parameters
+    ----------
+    results : dict
+        The document returned first by :func:`run_benchmark` (``"models"`` and ``"files"`` are read).
+    """
     models = results["models"]
     lines = [
         "| model | what | parameters | train RE % | test RE % | train relerr % | test relerr % |",
@@ -242,6 +248,15 @@ def plot_loops(curves: dict, names, path: Path) -> None:
     One column per plotted test file (one per amplitude), all samples of the
     file; the models Stribeck, LuGre, asymmetric GMS and the two GMS behind a backlash, those of them
     that ran (else the first four run).
+
+    Parameters
+    ----------
+    curves : dict
+        Per file: time [s], position [mm], measured and modelled force [N], as returned by :func:`run_benchmark`.
+    names : sequence of str
+        Models that ran; those drawn are picked from them.
+    path : Path
+        Image file to write; the format follows its extension.
     """
     plt = import_pyplot(path)
     preferred = ("stribeck", "lugre", "gms_asym", "gms_backlash", "gms_asym_backlash")

@@ -107,13 +107,39 @@ class CuttingCase:
         self.cutting = self.unit_truth != 0.0
 
     def mean_cut_force_N(self, strength: float, factor: float) -> float:
-        """Mean force [N] of the cut at ``strength`` (magnitude), over the samples in the cut."""
+        """Mean force [N] of the cut at ``strength`` (magnitude), over the samples in the cut.
+
+        Parameters
+        ----------
+        strength : float
+            Cut strength [A at 1000 mm/min, full engagement].
+        factor : float
+            Load constant turning the process current into force [N/A].
+        """
         return float(abs(strength * factor * np.mean(self.unit_truth[self.cutting])))
 
 
 def evaluate_model(kind: str, model, case: CuttingCase, config, detail_strength: float, target: float,
                    chunk_s: float) -> tuple[dict, object]:
-    """All figures of one fitted model on one cutting case, and its result at the detailed strength."""
+    """All figures of one fitted model on one cutting case, and its result at the detailed strength.
+
+    Parameters
+    ----------
+    kind : str
+        Model kind (a key of :data:`greybox.registry.MODEL_CLASSES`), reported in the row.
+    model : CurrentModel
+        The model fitted on the air cuts.
+    case : CuttingCase
+        Cutting logs of one trajectory and its air cuts.
+    config : AxisConfig
+        Axis metadata; its driving load constant [N/A] turns current into force.
+    detail_strength : float
+        Cut strength of the detailed figures [A]; must be one of ``case.strengths``.
+    target : float
+        Correlation target of recovered and true process current.
+    chunk_s : float
+        Chunk length of the prediction [s].
+    """
     factor = config.load_constants[0]  # the cuts oppose the motion: driving
     air_residual = case.air.current - predict_chunked(model, case.air, chunk_s=chunk_s)
     air_test = rmse(case.shipped.current, predict_chunked(model, case.shipped, chunk_s=chunk_s))
@@ -146,7 +172,13 @@ def evaluate_model(kind: str, model, case: CuttingCase, config, detail_strength:
 
 
 def detail_table(rows: list[dict]) -> str:
-    """The detailed figures at one strength as a Markdown table."""
+    """The detailed figures at one strength as a Markdown table.
+
+    Parameters
+    ----------
+    rows : list of dict
+        One per model and cutting log: the row :func:`evaluate_model` returns first.
+    """
     lines = [
         "| model | cutting log | air-cut test RMSE [A] | process RMSE [A] | correlation (ceiling) "
         "| process RMSE in cut [A] | force RMSE [N] | mean cut force true / estimated [N] |",
@@ -163,7 +195,19 @@ def detail_table(rows: list[dict]) -> str:
 
 
 def sweep_table(rows: list[dict], cases: dict, factor: float, target: float) -> str:
-    """Correlation per cut strength and the mean cut force needed for the target, as a Markdown table."""
+    """Correlation per cut strength and the mean cut force needed for the target, as a Markdown table.
+
+    Parameters
+    ----------
+    rows : list of dict
+        One per model and cutting log: the row :func:`evaluate_model` returns first.
+    cases : dict
+        ``{name: CuttingCase}``; the swept strengths are those of the first case.
+    factor : float
+        Driving load constant of the axis [N/A], turning process current into cut force.
+    target : float
+        Correlation target of recovered and true process current.
+    """
     strengths = next(iter(cases.values())).strengths
     header = " | ".join(f"r at {s:g} A" for s in strengths)
     lines = [f"| model | cutting log | {header} | r >= {target:g} from a cut of [A] / mean force [N] |",
@@ -191,7 +235,21 @@ def _needed(strength: float, force: float | None) -> str:
 
 
 def plot_correlation_vs_force(rows: list[dict], cases: dict, factor: float, target: float, path: Path):
-    """Correlation of recovered and true process current against the mean cut force, one panel per log."""
+    """Correlation of recovered and true process current against the mean cut force, one panel per log.
+
+    Parameters
+    ----------
+    rows : list of dict
+        One per model and cutting log: the row :func:`evaluate_model` returns first.
+    cases : dict
+        ``{name: CuttingCase}``, one panel each.
+    factor : float
+        Driving load constant of the axis [N/A], turning process current into cut force.
+    target : float
+        Correlation target of recovered and true process current.
+    path : Path or None
+        Image file to write; None returns the figure instead of the path.
+    """
     plt = import_pyplot(path)
     figure, axes = plt.subplots(1, len(cases), figsize=(5.5 * len(cases), 4.5), layout="constrained",
                                 sharey=True, squeeze=False)

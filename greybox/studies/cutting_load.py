@@ -180,6 +180,11 @@ def summarise(rows: list[dict]) -> dict:
 
     ``met`` judges GMS+SVR with the axis file: the median |mean force error| of each pass within
     :data:`TARGET_PCT`, with the share of members within it.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The members' rows (:func:`run_member`); the models are those of the first row.
     """
     names = list(rows[0]["models"]) if rows else []
     summary: dict = {"models": {}, "target_pct": TARGET_PCT}
@@ -208,7 +213,18 @@ def summarise(rows: list[dict]) -> dict:
 
 
 def cutting_load_markdown(settings: dict, summary: dict, seconds: float) -> str:
-    """The study's tables (Markdown)."""
+    """The study's tables (Markdown).
+
+    Parameters
+    ----------
+    settings : dict
+        The study's settings as :func:`run_cutting_load_study` stores them (``members``, ``family_seed``,
+        ``first``, ``workers``, ``cut_text`` are read).
+    summary : dict
+        :func:`summarise` of the members' rows.
+    seconds : float
+        Wall time of the study [s].
+    """
     n = settings["members"]
     lines = [f"Family seed {settings['family_seed']}, members {settings['first']}-{settings['first'] + n - 1} "
              f"({n} axes); models of the paper's experiment 2; dataset D cut with {settings['cut_text']}; "

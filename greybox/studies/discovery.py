@@ -125,6 +125,11 @@ def _library_current(name: str, run: AxisLog, context: EffectContext) -> np.ndar
 def case_logs(case: StudyCase) -> tuple[AxisLog, AxisLog, dict]:
     """Prepared training (dataset A) and test (dataset C) logs of a case, and what was hidden.
 
+    Parameters
+    ----------
+    case : StudyCase
+        Hidden effect, its strength, seed, plant and log length.
+
     Returns
     -------
     train, test : AxisLog
@@ -173,6 +178,17 @@ def null_logs(base, train: AxisLog, test: AxisLog, seed: int) -> tuple[AxisLog, 
     The noise is :class:`ResidualNoise` fitted to the base's residual on the
     training log (AR with the residual's autocorrelation and local level),
     drawn independently for each log.
+
+    Parameters
+    ----------
+    base : CurrentModel
+        Unfitted base model (cloned before fitting).
+    train : AxisLog
+        Prepared training log; the base is fitted on it and its residual gives the noise.
+    test : AxisLog
+        Prepared test log; its noise has the training residual's RMS as a constant level.
+    seed : int
+        Seed of the noise draws.
     """
     model = clone(base).fit(train)
     rng = np.random.default_rng([seed, 7919])
@@ -251,7 +267,23 @@ def run_case(base, case: StudyCase, *, background: frozenset = frozenset(), n_nu
 
 def run_null(base, seed: int, *, plant: str = "coulomb", duration_s: float = 30.0, n_null: int = 99,
              refit_base: bool = True) -> dict:
-    """Run the workflow on null data (:func:`null_logs`) of a plain log; return its verdict and names."""
+    """Run the workflow on null data (:func:`null_logs`) of a plain log; return its verdict and names.
+
+    Parameters
+    ----------
+    base : CurrentModel
+        Unfitted base model.
+    seed : int
+        Seed of the logs and of the null noise; the workflow runs with ``seed + 1000``.
+    plant : {"coulomb", "twin"}, default "coulomb"
+        Plant of the plain log (see the module notes).
+    duration_s : float, default 30.0
+        Length of the training and test logs [s].
+    n_null : int, default 99
+        Null replicates per step of the workflow.
+    refit_base : bool, default True
+        See :func:`discover`.
+    """
     started = time.perf_counter()
     train, test, _ = case_logs(StudyCase(None, 0.0, seed, plant, duration_s))
     null_train, null_test = null_logs(base, train, test, seed)
@@ -261,7 +293,17 @@ def run_null(base, seed: int, *, plant: str = "coulomb", duration_s: float = 30.
 
 
 def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95 % Wilson score interval of a proportion."""
+    """95 % Wilson score interval of a proportion.
+
+    Parameters
+    ----------
+    successes : int
+        Number of successes.
+    n : int
+        Number of trials; 0 gives ``(nan, nan)``.
+    z : float, default 1.96
+        Quantile of the standard normal distribution; 1.96 gives the 95 % interval.
+    """
     if n == 0:
         return float("nan"), float("nan")
     p = successes / n
@@ -272,6 +314,15 @@ def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, flo
 
 def summarise(cases: list[dict], nulls: list[dict], *, min_ratio: float = 0.5) -> dict:
     """The study's figures.
+
+    Parameters
+    ----------
+    cases : list of dict
+        Rows of :func:`run_case`.
+    nulls : list of dict
+        Rows of :func:`run_null`.
+    min_ratio : float, default 0.5
+        Smallest effect RMS over noise RMS of the cases counted in ``accuracy``, ``spurious_rate`` and ``closure``.
 
     Returns
     -------
@@ -325,7 +376,15 @@ SECTIONS = {
 
 
 def benchmark_relerr(runs, prediction) -> float:
-    """relerr [%] on the EMPS benchmark's decimated samples of one run (:mod:`greybox.studies.emps`)."""
+    """relerr [%] on the EMPS benchmark's decimated samples of one run (:mod:`greybox.studies.emps`).
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Exactly one prepared EMPS run, the measured force [N].
+    prediction : ndarray, shape (n,)
+        Modelled force over that run [N].
+    """
     (run,) = runs
     measured = decimate_benchmark(run.effort[EMPS_BORDER:])
     modelled = decimate_benchmark(prediction[EMPS_BORDER:])
@@ -386,7 +445,24 @@ def _fmt(value, spec=".2f") -> str:
 
 
 def markdown(section: str, settings: dict, summary: dict, cases: list, nulls: list, seconds: float) -> str:
-    """The tables of a synthetic section: the study's figures against their targets, and per effect and ratio."""
+    """The tables of a synthetic section: the study's figures against their targets, and per effect and ratio.
+
+    Parameters
+    ----------
+    section : str
+        Name of the section (a key of :data:`SECTIONS`).
+    settings : dict
+        The section's settings as :func:`run_section` stores them (``description``, ``base``, ``duration``,
+        ``seeds``, ``null_seeds``, ``ratios``, optionally ``background``).
+    summary : dict
+        :func:`summarise` of ``cases`` and ``nulls``.
+    cases : list of dict
+        Rows of :func:`run_case`; only their number is shown.
+    nulls : list of dict
+        Rows of :func:`run_null`; only their number is shown.
+    seconds : float
+        Wall time of the section [s].
+    """
     fp, acc, closure = summary["false_positive"], summary["accuracy"], summary["closure"]
     lines = [
         f"### Section `{section}`: {settings['description']}",

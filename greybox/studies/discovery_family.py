@@ -143,6 +143,13 @@ def _rate(count: int, n: int) -> dict:
 def summarise_family(rows: list[dict], *, min_ratio: float = 0.5) -> dict:
     """The study's figures against the targets of docs/discover.md.
 
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of :func:`run_family_case`, null and effect cases together.
+    min_ratio : float, default 0.5
+        Smallest hidden-effect RMS over noise RMS of the effect cases counted in ``first_correct`` and the closures.
+
     Returns
     -------
     dict
@@ -213,7 +220,20 @@ def _axis_table(rows: list[dict], seed: int, ratio: float) -> list[str]:
 
 def family_markdown(settings: dict, summary: dict, seconds: float, rows: list[dict] | None = None) -> str:
     """The study's tables: figures against targets, per hidden effect and ratio, and (with ``rows``) the
-    first axis case by case at the largest ratio."""
+    first axis case by case at the largest ratio.
+
+    Parameters
+    ----------
+    settings : dict
+        The study's settings as :func:`run_family_study` stores them (``seeds``, ``first_seed``, ``base``,
+        ``duration``, ``n_cases``, ``workers``, ``ratios`` are read).
+    summary : dict
+        :func:`summarise_family` of the rows.
+    seconds : float
+        Wall time of the study [s].
+    rows : list of dict, optional
+        Rows of :func:`run_family_case`; given, the first axis's cases are tabulated one by one.
+    """
     lines = [
         f"Hysteresis family ({settings['seeds']} axes, seeds {settings['first_seed']}-"
         f"{settings['first_seed'] + settings['seeds'] - 1}), base model {settings['base']}, two training and two "

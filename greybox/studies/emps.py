@@ -140,7 +140,13 @@ def benchmark_log(path: str | os.PathLike, step_ms: int = 1) -> AxisLog:
 
 
 def decimate_benchmark(values: np.ndarray) -> np.ndarray:
-    """The benchmark's decimation by 10: zero-phase Chebyshev-I IIR low-pass, every 10th sample."""
+    """The benchmark's decimation by 10: zero-phase Chebyshev-I IIR low-pass, every 10th sample.
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        Signal at 1 kHz (a force [N], a column of the observation matrix, the time [s], ...).
+    """
     return decimate(np.asarray(values, dtype=float), DECIMATION, ftype="iir", zero_phase=True)
 
 
@@ -219,6 +225,11 @@ def _json_value(value):
 def learned_parameters(model) -> tuple[dict, dict]:
     """The identified parameters of a fitted greybox model and their units, from its parameter table.
 
+    Parameters
+    ----------
+    model : CurrentModel
+        A fitted greybox model.
+
     Returns
     -------
     values : dict
@@ -233,6 +244,17 @@ def learned_parameters(model) -> tuple[dict, dict]:
 # ---------------------------------------------------------------- running
 def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None) -> tuple[dict, dict]:
     """Fit every named model on the training file and score it on both files.
+
+    Parameters
+    ----------
+    data : Path
+        Folder holding :data:`TRAIN_FILE` and :data:`TEST_FILE`.
+    names : sequence of str, default :data:`MODEL_NAMES`
+        Models to run, in this order: keys of :data:`IDIM_LS_MODELS` or :data:`GREYBOX_MODELS`.
+    seed : int, default 0
+        Seed of the multi-start identifications.
+    progress : None, bool or callable, optional
+        Progress of every greybox fit (see :meth:`greybox.estimator.CurrentModel.fit`).
 
     Returns
     -------
@@ -308,7 +330,13 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None) -
 
 # ---------------------------------------------------------------- outputs
 def markdown_table(results: dict) -> str:
-    """Markdown summary: relerr per model beside the published IDIM-LS, and the IDIM-LS parameters."""
+    """Markdown summary: relerr per model beside the published IDIM-LS, and the IDIM-LS parameters.
+
+    Parameters
+    ----------
+    results : dict
+        The document returned first by :func:`run_benchmark`.
+    """
     published = results["published"]["coulomb_idim_ls"]
     lines = [
         "| model | what | step | train relerr % | cross-test relerr % |",
@@ -337,7 +365,18 @@ def markdown_table(results: dict) -> str:
 
 
 def plot_curves(curves: dict, names, path: Path) -> None:
-    """Measured against modelled (decimated) force on the cross-test file, a zoom on a reversal, and the errors."""
+    """Measured against modelled (decimated) force on the cross-test file, a zoom on a reversal, and the errors.
+
+    Parameters
+    ----------
+    curves : dict
+        Per file: decimated time [s], velocity [mm/s], measured and modelled force [N], as returned by
+        :func:`run_benchmark`.
+    names : sequence of str
+        Models that ran; those drawn are picked from them.
+    path : Path
+        Image file to write; the format follows its extension.
+    """
     plt = import_pyplot(path)
     shown = [n for n in ("coulomb_idim_ls", "stribeck", "lugre", "gms", "gms_asym") if n in names] or list(names)[:4]
     test = curves["test"]

@@ -236,6 +236,15 @@ def find_log(data_dir: str | Path, axis: str, dataset: str) -> Path:
 
     Extensions are tried in the order of :data:`LOG_EXTENSIONS`.
 
+    Parameters
+    ----------
+    data_dir : str or Path
+        Folder holding the logs.
+    axis : str
+        Axis name, the part of the file name before ``_`` (e.g. ``"X"``).
+    dataset : str
+        Dataset id, the part after ``_`` (e.g. ``"A"``).
+
     Raises
     ------
     GreyboxError

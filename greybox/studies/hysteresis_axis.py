@@ -298,14 +298,28 @@ class Modifiers:
 
 # ----------------------------------------------------------------------------- axis and friction law
 def draw_axis(seed: int) -> AxisParameters:
-    """Draw the parameters of the family's axis ``seed`` uniformly from :data:`AXIS_RANGES`."""
+    """Draw the parameters of the family's axis ``seed`` uniformly from :data:`AXIS_RANGES`.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the axis; the same seed gives the same axis.
+    """
     rng = np.random.default_rng([seed, 0])
     return AxisParameters(**{name: float(rng.uniform(*AXIS_RANGES[name]))
                              for name in (f.name for f in dataclasses.fields(AxisParameters))})
 
 
 def steady_friction_A(speed_mm_s, axis: AxisParameters) -> np.ndarray:
-    """Stribeck curve :math:`F_{ss}(|v|)` [A] at the speed [mm/s] (its absolute value is taken)."""
+    """Stribeck curve :math:`F_{ss}(|v|)` [A] at the speed [mm/s] (its absolute value is taken).
+
+    Parameters
+    ----------
+    speed_mm_s : float or array_like
+        Speed or velocity [mm/s]; only its magnitude counts.
+    axis : AxisParameters
+        The axis, giving the Coulomb and static levels [A], Stribeck velocity [mm/s] and exponent.
+    """
     ratio = np.abs(np.asarray(speed_mm_s, dtype=float)) / axis.stribeck_velocity_mm_s
     return axis.coulomb_A + (axis.static_A - axis.coulomb_A) * np.exp(-ratio ** axis.stribeck_exponent)
 

@@ -69,6 +69,15 @@ def score_member(index: int, family_seed: int, *, train_share: float = 0.75) -> 
     candidate is scored by its RE over the noise floor's RE on the rest of A
     (new motion inside the window: interpolation) and on B (the whole travel:
     extrapolation in position), and by the mean of the two.
+
+    Parameters
+    ----------
+    index : int
+        Member index.
+    family_seed : int
+        Family seed (a development family's, not one a study reports).
+    train_share : float, default 0.75
+        Share of dataset A's duration, from its start, that both stages are fitted on.
     """
     started = time.perf_counter()
     member = draw_member(index, family_seed)
@@ -101,6 +110,19 @@ def _run(arguments):
 def run_prior_study(json_path: str | os.PathLike, *, members: int = 12, family_seed: int = 1, workers: int = 1,
                     progress=None) -> dict:
     """Score every candidate on ``members`` axes of the development family; write and return the summary.
+
+    Parameters
+    ----------
+    json_path : path-like
+        Where the returned document is written (JSON), once all members are scored.
+    members : int, default 12
+        Number of axes, member indices 0 to ``members - 1``.
+    family_seed : int, default 1
+        Seed of the development family.
+    workers : int, default 1
+        Processes scoring members side by side.
+    progress : callable, optional
+        Receives one line per scored member.
 
     Returns
     -------

@@ -123,7 +123,13 @@ def _quantiles(values) -> dict:
 
 
 def summarise(rows: list[dict]) -> dict:
-    """Median and 90th percentile per model (all members and per law), and whether GMS+SVR meets the targets."""
+    """Median and 90th percentile per model (all members and per law), and whether GMS+SVR meets the targets.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The members' rows (:func:`run_member`); the models are those of the first row.
+    """
     names = list(rows[0]["models"]) if rows else []
     summary = {"models": {}, "laws": {}, "targets": dict(TARGETS)}
     for name in names:
@@ -147,7 +153,18 @@ def _label(name: str) -> str:
 
 
 def robustness_markdown(settings: dict, summary: dict, seconds: float) -> str:
-    """The study's tables (Markdown)."""
+    """The study's tables (Markdown).
+
+    Parameters
+    ----------
+    settings : dict
+        The study's settings as :func:`run_robustness_study` stores them (``family_seed``, ``first``,
+        ``members``, ``workers`` are read).
+    summary : dict
+        :func:`summarise` of the members' rows (at least one: ``process_floor_pct`` is read).
+    seconds : float
+        Wall time of the study [s].
+    """
     lines = [f"Family seed {settings['family_seed']}, members {settings['first']}-"
              f"{settings['first'] + settings['members'] - 1} ({settings['members']} axes; laws cycled: "
              f"{', '.join(TRUTH_LAWS)}); train on A, test on C; {settings['workers']} worker process(es), "

@@ -57,6 +57,11 @@ AXES = {
 def axis_geometry(axis: str) -> AxisGeometry:
     """Return the geometry of ``axis`` (``"X"``, ``"Y"`` or ``"C"``, case-insensitive).
 
+    Parameters
+    ----------
+    axis : str
+        Axis name; surrounding blanks and the case are ignored.
+
     Raises
     ------
     GreyboxError

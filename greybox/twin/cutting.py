@@ -93,7 +93,14 @@ class CuttingSpec:
         return self.spindle_rpm * self.teeth / 60.0
 
     def workpiece(self, position_mm) -> tuple[float, float]:
-        """Extent [mm] of the workpiece for a log covering ``position_mm``."""
+        """Extent [mm] of the workpiece for a log covering ``position_mm``.
+
+        Parameters
+        ----------
+        position_mm : array_like
+            Positions [mm] the log covers; only their smallest and largest value count, and they
+            are ignored when ``workpiece_mm`` is set.
+        """
         if self.workpiece_mm is not None:
             return float(self.workpiece_mm[0]), float(self.workpiece_mm[1])
         low, high = float(np.min(position_mm)), float(np.max(position_mm))
@@ -117,7 +124,20 @@ def _engagement(position_mm, workpiece, entry_length_mm):
 
 
 def cutting_current(spec: CuttingSpec, time_s, position_mm, velocity_mm_s) -> np.ndarray:
-    """Process current [A] of the cutting load along a motion (zero outside the cut segments)."""
+    """Process current [A] of the cutting load along a motion (zero outside the cut segments).
+
+    Parameters
+    ----------
+    spec : CuttingSpec
+        Cutting conditions.
+    time_s : array_like, shape (n,)
+        Sample times [s]; they set the phase of the tooth-passing ripple.
+    position_mm : array_like, shape (n,)
+        True axis position [mm]; sets the engagement and, by default, the workpiece extent.
+    velocity_mm_s : array_like, shape (n,)
+        True axis velocity [mm/s]; its sign picks the cutting or return stroke and that of the current,
+        its magnitude the feed factor.
+    """
     v = np.asarray(velocity_mm_s, dtype=float)
     share = np.where(v * spec.cutting_direction > 0.0, 1.0, np.where(v != 0.0, spec.return_pass, 0.0))
     engagement = _engagement(position_mm, spec.workpiece(position_mm), spec.entry_length_mm)
@@ -128,7 +148,13 @@ def cutting_current(spec: CuttingSpec, time_s, position_mm, velocity_mm_s) -> np
 
 
 def cut_segments(process_current_A) -> list[tuple[int, int]]:
-    """Sample ranges ``[start, stop)`` during which the process current is non-zero."""
+    """Sample ranges ``[start, stop)`` during which the process current is non-zero.
+
+    Parameters
+    ----------
+    process_current_A : array_like, shape (n,)
+        Process current [A], e.g. from :func:`cutting_current`.
+    """
     active = np.concatenate(([False], np.asarray(process_current_A) != 0.0, [False]))
     edges = np.flatnonzero(np.diff(active.astype(np.int8)))
     return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]

@@ -61,6 +61,20 @@ def dataset_streams(seed: int, axis: str, dataset: str) -> tuple[np.random.Gener
     They derive from ``numpy.random.SeedSequence([seed, ord(axis), ord(dataset)])``,
     so every dataset of every axis has its own streams for one seed, and
     adding an effect or cutting changes neither the motion nor the noise.
+
+    Parameters
+    ----------
+    seed : int
+        Master seed, a non-negative integer.
+    axis : str
+        Axis name, one character (e.g. ``"X"``), as given: the case is not normalised here.
+    dataset : str
+        Dataset id, one character (e.g. ``"A"``), as given: the case is not normalised here.
+
+    Raises
+    ------
+    GreyboxError
+        For a seed that is not a non-negative integer.
     """
     _check_seed(seed)
     sequence = np.random.SeedSequence([int(seed), ord(axis), ord(dataset)])
@@ -228,7 +242,17 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
 
 
 def dataset_path(out_dir, axis: str, dataset: str) -> Path:
-    """File ``out_dir/<axis>_<dataset>.mcap`` of a synthetic dataset."""
+    """File ``out_dir/<axis>_<dataset>.mcap`` of a synthetic dataset.
+
+    Parameters
+    ----------
+    out_dir : str or path-like
+        Output directory.
+    axis : str
+        Axis name, used as given in the file name.
+    dataset : str
+        Dataset id, used as given in the file name.
+    """
     return Path(out_dir) / f"{axis}_{dataset}.mcap"
 
 
@@ -248,6 +272,14 @@ def _for_storage(log: AxisLog, keep: Sequence[str]) -> AxisLog:
 
 def stored(log: AxisLog, truth_channels: Sequence[str] | None = None) -> AxisLog:
     """The log as synthesised logs are written: only the given truth channels (default all), rounded to 1 uA.
+
+    Parameters
+    ----------
+    log : AxisLog
+        A synthesised log, e.g. from :func:`make_dataset`.
+    truth_channels : sequence of str, optional
+        Names from :data:`TRUTH_CHANNELS` to keep among the log's extras; default all of them.
+        Any other extra channel is dropped.
 
     Raises
     ------

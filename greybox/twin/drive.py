@@ -48,7 +48,13 @@ WORM_EFFICIENCIES = (0.8, 0.7)
 
 
 def load_gain_efficiencies(load_gain: float) -> tuple[float, float]:
-    """Efficiencies (driving, back-driven) that friction rising by ``load_gain`` A per A of axial load implies."""
+    """Efficiencies (driving, back-driven) that friction rising by ``load_gain`` A per A of axial load implies.
+
+    Parameters
+    ----------
+    load_gain : float
+        ``g`` [A/A]: friction current added per ampere of axial load; gives ``(1 / (1 + g), 1 - g)``.
+    """
     return 1.0 / (1.0 + load_gain), 1.0 - load_gain
 
 

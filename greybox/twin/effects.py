@@ -148,13 +148,35 @@ def _lookup(name: str) -> Callable[..., np.ndarray]:
 
 
 def effect_parameters(name: str) -> dict:
-    """Keyword parameters of an effect and their defaults."""
+    """Keyword parameters of an effect and their defaults.
+
+    Parameters
+    ----------
+    name : str
+        Name of the effect, a key of :data:`EFFECTS`.
+
+    Raises
+    ------
+    GreyboxError
+        If the effect is unknown.
+    """
     signature = inspect.signature(_lookup(name))
     return {p.name: p.default for p in list(signature.parameters.values())[2:]}
 
 
 def effect_current(name: str, inputs: EffectInputs, strength: float, **parameters) -> np.ndarray:
     """Current [A] of the named effect.
+
+    Parameters
+    ----------
+    name : str
+        Name of the effect, a key of :data:`EFFECTS`.
+    inputs : EffectInputs
+        True motion at the log samples.
+    strength : float
+        Amplitude [A] of the effect at its reference condition.
+    **parameters
+        The effect's own keyword parameters (see :func:`effect_parameters`); omitted ones keep their defaults.
 
     Raises
     ------

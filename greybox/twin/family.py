@@ -121,7 +121,13 @@ class FamilyPlant:
             raise GreyboxError("family plant: load gain and cogging must be non-negative, inertia positive")
 
     def position_terms(self, position_mm) -> tuple[np.ndarray, np.ndarray]:
-        """Position factor ``g(x)`` and cogging current [A] at positions [mm]."""
+        """Position factor ``g(x)`` and cogging current [A] at positions [mm].
+
+        Parameters
+        ----------
+        position_mm : array_like, shape (n,)
+            Positions [mm], a one-dimensional array.
+        """
         x = np.ascontiguousarray(position_mm, dtype=float)
         return _position_term_arrays(x, float(self.travel_mm[0]), float(self.travel_mm[1]), float(self.preload_gain),
                                      float(self.tilt_gain), float(self.lead_mm), float(self.lead_gain),
@@ -150,11 +156,27 @@ class FamilyPlant:
                              friction_direction=law.direction)
 
     def axis_config(self, name: str = "") -> AxisConfig:
-        """The axis file of this member: the twin's motor, this screw lead, the efficiencies of its load friction."""
+        """The axis file of this member: the twin's motor, this screw lead, the efficiencies of its load friction.
+
+        Parameters
+        ----------
+        name : str, default ""
+            Axis name written into the axis file.
+        """
         return drive_config(self.lead_mm, load_gain_efficiencies(self.load_gain), name)
 
     def process_load(self, process_A, velocity_mm_s) -> np.ndarray:
-        """Process force [N] on the table behind a process current [A] (losses booked in the friction)."""
+        """Process force [N] on the table behind a process current [A] (losses booked in the friction).
+
+        Parameters
+        ----------
+        process_A : array_like
+            Process current [A].
+        velocity_mm_s : array_like
+            Axis velocity [mm/s]; not used (the lossless constant applies in either direction of power flow),
+            taken for the same call as :meth:`PlantParameters.process_load
+            <greybox.twin.plant.PlantParameters.process_load>`.
+        """
         return self.axis_config().lossless_load_constant * np.asarray(process_A, dtype=float)
 
     def to_dict(self) -> dict:
@@ -232,6 +254,13 @@ def draw_member(index: int, family_seed: int) -> FamilyMember:
     index; every other parameter comes from one stream seeded by
     ``(family_seed, index)``, so a member does not depend on how many are drawn.
 
+    Parameters
+    ----------
+    index : int
+        Position of the member in the family, a non-negative integer.
+    family_seed : int
+        Seed of the family, a non-negative integer.
+
     Raises
     ------
     GreyboxError
@@ -277,7 +306,20 @@ def member_dataset(member: FamilyMember, dataset: str, *, repeat: int = 0, **opt
     noise, sensors and seed); ``options`` are the other arguments of ``make_dataset`` (cutting, duration_s,
     effect ...). ``repeat`` > 0 runs the dataset again on the same axis with other draws of its noise and of
     the random parts of its trajectory (the seed ``dataset_seed + repeat``). The log's ``attrs`` carry the
-    member under ``"family_member"``."""
+    member under ``"family_member"``.
+
+    Parameters
+    ----------
+    member : FamilyMember
+        The member, e.g. from :func:`draw_member`.
+    dataset : {"A", "B", "C", "D", "P"}
+        Dataset id.
+    repeat : int, default 0
+        Repetition number; the log's seed is ``(dataset_seed + repeat) mod 2**32``.
+    **options
+        Further keyword arguments of :func:`~greybox.twin.datasets.make_dataset`, except ``plant``,
+        ``noise`` and ``sensors``, which come from the member.
+    """
     seed = (member.dataset_seed + int(repeat)) % 2**32
     log = make_dataset(member.axis, dataset, seed, plant=member.plant, noise=member.noise,
                        sensors=member.sensors, **options)

@@ -40,7 +40,13 @@ class MotionLimits:
     max_jerk_mm_s3: float = 60000.0
 
     def ramp_duration(self, velocity_change_mm_s: float) -> float:
-        """Shortest cosine-ramp duration [s] for a velocity change [mm/s] within the limits."""
+        """Shortest cosine-ramp duration [s] for a velocity change [mm/s] within the limits.
+
+        Parameters
+        ----------
+        velocity_change_mm_s : float
+            Velocity change [mm/s]; only its magnitude counts (0 gives 0 s).
+        """
         dv = abs(velocity_change_mm_s)
         if dv == 0.0:
             return 0.0
@@ -53,6 +59,11 @@ class MotionLimits:
 
         The move starts at rest, visits the positive speeds [mm/s] in order and
         ends at rest; the cruise phases at each level are not included.
+
+        Parameters
+        ----------
+        speeds_mm_s : sequence of float
+            Speed levels [mm/s] in the order visited; their magnitudes are used.
         """
         levels = np.concatenate(([0.0], np.abs(np.asarray(speeds_mm_s, dtype=float)), [0.0]))
         return float(
@@ -174,11 +185,23 @@ class MotionProfile:
         self.position_mm = piece.end_mm
 
     def hold(self, duration_s: float) -> None:
-        """Keep the present velocity for ``duration_s`` [s] (a dwell when at rest)."""
+        """Keep the present velocity for ``duration_s`` [s] (a dwell when at rest).
+
+        Parameters
+        ----------
+        duration_s : float
+            Length [s] of the piece; nothing is appended if it is not positive.
+        """
         self._append(_Constant(self.time_s, float(duration_s), self.position_mm, self.velocity_mm_s))
 
     def ramp(self, velocity_mm_s: float) -> None:
-        """Change the velocity to ``velocity_mm_s`` [mm/s] as fast as the limits allow."""
+        """Change the velocity to ``velocity_mm_s`` [mm/s] as fast as the limits allow.
+
+        Parameters
+        ----------
+        velocity_mm_s : float
+            Signed target velocity [mm/s].
+        """
         duration = self.limits.ramp_duration(velocity_mm_s - self.velocity_mm_s)
         self._append(_Ramp(self.time_s, duration, self.position_mm, self.velocity_mm_s, float(velocity_mm_s)))
         self.velocity_mm_s = float(velocity_mm_s)
@@ -265,6 +288,16 @@ class MotionProfile:
         """Position [mm], velocity [mm/s] and acceleration [mm/s^2] at sorted times [s].
 
         Times after the end of the profile keep its final state (at rest).
+
+        Parameters
+        ----------
+        time_s : array_like, shape (n,)
+            Times [s] in ascending order.
+
+        Returns
+        -------
+        x, v, a : ndarray, shape (n,)
+            Position [mm], velocity [mm/s] and acceleration [mm/s^2].
         """
         t = np.asarray(time_s, dtype=float)
         x = np.full_like(t, self.position_mm)

@@ -37,7 +37,15 @@ class CurrentNoise:
             raise GreyboxError(f"noise: lag-1 correlation must be in [0, 1), got {self.lag1_correlation}")
 
     def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
-        """Draw ``n`` consecutive noise samples [A], stationary from the first one."""
+        """Draw ``n`` consecutive noise samples [A], stationary from the first one.
+
+        Parameters
+        ----------
+        n : int
+            Number of samples.
+        rng : numpy.random.Generator
+            Source of the white innovations.
+        """
         phi = self.lag1_correlation
         innovation = rng.standard_normal(n) * self.std_A
         innovation[1:] *= np.sqrt(1.0 - phi * phi)

@@ -174,7 +174,13 @@ class PlantParameters:
         return float(np.sum(self.breakaway_A))
 
     def stribeck_ratio(self, velocity_mm_s) -> np.ndarray:
-        """Steady Stribeck ratio ``rho(v)`` of the breakaway levels (1 at rest), at velocities [mm/s]."""
+        """Steady Stribeck ratio ``rho(v)`` of the breakaway levels (1 at rest), at velocities [mm/s].
+
+        Parameters
+        ----------
+        velocity_mm_s : float or array_like
+            Velocity [mm/s]; the ratio has its shape (a float for a scalar).
+        """
         velocity = np.asarray(velocity_mm_s, dtype=float)
         flat = np.ascontiguousarray(velocity.ravel())
         ratio = _stribeck_ratios(flat, float(self.coulomb_ratio), float(self.stribeck_velocity_mm_s),
@@ -194,31 +200,76 @@ class PlantParameters:
                 float(self.cogging_period_mm), float(self.cogging_phase_rad))
 
     def axis_config(self, name: str = "") -> AxisConfig:
-        """The axis file of this axis: the twin's motor, this lead, the X and Y axes' (or the C axis's) efficiencies."""
+        """The axis file of this axis: the twin's motor, this lead, the X and Y axes' (or the C axis's) efficiencies.
+
+        Parameters
+        ----------
+        name : str, default ""
+            Axis name written into the axis file.
+        """
         efficiencies = WORM_EFFICIENCIES if self.motion == "rotary" else AXIS_EFFICIENCIES
         return drive_config(self.lead_mm, efficiencies, name, self.motion)
 
     def process_load(self, process_A, velocity_mm_s) -> np.ndarray:
         """Process force [N] on the table (torque [Nm] on a rotary axis) behind a process current [A] (losses
-        booked in the current)."""
+        booked in the current).
+
+        Parameters
+        ----------
+        process_A : array_like
+            Process current [A].
+        velocity_mm_s : array_like
+            Axis velocity [mm/s, deg/s on a rotary axis]; its sign against the current's tells driving from
+            back-driving, which sets the efficiency used.
+        """
         return self.axis_config().process_load(process_A, velocity_mm_s)
 
     def position_factor(self, position_mm) -> np.ndarray:
-        """Position factor ``g(x)`` of the Maxwell-slip friction (dimensionless; :func:`position_factor_at`)."""
+        """Position factor ``g(x)`` of the Maxwell-slip friction (dimensionless; :func:`position_factor_at`).
+
+        Parameters
+        ----------
+        position_mm : float or array_like
+            Position [mm]; the factor has its shape.
+        """
         return self._position_terms(position_mm)[0]
 
     def cogging_current(self, position_mm) -> np.ndarray:
-        """Current [A] balancing the motor's cogging torque (:func:`cogging_current_at`)."""
+        """Current [A] balancing the motor's cogging torque (:func:`cogging_current_at`).
+
+        Parameters
+        ----------
+        position_mm : float or array_like
+            Position [mm]; the current has its shape.
+        """
         return self._position_terms(position_mm)[1]
 
     def steady_friction(self, velocity_mm_s, position_mm) -> np.ndarray:
-        """Friction current [A] in steady sliding at constant velocity [mm/s] and position [mm]."""
+        """Friction current [A] in steady sliding at constant velocity [mm/s] and position [mm].
+
+        Parameters
+        ----------
+        velocity_mm_s : float or array_like
+            Constant velocity [mm/s]; the friction is 0 at rest.
+        position_mm : float or array_like
+            Position [mm], broadcast against the velocity.
+        """
         v = np.asarray(velocity_mm_s, dtype=float)
         coulomb = self.static_friction_A * self.stribeck_ratio(v) * np.sign(v)
         return self.position_factor(position_mm) * coulomb + self.viscous_A_s_mm * v
 
     def simulate(self, motion, n_samples: int, sample_time_s: float = 0.002) -> "PlantResponse":
-        """Motion and current at the log samples along ``motion`` (:func:`simulate_plant`)."""
+        """Motion and current at the log samples along ``motion`` (:func:`simulate_plant`).
+
+        Parameters
+        ----------
+        motion : object
+            Has ``evaluate(time_s) -> (x_mm, v_mm_s, a_mm_s2)``.
+        n_samples : int
+            Number of log samples, at times ``k * sample_time_s``.
+        sample_time_s : float, default 0.002
+            Log sample time [s]; a whole multiple of ``internal_step_s``.
+        """
         return simulate_plant(self, motion, n_samples, sample_time_s)
 
     def to_dict(self) -> dict:
@@ -337,7 +388,19 @@ def position_factor_at(position_mm, low_mm, high_mm, preload_gain, tilt_gain, le
 
 @njit(cache=True)
 def cogging_current_at(position_mm, cogging_A, cogging_period_mm, cogging_phase_rad):
-    """Cogging current ``R(x) = a_cog sin(2 pi x / lambda_cog + phi_cog)`` [A] at ``position_mm`` [mm]."""
+    """Cogging current ``R(x) = a_cog sin(2 pi x / lambda_cog + phi_cog)`` [A].
+
+    Parameters
+    ----------
+    position_mm : float
+        Position ``x`` [mm].
+    cogging_A : float
+        Amplitude ``a_cog`` [A].
+    cogging_period_mm : float
+        Period ``lambda_cog`` [mm].
+    cogging_phase_rad : float
+        Phase ``phi_cog`` [rad].
+    """
     return cogging_A * math.sin(2.0 * math.pi * position_mm / cogging_period_mm + cogging_phase_rad)
 
 
@@ -508,6 +571,11 @@ class PlantResponse:
 
         The friction grows by ``load_gain (|I_inertia + I_process| - |I_inertia|)`` in the friction's
         direction; the process current itself is not included (the caller adds it).
+
+        Parameters
+        ----------
+        process_A : ndarray, shape (n,)
+            Process current [A] at the log samples.
         """
         if self.load_gain == 0.0:
             return self
@@ -516,7 +584,20 @@ class PlantResponse:
 
 
 def fine_steps_per_sample(params, sample_time_s: float) -> int:
-    """Number of internal steps per log sample; raises if the step does not divide the sample time."""
+    """Number of internal steps per log sample; raises if the step does not divide the sample time.
+
+    Parameters
+    ----------
+    params : object
+        A plant with ``internal_step_s`` [s], e.g. :class:`PlantParameters`.
+    sample_time_s : float
+        Log sample time [s].
+
+    Raises
+    ------
+    GreyboxError
+        If ``sample_time_s`` is not a whole multiple (at least 1) of the internal step.
+    """
     ratio = sample_time_s / params.internal_step_s
     stride = int(round(ratio))
     if stride < 1 or abs(ratio - stride) > 1e-9 * ratio:
@@ -581,6 +662,17 @@ def twin_plant_friction(parameters, state, position_mm, velocity_mm_s):
     """Friction and cogging [A] ``g(x) sum_i k_i d_i + sigma_v v + R(x)`` of the present state.
 
     Layout of ``parameters`` and ``state`` in :func:`twin_plant_law`.
+
+    Parameters
+    ----------
+    parameters : ndarray of float64
+        The law's parameters, in the layout of :func:`twin_plant_law`.
+    state : ndarray of float64
+        The law's state, in the layout of :func:`twin_plant_law`.
+    position_mm : float
+        Present position [mm].
+    velocity_mm_s : float
+        Present velocity [mm/s].
     """
     factor = position_factor_at(position_mm, parameters[5], parameters[6], parameters[7], parameters[8],
                                 parameters[9], parameters[10], parameters[11])
@@ -594,6 +686,17 @@ def twin_plant_advance(parameters, state, velocity_mm_s, step_s):
 
     The element displacement over the step is ``step_s * velocity_mm_s``;
     ``state[1]`` receives ``sum_i k_i d_i`` [A] after the step.
+
+    Parameters
+    ----------
+    parameters : ndarray of float64
+        The law's parameters, in the layout of :func:`twin_plant_law`.
+    state : ndarray of float64
+        The law's state, in the layout of :func:`twin_plant_law` (updated in place).
+    velocity_mm_s : float
+        Velocity over the step [mm/s].
+    step_s : float
+        Internal step [s].
     """
     m = (parameters.shape[0] - _TWIN_HEAD) // 2
     decay = lag_decay(step_s, parameters[3])

@@ -21,7 +21,19 @@ __all__ = ["band_limited_noise", "rectangular_envelope", "PreslidingExcitation"]
 
 
 def band_limited_noise(rng: np.random.Generator, n: int, step_s: float, low_hz: float, high_hz: float) -> np.ndarray:
-    """Gaussian noise of unit RMS whose spectrum is confined to ``[low_hz, high_hz]`` (ideal band-pass)."""
+    """Gaussian noise of unit RMS whose spectrum is confined to ``[low_hz, high_hz]`` (ideal band-pass).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of the white noise that is filtered.
+    n : int
+        Number of samples.
+    step_s : float
+        Sample spacing [s].
+    low_hz, high_hz : float
+        Lower and upper band edge [Hz]; FFT bins outside are set to zero.
+    """
     spectrum = np.fft.rfft(rng.standard_normal(n))
     frequency = np.fft.rfftfreq(n, step_s)
     spectrum[(frequency < low_hz) | (frequency > high_hz)] = 0.0
@@ -30,7 +42,15 @@ def band_limited_noise(rng: np.random.Generator, n: int, step_s: float, low_hz: 
 
 
 def rectangular_envelope(time_s, period_s: float = 10.0) -> np.ndarray:
-    """First three non-zero Fourier terms of a unit rectangular wave of period ``period_s`` [s]."""
+    """First three non-zero Fourier terms of a unit rectangular wave of period ``period_s`` [s].
+
+    Parameters
+    ----------
+    time_s : array_like
+        Times [s].
+    period_s : float, default 10.0
+        Period [s] of the rectangular wave.
+    """
     w = 2.0 * np.pi / period_s
     t = np.asarray(time_s, dtype=float)
     return 4.0 / np.pi * (np.sin(w * t) + np.sin(3.0 * w * t) / 3.0 + np.sin(5.0 * w * t) / 5.0)
@@ -116,7 +136,13 @@ class PreslidingExcitation:
         return {"duration_s": self.duration_s, "centre_mm": self.centre_mm, **self._settings}
 
     def evaluate(self, time_s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position [mm], velocity [mm/s] and acceleration [mm/s^2] at times [s]; at rest after the end."""
+        """Position [mm], velocity [mm/s] and acceleration [mm/s^2] at times [s]; at rest after the end.
+
+        Parameters
+        ----------
+        time_s : array_like
+            Times [s], in any order; times before 0 are evaluated at 0.
+        """
         t = np.clip(np.asarray(time_s, dtype=float), 0.0, self.duration_s)
         moving = np.asarray(time_s) < self.duration_s
         x = self.centre_mm + self._position(t)

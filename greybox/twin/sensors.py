@@ -19,7 +19,15 @@ def _decimals(step: float) -> int:
 
 
 def quantise(values, step: float) -> np.ndarray:
-    """Round ``values`` to multiples of ``step``, stored as the shortest decimal numbers."""
+    """Round ``values`` to multiples of ``step``, stored as the shortest decimal numbers.
+
+    Parameters
+    ----------
+    values : array_like
+        Values to round, in any unit.
+    step : float
+        Quantisation step, positive, in the unit of ``values``.
+    """
     quantised = np.round(np.asarray(values, dtype=float) / step) * step
     return np.round(quantised, _decimals(step)) + 0.0
 
@@ -51,16 +59,36 @@ class Sensors:
             raise GreyboxError("sensors: resolutions must be positive")
 
     def position(self, position_mm) -> np.ndarray:
-        """Encoder position [mm]."""
+        """Encoder position [mm].
+
+        Parameters
+        ----------
+        position_mm : array_like
+            True position [mm]; rounded to the encoder resolution.
+        """
         return quantise(position_mm, self.position_resolution_mm)
 
     def velocity(self, encoder_position_mm, sample_time_s: float) -> np.ndarray:
-        """Actual velocity [mm/s] from encoder positions; zero at the first sample (the axis starts at rest)."""
+        """Actual velocity [mm/s] from encoder positions; zero at the first sample (the axis starts at rest).
+
+        Parameters
+        ----------
+        encoder_position_mm : array_like, shape (n,)
+            Encoder positions [mm] at the log samples (e.g. from :meth:`position`).
+        sample_time_s : float
+            Log sample time [s].
+        """
         step = np.diff(np.asarray(encoder_position_mm, dtype=float), prepend=encoder_position_mm[0])
         return quantise(step / sample_time_s, self.position_resolution_mm / sample_time_s)
 
     def current(self, current_A) -> np.ndarray:
-        """Logged current [A]."""
+        """Logged current [A].
+
+        Parameters
+        ----------
+        current_A : array_like
+            Current [A] before logging; rounded to the current resolution.
+        """
         return quantise(current_A, self.current_resolution_A)
 
     def to_dict(self) -> dict:

@@ -194,6 +194,17 @@ def constant_speed_trajectory(geometry: AxisGeometry, speeds_mm_min, limits: Mot
 
     The axis starts at the upper end of the travel, moves to the lower end and
     back, dwelling ``dwell_s`` [s] at each end, then repeats at the next speed [mm/min].
+
+    Parameters
+    ----------
+    geometry : AxisGeometry
+        Axis whose whole travel is crossed.
+    speeds_mm_min : sequence of float
+        Positive constant speeds [mm/min], in the order run.
+    limits : MotionLimits, optional
+        Acceleration and jerk limits; default :class:`MotionLimits`.
+    dwell_s : float, default 0.2
+        Dwell [s] at the start and after every move.
     """
     low, high = geometry.travel_mm
     profile = MotionProfile(high, limits)
@@ -216,7 +227,21 @@ def constant_speed_trajectory(geometry: AxisGeometry, speeds_mm_min, limits: Mot
 
 def presliding_trajectory(geometry: AxisGeometry, rng: np.random.Generator, duration_s: float = 60.0,
                           **options) -> Trajectory:
-    """Pre-sliding excitation around the window centre (dataset P); see :class:`PreslidingExcitation`."""
+    """Pre-sliding excitation around the window centre (dataset P); see :class:`PreslidingExcitation`.
+
+    Parameters
+    ----------
+    geometry : AxisGeometry
+        Axis whose measurement window centres the motion; the excursion from the centre is limited to
+        0.4 times the window's width.
+    rng : numpy.random.Generator
+        Source of the random velocity.
+    duration_s : float, default 60.0
+        Length [s], rounded up to whole envelope periods.
+    **options
+        Further keyword arguments of :meth:`PreslidingExcitation.random` (``velocity_rms_mm_s``, ``cutoff_hz``,
+        ``envelope_period_s``, ``highpass_hz``, ``knot_step_s``).
+    """
     excitation = PreslidingExcitation.random(rng, geometry.window_centre_mm, duration_s=duration_s,
                                              max_excursion_mm=0.4 * (geometry.window_mm[1] - geometry.window_mm[0]),
                                              **options)

@@ -51,7 +51,9 @@ def backlash_screw_kernel(position_mm, velocity_mm_s, acceleration_mm_s2, step_s
     Parameters
     ----------
     position_mm, velocity_mm_s, acceleration_mm_s2 : ndarray, shape (n,)
-        Motor motion [mm, mm/s, mm/s^2] on the fine grid of step ``step_s`` [s].
+        Motor motion [mm, mm/s, mm/s^2] on the fine grid.
+    step_s : float
+        Step of the fine grid [s].
     stride : int
         Fine steps per output sample.
     play_mm : float
@@ -171,6 +173,13 @@ class BacklashScrewLaw(TruthLaw):
 
     @classmethod
     def draw(cls, rng: np.random.Generator) -> "BacklashScrewLaw":
+        """A law with parameters drawn from :attr:`RANGES`.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Source of randomness.
+        """
         r = cls.RANGES
         return cls(log_uniform(rng, *r["play_mm"][:2]), rng.uniform(*r["nut_A"][:2]),
                    log_uniform(rng, *r["nut_presliding_mm"][:2]), rng.uniform(*r["guide_static_A"][:2]),
@@ -191,11 +200,39 @@ class BacklashScrewLaw(TruthLaw):
             float(self.guide_presliding_mm), float(table_inertia), float(self.pulse_s))
 
     def friction_samples(self, position_mm, velocity_mm_s, step_s, stride):
+        """Nut and guideway friction [A] at every ``stride``-th fine point (as :meth:`TruthLaw.friction_samples`).
+
+        Parameters
+        ----------
+        position_mm, velocity_mm_s : ndarray, shape (n,)
+            Motor motion [mm, mm/s] on the fine grid.
+        step_s : float
+            Fine integration step [s]; it only times the contact pulse, which is inertia, so the friction
+            does not depend on it.
+        stride : int
+            Fine steps per log sample.
+        """
         # the friction does not depend on the acceleration; the table's inertia is left out here
         acceleration = np.zeros(np.shape(position_mm))
         return self._run(position_mm, velocity_mm_s, acceleration, step_s, stride, 0.0)[0]
 
     def respond(self, position_mm, velocity_mm_s, acceleration_mm_s2, step_s, stride, inertia_A_s2_mm):
+        """Friction and inertial current [A] at the log samples (as :meth:`TruthLaw.respond`).
+
+        The motor carries ``1 - table_share`` of the inertia at all times; the table's share is felt only
+        while the play is closed, plus the contact pulse when it closes.
+
+        Parameters
+        ----------
+        position_mm, velocity_mm_s, acceleration_mm_s2 : ndarray, shape (n,)
+            Motor motion [mm, mm/s, mm/s^2] at fine steps ``step_s`` [s].
+        step_s : float
+            Fine integration step [s].
+        stride : int
+            Fine steps per log sample.
+        inertia_A_s2_mm : float
+            Inertia of the whole axis, motor and table [A s^2/mm].
+        """
         friction, table = self._run(position_mm, velocity_mm_s, acceleration_mm_s2, step_s, stride,
                                     self.table_share * inertia_A_s2_mm)
         motor = (1.0 - self.table_share) * inertia_A_s2_mm * np.asarray(acceleration_mm_s2, float)[::stride]

@@ -21,7 +21,15 @@ __all__ = ["TruthLaw", "LawResponse", "log_uniform"]
 
 
 def log_uniform(rng: np.random.Generator, low: float, high: float) -> float:
-    """One draw, uniform in ``log`` between ``low`` and ``high`` (both positive)."""
+    """One draw, uniform in ``log`` between ``low`` and ``high`` (both positive).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of randomness.
+    low, high : float
+        Ends of the range, both positive, in the unit of the drawn quantity.
+    """
     return float(math.exp(rng.uniform(math.log(low), math.log(high))))
 
 
@@ -63,7 +71,13 @@ class TruthLaw:
 
     @classmethod
     def draw(cls, rng: np.random.Generator) -> "TruthLaw":  # pragma: no cover - abstract
-        """A law with parameters drawn from :attr:`RANGES`."""
+        """A law with parameters drawn from :attr:`RANGES`.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Source of randomness.
+        """
         raise NotImplementedError
 
     @property
@@ -72,7 +86,22 @@ class TruthLaw:
         raise NotImplementedError
 
     def friction_samples(self, position_mm, velocity_mm_s, step_s: float, stride: int) -> np.ndarray:
-        """Friction [A] at every ``stride``-th point of a motion on a fine grid of step ``step_s`` [s]."""
+        """Friction [A] at every ``stride``-th point of a motion on a fine grid of step ``step_s`` [s].
+
+        Parameters
+        ----------
+        position_mm, velocity_mm_s : ndarray, shape (n,)
+            Motion [mm, mm/s] on the fine grid.
+        step_s : float
+            Fine integration step [s].
+        stride : int
+            Fine steps per log sample.
+
+        Returns
+        -------
+        ndarray, shape ((n - 1) // stride + 1,)
+            Friction current [A] at fine steps 0, stride, 2 stride, ...
+        """
         raise NotImplementedError  # pragma: no cover - abstract
 
     def respond(self, position_mm, velocity_mm_s, acceleration_mm_s2, step_s: float, stride: int,

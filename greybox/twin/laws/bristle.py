@@ -35,7 +35,17 @@ __all__ = ["BristleLaw", "bristle_update", "bristle_kernel"]
 
 @njit(cache=True)
 def bristle_update(state_mm, step_mm, steady_mm):
-    """Exact bristle deflection [mm] after a displacement ``step_mm`` [mm], the steady deflection ``steady_mm`` held."""
+    """Exact bristle deflection [mm] after a displacement, the steady deflection held constant over it.
+
+    Parameters
+    ----------
+    state_mm : float
+        Bristle deflection before the displacement [mm].
+    step_mm : float
+        Displacement [mm] (its sign is the direction of motion).
+    steady_mm : float
+        Steady-state deflection at the current speed [mm], positive.
+    """
     if step_mm == 0.0:
         return state_mm
     target = steady_mm if step_mm > 0.0 else -steady_mm
@@ -110,6 +120,13 @@ class BristleLaw(TruthLaw):
 
     @classmethod
     def draw(cls, rng: np.random.Generator) -> "BristleLaw":
+        """A law with parameters drawn from :attr:`RANGES`.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Source of randomness.
+        """
         r = cls.RANGES
         return cls(rng.uniform(*r["static_A"][:2]), rng.uniform(*r["coulomb_ratio"][:2]),
                    log_uniform(rng, *r["stribeck_velocity_mm_s"][:2]), rng.uniform(*r["stribeck_shape"][:2]),
@@ -125,6 +142,17 @@ class BristleLaw(TruthLaw):
         return float(self.static_A)
 
     def friction_samples(self, position_mm, velocity_mm_s, step_s, stride):
+        """Bristle friction [A] at every ``stride``-th point of a motion (as :meth:`TruthLaw.friction_samples`).
+
+        Parameters
+        ----------
+        position_mm, velocity_mm_s : ndarray, shape (n,)
+            Motion [mm, mm/s] on the fine grid.
+        step_s : float
+            Fine integration step [s]; not used: the state update is exact in the displacement.
+        stride : int
+            Fine steps per log sample.
+        """
         return bristle_kernel(np.ascontiguousarray(position_mm, float), np.ascontiguousarray(velocity_mm_s, float),
                               int(stride), float(self.stiffness_A_mm), float(self.damping_A_s_mm),
                               float(self.static_A), float(self.coulomb_ratio), float(self.stribeck_velocity_mm_s),

@@ -35,7 +35,21 @@ __all__ = ["DahlLaw", "dahl_update", "dahl_kernel"]
 
 @njit(cache=True)
 def dahl_update(force_A, step_mm, level_A, stiffness_A_mm, exponent):
-    """Exact Dahl friction [A] after a monotone displacement ``step_mm`` [mm] from ``force_A`` [A]."""
+    """Exact Dahl friction [A] after a monotone displacement.
+
+    Parameters
+    ----------
+    force_A : float
+        Friction before the displacement [A].
+    step_mm : float
+        Displacement [mm] (its sign is the direction of motion).
+    level_A : float
+        Coulomb level ``F_c`` [A].
+    stiffness_A_mm : float
+        Rest stiffness ``sigma_0`` [A/mm].
+    exponent : float
+        Shape ``alpha``.
+    """
     if step_mm == 0.0:
         return force_A
     sign = 1.0 if step_mm > 0.0 else -1.0
@@ -53,7 +67,21 @@ def dahl_update(force_A, step_mm, level_A, stiffness_A_mm, exponent):
 
 @njit(cache=True)
 def dahl_kernel(position_mm, stride, level_A, stiffness_A_mm, exponent):
-    """Dahl friction [A] at every ``stride``-th point of a position path on a fine grid (0 at the start)."""
+    """Dahl friction [A] at every ``stride``-th point of a position path on a fine grid (0 at the start).
+
+    Parameters
+    ----------
+    position_mm : ndarray, shape (n,)
+        Position path [mm] on the fine grid.
+    stride : int
+        Fine steps per output sample.
+    level_A, stiffness_A_mm, exponent : float
+        ``F_c`` [A], ``sigma_0`` [A/mm] and ``alpha``, as in :func:`dahl_update`.
+
+    Returns
+    -------
+    ndarray, shape ((n - 1) // stride + 1,)
+    """
     n = position_mm.shape[0]
     out = np.empty((n - 1) // stride + 1)
     force = 0.0
@@ -92,6 +120,13 @@ class DahlLaw(TruthLaw):
 
     @classmethod
     def draw(cls, rng: np.random.Generator) -> "DahlLaw":
+        """A law with parameters drawn from :attr:`RANGES`.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Source of randomness.
+        """
         r = cls.RANGES
         return cls(rng.uniform(*r["level_A"][:2]), log_uniform(rng, *r["presliding_mm"][:2]),
                    rng.uniform(*r["exponent"][:2]))
@@ -101,5 +136,18 @@ class DahlLaw(TruthLaw):
         return float(self.level_A)
 
     def friction_samples(self, position_mm, velocity_mm_s, step_s, stride):
+        """Dahl friction [A] at every ``stride``-th point of a motion (as :meth:`TruthLaw.friction_samples`).
+
+        Parameters
+        ----------
+        position_mm : ndarray, shape (n,)
+            Position [mm] on the fine grid.
+        velocity_mm_s : ndarray, shape (n,)
+            Velocity [mm/s] on the fine grid; not used, the law is rate-independent.
+        step_s : float
+            Fine integration step [s]; not used, the law follows the position path only.
+        stride : int
+            Fine steps per log sample.
+        """
         return dahl_kernel(np.ascontiguousarray(position_mm, float), int(stride), float(self.level_A),
                            float(self.level_A / self.presliding_mm), float(self.exponent))

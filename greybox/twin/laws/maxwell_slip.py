@@ -58,6 +58,13 @@ class MaxwellSlipLaw(TruthLaw):
 
     @classmethod
     def draw(cls, rng: np.random.Generator) -> "MaxwellSlipLaw":
+        """A law with parameters drawn from :attr:`RANGES`; element deflections log-spaced from 0.1 to 10 um.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Source of randomness.
+        """
         r = cls.RANGES
         breakaway, deflection = _element_distribution(
             rng.uniform(*r["static_A"][:2]), n=int(rng.integers(r["elements"][0], r["elements"][1] + 1)),
@@ -72,6 +79,17 @@ class MaxwellSlipLaw(TruthLaw):
         return float(np.sum(self.breakaway_A))
 
     def friction_samples(self, position_mm, velocity_mm_s, step_s, stride):
+        """Maxwell-slip friction [A] at every ``stride``-th point of a motion (as :meth:`TruthLaw.friction_samples`).
+
+        Parameters
+        ----------
+        position_mm, velocity_mm_s : ndarray, shape (n,)
+            Motion [mm, mm/s] on the fine grid; the elements start relaxed.
+        step_s : float
+            Fine integration step [s]; sets the decay of the lagged Stribeck ratio.
+        stride : int
+            Fine steps per log sample.
+        """
         deflection = np.asarray(self.breakaway_deflection_mm, float)
         stiffness = np.asarray(self.breakaway_A, float) / deflection
         return maxwell_slip_kernel(np.ascontiguousarray(position_mm, float), np.ascontiguousarray(velocity_mm_s, float),
