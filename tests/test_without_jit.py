@@ -1,0 +1,32 @@
+"""The compiled kernels' tests once more with numba's compiler off (``NUMBA_DISABLE_JIT=1``).
+
+Each kernel then runs as the plain Python it is written in, against the same references. A kernel that
+leans on what only compiled code does (integers wrapping around, numba's choice of integer types) fails
+here, and a coverage tool run this way sees the kernels' lines.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Test files of the compiled kernels: GMS and LuGre, SVR kernel sums, plant laws, JSON numbers and MCAP
+#: records, the controller, the truth laws of the family of axes.
+KERNEL_TESTS = ("test_friction_kernels.py", "test_rbf.py", "test_plant_laws.py", "test_json_numbers.py",
+                "test_data_mcap.py", "test_control_pid.py", "test_twin_family.py")
+
+
+@pytest.mark.slow
+def test_kernel_tests_pass_with_the_compiler_off():
+    environment = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
+    command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-W", "error::RuntimeWarning",
+               *(str(ROOT / "tests" / name) for name in KERNEL_TESTS)]
+    result = subprocess.run(command, cwd=ROOT, env=environment, capture_output=True, text=True, timeout=1200)
+    assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
+    assert " passed" in result.stdout and " skipped" not in result.stdout
