@@ -123,3 +123,13 @@ def test_several_training_runs_each_drift_from_their_own_start():
     assert result.settings["train_samples"] == sum(len(run) for run in runs)
     assert result.residuals["train"]["time"].size == result.settings["train_samples"]
     assert np.all(np.diff(result.residuals["train"]["time"]) > 0)  # the runs follow one another
+
+
+def test_the_study_tables_print_without_null_runs_or_eligible_cases():
+    from greybox.studies.discovery import markdown
+
+    settings = {"description": "d", "base": "CoulombModel", "duration": 30.0, "seeds": 1, "null_seeds": 0,
+                "ratios": [1.0]}
+    text = markdown("s", settings, summarise([], []), [], [], 1.0)
+    assert "0/0 = - % (95 % CI --- %)" in text
+    assert "| cases naming an effect neither hidden nor background | - %" in text

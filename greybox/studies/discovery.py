@@ -444,6 +444,11 @@ def _fmt(value, spec=".2f") -> str:
     return "-" if value is None else format(value, spec)
 
 
+def _percent(share) -> str:
+    """A share as a percentage with one decimal; "-" when there is none (no runs of that kind)."""
+    return "-" if share is None or not np.isfinite(share) else f"{100 * share:.1f}"
+
+
 def markdown(section: str, settings: dict, summary: dict, cases: list, nulls: list, seconds: float) -> str:
     """The tables of a synthetic section: the study's figures against their targets, and per effect and ratio.
 
@@ -474,15 +479,15 @@ def markdown(section: str, settings: dict, summary: dict, cases: list, nulls: li
         "| figure | measured | target |",
         "|---|---|---|",
         f"| false positives on null data (verdict other than nothing_missing) | {fp['count']}/{fp['n']} = "
-        f"{100 * fp['rate']:.1f} % (95 % CI {100 * fp['interval_95'][0]:.1f}-{100 * fp['interval_95'][1]:.1f} %) "
+        f"{_percent(fp['rate'])} % (95 % CI {_percent(fp['interval_95'][0])}-{_percent(fp['interval_95'][1])} %) "
         f"| <= 5 % |",
         f"| naming accuracy, effect RMS >= {acc['min_ratio']:g} x noise RMS (absorbed effects excluded) | "
-        f"{acc['count']}/{acc['n']} = {100 * acc['rate']:.1f} % (95 % CI {100 * acc['interval_95'][0]:.1f}-"
-        f"{100 * acc['interval_95'][1]:.1f} %) | >= 90 % |",
+        f"{acc['count']}/{acc['n']} = {_percent(acc['rate'])} % (95 % CI {_percent(acc['interval_95'][0])}-"
+        f"{_percent(acc['interval_95'][1])} %) | >= 90 % |",
         f"| gap closure vs the true term, median over named cases | {_fmt(closure['median'], '.3f')} "
         f"({closure['n']} cases; {_fmt(100 * closure['share_at_least_0.8'] if closure['n'] else None, '.0f')} % "
         f"of them >= 0.8) | >= 0.8 |",
-        f"| cases naming an effect neither hidden nor background | {_fmt(100 * summary['spurious_rate'], '.1f')} % "
+        f"| cases naming an effect neither hidden nor background | {_percent(summary['spurious_rate'])} % "
         f"| - |",
         "",
         "Named (hidden effect found, period within 5 %) / cases, and the median gap closure, per effect and "
