@@ -300,13 +300,11 @@ class ProcessTally:
                                      self.n_outside if self._regions else None, self.n_samples)
 
 
-def check_process_inputs(model, runs: Sequence[AxisLog], axis_config: AxisConfig | None) -> None:
+def check_process_inputs(runs: Sequence[AxisLog], axis_config: AxisConfig | None) -> None:
     """Refuse runs of mixed effort units, axis metadata with a load log, or of the other kind of axis.
 
     Parameters
     ----------
-    model : CurrentModel
-        The model the runs are for (not examined by the checks).
     runs : sequence of AxisLog
         Prepared runs of one log; the first sets the effort unit and the kind of axis.
     axis_config : AxisConfig or None
@@ -505,7 +503,7 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
         or axis metadata of a linear axis with a rotary log (or the other way round).
     """
     runs = as_log_list(log)
-    check_process_inputs(model, runs, axis_config)
+    check_process_inputs(runs, axis_config)
     n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, chunk_s))) for run in runs)
     done = [0]
 

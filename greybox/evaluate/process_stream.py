@@ -111,7 +111,7 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
     blocks = prepared_blocks(log, tolerance=tolerance, cutoff_hz=cutoff_hz, sample_time=nominal,
                              block_samples=_aligned(log.block_samples, nominal, chunk_s))
     first = next(blocks)
-    check_process_inputs(model, [first], axis_config)
+    check_process_inputs([first], axis_config)
     tally = ProcessTally()
     done = [0]
 
