@@ -137,6 +137,11 @@ def test_missing_data_folder_is_reported(tmp_path):
     assert not (tmp_path / "x.json").exists()
 
 
+def test_an_unknown_model_name_is_refused_before_any_file_is_read(tmp_path):
+    with pytest.raises(GreyboxError, match="unknown model.*stribek.*known: "):
+        bench.run_benchmark(tmp_path / "nowhere", names=["coulomb", "stribek"])
+
+
 def test_outputs_never_replace_the_data_nor_an_existing_file_without_force(tmp_path):
     data = tmp_path / "EMPS"
     data.mkdir()

@@ -262,7 +262,15 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None) -
         The JSON document: ``{"models": {name: {...}}, "published": ..., "protocol": ...}``.
     curves : dict
         Decimated time [s], measured and modelled force [N] per file, for the plot.
+
+    Raises
+    ------
+    GreyboxError
+        For an unknown model name, before any file is read, or for a missing data file.
     """
+    unknown = [name for name in names if name not in IDIM_LS_MODELS and name not in GREYBOX_MODELS]
+    if unknown:
+        raise GreyboxError(f"unknown model(s) {', '.join(unknown)}; known: {', '.join(MODEL_NAMES)}")
     paths = {"train": data / TRAIN_FILE, "test": data / TEST_FILE}
     for path in paths.values():
         if not path.is_file():
