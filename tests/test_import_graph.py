@@ -8,6 +8,8 @@ rules (DESIGN.md, "Layout"):
 - no import cycle between modules;
 - only ``greybox.twin`` itself, ``greybox.control``, ``greybox.studies`` and
   ``greybox.cli`` import the synthetic twin;
+- ``greybox.threads`` (thread pools shared by the data readers and the models)
+  imports nothing of greybox;
 - ``greybox.base`` (the model protocol) and ``greybox.twin.laws.base`` (the
   truth laws' base class) import nothing of greybox, and the twin imports no
   model (``greybox.friction``, ``greybox.models``): a truth plant built from
@@ -227,6 +229,12 @@ def test_the_model_protocol_imports_nothing_of_greybox(graph):
     assert "greybox.base" in graph
     found = forbidden(graph, lambda m: m == "greybox.base", lambda t: True)
     assert not found, "greybox/base.py must import nothing of greybox:\n" + "\n".join(found)
+
+
+def test_the_shared_thread_pools_import_nothing_of_greybox(graph):
+    assert "greybox.threads" in graph  # used by the data readers and the models alike: below both
+    found = forbidden(graph, lambda m: m == "greybox.threads", lambda t: True)
+    assert not found, "greybox/threads.py must import nothing of greybox:\n" + "\n".join(found)
 
 
 def test_the_truth_laws_base_imports_nothing_of_greybox_and_no_truth_law_uses_a_model(graph):
