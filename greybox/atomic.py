@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-import signal
-import tempfile
-import threading
+import secrets
 from pathlib import Path
 from typing import Iterator
 
@@ -54,10 +52,15 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
         raise FileNotFoundError(f"{path}: directory {directory} does not exist")
     temporary = None
     try:
-        with _signals_held():  # a Ctrl-C or SIGTERM arrives once the name is known, so the file is removed
-            handle, temporary = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
-            os.close(handle)
-        yield Path(temporary)
+        while temporary is None:
+            # the name is known before the file exists: a Ctrl-C or SIGTERM (delivered to whichever thread,
+            # so it cannot be held back) that stops the command from here on finds the file and removes it
+            temporary = directory / f".{path.name}.{secrets.token_hex(8)}.tmp"
+            try:
+                os.close(os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+            except FileExistsError:  # another file of that name (not ours): draw again
+                temporary = None
+        yield temporary
         with open(temporary, "rb+") as stream:
             os.fsync(stream.fileno())
         os.chmod(temporary, _default_mode())
@@ -65,19 +68,6 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
     finally:
         if temporary is not None and os.path.exists(temporary):
             os.unlink(temporary)
-
-
-@contextlib.contextmanager
-def _signals_held() -> Iterator[None]:
-    """Hold back SIGINT and SIGTERM for the block (main thread, where the OS allows); they arrive after it."""
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def check_output_path(path: str | os.PathLike, *, overwrite: bool = False, protect=(),

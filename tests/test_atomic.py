@@ -35,12 +35,11 @@ def test_missing_directory_is_named(tmp_path):
         write_text_atomic(tmp_path / "nowhere" / "x.txt", "x")
 
 
-def test_a_signal_while_the_temporary_file_is_made_leaves_no_file(tmp_path, monkeypatch):
-    """SIGTERM right after the temporary file exists (before the block that removes it) is held back."""
+def test_a_signal_right_after_the_temporary_file_is_made_leaves_no_file(tmp_path, monkeypatch):
+    """SIGTERM the moment the temporary file exists: its handler's exception still finds the file and removes it."""
     import signal
-    import tempfile
 
-    from greybox.atomic import atomic_output
+    from greybox import atomic
 
     class Stop(Exception):
         pass
@@ -48,19 +47,21 @@ def test_a_signal_while_the_temporary_file_is_made_leaves_no_file(tmp_path, monk
     def stop(signum, frame):
         raise Stop()
 
-    made = tempfile.mkstemp
+    made = os.open
 
-    def mkstemp_then_signal(*args, **kwargs):
-        result = made(*args, **kwargs)
-        os.kill(os.getpid(), signal.SIGTERM)  # arrives here unless held back
-        return result
+    def open_then_signal(name, *args, **kwargs):
+        handle = made(name, *args, **kwargs)
+        if str(name).endswith(".tmp"):
+            os.kill(os.getpid(), signal.SIGTERM)  # the handler runs before the descriptor is even closed
+        return handle
 
     previous = signal.signal(signal.SIGTERM, stop)
-    monkeypatch.setattr(tempfile, "mkstemp", mkstemp_then_signal)
+    monkeypatch.setattr(atomic.os, "open", open_then_signal)
     try:
         with pytest.raises(Stop):
-            with atomic_output(tmp_path / "out.csv") as temporary:
+            with atomic.atomic_output(tmp_path / "out.csv") as temporary:
                 temporary.write_text("never finished")
     finally:
+        monkeypatch.undo()
         signal.signal(signal.SIGTERM, previous)
     assert list(tmp_path.iterdir()) == []
