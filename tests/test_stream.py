@@ -278,3 +278,60 @@ def test_mcap_channels_come_from_the_summary_or_from_the_records(tmp_path, repea
     np.testing.assert_array_equal(streamed.position, y.position[:n])
     with pytest.raises(LogError, match="several channels"):
         McapLog(path, block_samples=500)
+
+
+def _indexed_mcap(path: Path, log, *, index: bool = True) -> Path:
+    """The log on /axis/X with the mcap package's writer, with message-index records (its default) or without."""
+    from mcap.writer import IndexType, Writer
+
+    with open(path, "wb") as stream:
+        writer = Writer(stream, chunk_size=64 * 1024,
+                        index_types=IndexType.ALL if index else IndexType.CHUNK)
+        writer.start()
+        schema = writer.register_schema("greybox.AxisSample", "jsonschema", b"{}")
+        other = writer.register_channel("/temperature", "json", schema, {})  # a second channel in the chunks
+        channel = writer.register_channel("/axis/X", "json", schema, {"axis": "X"})
+        for k in range(len(log)):
+            stamp = int(round(log.time[k] * 1e9))
+            message = {"position_mm": log.position[k], "current_A": log.effort[k]}
+            writer.add_message(channel, stamp, json.dumps(message).encode(), stamp)
+            if k % 100 == 0:
+                writer.add_message(other, stamp, b'{"temperature_C": 21.5}', stamp)
+        writer.finish()
+    return path
+
+
+def test_mcap_times_come_from_the_message_index_without_opening_the_chunks(tmp_path, monkeypatch):
+    from greybox.data import mcap_io
+
+    log = make_dataset("X", "A", seed=9, duration_s=20)
+    indexed = McapLog(_indexed_mcap(tmp_path / "indexed.mcap", log), axis="X", block_samples=700)
+    plain = McapLog(_indexed_mcap(tmp_path / "plain.mcap", log, index=False), axis="X", block_samples=700)
+    from_chunks = np.concatenate(list(plain.times()))
+    monkeypatch.setattr(mcap_io, "_decompress", lambda *args: pytest.fail("a chunk was decompressed"))
+    from_index = np.concatenate(list(indexed.times()))
+    monkeypatch.undo()
+    np.testing.assert_array_equal(from_index, from_chunks)
+    np.testing.assert_array_equal(from_index, np.round(log.time * 1e9) * 1e-9)
+    assert indexed.n_samples == len(log) and indexed.time_span() == plain.time_span()
+    np.testing.assert_array_equal(concatenate(indexed.blocks()).position, log.position)
+
+
+def test_a_message_index_that_disagrees_with_the_messages_is_a_corrupt_file(tmp_path, capsys, models):
+    from greybox.data.mcap_io import scan_records
+
+    log = make_dataset("X", "A", seed=9, duration_s=20)
+    path = _indexed_mcap(tmp_path / "x.mcap", log)
+    data = bytearray(path.read_bytes())
+    buf = np.frombuffer(bytes(data), np.uint8)
+    opcodes, offsets, _, _ = scan_records(buf, 8, len(data) - 8)
+    index = offsets[np.flatnonzero(opcodes == 0x07)]
+    channel = [offset for offset in index if data[offset] == 2][3]  # /axis/X's index of the fourth chunk
+    stamp = int.from_bytes(data[channel + 6:channel + 14], "little")
+    data[channel + 6:channel + 14] = (stamp + 1).to_bytes(8, "little")  # 1 ns off: still in time order
+    path.write_bytes(bytes(data))
+    out = tmp_path / "out.parquet"
+    assert cli.main(["predict", str(models["gms"]), str(path), "--out", str(out), "--axis", "X", "--quiet"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert "corrupt MCAP file: the message index" in error and len(error.splitlines()) == 1
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["x.mcap"]

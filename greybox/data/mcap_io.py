@@ -72,7 +72,7 @@ AXIS_SAMPLE_SCHEMA = {
 }
 
 _MAGIC = b"\x89MCAP0\r\n"
-_OP_FOOTER, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x02, 0x04, 0x05, 0x06, 0x0F
+_OP_FOOTER, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_MESSAGE_INDEX, _OP_DATA_END = 0x02, 0x04, 0x05, 0x06, 0x07, 0x0F
 _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time u64
 _BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
 _BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
@@ -318,8 +318,7 @@ class _MessageCollector:
     def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, stamps_only: bool = False) -> None:
         if not offsets.size:
             return
-        header = buf[offsets[:, None] + np.arange(6, 14)]
-        self.stamps.append(np.ascontiguousarray(header).view("<u8").ravel().copy())
+        self.stamps.append(_log_times(buf, offsets))
         self.rows += offsets.size
         if stamps_only:
             return
@@ -425,7 +424,15 @@ def _choose(channels: Mapping[int, _Channel], topic: str | None, path) -> _Chann
 
 
 def _walk(path) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """Yield (buffer, opcodes, offsets, lengths) for the data section, a window of the file or a chunk at a time.
+    """Yield (buffer, opcodes, offsets, lengths) for the data section, a window of the file or a chunk at a time."""
+    for buf, data, opcodes, offsets, lengths, _ in _windows(path):
+        yield from _expand(buf, data, opcodes, offsets, lengths, path)
+
+
+def _windows(path) -> Iterator[tuple[np.ndarray, bytes, np.ndarray, np.ndarray, np.ndarray, bool]]:
+    """Yield (buffer, its bytes, opcodes, offsets, lengths, last) of the data section's records, chunks not opened.
+
+    ``last`` is True for the window that reaches the data-end record.
 
     The file is scanned :data:`_WINDOW_BYTES` at a time (a record longer than that is read whole), up to
     the data-end record, so that the memory held does not grow with the file.
@@ -460,7 +467,7 @@ def _walk(path) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
             opcodes, offsets, lengths, end = scan_records(buf, 0, buf.size)
             ends = np.flatnonzero(opcodes == _OP_DATA_END)
             last = int(ends[0]) if ends.size else opcodes.size
-            yield from _expand(buf, data, opcodes[:last], offsets[:last], lengths[:last], path)
+            yield buf, data, opcodes[:last], offsets[:last], lengths[:last], bool(ends.size)
             if ends.size:
                 return
             carry, start = data[end:], start + end
@@ -514,16 +521,81 @@ def _messages(path, topic: str | None, channels: dict[int, _Channel], collector:
     for buf, opcodes, offsets, lengths in _walk(path):
         _add_channels(channels, buf, opcodes, offsets, lengths, path)
         chosen = _match(channels, topic)
-        is_message = opcodes == _OP_MESSAGE
-        if chosen is None or not is_message.any():
+        if chosen is None or not np.any(opcodes == _OP_MESSAGE):
             continue
-        offs, lens = offsets[is_message], lengths[is_message]
-        if np.any(lens < _MESSAGE_HEADER):
-            raise LogError(path, "corrupt MCAP file: a message record is shorter than its header")
-        ids = buf[offs].astype(np.uint16) | (buf[offs + 1].astype(np.uint16) << 8)
-        mine = ids == chosen.id
-        collector.add(buf, offs[mine], lens[mine], stamps_only=stamps_only)
+        collector.add(buf, *_channel_messages(buf, opcodes, offsets, lengths, chosen.id, path),
+                      stamps_only=stamps_only)
         yield collector.rows
+
+
+def _channel_messages(buf, opcodes, offsets, lengths, channel_id: int, path) -> tuple[np.ndarray, np.ndarray]:
+    """Offsets and lengths of the message records of one channel among scanned records."""
+    is_message = opcodes == _OP_MESSAGE
+    offs, lens = offsets[is_message], lengths[is_message]
+    if np.any(lens < _MESSAGE_HEADER):
+        raise LogError(path, "corrupt MCAP file: a message record is shorter than its header")
+    ids = buf[offs].astype(np.uint16) | (buf[offs + 1].astype(np.uint16) << 8)
+    mine = ids == channel_id
+    return offs[mine], lens[mine]
+
+
+def _log_times(buf, offsets) -> np.ndarray:
+    """The ``log_time`` [ns] of the message records at ``offsets``."""
+    header = buf[offsets[:, None] + np.arange(6, 14)]
+    return np.ascontiguousarray(header).view("<u8").ravel().copy()
+
+
+def _channel_stamps(path, channel_id: int) -> Iterator[np.ndarray]:
+    """The ``log_time`` [ns] of one channel's messages in the order they are stored, a chunk at a time.
+
+    A chunk followed by its message-index records gives them from the index, without being decompressed;
+    a chunk without them (or whose index is cut by the scan window, or malformed) is decompressed.
+    """
+    for buf, data, opcodes, offsets, lengths, last in _windows(path):
+        begin = 0
+        for chunk in np.flatnonzero(opcodes == _OP_CHUNK).tolist() + [opcodes.size]:
+            offs, _ = _channel_messages(buf, opcodes[begin:chunk], offsets[begin:chunk], lengths[begin:chunk],
+                                        channel_id, path)  # messages outside chunks
+            if offs.size:
+                yield _log_times(buf, offs)
+            if chunk == opcodes.size:
+                break
+            end = chunk + 1
+            while end < opcodes.size and opcodes[end] == _OP_MESSAGE_INDEX:
+                end += 1
+            stamps = None
+            if chunk + 1 < end and (end < opcodes.size or last):  # its index records, none cut off by the window
+                stamps = _indexed_stamps(buf, offsets[chunk + 1:end], lengths[chunk + 1:end], channel_id)
+            if stamps is None:
+                raw = _decompress(data[offsets[chunk]:offsets[chunk] + lengths[chunk]], path)
+                inner = np.frombuffer(raw, np.uint8)
+                ops, offs, lens, stop = scan_records(inner, 0, inner.size)
+                if stop != inner.size:
+                    raise LogError(path, "corrupt MCAP file: a chunk holds a partial record")
+                stamps = _log_times(inner, _channel_messages(inner, ops, offs, lens, channel_id, path)[0])
+            if stamps.size:
+                yield stamps
+            begin = end
+
+
+def _indexed_stamps(buf, offsets, lengths, channel_id: int) -> np.ndarray | None:
+    """A chunk's ``log_time`` values of one channel from its message-index records, in storage order.
+
+    Returns None when a record is malformed (then the chunk is read instead).
+    """
+    pairs = []
+    for offset, length in zip(offsets.tolist(), lengths.tolist()):
+        if length < 6:
+            return None
+        size = int.from_bytes(bytes(buf[offset + 2:offset + 6]), "little")
+        if size % 16 or 6 + size != length:
+            return None
+        if int(buf[offset]) | int(buf[offset + 1]) << 8 == channel_id:
+            pairs.append(np.frombuffer(bytes(buf[offset + 6:offset + length]), "<u8").reshape(-1, 2))
+    if not pairs:
+        return np.empty(0, np.uint64)
+    pairs = np.concatenate(pairs)
+    return pairs[np.argsort(pairs[:, 1], kind="stable"), 0].astype(np.uint64)
 
 
 def _resolve_channel(channels: Mapping[int, _Channel], topic: str | None, axis: str | None,
@@ -696,6 +768,7 @@ class McapLog:
         self.axis = self._select if self._select is not None else self._fields["axis"]
         self.n_samples = None
         self._span = None
+        self._digest = None  # (count, sum of log_time) of the messages, from the first pass of times()
         first = next(self.blocks(2), None)
         if first is None:
             raise LogError(self.path, f"channel '{self._channel.topic}' has no messages")
@@ -703,18 +776,17 @@ class McapLog:
 
     def times(self) -> Iterator[np.ndarray]:
         """The message times [s] of the channel, as they come in the file (messages not parsed)."""
-        collector = _MessageCollector(self.path)
-        count, first, last = 0, None, None
-        for rows in _messages(self.path, self._topic, {}, collector, stamps_only=True):
-            if rows:
-                stamps = collector.take_stamps()
-                if np.any(stamps[1:] < stamps[:-1]) or (last is not None and stamps[0] < last):
-                    raise CannotStream(f"{self.path}: messages not stored in time order")
-                first = stamps[0] if first is None else first
-                last = stamps[-1]
-                count += stamps.size
-                yield stamps * 1e-9
+        count, first, last, total = 0, None, None, np.uint64(0)
+        for stamps in _channel_stamps(self.path, self._channel.id):
+            if np.any(stamps[1:] < stamps[:-1]) or (last is not None and stamps[0] < last):
+                raise CannotStream(f"{self.path}: messages not stored in time order")
+            first = stamps[0] if first is None else first
+            last = stamps[-1]
+            count += stamps.size
+            total += np.sum(stamps, dtype=np.uint64)
+            yield stamps * 1e-9
         self.n_samples, self._span = count, (None if first is None else (first * 1e-9, last * 1e-9))
+        self._digest = (count, total)
 
     def time_span(self) -> tuple[float, float]:
         """Times of the first and the last sample [s] (after a pass of :meth:`times`)."""
@@ -736,11 +808,19 @@ class McapLog:
 
     def _pieces(self, size: int) -> Iterator[AxisLog]:
         collector = _MessageCollector(self.path)
+        count, total = 0, np.uint64(0)
         for rows in _messages(self.path, self._topic, {}, collector):
             if rows >= size:
-                yield self._convert(*collector.columns())
+                stamps, table = collector.columns()
+                count, total = count + stamps.size, total + np.sum(stamps, dtype=np.uint64)
+                yield self._convert(stamps, table)
         if collector.rows:
-            yield self._convert(*collector.columns())
+            stamps, table = collector.columns()
+            count, total = count + stamps.size, total + np.sum(stamps, dtype=np.uint64)
+            yield self._convert(stamps, table)
+        if self._digest is not None and (count, total) != self._digest:  # raised before the output is kept
+            raise LogError(self.path, f"corrupt MCAP file: the message index gives {self._digest[0]} messages of "
+                                      f"channel '{self._channel.topic}' (or other times) where {count} are stored")
 
     def _convert(self, stamps: np.ndarray, table: dict) -> AxisLog:
         return log_from_columns(table, source=self.path, columns=self.columns, time=stamps * 1e-9,
