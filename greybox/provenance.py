@@ -49,7 +49,9 @@ def provenance() -> dict:
 
 
 def provenance_line(info: dict | None = None) -> str:
-    """One line for text and Markdown reports, e.g. ``greybox 0.1.0, Python 3.11.7, 2 cores, numpy 2.4.6, ...``.
+    """One line for text and Markdown reports.
+
+    For example ``greybox 0.1.0, Python 3.11.7, Linux 6.1 x86_64, 2 cores; numpy 2.4.6, ...``.
 
     Parameters
     ----------

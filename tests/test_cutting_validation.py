@@ -95,3 +95,13 @@ def test_existing_outputs_are_kept_without_force(tmp_path):
         cutting_validation(DATA, AXIS_CONFIG, kinds=("coulomb",), strengths=(0.5,), strength=0.5,
                            plot_dir=tmp_path / "figures")
     assert existing.read_text() == "mine"
+
+
+def test_a_detail_strength_outside_the_case_is_refused_before_any_prediction():
+    from types import SimpleNamespace
+
+    from greybox.studies.cutting import evaluate_model
+
+    case = SimpleNamespace(strengths=(0.25, 0.5, 1.0))  # nothing else is read before the check
+    with pytest.raises(ValueError, match=r"detail_strength 0.75 A is not one of the case's cut strengths \(0.25"):
+        evaluate_model("gms", None, case, None, 0.75, 0.95, 60.0)

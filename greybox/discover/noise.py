@@ -90,7 +90,7 @@ class ResidualNoise:
     innovation_std : float
         Standard deviation of ``w`` (the normalised process has unit variance).
     levels : tuple of ndarray
-        Local level ``s`` [A] of each run.
+        Local level ``s`` of each run, in the unit of the residual (A for a current log, N or Nm for a load log).
     ar_covariance : ndarray, shape (p, p)
         Covariance of the fitted coefficients (zeros: treat them as exact).
     """
@@ -103,7 +103,7 @@ class ResidualNoise:
     @classmethod
     def fit(cls, residuals: Sequence[np.ndarray], sample_times: Sequence[float], *, max_order: int = 20,
             level_window_s: float = 1.0) -> "ResidualNoise":
-        """Fit to the residual of each run [A].
+        """Fit to the residual of each run (in the log's effort unit: A, N or Nm).
 
         Parameters
         ----------
@@ -170,7 +170,7 @@ class ResidualNoise:
         return draws
 
     def simulate(self, n_replicates: int, rng: np.random.Generator) -> list[np.ndarray]:
-        """Simulated noise, one array ``(n_i, n_replicates)`` per run [A].
+        """Simulated noise, one array ``(n_i, n_replicates)`` per run, in the unit of the fitted residual.
 
         Each replicate has its own coefficients (:meth:`draw_coefficients`),
         the same in every run, and unit variance before the level is applied.
@@ -195,7 +195,7 @@ class ResidualNoise:
         return out
 
     def describe(self) -> dict:
-        """Summary for reports: AR order, lag-1 correlation, RMS of the level [A]."""
+        """Summary for reports: AR order, lag-1 correlation, RMS of the level (unit of the residual)."""
         level = np.concatenate(self.levels)
         return {"ar_order": int(self.ar.size), "lag1_correlation": self.lag1_correlation,
                 "rms": float(np.sqrt(np.mean(level ** 2)))}

@@ -139,7 +139,15 @@ def evaluate_model(kind: str, model, case: CuttingCase, config, detail_strength:
         Correlation target of recovered and true process current.
     chunk_s : float
         Chunk length of the prediction [s].
+
+    Raises
+    ------
+    ValueError
+        If ``detail_strength`` is not one of ``case.strengths`` (before any prediction).
     """
+    if not np.any(np.isclose(case.strengths, detail_strength)):
+        raise ValueError(f"detail_strength {detail_strength:g} A is not one of the case's cut strengths "
+                         f"({', '.join(f'{s:g}' for s in case.strengths)} A)")
     factor = config.load_constants[0]  # the cuts oppose the motion: driving
     air_residual = case.air.current - predict_chunked(model, case.air, chunk_s=chunk_s)
     air_test = rmse(case.shipped.current, predict_chunked(model, case.shipped, chunk_s=chunk_s))

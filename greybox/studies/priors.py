@@ -36,7 +36,7 @@ from ..models.gmssvr import GMSSVRModel
 from ..twin.family import draw_member, member_dataset
 from .experiments import MODEL_SETTINGS
 
-__all__ = ["CANDIDATES", "DEFAULT", "EQUIVALENT", "score_member", "run_prior_study"]
+__all__ = ["CANDIDATES", "DEFAULT", "EQUIVALENT", "TRAIN_SHARE", "score_member", "run_prior_study"]
 
 #: Candidate priors: name -> (target, gamma interval, or None for the default search intervals).
 CANDIDATES = {
@@ -57,12 +57,15 @@ DEFAULT = "residual, gamma >= 0.01"
 #: then kept (no change of a default without evidence for it).
 EQUIVALENT = 0.01
 
+#: Share of dataset A (from its start) both stages are fitted on; the rest of A and B score the candidates.
+TRAIN_SHARE = 0.75
+
 
 def _ratio(log, predicted) -> float:
     return relative_error(log.effort, predicted) / relative_error(log.effort, log.extras[TRUTH_CHANNEL])
 
 
-def score_member(index: int, family_seed: int, *, train_share: float = 0.75) -> dict:
+def score_member(index: int, family_seed: int, *, train_share: float = TRAIN_SHARE) -> dict:
     """Scores of every candidate on one family member's training runs.
 
     Both stages are fitted on the first ``train_share`` of dataset A; each
@@ -76,7 +79,7 @@ def score_member(index: int, family_seed: int, *, train_share: float = 0.75) -> 
         Member index.
     family_seed : int
         Family seed (a development family's, not one a study reports).
-    train_share : float, default 0.75
+    train_share : float, default :data:`TRAIN_SHARE`
         Share of dataset A's duration, from its start, that both stages are fitted on.
     """
     started = time.perf_counter()
@@ -141,7 +144,8 @@ def run_prior_study(json_path: str | os.PathLike, *, members: int = 12, family_s
     summary = {name: {key: {"median": float(np.median([r["scores"][name][key] for r in rows])),
                             "p90": float(np.quantile([r["scores"][name][key] for r in rows], 0.9))}
                       for key in ("A_tail", "B", "mean")} for name in CANDIDATES}
-    result = {"settings": {"family_seed": family_seed, "members": members, "train": "first 75 % of A",
+    result = {"settings": {"family_seed": family_seed, "members": members,
+                           "train": f"first {100 * TRAIN_SHARE:g} % of A",
                            "scored_on": "rest of A, and B", "model_settings": MODEL_SETTINGS["gmssvr"]},
               "summary": summary, **_choice(summary), "members": rows, "seconds": time.perf_counter() - started}
     write_text_atomic(json_path, json.dumps(result, indent=1) + "\n")
