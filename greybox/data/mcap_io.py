@@ -494,15 +494,20 @@ def _expand(buf, data: bytes, opcodes, offsets, lengths, path):
                     ahead = chunks[number + _CHUNKS_AHEAD]
                     pending.append(pool.submit(_decompress, data[offsets[ahead]:offsets[ahead] + lengths[ahead]],
                                                path))
-                inner = np.frombuffer(raw, np.uint8)
-                ops, offs, lens, end = scan_records(inner, 0, inner.size)
-                if end != inner.size:
-                    raise LogError(path, "corrupt MCAP file: a chunk holds a partial record")
-                yield inner, ops, offs, lens
+                yield _chunk_records(raw, path)
             begin = index + 1
     finally:
         for future in pending:
             future.cancel()
+
+
+def _chunk_records(raw: bytes, path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(buffer, opcodes, offsets, lengths) of the records of a decompressed chunk, which must hold whole records."""
+    inner = np.frombuffer(raw, np.uint8)
+    opcodes, offsets, lengths, end = scan_records(inner, 0, inner.size)
+    if end != inner.size:
+        raise LogError(path, "corrupt MCAP file: a chunk holds a partial record")
+    return inner, opcodes, offsets, lengths
 
 
 def _collect(path, topic: str | None) -> tuple[dict[int, _Channel], _MessageCollector]:
@@ -567,11 +572,8 @@ def _channel_stamps(path, channel_id: int) -> Iterator[np.ndarray]:
             if chunk + 1 < end and (end < opcodes.size or last):  # its index records, none cut off by the window
                 stamps = _indexed_stamps(buf, offsets[chunk + 1:end], lengths[chunk + 1:end], channel_id)
             if stamps is None:
-                raw = _decompress(data[offsets[chunk]:offsets[chunk] + lengths[chunk]], path)
-                inner = np.frombuffer(raw, np.uint8)
-                ops, offs, lens, stop = scan_records(inner, 0, inner.size)
-                if stop != inner.size:
-                    raise LogError(path, "corrupt MCAP file: a chunk holds a partial record")
+                inner, ops, offs, lens = _chunk_records(
+                    _decompress(data[offsets[chunk]:offsets[chunk] + lengths[chunk]], path), path)
                 stamps = _log_times(inner, _channel_messages(inner, ops, offs, lens, channel_id, path)[0])
             if stamps.size:
                 yield stamps
@@ -808,14 +810,16 @@ class McapLog:
 
     def _pieces(self, size: int) -> Iterator[AxisLog]:
         collector = _MessageCollector(self.path)
+
+        def batches():
+            for rows in _messages(self.path, self._topic, {}, collector):
+                if rows >= size:
+                    yield collector.columns()
+            if collector.rows:
+                yield collector.columns()
+
         count, total = 0, np.uint64(0)
-        for rows in _messages(self.path, self._topic, {}, collector):
-            if rows >= size:
-                stamps, table = collector.columns()
-                count, total = count + stamps.size, total + np.sum(stamps, dtype=np.uint64)
-                yield self._convert(stamps, table)
-        if collector.rows:
-            stamps, table = collector.columns()
+        for stamps, table in batches():
             count, total = count + stamps.size, total + np.sum(stamps, dtype=np.uint64)
             yield self._convert(stamps, table)
         if self._digest is not None and (count, total) != self._digest:  # raised before the output is kept
