@@ -208,6 +208,23 @@ def test_streamed_predict_writes_what_the_whole_log_gives(tmp_path, capsys, logs
     assert figures and figures == [line for line in streamed_text.splitlines() if line.startswith("  ")]
 
 
+@pytest.mark.parametrize("suffix", [".mcap", ".parquet"])
+@pytest.mark.parametrize("problem, message", [("missing", "no such file"), ("empty", "empty file"),
+                                              ("directory", "no log file")])
+def test_a_log_that_is_not_a_file_is_one_line_as_when_read_whole(tmp_path, capsys, models, suffix, problem,
+                                                                  message):
+    log = tmp_path / f"log{suffix}"
+    if problem == "empty":
+        log.write_bytes(b"")
+    elif problem == "directory":
+        log.mkdir()
+    out = tmp_path / "out.parquet"
+    assert cli.main(["predict", str(models["gms"]), str(log), "--out", str(out), "--quiet"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert message in error and str(log) in error and len(error.splitlines()) == 1
+    assert not out.exists()
+
+
 def test_streamed_predict_leaves_no_output_on_a_damaged_log(tmp_path, capsys, models):
     log = make_dataset("X", "C", seed=6, duration_s=30, cutting=True)
     effort = log.effort.copy()

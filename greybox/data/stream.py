@@ -59,7 +59,8 @@ def open_stream(path, *, columns: Mapping[str, str] | None = None, topic: str | 
     the log is to be read whole.
 
     Read whole: formats other than Parquet and MCAP, logs to be given a sample time or resampled, a
-    Parquet log with a topic (to be refused where it is read), and rotary axes (a modulo axis is unwrapped
+    Parquet log with a topic (to be refused where it is read), a path that is not a non-empty file (the
+    error is given where it is read), and rotary axes (a modulo axis is unwrapped
     over the whole log).
 
     Parameters
@@ -88,6 +89,8 @@ def open_stream(path, *, columns: Mapping[str, str] | None = None, topic: str | 
     if suffix not in STREAM_SUFFIXES or sample_time is not None or resample is not None or \
             (topic is not None and suffix != ".mcap"):
         return None
+    if not os.path.isfile(path) or os.path.getsize(path) == 0:
+        return None  # missing, a directory or empty: read_log names the problem
     if suffix == ".mcap":
         from .mcap_io import McapLog
 
