@@ -12,9 +12,11 @@ figures of the README)::
 The JSON is rewritten after every member, so a long run can be followed.
 ``--choose-priors`` instead scores the GMS+SVR prior candidates on the training
 runs (fit on three quarters of A, score on the rest of A and on B) of a
-development family (:mod:`greybox.studies.priors`)::
+development family (:mod:`greybox.studies.priors`); with ``--model svr`` the
+sole SVR's kernel candidates::
 
     python scripts/family_study.py --choose-priors --members 12 --seed 1 --workers 2 --json priors.json
+    python scripts/family_study.py --choose-priors --model svr --members 12 --seed 1 --workers 2 --json svr.json
 """
 
 from __future__ import annotations
@@ -36,6 +38,8 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument("--markdown", metavar="MD", help="the tables")
     parser.add_argument("--choose-priors", action="store_true",
                         help="score the GMS+SVR prior candidates on the training runs A and B instead")
+    parser.add_argument("--model", choices=("gmssvr", "svr"), default="gmssvr",
+                        help="with --choose-priors: the study, GMS+SVR's priors or the sole SVR's kernel")
     return parser.parse_args(argv)
 
 
@@ -43,7 +47,7 @@ def main(argv=None) -> int:
     args = parse_args(argv)
     if args.choose_priors:
         result = run_prior_study(args.json, members=args.members, family_seed=args.seed, workers=args.workers,
-                                 progress=lambda line: print(line, flush=True))
+                                 model=args.model, progress=lambda line: print(line, flush=True))
         for name, cell in result["summary"].items():
             print(f"{name}: RE / noise floor, median (p90): rest of A {cell['A_tail']['median']:.3f} "
                   f"({cell['A_tail']['p90']:.3f}), B {cell['B']['median']:.3f} ({cell['B']['p90']:.3f}), "

@@ -76,3 +76,23 @@ def test_members_run_in_order_and_the_json_holds_every_row(tmp_path):
     saved = json.loads(path.read_text())
     assert saved["settings"] == {"what": "squares"} and [r["index"] for r in saved["members"]] == [3, 1, 2]
     assert saved["summary"] == summary
+
+
+def test_the_sole_svr_study_keeps_its_own_default_and_scores_both_kernels(monkeypatch):
+    def summary(scores):
+        return {name: {"mean": {"median": score}} for name, score in scores.items()}
+
+    other = [name for name in priors.SVR_CANDIDATES if name != priors.SVR_DEFAULT][0]
+    close = priors._choice(summary({priors.SVR_DEFAULT: 1.005, other: 1.0}), priors.SVR_DEFAULT)
+    assert close["chosen"] == priors.SVR_DEFAULT
+    assert priors._choice(summary({priors.SVR_DEFAULT: 1.05, other: 1.0}), priors.SVR_DEFAULT)["chosen"] == other
+    with pytest.raises(ValueError, match="model must be one of gmssvr, svr"):
+        priors.run_prior_study("unused.json", model="lugre")
+
+    monkeypatch.setitem(priors.MODEL_SETTINGS, "svr", QUICK_SETTINGS["svr"])
+    row = priors.score_member(3, 1, model="svr")
+    assert set(row["scores"]) == set(priors.SVR_CANDIDATES)
+    for cell in row["scores"].values():
+        assert cell["A_tail"] > 0.97 and cell["B"] > 0.97  # no model beats the noise
+        assert cell["mean"] == pytest.approx(0.5 * (cell["A_tail"] + cell["B"]))
+    assert row["scores"][priors.SVR_DEFAULT] != row["scores"][other]

@@ -150,9 +150,11 @@ def test_noise_floor_ratio():
 def test_hyperparameter_table_like_table_2():
     row = {"experiment": 1, "axis": "X", "model": "gmssvr", "kernel": "rbf", "epsilon": 0.01234, "C": 5.0,
            "gamma": 0.5, "n_support": 321, "n_train": 1000, "optimised": ["epsilon", "C", "gamma"], "cv_rmse": 0.08}
-    table = hyperparameter_table([row])
-    assert table.header[3:7] == ["kernel", "epsilon [A]", "C [A]", "gamma"]
-    assert table.rows[0][3:7] == ["Gaussian (RBF)", "0.01234", "5", "0.5"]
+    sole = {**row, "model": "svr", "velocity_weight": 312.5}
+    table = hyperparameter_table([row, sole])
+    assert table.header[3:8] == ["kernel", "epsilon [A]", "C [A]", "gamma", "velocity weight"]
+    assert table.rows[0][3:8] == ["Gaussian (RBF)", "0.01234", "5", "0.5", "–"]
+    assert table.rows[1][7] == "312.5"
 
 
 def test_report_tables_and_files(tmp_path):

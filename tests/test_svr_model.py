@@ -83,7 +83,7 @@ def test_bayesian_optimisation_chooses_free_hyperparameters_within_bounds():
     model = SVRCurrentModel(C=3.0, n_subset=250, n_calls=5, cv_folds=2, cv_blocks=6).fit(train)
     table = model.hyperparameters_table()
     assert table["kernel"] == "rbf" and table["C"] == 3.0
-    assert table["optimised"] == ["epsilon", "gamma"]
+    assert table["optimised"] == ["epsilon", "gamma", "velocity_weight"]
     assert len(model.search_history_) == 5
     target = np.concatenate([r.current - model.J_ * r.acceleration for r in train]) - model.offset_
     bounds = default_bounds(np.std(target))
@@ -110,8 +110,8 @@ def test_an_optimum_at_the_end_of_its_interval_is_reported():
     assert not _near_bound(10.0, (1.0, 100.0))
     train = [sweep_run(1, n=2000), sweep_run(2, n=2000)]
     # An interval too narrow to leave its ends: whatever is chosen sits at one.
-    model = SVRCurrentModel(C=3.0, epsilon=0.01, n_subset=150, n_calls=2, cv_folds=2, cv_blocks=4,
-                            bounds={"gamma": (0.5, 0.5000001)})
+    model = SVRCurrentModel(C=3.0, epsilon=0.01, velocity_weight=1.0, n_subset=150, n_calls=2, cv_folds=2,
+                            cv_blocks=4, bounds={"gamma": (0.5, 0.5000001)})
     with pytest.warns(UserWarning, match="gamma = 0.5 ended at the end of its search interval"):
         model.fit(train)
     assert model.hyperparameters_table()["at_bounds"] == ["gamma"]
@@ -127,3 +127,61 @@ def test_bad_settings_are_refused_with_a_clear_error():
         SVRCurrentModel(C=-1.0, optimize=False).fit(run)
     with pytest.raises(ParameterError, match="random_state"):
         SVRCurrentModel(random_state=None, optimize=False).fit(run)
+
+
+def test_velocity_weight_is_an_anisotropic_kernel_in_the_standardised_plane():
+    from sklearn.svm import SVR
+
+    run = sweep_run(1, n=3000)
+    weight = 16.0
+    model = SVRCurrentModel(**{**FIXED, "n_subset": 3000}, velocity_weight=weight).fit(run)
+    # libsvm on the standardised inputs with the velocity column stretched by sqrt(weight): the same model.
+    X = np.column_stack((run.position, run.velocity))
+    scaled = (X - X.mean(axis=0)) / X.std(axis=0) * np.array([1.0, np.sqrt(weight)])
+    target = run.current - model.J_ * run.acceleration - model.offset_
+    reference = SVR(C=FIXED["C"], epsilon=FIXED["epsilon"], gamma=FIXED["gamma"]).fit(scaled, target)
+    test = sweep_run(3, n=1000)
+    X_test = np.column_stack((test.position, test.velocity))
+    expected = reference.predict((X_test - X.mean(axis=0)) / X.std(axis=0) * np.array([1.0, np.sqrt(weight)]))
+    np.testing.assert_allclose(model.friction(test), expected, atol=1e-9)
+    np.testing.assert_array_equal(model.input_weights_, [1.0, weight])
+    assert model.hyperparameters_table()["velocity_weight"] == weight
+    assert {row.name: row.value for row in model.parameter_table()}["velocity_weight"] == weight
+    isotropic = SVRCurrentModel(**{**FIXED, "n_subset": 3000}).fit(run)  # not optimised: weight 1
+    np.testing.assert_array_equal(isotropic.input_weights_, [1.0, 1.0])
+    assert np.max(np.abs(isotropic.friction(test) - model.friction(test))) > 0.01
+
+
+def step_run(seed, n=4000, dt=0.002):
+    """A Coulomb step in velocity over a gentle position trend: the kernel must be narrow in v, wide in p."""
+    rng = np.random.default_rng(seed)
+    t, p, v, a = multisine_motion(rng, n, dt)
+    current = J_TRUE * a + 0.8 * np.sign(v) * (1.0 + p / 2000.0) + 0.01 * rng.standard_normal(n)
+    return AxisLog(time=t, position=p, effort=current, velocity=v, acceleration=a)
+
+
+@pytest.mark.filterwarnings("ignore:SVR hyperparameters:UserWarning")  # a pure step: the weight may reach its top
+def test_a_searched_velocity_weight_narrows_the_kernel_across_the_coulomb_step():
+    from greybox.models.svr import WEIGHT_BOUNDS
+
+    train = [step_run(1), step_run(2)]
+    settings = dict(n_subset=600, n_calls=12, cv_folds=2, cv_blocks=8)
+    searched = SVRCurrentModel(velocity_weight=None, **settings).fit(train)
+    isotropic = SVRCurrentModel(velocity_weight=1.0, **settings).fit(train)
+    assert "velocity_weight" in searched.optimised_ and "velocity_weight" not in isotropic.optimised_
+    weight = searched.hyperparameters_table()["velocity_weight"]
+    assert 1.0 < weight <= WEIGHT_BOUNDS[1]
+    assert all(WEIGHT_BOUNDS[0] <= h["velocity_weight"] <= WEIGHT_BOUNDS[1] for h in searched.search_history_)
+    test = step_run(3)
+    assert rmse(searched.predict(test), test.current) < 0.8 * rmse(isotropic.predict(test), test.current)
+
+
+def test_bad_velocity_weights_are_refused():
+    from greybox.errors import ParameterError
+
+    run = sweep_run(1, n=500)
+    for weight in (0.0, -1.0, float("nan"), "wide"):
+        with pytest.raises(ParameterError, match="velocity_weight must be positive"):
+            SVRCurrentModel(velocity_weight=weight, optimize=False).fit(run)
+    with pytest.raises(ParameterError, match="bounds of 'velocity_weight' must satisfy"):
+        SVRCurrentModel(velocity_weight=None, bounds={"velocity_weight": (10.0, 1.0)}).fit(run)

@@ -37,3 +37,43 @@ def test_grey_box_model_with_nested_gms_stage_round_trips(tmp_path, monkeypatch,
     test = gms_run(2, n=2000)
     np.testing.assert_array_equal(loaded.predict(test), model.predict(test))
     np.testing.assert_array_equal(loaded.states(test)[0], model.states(test)[0])
+
+
+def test_the_kernel_weights_round_trip_and_a_file_with_bad_ones_is_refused(tmp_path, monkeypatch):
+    import json
+    import zipfile
+
+    from greybox.errors import ModelFileError
+
+    monkeypatch.setitem(registry.MODEL_CLASSES, "svr", SVRCurrentModel)
+    model = SVRCurrentModel(**FIXED, velocity_weight=9.0).fit(sweep_run(1))
+    path = persistence.save_model(model, tmp_path / "svr.gbm")
+    loaded = persistence.load_model(path)
+    np.testing.assert_array_equal(loaded.input_weights_, [1.0, 9.0])
+    test = sweep_run(3, n=1000)
+    np.testing.assert_array_equal(loaded.predict(test), model.predict(test))
+
+    with zipfile.ZipFile(path) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    member = json.loads(members["model.json"])["model"]["attributes"]["input_weights_"]["__ndarray__"]
+    for bad in ([1.0, -9.0], [1.0, 9.0, 1.0]):
+        buffer = __import__("io").BytesIO()
+        np.save(buffer, np.array(bad), allow_pickle=False)
+        hostile = tmp_path / f"hostile_{len(bad)}_{bad[1]:g}.gbm"
+        with zipfile.ZipFile(hostile, "w") as archive:
+            for name, data in members.items():
+                archive.writestr(name, buffer.getvalue() if name == member else data)
+        with pytest.raises(ModelFileError, match="input_weights_ must hold one positive weight per input"):
+            persistence.load_model(hostile)
+
+
+def test_a_file_from_before_the_kernel_weights_predicts_with_the_isotropic_kernel(tmp_path, monkeypatch):
+    monkeypatch.setitem(registry.MODEL_CLASSES, "svr", SVRCurrentModel)
+    model = SVRCurrentModel(**FIXED).fit(sweep_run(1))
+    test = sweep_run(3, n=1000)
+    expected = model.predict(test)
+    del model.input_weights_
+    loaded = persistence.load_model(persistence.save_model(model, tmp_path / "old.gbm"))
+    assert not hasattr(loaded, "input_weights_")
+    np.testing.assert_array_equal(loaded.predict(test), expected)
+    assert loaded.hyperparameters_table()["velocity_weight"] == 1.0

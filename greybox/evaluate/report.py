@@ -265,30 +265,33 @@ def experiment_table(records: Sequence[Mapping], experiment: int, *, title: str 
 
 
 def hyperparameter_table(rows: Sequence[Mapping]) -> Table:
-    """The SVR settings like the paper's Table 2: kernel, epsilon, C and gamma.
+    """The SVR settings like the paper's Table 2: kernel, epsilon, C, gamma and the sole SVR's velocity weight.
 
     Parameters
     ----------
     rows : sequence of dict
         ``experiment``, ``axis``, ``model`` and the keys of a model's
         ``hyperparameters_table()`` (``kernel``, ``epsilon`` [A], ``C`` [A],
-        ``gamma``, ``n_support``, ``n_train``, ``optimised``, ``cv_rmse`` [A]).
+        ``gamma``, ``n_support``, ``n_train``, ``optimised``, ``cv_rmse`` [A],
+        and for the sole SVR ``velocity_weight``).
 
     Returns
     -------
     Table
     """
-    header = ["experiment", "axis", "model", "kernel", "epsilon [A]", "C [A]", "gamma",
+    header = ["experiment", "axis", "model", "kernel", "epsilon [A]", "C [A]", "gamma", "velocity weight",
               "support vectors", "training samples", "CV RMSE [A]", "optimised"]
     body = []
     for row in rows:
         body.append([str(row.get("experiment", "")), str(row.get("axis", "")), _label(row.get("model", "")),
                      "Gaussian (RBF)" if row.get("kernel") == "rbf" else str(row.get("kernel", "")),
                      f"{row['epsilon']:.4g}", f"{row['C']:.4g}", f"{row['gamma']:.4g}",
+                     f"{row['velocity_weight']:.4g}" if "velocity_weight" in row else "–",
                      str(row.get("n_support", "")), str(row.get("n_train", "")),
                      _number(row.get("cv_rmse"), 4), ", ".join(row.get("optimised", [])) or "none"])
     notes = ["gamma in 1/(standardised unit)^2: every SVR input is standardised (zero mean, unit variance) "
-             "over the training data. Hyperparameters chosen by Bayesian optimisation (log-uniform priors) "
+             "over the training data. The sole SVR's kernel weighs the squared velocity distance by its velocity "
+             "weight (1: isotropic). Hyperparameters chosen by Bayesian optimisation (log-uniform priors) "
              "over a time-blocked cross-validation, as the paper's Table 2 reports them."]
     return Table("SVR hyperparameters (paper's Table 2)", header, body, notes)
 

@@ -61,6 +61,11 @@ __all__ = [
 #: Names of the SVR hyperparameters, in the order of the paper's Table 2.
 HYPERPARAMETERS = ("epsilon", "C", "gamma")
 
+#: Search interval of an input weight (see ``weighted`` of :func:`fit_svr_expansion`): the weight multiplies
+#: the input's squared standardised distance in the kernel, so 1e4 makes the kernel 100 times narrower in
+#: that input than in the unweighted ones, 1e-2 ten times wider.
+WEIGHT_BOUNDS = (1e-2, 1e4)
+
 #: At most this many test samples per cross-validation fold are predicted
 #: (an even stride through the fold), to bound the cost of one evaluation.
 MAX_TEST_SAMPLES_PER_FOLD = 20_000
@@ -125,6 +130,11 @@ class SVRExpansion:
         outside it.
     n_train : int
         Number of training samples (the subset).
+    input_weights : ndarray, shape (n_features,)
+        Weight of each input's squared standardised distance in the kernel,
+        ``K(x, x') = exp(-gamma sum_d w_d (x_d - x'_d)^2)``; the support
+        vectors are stored multiplied by ``sqrt(w)``. Ones unless some inputs
+        were weighted.
     """
 
     input_mean: np.ndarray
@@ -138,6 +148,7 @@ class SVRExpansion:
     history: list[dict[str, float]] = field(default_factory=list)
     at_bounds: list[str] = field(default_factory=list)
     n_train: int = 0
+    input_weights: np.ndarray | None = None
 
 
 def _train(X, y, hyper: Mapping[str, float]):
@@ -165,6 +176,7 @@ def fit_svr_expansion(
     random_state: int,
     progress: Callable[[ProgressEvent], None] | None = None,
     stage: str = "SVR hyperparameters",
+    weighted: Mapping[str, int] | None = None,
 ) -> SVRExpansion:
     """Standardise, choose hyperparameters, train on a covering subset.
 
@@ -180,8 +192,9 @@ def fit_svr_expansion(
     run_lengths : sequence of int
         Samples per run, so that cross-validation blocks never span runs.
     fixed : dict
-        ``{name: value or None}`` for ``epsilon``, ``C``, ``gamma``; a value
-        is kept as given, ``None`` is optimised (or defaulted, see below).
+        ``{name: value or None}`` for ``epsilon``, ``C``, ``gamma`` and the
+        names of ``weighted``; a value is kept as given, ``None`` is optimised
+        (or defaulted, see below).
     n_subset : int
         Training samples (in every fold and in the final fit).
     optimize : bool
@@ -200,6 +213,12 @@ def fit_svr_expansion(
         evaluation; its cost is the CV mean squared error over ``var(y)``.
     stage : str
         Stage name in the progress events.
+    weighted : dict, optional
+        ``{name: column}``: input columns whose squared standardised distance
+        the kernel weighs by a hyperparameter of that name (an anisotropic
+        Gaussian kernel; the unweighted columns have weight 1, and ``gamma``
+        sets the overall width). Searched over :data:`WEIGHT_BOUNDS` in log
+        scale when optimised, 1 when defaulted.
 
     Returns
     -------
@@ -217,11 +236,23 @@ def fit_svr_expansion(
     target_std = float(np.std(y))
     variance = target_std**2 if target_std > 0 else 1.0
 
-    unknown = [name for name in list(fixed) + list(bounds or {}) if name not in HYPERPARAMETERS]
+    weighted = dict(weighted or {})
+    if any(not 0 <= column < n_features for column in weighted.values()):
+        raise ParameterError(f"weighted names input columns {sorted(weighted.values())}; the inputs have "
+                             f"{n_features} columns")
+    names = HYPERPARAMETERS + tuple(weighted)
+    unknown = [name for name in list(fixed) + list(bounds or {}) if name not in names]
     if unknown:
-        raise ParameterError(f"unknown SVR hyperparameter(s) {unknown}; expected {HYPERPARAMETERS}")
+        raise ParameterError(f"unknown SVR hyperparameter(s) {unknown}; expected {names}")
+
+    def weights(values: Mapping[str, float]) -> np.ndarray:
+        out = np.ones(n_features)
+        for name, column in weighted.items():
+            out[column] = values[name]
+        return out
+
     hyper: dict[str, float] = {}
-    for name in HYPERPARAMETERS:
+    for name in names:
         value = fixed.get(name)
         if value is not None:
             smallest_allowed = 0.0 if name == "epsilon" else np.nextafter(0.0, 1.0)
@@ -229,14 +260,14 @@ def fit_svr_expansion(
                 kind = "non-negative" if name == "epsilon" else "positive"
                 raise ParameterError(f"SVR hyperparameter {name} must be {kind} and finite, got {value}")
             hyper[name] = float(value)
-    free = [name for name in HYPERPARAMETERS if name not in hyper]
+    free = [name for name in names if name not in hyper]
 
     history: list[dict[str, float]] = []
     cv_rmse = float("nan")
     optimised: list[str] = []
     at_bounds: list[str] = []
     if optimize and free:
-        search = dict(default_bounds(target_std))
+        search = {**default_bounds(target_std), **{name: WEIGHT_BOUNDS for name in weighted}}
         search.update(bounds or {})
         folds = blocked_folds(run_lengths, n_folds=cv_folds, n_blocks=cv_blocks)
         prepared = []
@@ -249,10 +280,11 @@ def fit_svr_expansion(
 
         def objective(params: dict[str, float]) -> float:
             trial = {**hyper, **params}
+            Xw = Xs * np.sqrt(weights(trial)) if weighted else Xs
             squared, count = 0.0, 0
             for chosen, test in prepared:
-                sv, alpha, b = _train(Xs[chosen], y[chosen], trial)
-                error = rbf_expansion(Xs[test], sv, alpha, b, trial["gamma"]) - y[test]
+                sv, alpha, b = _train(Xw[chosen], y[chosen], trial)
+                error = rbf_expansion(Xw[test], sv, alpha, b, trial["gamma"]) - y[test]
                 squared += float(error @ error)
                 count += test.size
             return float(np.sqrt(squared / count))
@@ -279,26 +311,29 @@ def fit_svr_expansion(
                 UserWarning, stacklevel=3)
     else:
         for name in free:
-            hyper[name] = _default_value(name, target_std, n_features)
+            hyper[name] = 1.0 if name in weighted else _default_value(name, target_std, n_features)
 
     chosen = coverage_subset(coverage, n_subset, random_state=random_state)
-    sv, alpha, b = _train(Xs[chosen], y[chosen], hyper)
+    input_weights = weights(hyper)
+    sv, alpha, b = _train(Xs[chosen] * np.sqrt(input_weights), y[chosen], hyper)
     return SVRExpansion(
         input_mean=mean, input_scale=scale, support_vectors=sv, dual_coef=alpha, intercept=b,
-        hyperparameters={name: hyper[name] for name in HYPERPARAMETERS}, optimised=optimised,
+        hyperparameters={name: hyper[name] for name in names}, optimised=optimised,
         cv_rmse=cv_rmse, history=history, at_bounds=at_bounds, n_train=int(chosen.size),
+        input_weights=input_weights,
     )
 
 
-def _check_bounds(bounds) -> None:
-    """Raise :class:`ParameterError` unless ``bounds`` is None or ``{name: (low, high)}`` with 0 < low < high < inf."""
+def _check_bounds(bounds, names: Sequence[str] = HYPERPARAMETERS) -> None:
+    """Raise :class:`ParameterError` unless ``bounds`` is None or ``{name: (low, high)}`` with 0 < low < high < inf
+    and every name one of ``names``."""
     if bounds is None:
         return
     if not isinstance(bounds, Mapping):
         raise ParameterError(f"bounds must map hyperparameter names to (low, high), got {bounds!r}")
     for name, interval in bounds.items():
-        if name not in HYPERPARAMETERS:
-            raise ParameterError(f"bounds name an unknown SVR hyperparameter {name!r}; expected {HYPERPARAMETERS}")
+        if name not in names:
+            raise ParameterError(f"bounds name an unknown SVR hyperparameter {name!r}; expected {tuple(names)}")
         try:
             low, high = (float(value) for value in interval)
         except (TypeError, ValueError):
@@ -366,13 +401,19 @@ class KernelRegressionModel(CurrentModel):
     learned attributes ``input_mean_``, ``input_scale_``, ``support_vectors_``,
     ``dual_coef_``, ``intercept_``, ``epsilon_``, ``C_``, ``gamma_``,
     ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_``,
-    ``n_train_`` and ``input_range_`` (the lowest and highest value of each
+    ``n_train_``, ``input_weights_`` (the kernel's weight of each input, see
+    :class:`SVRExpansion`) and ``input_range_`` (the lowest and highest value of each
     input over the training data, shape (2, n_features)), and evaluates it.
-    A subclass gives the inputs of a chunk of a run by ``_inputs_chunk(run, state, sample_time)``.
+    A subclass gives the inputs of a chunk of a run by ``_inputs_chunk(run, state, sample_time)``,
+    and names in ``_weighted`` (``{setting: input column}``) the settings that weight an input in the kernel.
     """
 
+    #: ``{setting name: input column}`` of the inputs the kernel weighs by a setting of that name.
+    _weighted: Mapping[str, int] = {}
+
     def _check_params(self) -> None:
-        for name in HYPERPARAMETERS:
+        names = HYPERPARAMETERS + tuple(self._weighted)
+        for name in names:
             value = getattr(self, name)
             smallest_allowed = 0.0 if name == "epsilon" else np.nextafter(0.0, 1.0)
             if value is not None and not (isinstance(value, (int, float, np.number)) and np.isfinite(value)
@@ -385,7 +426,7 @@ class KernelRegressionModel(CurrentModel):
                 raise ParameterError(f"{name} must be an integer of at least {least}, got {value!r}")
         check_seed(self.random_state)
         self._check_flags("optimize")
-        _check_bounds(self.bounds)
+        _check_bounds(self.bounds, names)
 
     def _fit_kernel(self, X, y, coverage, run_lengths: Sequence[int],
                     progress: Callable[[ProgressEvent], None] | None, *,
@@ -393,10 +434,10 @@ class KernelRegressionModel(CurrentModel):
         """Fit :func:`fit_svr_expansion` with this model's SVR settings and keep it as learned attributes."""
         fit = fit_svr_expansion(
             X, y, coverage, run_lengths,
-            fixed={"epsilon": self.epsilon, "C": self.C, "gamma": self.gamma},
+            fixed={name: getattr(self, name) for name in HYPERPARAMETERS + tuple(self._weighted)},
             n_subset=self.n_subset, optimize=self.optimize, n_calls=self.n_calls,
             cv_folds=self.cv_folds, cv_blocks=self.cv_blocks, bounds=self.bounds,
-            random_state=self.random_state, progress=progress, stage=stage)
+            random_state=self.random_state, progress=progress, stage=stage, weighted=self._weighted)
         self.input_mean_ = fit.input_mean
         self.input_scale_ = fit.input_scale
         self.support_vectors_ = fit.support_vectors
@@ -410,6 +451,7 @@ class KernelRegressionModel(CurrentModel):
         self.search_history_ = list(fit.history)
         self.at_bounds_ = list(fit.at_bounds)
         self.n_train_ = fit.n_train
+        self.input_weights_ = fit.input_weights
         self.input_range_ = np.vstack((np.min(X, axis=0), np.max(X, axis=0)))
 
     def _inputs_chunk(self, run: AxisLog, state, sample_time: float):  # pragma: no cover - abstract
@@ -466,6 +508,12 @@ class KernelRegressionModel(CurrentModel):
     def _kernel_predict(self, X) -> np.ndarray:
         """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
         scaled = (np.asarray(X, dtype=np.float64) - self.input_mean_) / self.input_scale_
+        weights = getattr(self, "input_weights_", None)  # None: a file that predates the weights (all 1)
+        if weights is not None:
+            if np.shape(weights) != np.shape(self.input_scale_) or not np.all(np.asarray(weights) > 0):
+                raise ParameterError(f"input_weights_ must hold one positive weight per input "
+                                     f"({np.size(self.input_scale_)}), got {weights!r}")
+            scaled = scaled * np.sqrt(weights)
         return rbf_expansion(scaled, self.support_vectors_, self.dual_coef_, self.intercept_, self.gamma_)
 
     def _kernel_parameters(self) -> list[Parameter]:
@@ -474,9 +522,16 @@ class KernelRegressionModel(CurrentModel):
             Parameter("C", self.C_, EFFORT, "SVR regularisation"),
             Parameter("epsilon", self.epsilon_, EFFORT, "SVR insensitive tube half-width"),
             Parameter("gamma", self.gamma_, "1/(standardised unit)^2", "RBF kernel parameter"),
+            *(Parameter(name, self._weight(name), "-", f"kernel weight of input {self.input_names[column]}")
+              for name, column in self._weighted.items()),
             Parameter("n_support", int(self.dual_coef_.size), "-", "support vectors"),
             Parameter("intercept", self.intercept_, EFFORT, "SVR intercept"),
         ]
+
+    def _weight(self, name: str) -> float:
+        """The fitted kernel weight of the setting ``name`` of ``_weighted`` (1 in a file that predates weights)."""
+        weights = getattr(self, "input_weights_", None)
+        return 1.0 if weights is None else float(weights[self._weighted[name]])
 
     def _fit_statistics(self) -> dict:
         unit = self.effort_unit_
@@ -490,7 +545,8 @@ class KernelRegressionModel(CurrentModel):
         -------
         dict
             ``kernel`` ("rbf"), ``epsilon`` [A], ``C`` [A], ``gamma``
-            [1/(standardised unit)^2], ``n_support``, ``n_train``,
+            [1/(standardised unit)^2], the input weights of ``_weighted`` by
+            their setting's name (e.g. ``velocity_weight``), ``n_support``, ``n_train``,
             ``optimised`` (names chosen by Bayesian optimisation),
             ``at_bounds`` (those that ended at an end of their search
             interval) and ``cv_rmse`` [A].
@@ -501,6 +557,7 @@ class KernelRegressionModel(CurrentModel):
             "epsilon": self.epsilon_,
             "C": self.C_,
             "gamma": self.gamma_,
+            **{name: self._weight(name) for name in self._weighted},
             "n_support": int(self.dual_coef_.size),
             "n_train": self.n_train_,
             "optimised": list(self.optimised_),
@@ -523,6 +580,16 @@ class SVRCurrentModel(KernelRegressionModel):
         Width of the SVR's insensitive tube [A]; optimised when None.
     gamma : float, optional
         RBF kernel parameter [1/(standardised unit)^2]; optimised when None.
+    velocity_weight : float, optional
+        Weight of the velocity's squared standardised distance in the kernel,
+        ``K = exp(-gamma (dp^2 + velocity_weight dv^2))`` (an anisotropic
+        Gaussian kernel: above 1 it is narrower in velocity than in position,
+        so that it can follow the friction's sign change at zero speed while
+        staying smooth along the travel); searched over
+        :data:`WEIGHT_BOUNDS` with the others when None (1 when not
+        optimised). 1 is the isotropic kernel, the only one before the
+        weight existed; searching it was chosen on the training runs of a
+        development family of truth axes (:mod:`greybox.studies.priors`).
     n_subset : int, default 2000
         Training samples, chosen to cover the (p, v) plane evenly
         (SVR training time grows roughly with its square).
@@ -551,7 +618,7 @@ class SVRCurrentModel(KernelRegressionModel):
     input_mean_, input_scale_ : ndarray, shape (2,)
         Standardisation of (position [mm], velocity [mm/s]).
     support_vectors_ : ndarray, shape (n_support, 2)
-        Standardised support vectors.
+        Standardised support vectors, multiplied by the square root of their input's kernel weight.
     dual_coef_ : ndarray, shape (n_support,)
         Dual coefficients [A].
     intercept_ : float
@@ -568,17 +635,22 @@ class SVRCurrentModel(KernelRegressionModel):
         Optimised hyperparameters that ended at an end of their search interval.
     n_train_ : int
         Size of the training subset.
+    input_weights_ : ndarray, shape (2,)
+        Kernel weights of (position, velocity): ``(1, velocity weight used)``.
     """
 
     #: Names of the model inputs, in the order of the columns of the support vectors.
     input_names = ("position_mm", "velocity_mm_s")
 
-    def __init__(self, *, inertia=None, C=None, epsilon=None, gamma=None, n_subset=2000, optimize=True,
-                 n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
+    _weighted = {"velocity_weight": 1}
+
+    def __init__(self, *, inertia=None, C=None, epsilon=None, gamma=None, velocity_weight=None, n_subset=2000,
+                 optimize=True, n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
         self.inertia = inertia
         self.C = C
         self.epsilon = epsilon
         self.gamma = gamma
+        self.velocity_weight = velocity_weight
         self.n_subset = n_subset
         self.optimize = optimize
         self.n_calls = n_calls
