@@ -53,7 +53,8 @@ def test_search_at_its_bound_is_one_note_naming_set_bounds(air_cut, tmp_path, ca
     out = tmp_path / "svr.gbm"
     status, printed, err = _main(capsys, "train", "--model", "svr", "--train", air_cut, "--out", out, "--quiet",
                                  "--set", "n_calls=6", "--set", "n_subset=600", "--set", "epsilon=0.01",
-                                 "--set", "gamma=1", "--set", 'bounds={"C": [1e-5, 1e-4]}')
+                                 "--set", "gamma=1", "--set", "velocity_weight=1",
+                                 "--set", 'bounds={"C": [1e-5, 1e-4]}')
     assert status == 0, err
     assert load_model(out).at_bounds_ == ["C"]  # the search did end at its bound
     notes = [line for line in err.splitlines() if line]
@@ -123,3 +124,13 @@ def test_log_errors_name_the_reading_options(tmp_path, capsys, content, option):
     status, _, err = _main(capsys, "info", str(path), *extra)
     assert status == 2 and option in err
     assert "columns=" not in err and "sample_time" not in err
+
+
+def test_a_velocity_weight_at_its_bound_names_it_in_the_set_bounds_example(capsys):
+    args = argparse.Namespace(command="train", set=[])
+    with command_notes(args):
+        warnings.warn("SVR hyperparameters: velocity_weight = 9.9e+03 ended at the end of its search interval; "
+                      "the optimum may lie outside (widen it with bounds=)", UserWarning, stacklevel=1)
+    err = capsys.readouterr().err
+    assert "--set bounds='{\"velocity_weight\": [LOW, HIGH]}'" in err, err
+    assert "SVR hyperparameters: velocity_weight = 9.9e+03 ended" in err  # a reported value stays as it is

@@ -41,9 +41,9 @@ _EXAMPLES = {"bounds": "'{\"NAME\": [LOW, HIGH]}'"}
 
 def _bounds_example(text: str) -> str:
     """``--set bounds=`` value for the SVR hyperparameters ``text`` reports as ``name = value``, else generic."""
-    from ..models.svr import HYPERPARAMETERS
+    from ..models.svr import BOUNDED
 
-    named = [name for name in HYPERPARAMETERS if re.search(rf"(?<![\w.\-]){re.escape(name)} = ", text)]
+    named = [name for name in BOUNDED if re.search(rf"(?<![\w.\-]){re.escape(name)} = ", text)]
     if not named:
         return _EXAMPLES["bounds"]
     return "'{" + ", ".join(f'"{name}": [LOW, HIGH]' for name in named) + "}'"
@@ -97,8 +97,9 @@ def option_words(text: str, *, parameters: bool = False, settable: bool = True, 
     str
         ``name=True`` -> the flag (``--asymmetric``); ``name=VALUE`` -> ``--option VALUE`` or
         ``--set name=VALUE``; ``name=`` -> the same with a placeholder; a bare name with an
-        underscore (``fit_offset``) -> its option, or ``--set name``. Other words are kept, and so
-        is the whole text when it names no hyperparameter.
+        underscore (``fit_offset``) -> its option, or ``--set name``, unless it is quoted or reports
+        a value (``name = 3.2``). Other words are kept, and so is the whole text when it names no
+        hyperparameter.
 
     Examples
     --------
@@ -124,7 +125,8 @@ def option_words(text: str, *, parameters: bool = False, settable: bool = True, 
 
     identifiers = [name for name in names if "_" in name or (parameters and name in OPTION_OF)]
     if identifiers:
-        pattern = edge + "(" + "|".join(re.escape(name) for name in identifiers) + r")(?![\w\-=])"
+        # not a quoted key ("NAME" of a bounds example) nor a reported value ("name = 3.2")
+        pattern = r"(?<![\w.\-\"])(" + "|".join(re.escape(name) for name in identifiers) + r")(?![\w\-=\"]| = )"
         text = re.sub(pattern, bare, text)
     return text
 

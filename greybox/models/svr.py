@@ -56,6 +56,8 @@ __all__ = [
     "inertia_offset_proxy",
     "default_bounds",
     "HYPERPARAMETERS",
+    "BOUNDED",
+    "WEIGHT_BOUNDS",
 ]
 
 #: Names of the SVR hyperparameters, in the order of the paper's Table 2.
@@ -685,3 +687,8 @@ class SVRCurrentModel(KernelRegressionModel):
 
     def _own_parameters(self) -> list[Parameter]:
         return self._kernel_parameters()
+
+
+#: Every name a search interval can be given for (``bounds=``) in the kernel models: the SVR
+#: hyperparameters and the sole SVR's kernel weights.
+BOUNDED = HYPERPARAMETERS + tuple(SVRCurrentModel._weighted)
