@@ -90,8 +90,10 @@ def _format_value(value) -> str:
 
 def describe_parameters(model) -> list[str]:
     """Lines ``name = value unit`` of the model's parameter table (see ``parameter_table``)."""
-    return [f"  {row.name:<14} = {_format_value(row.value)} {row.unit if row.unit != '-' else ''}".rstrip()
-            for row in model.parameter_table()]
+    rows = model.parameter_table()
+    width = max([14, *(len(row.name) for row in rows)])
+    return [f"  {row.name:<{width}} = {_format_value(row.value)} {row.unit if row.unit != '-' else ''}".rstrip()
+            for row in rows]
 
 
 def _read(args: argparse.Namespace, paths, axis=None) -> tuple[list[str], list]:
