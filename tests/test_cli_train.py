@@ -238,9 +238,9 @@ def test_gmssvr_stages_take_their_own_logs(tmp_path, capsys):
 def test_parameter_lines_align_their_equals_signs_whatever_the_longest_name():
     from test_svr_model import FIXED, sweep_run
 
-    from greybox.cli.train import describe_parameters
+    from greybox.cli._model_text import parameter_lines
     from greybox.models.svr import SVRCurrentModel
 
-    lines = describe_parameters(SVRCurrentModel(**FIXED, velocity_weight=4.0).fit(sweep_run(1, n=1500)))
+    lines = parameter_lines(SVRCurrentModel(**FIXED, velocity_weight=4.0).fit(sweep_run(1, n=1500)))
     assert any(line.startswith("  velocity_weight = 4 ") or line == "  velocity_weight = 4" for line in lines)
     assert len({line.index(" = ") for line in lines}) == 1, lines

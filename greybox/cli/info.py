@@ -1,25 +1,35 @@
-"""``greybox info``: summarise logs (samples, step, ranges, effort, noise floor)."""
+"""``greybox info``: summarise logs (samples, step, ranges, effort, noise floor) and model files."""
 
 from __future__ import annotations
 
 import argparse
 import json
-from pathlib import PurePath
+import zipfile
+from pathlib import Path, PurePath
 
 import numpy as np
 
 from ..data.log import AxisLog
+from ..persistence import load_model
+from ..registry import model_kind
+from ._model_text import fit_lines, parameter_lines
 from ._options import add_log_arguments, read_named_runs
+
+#: Suffix of greybox model files by convention (any name works; a ZIP archive is taken for a model file too).
+MODEL_SUFFIX = ".gbm"
 
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "info",
-        help="summarise logs",
-        description="Print one line per log: samples, step, duration, position, velocity and effort ranges.",
+        help="summarise logs and model files",
+        description="Print one line per log: samples, step, duration, position, velocity and effort ranges; "
+                    "for a model file (.gbm) its kind, parameters and fit.",
     )
-    parser.add_argument("logs", nargs="+", metavar="LOG", help="log files (CSV, Parquet, MCAP, TDMS or MATLAB .mat)")
-    parser.add_argument("--json", action="store_true", help="print one JSON object per log instead of a table")
+    parser.add_argument("logs", nargs="+", metavar="FILE",
+                        help="log files (CSV, Parquet, MCAP, TDMS or MATLAB .mat) or model files (.gbm)")
+    parser.add_argument("--json", action="store_true",
+                        help="print one JSON object per log or model instead of a table")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -93,13 +103,89 @@ def display_names(paths) -> list[str]:
             depth[i] += 1
 
 
+def is_model_file(path) -> bool:
+    """Whether ``path`` is to be read as a model file: named ``*.gbm``, or a ZIP archive (no log format is one).
+
+    Parameters
+    ----------
+    path : str or path-like
+        A path given to ``greybox info``.
+    """
+    path = Path(path)
+    return path.suffix.lower() == MODEL_SUFFIX or (path.is_file() and zipfile.is_zipfile(path))
+
+
+def _plain(value):
+    """``value`` with NumPy arrays and numbers as lists and Python numbers, NaN and infinities as None: strict JSON."""
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return _plain(value.item())
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    return value
+
+
+def describe_model(path, model) -> dict:
+    """The summary of a loaded model file: kind, axis kind, effort unit, step, parameters and fit figures.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The model file.
+    model : CurrentModel
+        The fitted model loaded from it.
+
+    Returns
+    -------
+    dict
+        ``file``, ``kind``, ``motion``, ``effort_unit``, ``sample_time_ms``, ``parameters`` (``{name:
+        {"value", "unit"}}``) and ``fit`` (the model's ``fit_summary``), NumPy values as lists and numbers,
+        NaN as None.
+    """
+    return {"file": str(path), "kind": model_kind(model), "motion": getattr(model, "motion_", "linear"),
+            "effort_unit": model.effort_unit_, "sample_time_ms": 1e3 * float(model.sample_time_),
+            "parameters": {row.name: {"value": _plain(row.value), "unit": row.unit} for row in model.parameter_table()},
+            "fit": _plain(model.fit_summary())}
+
+
+def _print_model(name: str, summary: dict, model) -> None:
+    print(f"model {name}: {summary['kind']}, {summary['motion']} axis, effort in {summary['effort_unit']}, "
+          f"step {summary['sample_time_ms']:g} ms")
+    print("parameters:")
+    for line in parameter_lines(model):
+        print(line)
+    print("fit:")
+    for line in fit_lines(model):
+        print(line)
+
+
 def run(args: argparse.Namespace) -> int:
-    runs, names = read_named_runs(args, args.logs, display_names(list(args.logs)))
+    shown = dict(zip(args.logs, display_names(list(args.logs))))
+    models = [(path, load_model(path)) for path in args.logs if is_model_file(path)]  # every file checked first
+    logs = [path for path in args.logs if not is_model_file(path)]
+    for path, model in models:
+        summary = describe_model(path, model)
+        if args.json:
+            print(json.dumps(summary))
+        else:
+            _print_model(shown[path], summary, model)
+    if logs:
+        _print_logs(args, logs, [shown[path] for path in logs])
+    return 0
+
+
+def _print_logs(args: argparse.Namespace, paths, shown) -> None:
+    runs, names = read_named_runs(args, paths, shown)
     summaries = [summarise(log) for log in runs]
     if args.json:
         for summary in summaries:
             print(json.dumps(summary))
-        return 0
+        return
     width = max([28, *map(len, names)])
     lengths = {log.units.length for log in runs}
     length = lengths.pop() if len(lengths) == 1 else "mm|deg"
@@ -116,4 +202,3 @@ def run(args: argparse.Namespace) -> int:
             f"{s['duration_s']:>8.1f} {s[f'position_min_{unit}']:>9.2f}..{s[f'position_max_{unit}']:<8.2f} "
             f"{vmax:>12} {s['effort_rms']:>10.4f} {s['effort_unit']:<2} {noise:>8}"
         )
-    return 0

@@ -15,6 +15,7 @@ from ..metrics import metrics_table
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model
+from ._model_text import fit_lines, parameter_lines
 from ._options import add_log_arguments, read_named_runs
 from ._types import POSITIVE_INT
 
@@ -70,30 +71,6 @@ def add_parser(subparsers) -> None:
                        help="with --per-machine: processes of the local cluster (default: one per core)")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
-
-
-#: Arrays and lists longer than this are summarised by their shape, not printed.
-_MAX_PRINTED = 12
-
-
-def _format_value(value) -> str:
-    if isinstance(value, np.ndarray):
-        if value.size > _MAX_PRINTED:
-            return f"<array of shape {value.shape}>"
-        return "[" + ", ".join(f"{v:.6g}" for v in value.ravel()) + "]"
-    if isinstance(value, (list, tuple, dict)) and len(value) > _MAX_PRINTED:
-        return f"<{type(value).__name__} of {len(value)} items>"
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return str(value)
-
-
-def describe_parameters(model) -> list[str]:
-    """Lines ``name = value unit`` of the model's parameter table (see ``parameter_table``)."""
-    rows = model.parameter_table()
-    width = max([14, *(len(row.name) for row in rows)])
-    return [f"  {row.name:<{width}} = {_format_value(row.value)} {row.unit if row.unit != '-' else ''}".rstrip()
-            for row in rows]
 
 
 def _read(args: argparse.Namespace, paths, axis=None) -> tuple[list[str], list]:
@@ -166,11 +143,11 @@ def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
         print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     print("  (RE = RMSE / mean |effort|)")
     print("parameters:")
-    for line in describe_parameters(model):
+    for line in parameter_lines(model):
         print(line)
     print("fit:")
-    for name, value in model.fit_summary().items():
-        print(f"  {name:<18} = {_format_value(value)}")
+    for line in fit_lines(model):
+        print(line)
     return predictions
 
 
