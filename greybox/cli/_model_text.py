@@ -50,3 +50,14 @@ def fit_lines(model) -> list[str]:
         A fitted model.
     """
     return [f"  {name:<18} = {format_value(value)}" for name, value in model.fit_summary().items()]
+
+
+def model_lines(model) -> list[str]:
+    """The ``parameters:`` and ``fit:`` sections of a fitted model, as ``greybox train`` and ``info`` print them.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        A fitted model.
+    """
+    return ["parameters:", *parameter_lines(model), "fit:", *fit_lines(model)]

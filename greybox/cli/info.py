@@ -12,7 +12,7 @@ import numpy as np
 from ..data.log import AxisLog
 from ..persistence import load_model
 from ..registry import model_kind
-from ._model_text import fit_lines, parameter_lines
+from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
 
 #: Suffix of greybox model files by convention (any name works; a ZIP archive is taken for a model file too).
@@ -156,12 +156,7 @@ def describe_model(path, model) -> dict:
 def _print_model(name: str, summary: dict, model) -> None:
     print(f"model {name}: {summary['kind']}, {summary['motion']} axis, effort in {summary['effort_unit']}, "
           f"step {summary['sample_time_ms']:g} ms")
-    print("parameters:")
-    for line in parameter_lines(model):
-        print(line)
-    print("fit:")
-    for line in fit_lines(model):
-        print(line)
+    print("\n".join(model_lines(model)))
 
 
 def run(args: argparse.Namespace) -> int:

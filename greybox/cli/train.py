@@ -15,7 +15,7 @@ from ..metrics import metrics_table
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model
-from ._model_text import fit_lines, parameter_lines
+from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
 from ._types import POSITIVE_INT
 
@@ -142,12 +142,7 @@ def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
         table = metrics_table(np.concatenate([r.effort for r in runs]), np.concatenate(predictions))
         print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     print("  (RE = RMSE / mean |effort|)")
-    print("parameters:")
-    for line in parameter_lines(model):
-        print(line)
-    print("fit:")
-    for line in fit_lines(model):
-        print(line)
+    print("\n".join(model_lines(model)))
     return predictions
 
 
