@@ -10,6 +10,7 @@ from pathlib import Path, PurePath
 import numpy as np
 
 from ..data.log import AxisLog
+from ..json_values import jsonable
 from ..persistence import load_model
 from ..registry import model_kind
 from ._model_text import model_lines
@@ -115,21 +116,6 @@ def is_model_file(path) -> bool:
     return path.suffix.lower() == MODEL_SUFFIX or (path.is_file() and zipfile.is_zipfile(path))
 
 
-def _plain(value):
-    """``value`` with NumPy arrays and numbers as lists and Python numbers, NaN and infinities as None: strict JSON."""
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, np.generic):
-        return _plain(value.item())
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    return value
-
-
 def describe_model(path, model) -> dict:
     """The summary of a loaded model file: kind, axis kind, effort unit, step, parameters and fit figures.
 
@@ -149,8 +135,9 @@ def describe_model(path, model) -> dict:
     """
     return {"file": str(path), "kind": model_kind(model), "motion": getattr(model, "motion_", "linear"),
             "effort_unit": model.effort_unit_, "sample_time_ms": 1e3 * float(model.sample_time_),
-            "parameters": {row.name: {"value": _plain(row.value), "unit": row.unit} for row in model.parameter_table()},
-            "fit": _plain(model.fit_summary())}
+            "parameters": {row.name: {"value": jsonable(row.value), "unit": row.unit}
+                           for row in model.parameter_table()},
+            "fit": jsonable(model.fit_summary())}
 
 
 def _print_model(name: str, summary: dict, model) -> None:
@@ -161,8 +148,9 @@ def _print_model(name: str, summary: dict, model) -> None:
 
 def run(args: argparse.Namespace) -> int:
     shown = dict(zip(args.logs, display_names(list(args.logs))))
-    models = [(path, load_model(path)) for path in args.logs if is_model_file(path)]  # every file checked first
-    logs = [path for path in args.logs if not is_model_file(path)]
+    kinds = {path: is_model_file(path) for path in args.logs}
+    models = [(path, load_model(path)) for path in args.logs if kinds[path]]  # every model file checked first
+    logs = [path for path in args.logs if not kinds[path]]
     for path, model in models:
         summary = describe_model(path, model)
         if args.json:

@@ -18,7 +18,6 @@ figures
 from __future__ import annotations
 
 import json
-import math
 import os
 from pathlib import Path
 
@@ -26,6 +25,7 @@ import numpy as np
 
 from ..atomic import write_text_atomic
 from ..evaluate.plots import import_pyplot, save_figure
+from ..json_values import jsonable
 from .workflow import DiscoveryResult
 
 __all__ = ["REPORT_FILES", "jsonable", "write_json", "plot_residuals", "plot_evidence", "write_report"]
@@ -35,29 +35,6 @@ REPORT_FILES = ("discovery.json", "residual_train.png", "residual_test.png", "ev
 
 #: Most points drawn of a residual over time.
 _MAX_POINTS = 20_000
-
-
-def jsonable(value):
-    """``value`` with NumPy types turned into Python ones and non-finite floats into None.
-
-    Parameters
-    ----------
-    value : object
-        A scalar, array, or dict / list / tuple nesting them (dict keys become str); other objects pass unchanged.
-    """
-    if isinstance(value, dict):
-        return {str(key): jsonable(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(item) for item in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    return value
 
 
 def write_json(document: dict, path: str | os.PathLike) -> Path:
