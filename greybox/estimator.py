@@ -23,10 +23,12 @@ from .base import EFFORT, LENGTH, ModelProtocol, Parameter
 from .data.log import AxisLog, as_log_list
 from .data.quantities import MOTIONS, Motion
 from .errors import LogError, ParameterError
+from .identify.inertia import inertia_note
 from .identify.progress import make_progress
+from .identify.selection import check_selection_record
 from .metrics import rmse
 
-__all__ = ["CurrentModel", "check_runs", "MAX_PARAMETER_MAGNITUDE"]
+__all__ = ["CurrentModel", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE"]
 
 #: Largest magnitude of an identified parameter a model file may carry: currents of a feed axis are
 #: amperes, stiffnesses thousands of A/mm; 1e12 in any unit is a corrupt or hostile file.
@@ -76,6 +78,22 @@ def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
     return runs
 
 
+def check_inertia(value) -> None:
+    """Raise :class:`ParameterError` unless ``value`` is None or a finite, non-negative inertia.
+
+    Parameters
+    ----------
+    value : object
+        The ``inertia`` hyperparameter of a model [A s^2/mm] (or [N s^2/mm], [Nm s^2/deg]).
+    """
+    if value is None:
+        return
+    if not (isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_))
+            and np.isfinite(value) and value >= 0.0):
+        raise ParameterError(f"inertia must be None (identified) or a finite, non-negative inertia in "
+                             f"effort s^2/length (0 for an effort measured at the load), got {value!r}")
+
+
 class CurrentModel(ModelProtocol):
     """Base class of the current models (scikit-learn estimator conventions).
 
@@ -117,10 +135,39 @@ class CurrentModel(ModelProtocol):
         self
         """
         self._check_params()
+        check_inertia(self.inertia)
         runs = check_runs(logs)
         self._set_fit_info(runs)
-        self._fit_runs(runs, make_progress(progress))
+        if self.inertia is None:
+            self._fit_runs(runs, make_progress(progress))
+            note = inertia_note(runs, float(self.J_), f"{self.effort_unit_} s^2/{self.units_.length}")
+            self.notes_ = [] if note is None else [note]
+            return self
+        known = float(self.inertia)
+        self._fit_runs([run.replace(effort=run.effort - known * run.acceleration,
+                                    acceleration=np.zeros(len(run))) for run in runs], make_progress(progress))
+        self.J_ = known
+        self.notes_ = []
         return self
+
+    def fit_notes(self) -> list[str]:
+        """What the fit could not settle from the runs, one sentence each (empty when nothing).
+
+        Returns
+        -------
+        list of str
+            E.g. an inertia that the runs cannot tell from a spring force
+            (:func:`greybox.identify.inertia.inertia_note`); empty for a model
+            loaded from a file that predates the record.
+        """
+        check_is_fitted(self)
+        return list(getattr(self, "notes_", []))
+
+    #: Known inertia ``J`` [A s^2/mm] (hyperparameter of the models that take it; ``None``: identified from the
+    #: runs). A model with a known inertia is fitted on the effort less ``J a``, with no inertia of its own to find:
+    #: 0 for an effort measured at the load (a force or torque sensor on the device), where no inertia lies
+    #: between the sensor and the friction.
+    inertia: float | None = None
 
     #: Hyperparameter that holds the first-stage model of a two-stage model (``None``: one stage). Options
     #: of the command line that the model does not take but its first stage does are set there.
@@ -321,6 +368,7 @@ class CurrentModel(ModelProtocol):
             probe prediction gave.
         """
         self._check_params()
+        check_inertia(self.inertia)
         try:
             check_is_fitted(self)
             motion = getattr(self, "motion_", "linear")
@@ -336,6 +384,12 @@ class CurrentModel(ModelProtocol):
                 if values.size and np.max(np.abs(values)) > MAX_PARAMETER_MAGNITUDE:
                     raise ParameterError(f"parameter {row.name} = {np.max(np.abs(values)):.3g} in magnitude, beyond "
                                          f"{MAX_PARAMETER_MAGNITUDE:g}: not a model of a feed axis")
+            record = getattr(self, "selection_", None)  # only a model chosen by cross-validation has one
+            if record is not None:
+                check_selection_record(record)
+            notes = getattr(self, "notes_", [])
+            if not (isinstance(notes, list) and all(isinstance(note, str) and len(note) <= 2000 for note in notes)):
+                raise ParameterError("notes_ must be a list of sentences (text of at most 2000 characters each)")
             step = float(self.sample_time_)
             if not (np.isfinite(step) and step > 0.0):
                 raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")

@@ -8,7 +8,7 @@ import json
 from ..errors import GreyboxError
 from ..friction.backlash import BacklashModel
 from ..registry import model_class
-from ._types import POSITIVE_INT, SEED
+from ._types import NON_NEGATIVE, POSITIVE_INT, SEED
 
 __all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting"]
 
@@ -22,6 +22,7 @@ _MODEL_OPTIONS = (
     ("--asymmetric", "asymmetric", "asymmetric"),
     ("--elements", "elements", "n_elements"),
     ("--model-seed", "model_seed", "random_state"),
+    ("--inertia", "inertia", "inertia"),
 )
 
 
@@ -48,6 +49,13 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
                        "and the GMS stage of gmssvr; not with --offset)")
     group.add_argument("--elements", type=POSITIVE_INT, metavar="N",
                        help="number of Maxwell-slip elements (gms and the GMS stage of gmssvr; default 4)")
+    inertia = group.add_mutually_exclusive_group()
+    inertia.add_argument("--inertia", type=NON_NEGATIVE, metavar="J",
+                         help="known inertia J in effort s^2/length (A s^2/mm, N s^2/mm = t, Nm s^2/deg), e.g. from "
+                         "the drive's commissioning: the model identifies no inertia of its own (default: identified)")
+    inertia.add_argument("--load-side", dest="inertia", action="store_const", const=0.0,
+                         help="the effort is measured at the load (a force or torque sensor on the device), so no "
+                         "inertia lies between the sensor and the friction: J = 0 (the same as --inertia 0)")
     if backlash:
         group.add_argument("--backlash", action="store_true",
                            help="put the model behind a backlash whose width is identified from the data: no force "

@@ -52,6 +52,33 @@ def fit_lines(model) -> list[str]:
     return [f"  {name:<18} = {format_value(value)}" for name, value in model.fit_summary().items()]
 
 
+def selection_lines(record: dict) -> list[str]:
+    """The table a model chosen by ``greybox train --model auto`` was chosen from, best held-out RE first.
+
+    Parameters
+    ----------
+    record : dict
+        The model's ``selection_`` (:func:`greybox.identify.selection.selection_record`).
+    """
+    rows = sorted(record["candidates"], key=lambda c: (c["re"] is None, c["re"] if c["re"] is not None else 0.0))
+    width = max(len(row["label"]) for row in rows)
+    lines = [f"model choice: {len(record['candidates'])} candidates, held out in turn: {', '.join(record['folds'])}",
+             f"  {'candidate':<{width}}  {'params':>6}  {'held-out RE %':>13}  {'+-SE':>6}  per fold"]
+    for row in rows:
+        mark = "  <- chosen" if row["label"] == record["chosen"] else ""
+        if row["error"] is not None:
+            lines.append(f"  {row['label']:<{width}}  {'':>6}  {'failed':>13}  {'':>6}  {row['error']}")
+            continue
+        spread = f"{row['re_se']:.2f}" if row["re_se"] is not None else "-"
+        folds = " ".join(f"{value:.2f}" for value in row["fold_re"])
+        lines.append(f"  {row['label']:<{width}}  {row['n_params']:>6d}  {row['re']:>13.2f}  {spread:>6}  "
+                     f"{folds}{mark}")
+    lines.append(f"  rule: {record['rule']}")
+    lines.append("  (RE = RMSE / mean |effort| of the runs held out)")
+    lines += [f"  note: {note}" for note in record["notes"]]
+    return lines
+
+
 def model_lines(model) -> list[str]:
     """The ``parameters:`` and ``fit:`` sections of a fitted model, as ``greybox train`` and ``info`` print them.
 
@@ -60,4 +87,8 @@ def model_lines(model) -> list[str]:
     model : CurrentModel
         A fitted model.
     """
-    return ["parameters:", *parameter_lines(model), "fit:", *fit_lines(model)]
+    notes = model.fit_notes()
+    record = getattr(model, "selection_", None)  # only a model chosen by --model auto has one
+    return ["parameters:", *parameter_lines(model), "fit:", *fit_lines(model),
+            *(["notes:"] + [f"  - {note}" for note in notes] if notes else []),
+            *(selection_lines(record) if record is not None else [])]

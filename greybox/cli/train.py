@@ -12,6 +12,7 @@ import numpy as np
 from ..atomic import check_output_path
 from ..errors import GreyboxError, ModelFileError
 from ..metrics import metrics_table
+from ..model_choice import DEFAULT_CANDIDATES
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import add_model_arguments, build_model
@@ -30,7 +31,14 @@ def add_parser(subparsers) -> None:
         "directory with one model file per axis and a manifest machine.json. With --per-machine, train one model "
         "per machine (the folder of its logs) and axis, on Dask.",
     )
-    parser.add_argument("--model", required=True, choices=sorted(MODEL_CLASSES), help="model kind")
+    parser.add_argument("--model", required=True, choices=sorted(MODEL_CLASSES) + [AUTO],
+                        help="model kind; 'auto' fits the candidates of --candidates, scores each on the training "
+                        "logs it was not fitted on (leave one log out; one log: three stretches held out in turn) "
+                        "and keeps the one that predicts them best, the simpler within one standard error")
+    parser.add_argument("--candidates", nargs="+", metavar="KIND[:OPTION,...]",
+                        help="with --model auto: the candidates, e.g. gms:asymmetric stribeck:offset,backlash "
+                        "(options asymmetric, offset, backlash, elements=N, inertia=J; default: "
+                        f"{' '.join(DEFAULT_CANDIDATES)})")
     parser.add_argument(
         "--train", required=True, nargs="+", metavar="LOG",
         help="training logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat); with --per-machine also directories "
@@ -68,7 +76,8 @@ def add_parser(subparsers) -> None:
                        help="with --per-machine: address of a running dask.distributed scheduler, e.g. "
                        "tcp://10.0.0.5:8786 (default: a local cluster of processes)")
     fleet.add_argument("--workers", type=POSITIVE_INT, metavar="N",
-                       help="with --per-machine: processes of the local cluster (default: one per core)")
+                       help="with --per-machine: processes of the local cluster (default: one per core); with "
+                       "--model auto: processes fitting the candidates (default: one per core)")
     add_log_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -213,7 +222,53 @@ def _refuse_fleet_items(items) -> None:
                                "or give --per-machine to train one model per machine")
 
 
+#: The ``--model`` value that chooses the model by cross-validation.
+AUTO = "auto"
+
+
+def _run_auto(args: argparse.Namespace) -> int:
+    """``greybox train --model auto``: choose the model by held-out runs, save it with the table."""
+    from ..model_choice import choose_model
+
+    for option, value in (("--per-machine", args.per_machine), ("--axes", args.axes), ("--machine", args.machine),
+                          ("--stage2", args.stage2), ("--asymmetric", args.asymmetric), ("--offset", args.offset),
+                          ("--elements", args.elements), ("--backlash", args.backlash), ("--set", args.set)):
+        if value:
+            raise GreyboxError(f"{option} does not apply with --model auto: write a candidate's options into "
+                               "--candidates, e.g. --candidates gms:asymmetric,backlash stribeck:offset")
+    out = Path(args.out)
+    check_output_path(out, overwrite=args.force, protect=list(args.train), error=ModelFileError,
+                      inputs_name="one of the training logs")
+    runs, groups = [], []
+    for path in args.train:
+        pieces, _ = read_named_runs(args, [path], [path])
+        runs += pieces
+        groups += [str(path)] * len(pieces)
+    started = time.perf_counter()
+    report = None if args.quiet else (lambda line: print(f"  {line}", flush=True))
+    model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.inertia,
+                         workers=args.workers or os.cpu_count() or 1, progress=report)
+    names = [Path(group).name for group in groups]
+    predictions = _report_fit(model, names, runs, time.perf_counter() - started,
+                              f"{model.selection_['chosen']} (chosen by held-out runs)")
+    _save_checked(model, out, args.force, runs, predictions)
+    return 0
+
+
+def _save_checked(model, out: Path, overwrite: bool, runs, predictions) -> None:
+    """Save the model and check that the file predicts what the fitted model did."""
+    save_model(model, out, overwrite=overwrite)
+    reloaded = load_model(out)
+    if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):
+        raise ModelFileError(f"{out}: the saved model does not reproduce the fitted model's predictions")
+    print(f"wrote {out}")
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.model == AUTO:
+        return _run_auto(args)
+    if args.candidates:
+        raise GreyboxError("--candidates applies with --model auto")
     if args.per_machine:
         return _run_per_machine(args)
     if args.scheduler or args.workers:
@@ -232,9 +287,5 @@ def run(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     names, runs = _fit(model, args, *_read_all(args))
     predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
-    save_model(model, out, overwrite=args.force)
-    reloaded = load_model(out)
-    if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):
-        raise ModelFileError(f"{out}: the saved model does not reproduce the fitted model's predictions")
-    print(f"wrote {out}")
+    _save_checked(model, out, args.force, runs, predictions)
     return 0

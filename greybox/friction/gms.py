@@ -351,6 +351,9 @@ class GMSModel(CurrentModel):
     staged : bool, default True
         Run stage 2 before the joint search; if False, the multi-start search
         runs on all shape parameters directly.
+    inertia : float, optional
+        Known inertia ``J`` [A s^2/mm] (e.g. from the drive's commissioning; 0 for an effort measured at the
+        load, by a force or torque sensor on the device); identified from the runs when None.
 
     Attributes
     ----------
@@ -388,7 +391,8 @@ class GMSModel(CurrentModel):
 
     def __init__(self, *, n_elements: int = 4, asymmetric: bool = False, fit_offset: bool = False,
                  method: str = "nelder-mead", n_starts: int = 4, random_state=0, max_iter: int = 400,
-                 staged: bool = True):
+                 staged: bool = True, inertia=None):
+        self.inertia = inertia
         self.n_elements = n_elements
         self.asymmetric = asymmetric
         self.fit_offset = fit_offset

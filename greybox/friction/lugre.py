@@ -240,6 +240,9 @@ class LuGreModel(CurrentModel):
     max_iter : int, default 300
         Iterations per start (Nelder-Mead) or residual evaluations (least
         squares); the same for the per-direction search of the asymmetric model.
+    inertia : float, optional
+        Known inertia ``J`` [A s^2/mm] (e.g. from the drive's commissioning; 0 for an effort measured at the
+        load, by a force or torque sensor on the device); identified from the runs when None.
 
     Attributes
     ----------
@@ -270,7 +273,8 @@ class LuGreModel(CurrentModel):
     """
 
     def __init__(self, *, asymmetric: bool = False, fit_offset: bool = False, method: str = "nelder-mead",
-                 n_starts: int = 3, random_state=0, max_iter: int = 300):
+                 n_starts: int = 3, random_state=0, max_iter: int = 300, inertia=None):
+        self.inertia = inertia
         self.asymmetric = asymmetric
         self.fit_offset = fit_offset
         self.method = method

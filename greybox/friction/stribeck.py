@@ -41,6 +41,9 @@ class StribeckModel(CurrentModel):
         Fit a constant offset ``I_0`` [A] (not together with ``asymmetric``).
     min_speed : float, default 0.0
         Samples slower than this [mm/s] are left out of the fit.
+    inertia : float, optional
+        Known inertia ``J`` [A s^2/mm] (e.g. from the drive's commissioning; 0 for an effort measured at the
+        load, by a force or torque sensor on the device); identified from the runs when None.
 
     Attributes
     ----------
@@ -69,7 +72,9 @@ class StribeckModel(CurrentModel):
         Unit of the effort the model was fitted on, "A" or "N".
     """
 
-    def __init__(self, *, asymmetric: bool = False, fit_offset: bool = False, min_speed: float = 0.0):
+    def __init__(self, *, asymmetric: bool = False, fit_offset: bool = False, min_speed: float = 0.0,
+                 inertia=None):
+        self.inertia = inertia
         self.asymmetric = asymmetric
         self.fit_offset = fit_offset
         self.min_speed = min_speed

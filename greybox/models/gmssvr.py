@@ -262,6 +262,7 @@ class GMSSVRModel(KernelRegressionModel):
         self._widen_region(self.gms_)
         self.J_ = float(self.gms_.J_)
         self.offset_ = float(self.gms_.offset_)
+        self.notes_ = self.gms_.fit_notes()
 
         X = np.concatenate([self._inputs(run, self.gms_.initial_state(), run.sample_time)[0] for run in runs])
         coverage = np.concatenate([np.column_stack((run.position, run.velocity)) for run in runs])

@@ -1,0 +1,344 @@
+"""Model choice by how each candidate predicts runs it was not fitted on.
+
+A model's training error says how well it can follow the runs it saw; what
+a user needs is how well it predicts the next run, at other feeds and
+amplitudes. Here every candidate is fitted on all training runs but one
+*group* (a log file: the runs of one recording share its conditions) and
+scored on the group it did not see, once per group: leave-one-run-out
+cross-validation, which is leave-one-speed-out where the logs differ in
+speed. With a single group, each run is cut into ``n_blocks`` contiguous
+stretches, and stretch ``j`` of every run is held out in fold ``j``; a held-out
+stretch is predicted as a run of its own, from rest.
+
+The score of a fold is the relative error ``RE = RMSE / mean |effort|`` [%]
+of its held-out samples (:func:`greybox.metrics.relative_error`); a
+candidate's score is the mean over the folds, with the standard error of that
+mean. The choice follows the one-standard-error rule: among the candidates
+whose mean lies within one standard error of the best mean, the one with the
+fewest identified parameters wins (ties: the lower mean). Prediction error on
+unseen runs is what is compared, so a candidate that fits the training runs
+better by following their noise does not win.
+
+This module knows no model kind: the caller gives the candidate models
+(unfitted estimators with ``fit``, ``predict`` and ``n_params``).
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+from sklearn.base import clone
+
+from ..errors import GreyboxError, ParameterError
+from ..metrics import relative_error, rmse
+
+__all__ = ["Fold", "CandidateScore", "held_out_folds", "score_candidates", "choose", "selection_record",
+           "check_selection_record", "RULE"]
+
+#: The choice rule, as recorded with the result.
+RULE = ("lowest mean held-out RE; among candidates within one standard error of it, the fewest parameters")
+
+#: Samples a held-out stretch needs at least (one second at 2 ms), so that it holds motion and reversals.
+MIN_FOLD_SAMPLES = 500
+
+
+@dataclass(frozen=True)
+class Fold:
+    """One split of the training runs.
+
+    Attributes
+    ----------
+    name : str
+        What is held out: a log's name, or ``"stretch 2 of 3"``.
+    train : list of AxisLog
+        Prepared runs the candidate is fitted on.
+    test : list of AxisLog
+        Prepared runs it predicts (each from rest).
+    """
+
+    name: str
+    train: list
+    test: list
+
+
+@dataclass
+class CandidateScore:
+    """The held-out figures of one candidate.
+
+    Attributes
+    ----------
+    label : str
+        The candidate's name.
+    fold_re : list of float
+        Held-out RE [%] per fold.
+    fold_rmse : list of float
+        Held-out RMSE per fold [effort unit].
+    n_params : int
+        Identified parameters (the median over the folds' fits).
+    seconds : float
+        Wall time of the fits and predictions [s].
+    error : str or None
+        Why the candidate could not be scored (a fit or prediction failed), else None.
+    """
+
+    label: str
+    fold_re: list = field(default_factory=list)
+    fold_rmse: list = field(default_factory=list)
+    n_params: int = 0
+    seconds: float = 0.0
+    error: str | None = None
+
+    @property
+    def re(self) -> float:
+        """Mean held-out RE over the folds [%] (NaN when not scored)."""
+        return float(np.mean(self.fold_re)) if self.fold_re and self.error is None else math.nan
+
+    @property
+    def re_se(self) -> float:
+        """Standard error of :attr:`re` [%] (the folds' sample standard deviation over sqrt(folds))."""
+        if self.error is not None or len(self.fold_re) < 2:
+            return math.nan
+        return float(np.std(self.fold_re, ddof=1) / np.sqrt(len(self.fold_re)))
+
+    @property
+    def rmse(self) -> float:
+        """Root mean of the folds' squared RMSE [effort unit] (NaN when not scored)."""
+        return float(np.sqrt(np.mean(np.square(self.fold_rmse)))) if self.fold_rmse and self.error is None \
+            else math.nan
+
+
+def held_out_folds(runs: Sequence, groups: Sequence[str], *, n_blocks: int = 3) -> list[Fold]:
+    """The folds of leave-one-group-out cross-validation (or of held-out stretches for one group).
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared training runs.
+    groups : sequence of str
+        The group of each run (its log file's name); runs of one group are held out together.
+    n_blocks : int, default 3
+        Stretches per run when all runs belong to one group.
+
+    Returns
+    -------
+    list of Fold
+
+    Raises
+    ------
+    GreyboxError
+        If ``groups`` does not match ``runs``, or a single group's runs are too short to cut into
+        ``n_blocks`` stretches of :data:`MIN_FOLD_SAMPLES` samples.
+    """
+    runs = list(runs)
+    groups = [str(group) for group in groups]
+    if len(groups) != len(runs) or not runs:
+        raise GreyboxError(f"model choice needs one group per run, got {len(groups)} for {len(runs)} run(s)")
+    names = list(dict.fromkeys(groups))
+    if len(names) > 1:
+        return [Fold(name, [run for run, group in zip(runs, groups) if group != name],
+                     [run for run, group in zip(runs, groups) if group == name]) for name in names]
+    if not (isinstance(n_blocks, int) and n_blocks >= 2):
+        raise GreyboxError(f"n_blocks must be an integer of at least 2, got {n_blocks!r}")
+    shortest = min(len(run) for run in runs)
+    if shortest < n_blocks * MIN_FOLD_SAMPLES:
+        raise GreyboxError(f"{names[0]}: a run of {shortest} samples is too short to hold out {n_blocks} stretches "
+                           f"of {MIN_FOLD_SAMPLES} samples; give more training logs (each is held out in turn)")
+    cuts = [np.linspace(0, len(run), n_blocks + 1).round().astype(int) for run in runs]
+    pieces = [[run.select(slice(int(c[j]), int(c[j + 1]))) for j in range(n_blocks)] for run, c in zip(runs, cuts)]
+    return [Fold(f"{names[0]}: stretch {j + 1} of {n_blocks}",
+                 [piece for run_pieces in pieces for i, piece in enumerate(run_pieces) if i != j],
+                 [run_pieces[j] for run_pieces in pieces]) for j in range(n_blocks)]
+
+
+def _score_fold(model, fold: Fold) -> tuple[float, float, int, float]:
+    """Fit a clone of ``model`` on the fold's training runs; its held-out RE [%], RMSE, parameters, seconds."""
+    started = time.perf_counter()
+    fitted = clone(model).fit(fold.train)
+    prediction = fitted.predict(fold.test)
+    effort = np.concatenate([run.effort for run in fold.test])
+    if not np.all(np.isfinite(prediction)):
+        raise GreyboxError(f"the prediction of {fold.name} is not finite")
+    return (relative_error(effort, prediction), rmse(effort, prediction), int(fitted.n_params),
+            time.perf_counter() - started)
+
+
+def _job(arguments):
+    """One (candidate, fold) fit in a worker process: the figures, or the error's text."""
+    model, fold = arguments
+    try:
+        return _score_fold(model, fold), None
+    except GreyboxError as error:
+        return None, str(error)
+    except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:  # a numerical failure of one fit
+        return None, f"{type(error).__name__}: {error}"
+
+
+def score_candidates(candidates: Sequence[tuple[str, object]], folds: Sequence[Fold], *, workers: int = 1,
+                     progress: Callable[[str], None] | None = None) -> list[CandidateScore]:
+    """Fit every candidate on every fold's training runs and score it on the runs held out.
+
+    Parameters
+    ----------
+    candidates : sequence of (str, estimator)
+        Label and unfitted model of each candidate.
+    folds : sequence of Fold
+        From :func:`held_out_folds`.
+    workers : int, default 1
+        Processes fitting in parallel (1: in this process).
+    progress : callable, optional
+        Called with one line of text per finished fit.
+
+    Returns
+    -------
+    list of CandidateScore
+        In the order of ``candidates``; a candidate one of whose fits failed carries the error.
+    """
+    jobs = [(c, f) for c in range(len(candidates)) for f in range(len(folds))]
+    scores = [CandidateScore(label) for label, _ in candidates]
+    fits: list[list[int]] = [[] for _ in candidates]
+    arguments = [(candidates[c][1], folds[f]) for c, f in jobs]
+
+    def record(job, outcome) -> None:
+        (c, f), (figures, error) = job, outcome
+        score = scores[c]
+        if error is not None:
+            score.error = score.error or f"{folds[f].name}: {error}"
+        else:
+            re, error_rms, n_params, seconds = figures
+            score.fold_re.append(re)
+            score.fold_rmse.append(error_rms)
+            fits[c].append(n_params)
+            score.seconds += seconds
+        if progress is not None:
+            figure = f"RE {figures[0]:.2f} %" if error is None else "failed"
+            progress(f"{candidates[c][0]} without {folds[f].name}: {figure}")
+
+    if workers <= 1 or len(jobs) <= 1:
+        for job, argument in zip(jobs, arguments):
+            record(job, _job(argument))
+    else:
+        # fresh interpreters, not forks: a fork of a process whose compiled kernels run threads may deadlock
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=context) as pool:
+            for job, outcome in zip(jobs, pool.map(_job, arguments)):
+                record(job, outcome)
+    for score, n_params in zip(scores, fits):
+        score.n_params = int(np.median(n_params)) if n_params else 0
+        if score.error is not None:
+            score.fold_re, score.fold_rmse = [], []
+    return scores
+
+
+def choose(scores: Sequence[CandidateScore]) -> int:
+    """Index of the chosen candidate by the one-standard-error rule (:data:`RULE`).
+
+    Parameters
+    ----------
+    scores : sequence of CandidateScore
+        Scored candidates; failed ones are never chosen.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    GreyboxError
+        If no candidate could be scored.
+    """
+    scored = [i for i, score in enumerate(scores) if score.error is None and score.fold_re]
+    if not scored:
+        reasons = "; ".join(f"{score.label}: {score.error}" for score in scores)
+        raise GreyboxError(f"no candidate model could be scored on the held-out runs ({reasons})")
+    best = min(scored, key=lambda i: scores[i].re)
+    spread = scores[best].re_se
+    limit = scores[best].re + (spread if math.isfinite(spread) else 0.0)
+    within = [i for i in scored if scores[i].re <= limit]
+    return min(within, key=lambda i: (scores[i].n_params, scores[i].re))
+
+
+def selection_record(scores: Sequence[CandidateScore], folds: Sequence[Fold], chosen: int, notes=()) -> dict:
+    """The record of a model choice that a model file keeps (plain values only).
+
+    Parameters
+    ----------
+    scores : sequence of CandidateScore
+        Every candidate's figures.
+    folds : sequence of Fold
+        The folds they were scored on.
+    chosen : int
+        Index of the chosen candidate.
+    notes : sequence of str, optional
+        What the choice decided besides the scores (e.g. an inertia refused).
+
+    Returns
+    -------
+    dict
+        ``rule``, ``metric``, ``folds`` (names), ``chosen`` (label), ``notes`` and ``candidates``: one
+        object per candidate with ``label``, ``re``, ``re_se``, ``rmse``, ``n_params``, ``fold_re`` and
+        ``error`` (None when scored).
+    """
+    def number(value):
+        return float(value) if math.isfinite(value) else None
+
+    return {
+        "rule": RULE,
+        "metric": "RE = RMSE / mean |effort| of the held-out runs [%], mean over the folds",
+        "folds": [fold.name for fold in folds],
+        "chosen": scores[chosen].label,
+        "notes": [str(note) for note in notes],
+        "candidates": [{"label": s.label, "re": number(s.re), "re_se": number(s.re_se), "rmse": number(s.rmse),
+                        "n_params": int(s.n_params), "fold_re": [float(v) for v in s.fold_re], "error": s.error}
+                       for s in scores],
+    }
+
+
+def _text(value, limit: int = 2000) -> bool:
+    return isinstance(value, str) and len(value) <= limit
+
+
+def _number(value) -> bool:
+    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+                             and value >= 0.0)
+
+
+def check_selection_record(record) -> None:
+    """Raise :class:`GreyboxError` unless ``record`` has the shape :func:`selection_record` gives.
+
+    Parameters
+    ----------
+    record : object
+        The ``selection_`` attribute read from a model file.
+    """
+    def fail(problem: str):
+        raise ParameterError(f"selection_ (the record of the model choice) {problem}")
+
+    if not isinstance(record, dict) or set(record) != {"rule", "metric", "folds", "chosen", "notes", "candidates"}:
+        fail("must be an object with rule, metric, folds, chosen, notes and candidates")
+    if not all(_text(record[name]) for name in ("rule", "metric", "chosen")):
+        fail("has a rule, metric or chosen label that is not short text")
+    for name in ("folds", "notes"):
+        if not (isinstance(record[name], list) and len(record[name]) <= 1000 and all(map(_text, record[name]))):
+            fail(f"has {name} that are not a list of short texts")
+    candidates = record["candidates"]
+    if not (isinstance(candidates, list) and 0 < len(candidates) <= 1000):
+        fail("must list between 1 and 1000 candidates")
+    keys = {"label", "re", "re_se", "rmse", "n_params", "fold_re", "error"}
+    for entry in candidates:
+        if not isinstance(entry, dict) or set(entry) != keys:
+            fail(f"has a candidate that is not an object with {', '.join(sorted(keys))}")
+        if not (_text(entry["label"]) and all(_number(entry[name]) for name in ("re", "re_se", "rmse"))
+                and isinstance(entry["n_params"], int) and not isinstance(entry["n_params"], bool)
+                and entry["n_params"] >= 0 and isinstance(entry["fold_re"], list)
+                and len(entry["fold_re"]) <= len(record["folds"])
+                and all(_number(v) and v is not None for v in entry["fold_re"])
+                and (entry["error"] is None or _text(entry["error"]))):
+            fail(f"has a malformed candidate {str(entry.get('label'))[:80]!r}")
+    if record["chosen"] not in [entry["label"] for entry in candidates]:
+        fail(f"names a chosen candidate {record['chosen'][:80]!r} that is not among its candidates")

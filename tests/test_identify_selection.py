@@ -1,0 +1,148 @@
+"""Model choice by held-out runs (greybox.identify.selection, greybox.model_choice)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from sklearn.base import BaseEstimator
+
+from greybox.errors import GreyboxError, ParameterError
+from greybox.friction import CoulombModel, GMSModel, StribeckModel
+from greybox.friction.backlash import BacklashModel
+from greybox.friction.signals import motion_log, velocity_profile
+from greybox.identify.selection import (
+    CandidateScore,
+    check_selection_record,
+    choose,
+    held_out_folds,
+    score_candidates,
+    selection_record,
+)
+from greybox.model_choice import build_candidate, choose_model
+from greybox.models.gmssvr import GMSSVRModel
+from greybox.persistence import load_model, save_model
+
+
+def _coulomb_run(seed: int, duration: float = 6.0, noise: float = 0.02):
+    """A run whose effort is Coulomb + viscous friction plus a little white noise."""
+    velocity = velocity_profile(duration, seed=seed, v_max=60.0)
+    log = motion_log(velocity, source=f"run{seed}.csv")
+    rng = np.random.default_rng(seed)
+    effort = 0.8 * np.sign(velocity) + 0.01 * velocity + noise * rng.standard_normal(len(velocity))
+    return log.replace(effort=effort)
+
+
+class _Memoriser(BaseEstimator):
+    """Returns the effort of every run it was fitted on exactly, and nothing (zero) for a run it has not seen."""
+
+    def fit(self, runs):
+        self.seen_ = {run.velocity.tobytes(): run.effort for run in runs}
+        return self
+
+    @property
+    def n_params(self):
+        return sum(effort.size for effort in self.seen_.values())
+
+    def predict(self, runs):
+        runs = runs if isinstance(runs, list) else [runs]
+        return np.concatenate([self.seen_.get(run.velocity.tobytes(), np.zeros(len(run))) for run in runs])
+
+
+def test_leave_one_group_out_holds_each_file_out_once():
+    runs = [_coulomb_run(s, 2.0) for s in range(4)]
+    groups = ["a.csv", "a.csv", "b.csv", "c.csv"]
+    folds = held_out_folds(runs, groups)
+    assert [fold.name for fold in folds] == ["a.csv", "b.csv", "c.csv"]
+    for fold, held in zip(folds, ([0, 1], [2], [3])):
+        assert [id(run) for run in fold.test] == [id(runs[i]) for i in held]
+        assert [id(run) for run in fold.train] == [id(runs[i]) for i in range(4) if i not in held]
+
+
+def test_one_file_is_cut_into_contiguous_stretches_that_cover_it():
+    run = _coulomb_run(0, 6.0)
+    folds = held_out_folds([run], ["only.csv"], n_blocks=3)
+    assert len(folds) == 3
+    held = np.concatenate([fold.test[0].time for fold in folds])
+    np.testing.assert_array_equal(held, run.time)  # every sample held out exactly once, in order
+    for fold in folds:
+        assert len(fold.train) == 2
+        assert sum(len(r) for r in fold.train) + len(fold.test[0]) == len(run)
+
+
+def test_too_short_a_single_file_is_one_clear_error():
+    with pytest.raises(GreyboxError, match="too short to hold out"):
+        held_out_folds([_coulomb_run(0, 1.0)], ["short.csv"])
+    with pytest.raises(GreyboxError, match="one group per run"):
+        held_out_folds([_coulomb_run(0, 1.0)], ["a", "b"])
+
+
+def test_the_choice_follows_held_out_error_not_training_error():
+    runs = [_coulomb_run(s) for s in range(3)]
+    np.testing.assert_array_equal(_Memoriser().fit(runs).predict(runs), np.concatenate([r.effort for r in runs]))
+    folds = held_out_folds(runs, ["r0", "r1", "r2"])
+    scores = score_candidates([("memoriser", _Memoriser()), ("coulomb", CoulombModel())], folds)
+    assert [s.label for s in scores] == ["memoriser", "coulomb"]
+    assert scores[1].re < scores[0].re
+    assert choose(scores) == 1
+
+
+def _score(label, folds, n_params, error=None):
+    return CandidateScore(label, fold_re=list(folds), fold_rmse=[0.1] * len(folds), n_params=n_params, error=error)
+
+
+def test_one_standard_error_rule_prefers_the_simpler_model():
+    best = _score("complex", [10.0, 12.0, 14.0], 20)  # mean 12, SE 1.15
+    close = _score("simple", [12.0, 13.0, 13.9], 4)  # mean 12.97 within one SE
+    far = _score("simplest", [15.0, 16.0, 17.0], 2)
+    assert choose([best, close, far]) == 1
+    assert choose([best, far]) == 0  # nothing simpler lies within one SE
+    failed = _score("failed", [1.0, 1.0, 1.0], 1, error="fold x: diverged")
+    assert math.isnan(failed.re)
+    assert choose([failed, best]) == 1
+    with pytest.raises(GreyboxError, match="no candidate model could be scored"):
+        choose([failed])
+
+
+def test_candidate_specifications_build_the_models_they_name():
+    model = build_candidate("gms:asymmetric,elements=3")
+    assert isinstance(model, GMSModel) and model.asymmetric and model.n_elements == 3
+    model = build_candidate("gmssvr:asymmetric", inertia=0.0)
+    assert isinstance(model, GMSSVRModel) and model.gms.asymmetric and model.gms.inertia == 0.0
+    model = build_candidate("stribeck:offset,backlash,inertia=0.5")
+    assert isinstance(model, BacklashModel) and model.base.fit_offset and model.base.inertia == 0.5
+    for bad, message in (("nosuch", "unknown model kind"), ("gms:wobble", "unknown option"),
+                         ("gms:elements=x", "needs a number"), ("coulomb:elements=3", "takes no n_elements")):
+        with pytest.raises(GreyboxError, match=message):
+            build_candidate(bad)
+
+
+def test_choose_model_refits_the_choice_and_records_the_table(tmp_path):
+    runs = [_coulomb_run(s) for s in range(3)]
+    model = choose_model(runs, ["a.csv", "b.csv", "c.csv"], candidates=["coulomb", "stribeck"])
+    record = model.selection_
+    assert record["folds"] == ["a.csv", "b.csv", "c.csv"]
+    assert [c["label"] for c in record["candidates"]] == ["coulomb", "stribeck"]
+    assert all(len(c["fold_re"]) == 3 and c["error"] is None for c in record["candidates"])
+    assert isinstance(model, CoulombModel if record["chosen"] == "coulomb" else StribeckModel)
+    assert model.n_samples_fit_ == sum(len(r) for r in runs)  # refitted on every run
+    path = save_model(model, tmp_path / "auto.gbm")
+    assert load_model(path).selection_ == record
+
+
+def test_a_hostile_selection_record_is_refused_on_load(tmp_path):
+    runs = [_coulomb_run(s, 3.0) for s in range(2)]
+    model = CoulombModel().fit(runs)
+    scores = [_score("coulomb", [1.0, 2.0], 4)]
+    good = selection_record(scores, held_out_folds(runs, ["a", "b"]), 0)
+    check_selection_record(good)
+    for broken in ({**good, "chosen": "other"}, {**good, "candidates": []}, {**good, "extra": 1},
+                   {**good, "candidates": [{**good["candidates"][0], "re": -1.0}]},
+                   {**good, "candidates": [{**good["candidates"][0], "n_params": True}]}):
+        with pytest.raises(ParameterError, match="selection_"):
+            check_selection_record(broken)
+        model.selection_ = broken
+        path = save_model(model, tmp_path / "hostile.gbm", overwrite=True)
+        with pytest.raises(GreyboxError, match="hostile.gbm: invalid CoulombModel.*selection_"):
+            load_model(path)
