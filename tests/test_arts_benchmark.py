@@ -7,6 +7,7 @@ prediction, and RE = 100 RMSE / mean|F| written out.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import subprocess
@@ -21,6 +22,7 @@ from greybox.data.arts import read_arts
 from greybox.errors import GreyboxError, LogError
 from greybox.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.friction.backlash import BacklashModel
+from greybox.model_choice import choose_model
 from greybox.studies import arts as bench
 
 REPO = Path(__file__).resolve().parents[1]
@@ -109,8 +111,10 @@ def test_bad_files_raise_a_log_error_naming_the_file(tmp_path, name, make, fragm
 def test_the_model_table_has_every_kind_symmetric_with_offset_and_asymmetric_without():
     kinds = ("coulomb", "stribeck", "lugre", "gms")
     assert bench.MODEL_NAMES == tuple(name for kind in kinds for name in (kind, f"{kind}_asym")) + (
-        "gms_backlash", "gms_asym_backlash")
+        "gms_backlash", "gms_asym_backlash", "auto")
     for name, (factory, _) in bench.MODELS.items():
+        if name == "auto":  # not a model: the choice among the candidates of --model auto
+            continue
         model = factory(3)  # a constructor without the option raises TypeError here: nothing is skipped
         if name.endswith("_backlash"):
             assert model.width is None  # identified
@@ -173,6 +177,22 @@ def test_a_model_behind_a_backlash_reports_its_width_and_offset(tmp_path, arts, 
     entry = json.loads(out.read_text())["models"]["gms_backlash"]
     assert entry["fit_offset"] is True and entry["params"]["width"] == 3.0
     assert entry["n_params"] == quick.base_.n_params  # a given width is not a fitted parameter
+
+
+def test_auto_reports_the_model_it_chose_and_the_fast_tests(tmp_path, arts, monkeypatch):
+    candidates = ["coulomb:offset", "stribeck:offset"]
+    monkeypatch.setattr(bench, "choose_model", functools.partial(choose_model, candidates=candidates))
+    out = tmp_path / "arts.json"
+    table = bench.arts_benchmark(arts, out, names=["auto", "coulomb"], train=["test1.npy", "test6.npy"],
+                                 test=["test2.npy", "test4.npy"])
+    results = json.loads(out.read_text())
+    auto = results["models"]["auto"]
+    assert auto["selection"]["chosen"] in candidates
+    assert auto["selection"]["folds"] == [str(arts / "test1.npy"), str(arts / "test6.npy")]
+    assert results["protocol"]["fast"] == ["test4.npy"]
+    for entry in results["models"].values():
+        assert entry["fast"] == entry["files"]["test4.npy"]  # the one 1-2 Hz file of this split
+    assert f"| {auto['fast']['re']:.2f} |" in table and f": {auto['selection']['chosen']} |" in table
 
 
 def test_the_run_checks_names_split_and_files_before_reading(tmp_path, arts):
