@@ -11,7 +11,8 @@ first stage (``gms:asymmetric``, ``gmssvr:asymmetric``), among them
 - ``inertia=J``: a known inertia [effort s^2/length] (``inertia=0``: the effort is measured at the load).
 
 :data:`DEFAULT_CANDIDATES` runs from the static curves to the grey-box
-model; :func:`choose_model` scores each by leave-one-run-out
+model, and :data:`GAP_CANDIDATES` (dynamic models behind a backlash) join
+them when a static model behind a backlash shows a gap; :func:`choose_model` scores each by leave-one-run-out
 cross-validation (:mod:`greybox.identify.selection`), refits the chosen one
 on every run and keeps the table it chose from in ``selection_``.
 
@@ -33,7 +34,7 @@ from .identify.inertia import SPRING_SHARE_LIMIT, spring_share
 from .identify.selection import choose, held_out_folds, score_candidates, selection_record
 from .registry import MODEL_CLASSES
 
-__all__ = ["DEFAULT_CANDIDATES", "build_candidate", "choose_model"]
+__all__ = ["DEFAULT_CANDIDATES", "GAP_CANDIDATES", "GAP_EVIDENCE", "build_candidate", "choose_model"]
 
 #: The candidates of ``--model auto``, simplest first: each kind's symmetric form with an offset and its
 #: direction-dependent form, a static model behind a backlash, and the grey-box model.
@@ -49,6 +50,15 @@ DEFAULT_CANDIDATES = (
     "gms:asymmetric",
     "gmssvr",
 )
+
+#: Candidates tried only when the runs show a gap: when a static model behind an identified backlash
+#: predicts the held-out runs better than the same model without it (:data:`GAP_EVIDENCE`). A dynamic model
+#: behind a backlash is identified by one fit per trial width (about 18), too slow to try on every axis.
+GAP_CANDIDATES = ("gms:offset,backlash", "gms:asymmetric,backlash")
+
+#: (model without a gap, the same behind a backlash): both among the candidates, the second better on the
+#: held-out runs is the evidence of a gap that :data:`GAP_CANDIDATES` need.
+GAP_EVIDENCE = ("stribeck:asymmetric", "stribeck:asymmetric,backlash")
 
 #: Candidate options that are switches: option -> hyperparameter.
 _SWITCHES = {"asymmetric": "asymmetric", "offset": "fit_offset"}
@@ -116,8 +126,8 @@ def build_candidate(spec: str, *, inertia: float | None = None):
 
 
 def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[str] = DEFAULT_CANDIDATES,
-                 inertia: float | None = None, n_blocks: int = 3, workers: int = 1,
-                 progress: Callable[[str], None] | None = None):
+                 gap_candidates: Sequence[str] = GAP_CANDIDATES, inertia: float | None = None, n_blocks: int = 3,
+                 workers: int = 1, progress: Callable[[str], None] | None = None):
     """Score the candidates on held-out runs, refit the chosen one on all runs and return it.
 
     Parameters
@@ -128,6 +138,9 @@ def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[
         The log file of each run; a file's runs are held out together.
     candidates : sequence of str, default :data:`DEFAULT_CANDIDATES`
         Candidate specifications (``KIND[:OPTION,...]``).
+    gap_candidates : sequence of str, default :data:`GAP_CANDIDATES`
+        Candidates scored too when both of :data:`GAP_EVIDENCE` are among ``candidates`` and the second
+        predicts the held-out runs better (and not already among them).
     inertia : float, optional
         Known inertia [effort s^2/length] of every candidate (0: the effort is measured at the load);
         identified by each candidate when None, unless the runs cannot tell it from a spring force.
@@ -165,6 +178,16 @@ def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[
     models = [(spec, build_candidate(spec, inertia=inertia)) for spec in candidates]
     folds = held_out_folds(runs, groups, n_blocks=n_blocks)
     scores = score_candidates(models, folds, workers=workers, progress=progress)
+    labels = [score.label for score in scores]
+    gap_tried = [spec for spec in gap_candidates if spec not in labels]
+    if gap_tried and all(spec in labels for spec in GAP_EVIDENCE):
+        without, behind = (scores[labels.index(spec)] for spec in GAP_EVIDENCE)
+        if behind.error is None and without.error is None and behind.re < without.re:
+            notes.append(f"a gap: {GAP_EVIDENCE[1]} predicts the held-out runs better than {GAP_EVIDENCE[0]} "
+                         f"(RE {behind.re:.2f} against {without.re:.2f} %), so {', '.join(gap_tried)} were tried too")
+            extra = [(spec, build_candidate(spec, inertia=inertia)) for spec in gap_tried]
+            models += extra
+            scores += score_candidates(extra, folds, workers=workers, progress=progress)
     chosen = choose(scores)
     model = models[chosen][1].fit(list(runs))
     model.selection_ = selection_record(scores, folds, chosen, notes)

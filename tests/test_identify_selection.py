@@ -146,3 +146,30 @@ def test_a_hostile_selection_record_is_refused_on_load(tmp_path):
         path = save_model(model, tmp_path / "hostile.gbm", overwrite=True)
         with pytest.raises(GreyboxError, match="hostile.gbm: invalid CoulombModel.*selection_"):
             load_model(path)
+
+
+def _gap_run(seed: int, width: float, duration: float = 6.0):
+    """Coulomb friction behind a gap on a sine: after each reversal no force until the motion crossed ``width`` [mm]."""
+    t = np.arange(int(duration / 0.002)) * 0.002
+    w = 2 * np.pi * (0.5 + 0.25 * seed)
+    velocity = (10.0 + 5.0 * seed) * w * np.cos(w * t)
+    log = motion_log(velocity, source=f"gap{seed}.csv")
+    effort = np.zeros(len(log))
+    direction, start = 0.0, log.position[0]
+    for i, (x, v) in enumerate(zip(log.position, velocity)):
+        if v != 0.0 and np.sign(v) != direction:
+            direction, start = np.sign(v), x
+        effort[i] = direction * 1.0 if abs(x - start) >= width else 0.0
+    noise = 0.01 * np.random.default_rng(seed).standard_normal(len(log))
+    return log.replace(effort=effort + noise)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("width, tried", [(3.0, True), (0.0, False)])
+def test_dynamic_models_behind_a_gap_are_tried_when_the_runs_show_one(width, tried):
+    runs = [_gap_run(s, width, duration=6.0) for s in range(3)]
+    model = choose_model(runs, ["a", "b", "c"], candidates=["stribeck:asymmetric", "stribeck:asymmetric,backlash"],
+                         gap_candidates=["coulomb:backlash"])
+    labels = [c["label"] for c in model.selection_["candidates"]]
+    assert ("coulomb:backlash" in labels) is tried
+    assert any("a gap:" in note for note in model.selection_["notes"]) is tried
