@@ -24,6 +24,7 @@ from greybox.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.friction.backlash import BacklashModel
 from greybox.model_choice import choose_model
 from greybox.studies import arts as bench
+from greybox.studies import auto
 
 REPO = Path(__file__).resolve().parents[1]
 SCRIPT = REPO / "scripts" / "arts_benchmark.py"
@@ -181,18 +182,18 @@ def test_a_model_behind_a_backlash_reports_its_width_and_offset(tmp_path, arts, 
 
 def test_auto_reports_the_model_it_chose_and_the_fast_tests(tmp_path, arts, monkeypatch):
     candidates = ["coulomb:offset", "stribeck:offset"]
-    monkeypatch.setattr(bench, "choose_model", functools.partial(choose_model, candidates=candidates))
+    monkeypatch.setattr(auto, "choose_model", functools.partial(choose_model, candidates=candidates))
     out = tmp_path / "arts.json"
     table = bench.arts_benchmark(arts, out, names=["auto", "coulomb"], train=["test1.npy", "test6.npy"],
                                  test=["test2.npy", "test4.npy"])
     results = json.loads(out.read_text())
-    auto = results["models"]["auto"]
-    assert auto["selection"]["chosen"] in candidates
-    assert auto["selection"]["folds"] == [str(arts / "test1.npy"), str(arts / "test6.npy")]
+    entry = results["models"]["auto"]
+    assert entry["selection"]["chosen"] in candidates
+    assert entry["selection"]["folds"] == [str(arts / "test1.npy"), str(arts / "test6.npy")]
     assert results["protocol"]["fast"] == ["test4.npy"]
-    for entry in results["models"].values():
-        assert entry["fast"] == entry["files"]["test4.npy"]  # the one 1-2 Hz file of this split
-    assert f"| {auto['fast']['re']:.2f} |" in table and f": {auto['selection']['chosen']} |" in table
+    for other in results["models"].values():
+        assert other["fast"] == other["files"]["test4.npy"]  # the one 1-2 Hz file of this split
+    assert f"| {entry['fast']['re']:.2f} |" in table and f": {entry['selection']['chosen']} |" in table
 
 
 def test_the_run_checks_names_split_and_files_before_reading(tmp_path, arts):

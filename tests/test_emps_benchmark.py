@@ -9,6 +9,7 @@ on relerr.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import subprocess
@@ -20,6 +21,8 @@ import pytest
 
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel
+from greybox.model_choice import choose_model
+from greybox.studies import auto
 from greybox.studies import emps as bench
 
 REPO = Path(__file__).resolve().parents[1]
@@ -161,3 +164,15 @@ def test_the_script_finds_the_data_through_greybox_real_data(tmp_path):
     result = subprocess.run([sys.executable, str(SCRIPT), "--json", str(tmp_path / "x.json")], env=env,
                             capture_output=True, text=True, timeout=300)
     assert result.returncode == 2 and str(tmp_path / "elsewhere" / "EMPS") in result.stderr
+
+
+def test_auto_runs_the_choice_on_three_stretches_of_the_training_file(emps, monkeypatch):
+    candidates = ["coulomb:offset", "coulomb:asymmetric"]
+    monkeypatch.setattr(auto, "choose_model", functools.partial(choose_model, candidates=candidates))
+    results, _ = bench.run_benchmark(emps, ["auto"])
+    entry = results["models"]["auto"]
+    assert entry["selection"]["chosen"] in candidates
+    assert [fold.split(": ")[-1] for fold in entry["selection"]["folds"]] == [
+        "stretch 1 of 3", "stretch 2 of 3", "stretch 3 of 3"]
+    assert 0 < entry["test_relerr"] < 100 and entry["n_params"] in (4, 5)
+    assert f": {entry['selection']['chosen']} |" in bench.markdown_table(results)

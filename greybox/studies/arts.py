@@ -53,8 +53,8 @@ from ..evaluate.plots import import_pyplot, save_figure
 from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from ..friction.backlash import BacklashModel
 from ..metrics import metrics_table
-from ..model_choice import choose_model
 from ..provenance import provenance, provenance_line
+from .auto import HeldOutChoice
 from .emps import learned_parameters
 
 __all__ = ["TRAIN_FILES", "TEST_FILES", "FAST_FILES", "PLOT_FILES", "MODELS", "MODEL_NAMES", "benchmark_log",
@@ -71,34 +71,6 @@ FAST_FILES = ("test3.npy", "test4.npy", "test8.npy", "test12.npy")
 PLOT_FILES = ("test2.npy", "test7.npy", "test11.npy")
 
 
-class _HeldOutChoice:
-    """``greybox train --model auto`` inside the protocol: its default candidates, each training file held out in turn.
-
-    :meth:`fit` returns the chosen model, fitted on every training file (with the table it was chosen from).
-
-    Parameters
-    ----------
-    seed : int
-        Not used: the candidates run with their default seeds, as ``--model auto`` runs them.
-    """
-
-    def __init__(self, seed: int):
-        self.seed = seed
-
-    def fit(self, runs, progress=None):
-        """The model :func:`greybox.model_choice.choose_model` chooses on ``runs`` (one group per file).
-
-        Parameters
-        ----------
-        runs : list of AxisLog
-            The prepared training files.
-        progress : None, bool or callable, optional
-            Any true value prints a line per candidate fit.
-        """
-        report = (lambda line: print(f"  auto: {line}", flush=True)) if progress else None
-        return choose_model(runs, [run.source for run in runs], workers=os.cpu_count() or 1, progress=report)
-
-
 #: Models: name -> (constructor taking the seed, description). Symmetric ones fit an offset, asymmetric ones cannot.
 MODELS = {
     "coulomb": (lambda seed: CoulombModel(fit_offset=True), "Coulomb + viscous + offset"),
@@ -113,7 +85,7 @@ MODELS = {
                      "GMS, N = 4, + offset, behind an identified backlash"),
     "gms_asym_backlash": (lambda seed: BacklashModel(base=GMSModel(asymmetric=True, random_state=seed)),
                           "GMS, N = 4, per direction, behind an identified backlash"),
-    "auto": (_HeldOutChoice, "chosen by `greybox train --model auto` (each training file held out in turn)"),
+    "auto": (HeldOutChoice, "chosen by `greybox train --model auto` (each training file held out in turn)"),
 }
 MODEL_NAMES = tuple(MODELS)
 

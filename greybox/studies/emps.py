@@ -59,6 +59,7 @@ from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from ..friction.backlash import BacklashModel
 from ..metrics import relerr
 from ..provenance import provenance, provenance_line
+from .auto import HeldOutChoice
 
 __all__ = ["TRAIN_FILE", "TEST_FILE", "PUBLISHED", "GREYBOX_MODELS", "IDIM_LS_MODELS", "MODEL_NAMES",
            "benchmark_log", "decimate_benchmark", "benchmark_relerr", "idim_ls", "learned_parameters",
@@ -105,6 +106,7 @@ GREYBOX_MODELS = {
     "gms_2ms": (lambda seed: GMSModel(fit_offset=True, random_state=seed), 2, "GMS, N = 4, + offset, 2 ms step"),
     "gms_asym_backlash": (lambda seed: BacklashModel(base=GMSModel(asymmetric=True, random_state=seed)), 1,
                           "asymmetric GMS, N = 4, behind an identified backlash"),
+    "auto": (HeldOutChoice, 1, "chosen by `greybox train --model auto` (three stretches held out in turn)"),
 }
 IDIM_LS_MODELS = {
     "coulomb_idim_ls": (False, "benchmark IDIM-LS: Coulomb + viscous + offset"),
@@ -303,7 +305,7 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None) -
             }
         else:
             factory, step, description = GREYBOX_MODELS[name]
-            model = factory(seed).fit(logs[step]["train"], progress=progress)
+            model = factory(seed).fit(logs[step]["train"], progress=progress)  # auto: the model it chose
             predictions = {role: (model.predict(log), log.time) for role, log in logs[step].items()}
             values, units = learned_parameters(model)
             entry = {
@@ -314,6 +316,8 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None) -
                 "units": units,
                 "n_params": int(model.n_params),
             }
+            if getattr(model, "selection_", None) is not None:  # the entry auto: the table it chose from
+                entry["selection"] = model.selection_
         for role, (prediction, times) in predictions.items():
             entry[f"{role}_relerr"] = benchmark_relerr(reference[role], prediction, times)
             on_grid = prediction if times is None else np.interp(reference[role].time, times, prediction)
@@ -355,8 +359,9 @@ def markdown_table(results: dict) -> str:
         f"{results['published']['coulomb_asym_idim_ls']['train_relerr']:.2f} | - |",
     ]
     for name, entry in results["models"].items():
+        what = entry["description"] + (f": {entry['selection']['chosen']}" if "selection" in entry else "")
         lines.append(
-            f"| `{name}` | {entry['description']} | {entry['step_ms']} ms | "
+            f"| `{name}` | {what} | {entry['step_ms']} ms | "
             f"{entry['train_relerr']:.2f} | {entry['test_relerr']:.2f} |"
         )
     for name in ("coulomb_idim_ls", "coulomb_asym_idim_ls"):
