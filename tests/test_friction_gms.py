@@ -7,7 +7,7 @@ import pytest
 
 from greybox.errors import ParameterError
 from greybox.friction import GMSModel, stribeck_curve
-from greybox.friction.gms import check_gms_parameters, simulate_gms
+from greybox.friction.gms import PRUNE_SHARE, _Regression, check_gms_parameters, simulate_gms
 from greybox.friction.reference import gms_reference
 from greybox.friction.signals import STEP, motion_log, velocity_profile
 
@@ -201,12 +201,63 @@ def test_identification_is_reproducible_for_a_seed_and_reports_progress():
 def test_ten_elements_and_least_squares():
     log = synthetic_log(6.0, seed=4, noise=0.005)
     model = GMSModel(n_elements=10, method="least-squares", n_starts=1, max_iter=40).fit(log)
-    assert model.alpha_.shape == (10,) and model.k_.shape == (10,)
+    n = 10 - model.n_pruned_
+    assert model.alpha_.shape == (n,) and model.k_.shape == (n,)
+    # every element left carries force: those with a zero stiffness were pruned
+    share = model.k_ * model.alpha_
+    assert np.all(share > PRUNE_SHARE * share.sum())
+    assert model.n_params == 2 * n + 6
     assert model.alpha_.sum() == pytest.approx(1.0)
     residual = model.predict(log) - log.effort
     assert np.sqrt(np.mean(residual ** 2)) < 0.05 * np.std(log.effort)
     z, stick = model.states(log)
-    assert z.shape == (len(log), 10)
+    assert z.shape == (len(log), n)
+
+
+def test_an_element_without_stiffness_is_pruned_and_the_others_kept_as_they_were():
+    """Pruning drops the element, keeps the break-away deflections and slip rates of the others, refits k."""
+    params = dict(TRUTH, alpha=np.array([0.1, 0.2, 0.3, 0.15, 0.25]), k=np.array([40.0, 60.0, 30.0, 45.0, 0.0]),
+                  sigma=0.0)
+    log = synthetic_log(6.0, seed=5, params=params)
+    shape = (params["alpha"], params["s_0"], params["s_inf"], params["v_s"], params["C"])
+    x, residual = _Regression([log], 5, False, False).solve(shape)
+    assert np.max(np.abs(residual)) < 1e-9 and abs(x[4]) < 1e-6  # the truth, up to rounding
+    model = GMSModel(n_elements=5)
+    (alpha, s_0, s_inf, v_s, c), x_kept, kept_residual, dropped = model._pruned([log], shape, x, residual)
+    assert dropped == 1 and alpha.shape == (4,) and alpha.sum() == pytest.approx(1.0)
+    np.testing.assert_allclose(alpha * s_0, params["alpha"][:4] * params["s_0"], rtol=1e-12)
+    np.testing.assert_allclose(alpha * s_inf, params["alpha"][:4] * params["s_inf"], rtol=1e-12)
+    np.testing.assert_allclose(alpha * c, params["alpha"][:4] * params["C"], rtol=1e-12)
+    np.testing.assert_allclose(x_kept[:4], params["k"][:4], rtol=1e-6)
+    assert np.max(np.abs(kept_residual)) < 1e-9
+    # nothing to drop: the shape is returned as it was
+    assert model._pruned([log], shape, np.concatenate(([1.0] * 5, x[5:])), residual)[3] == 0
+
+
+@pytest.mark.slow
+def test_the_fitted_speed_law_beyond_three_times_the_training_speed_is_a_level_plus_the_viscous_line():
+    """On data whose friction keeps falling over the training speeds (a Stribeck velocity far above them),
+    the fit still has a non-negative viscous term and a Stribeck velocity within the training speeds: beyond
+    3x the fastest training speed the sliding friction is its level there plus the viscous line, within the
+    e^-3 of the Stribeck drop left, so it neither falls on nor grows faster than linearly."""
+    params = dict(TRUTH, s_0=0.03, s_inf=0.005, v_s=400.0, mu=0.0)
+    log = synthetic_log(6.0, seed=6, params=params, noise=0.01)
+    model = GMSModel(n_starts=2, max_iter=80).fit(log)
+    top = float(np.max(np.abs(log.velocity)))
+    assert 400.0 > 4 * top  # the truth's curve falls all over the training speeds
+    assert model.viscous_ >= 0.0 and model.v_s_ <= top
+    stiffness = float(np.sum(model.k_ * model.alpha_))
+    for sign in (1.0, -1.0):
+        speeds = np.linspace(3.0, 30.0, 28) * top
+        levels = []
+        for speed in speeds:  # steady sliding: a ramp to the speed, then held
+            velocity = sign * np.concatenate((np.linspace(0.0, speed, 200), np.full(2000, speed)))
+            levels.append(model.friction(motion_log(velocity))[-1])
+        levels = sign * np.array(levels)
+        line = levels[0] + model.viscous_ * (speeds - speeds[0])
+        drop = stiffness * abs(model.s_0_ - model.s_inf_) * np.exp(-3.0)
+        assert np.all(np.abs(levels - line) <= drop + 1e-9)
+        assert np.all(levels > 0)
 
 
 def test_single_element_without_stages():

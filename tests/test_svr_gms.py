@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from multisine import multisine_motion
+from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 
 from greybox.data.log import AxisLog
@@ -99,17 +100,28 @@ def test_incomplete_models_are_refused():
         GMSSVRModel(**SVR_FIXED).fit_svr(run, gms=GMSModel())
 
 
-def test_residual_target_falls_back_to_the_gms_stage_far_from_the_training_data(fitted):
+def test_far_from_the_training_data_both_targets_hand_over_to_the_gms_stage(fitted):
     model, train = fitted
     residual = GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit_svr(train, gms=model.gms_)
-    assert residual.target == "residual"  # the default
+    assert residual.target == "residual" and residual.handover  # the defaults
     test = gms_run(3)
     assert rmse(residual.predict(test), test.current) < 0.5 * rmse(model.gms_predict(test), test.current)
-    # 10 m away from the travel the kernel terms vanish: the prediction is I_GMS + intercept,
-    # while the "current" target collapses to its intercept alone.
+    # 10 m away from the travel: the GMS stage alone, whatever the target
     far = test.replace(position=test.position + 1e4)
-    np.testing.assert_allclose(residual.predict(far), model.gms_predict(far) + residual.intercept_, atol=1e-9)
-    np.testing.assert_allclose(model.predict(far), model.intercept_, atol=1e-9)
+    np.testing.assert_allclose(residual.predict(far), model.gms_predict(far), atol=1e-9)
+    np.testing.assert_allclose(model.predict(far), model.gms_predict(far), atol=1e-9)
+    # without the hand-over the kernel terms vanish there: the prediction is I_GMS + intercept,
+    # while the "current" target collapses to its intercept alone
+    old_residual = GMSSVRModel(gms=quick_gms(), **SVR_FIXED, handover=False).fit_svr(train, gms=model.gms_)
+    np.testing.assert_allclose(old_residual.predict(far), model.gms_predict(far) + old_residual.intercept_,
+                               atol=1e-9)
+    old_current = clone(model).set_params(handover=False).fit_svr(train, gms=model.gms_)
+    np.testing.assert_allclose(old_current.predict(far), old_current.intercept_, atol=1e-9)
+    # inside the box of the training inputs the hand-over changes nothing
+    inside = ~residual.outside_training(test)["inputs"]
+    assert inside.mean() > 0.5
+    np.testing.assert_array_equal(residual.predict(test)[inside], old_residual.predict(test)[inside])
+    np.testing.assert_array_equal(model.predict(test)[inside], old_current.predict(test)[inside])
     with pytest.raises(ParameterError, match="target"):
         GMSSVRModel(target="force", **SVR_FIXED).fit_svr(train, gms=model.gms_)
 

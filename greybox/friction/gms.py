@@ -54,6 +54,13 @@ _SLOW_SLIP_RATIO = 0.05
 #: Residual evaluations of the least-squares polish after the joint Nelder-Mead search (Jacobians not counted).
 _POLISH_EVALUATIONS = 100
 
+#: An element whose share ``k_i alpha_i / sum_j k_j alpha_j`` of the sliding force is at most this is pruned
+#: after the fit (it carries no force: a zero stiffness at the bound of the linear fit, or a negligible one).
+PRUNE_SHARE = 1e-6
+
+#: Joint fits (the best by training cost) each polished by least squares after the Nelder-Mead search.
+_POLISHED_STARTS = 1
+
 #: Ratio of the largest to the smallest element fraction of the initial guess.
 _ALPHA_SPREAD = 20.0
 
@@ -323,6 +330,9 @@ class GMSModel(CurrentModel):
        basins the cost has along ``C``, so the result no longer hangs on
        which perturbed start happens to win stage 2 (seed spread of the
        EMPS cross-test relerr from 0.22 to below 0.01 percentage points).
+    4. pruning: an element left with no share of the sliding force (its
+       stiffness at the bound 0 of the linear fit) is dropped, the others
+       kept as they are, and the linear part refitted (``n_pruned_``).
 
     ``C`` is searched as ``r = T C / min(s_0, s_inf)`` in ``(0, 1]`` (``T``
     the largest step of the runs), so the forward-Euler slip step is stable
@@ -382,6 +392,9 @@ class GMSModel(CurrentModel):
         Final cost: mean squared error over the effort variance (NMSE / 100).
     n_evaluations_ : int
         Number of simulations run by the identification.
+    n_pruned_ : int
+        Elements dropped after the search because they carried no force (see :data:`PRUNE_SHARE`):
+        the model has ``n_elements - n_pruned_`` elements.
     effort_unit_ : str
         Unit of the effort the model was fitted on, "A" or "N".
     """
@@ -498,26 +511,28 @@ class GMSModel(CurrentModel):
                                             method=self.method, max_iter=self.max_iter, stage="GMS pre-sliding",
                                             progress=progress, fixed_starts=[slower_slip])
             # stage 3: all shape parameters from every pre-sliding fit; the best joint fit wins
-            result = None
+            joints = []
             for index, start in enumerate(presliding):
                 n_evaluations += start.n_evaluations
                 joint = local_search(full_residuals, np.clip(expand(start.x), full_lower, full_upper), full_lower,
                                      full_upper, scale=full_scale, method=self.method, max_iter=self.max_iter,
                                      stage="GMS joint", progress=progress, start=index, n_starts=len(presliding),
-                                     best_so_far=np.inf if result is None else result.cost)
+                                     best_so_far=min((j.cost for j in joints), default=np.inf))
                 n_evaluations += joint.n_evaluations
-                if result is None or joint.cost < result.cost:
-                    result = joint
-            result.n_evaluations = 0  # counted above
+                joints.append(joint)
+            joints.sort(key=lambda joint: joint.cost)
             if self.method == "nelder-mead":
-                # the simplex stalls short of the minimum in many dimensions: trust-region least squares ends it
-                polished = local_search(full_residuals, result.x, full_lower, full_upper, scale=full_scale,
-                                        method="least-squares", max_iter=_POLISH_EVALUATIONS, stage="GMS joint",
-                                        progress=progress, best_so_far=result.cost)
-                n_evaluations += polished.n_evaluations
-                if polished.cost < result.cost:
-                    result = polished
-                    result.n_evaluations = 0
+                # the simplex stalls short of the minimum in many dimensions: trust-region least squares ends it,
+                # from each of the best joint fits (they stall at different points of one flat valley)
+                for index, joint in enumerate(joints[:_POLISHED_STARTS]):
+                    polished = local_search(full_residuals, joint.x, full_lower, full_upper, scale=full_scale,
+                                            method="least-squares", max_iter=_POLISH_EVALUATIONS, stage="GMS joint",
+                                            progress=progress, best_so_far=joints[0].cost)
+                    n_evaluations += polished.n_evaluations
+                    if polished.cost < joint.cost:
+                        joints[index] = polished
+            result = min(joints, key=lambda joint: joint.cost)
+            result.n_evaluations = 0  # counted above
         else:
             result = multistart(full_residuals, theta, full_lower, full_upper, scale=full_scale,
                                 n_starts=self.n_starts, random_state=self.random_state, method=self.method,
@@ -526,6 +541,7 @@ class GMSModel(CurrentModel):
 
         shape = self._shape(result.x, max_step)
         x, residual = regression.solve(shape)
+        shape, x, residual, self.n_pruned_ = self._pruned(runs, shape, x, residual)
         alpha, s_0, s_inf, v_s, c = shape
         self.alpha_ = alpha
         self.set_linear_coefficients(x)
@@ -537,6 +553,27 @@ class GMSModel(CurrentModel):
             self.s_0_neg_, self.s_inf_neg_, self.v_s_neg_ = (float(value) for value in curves[1])
         self.cost_ = float(residual @ residual)
         self.n_evaluations_ = int(n_evaluations)
+
+    def _pruned(self, runs, shape, x, residual):
+        """Drop the elements that carry no force (share at most :data:`PRUNE_SHARE`) and refit the linear part.
+
+        The other elements keep their break-away deflections ``alpha_i s(v)`` and slip rates ``alpha_i C``:
+        the fractions of those kept are scaled up to sum 1, ``s_0``, ``s_inf`` and ``C`` down by the same
+        factor. The linear parameters (stiffnesses, damping, viscous, inertia, offset) are refitted, since a
+        dropped element's deflection rate was part of the damping term. One element always stays.
+
+        Returns ``(shape, linear coefficients, residuals, number of elements dropped)``.
+        """
+        alpha, s_0, s_inf, v_s, c = shape
+        share = x[:alpha.size] * alpha
+        keep = share > PRUNE_SHARE * np.sum(share)
+        if keep.all() or not keep.any():
+            return shape, x, residual, 0
+        kept = float(alpha[keep].sum())
+        shape = (alpha[keep] / kept, np.multiply(s_0, kept), np.multiply(s_inf, kept), v_s, c * kept)
+        regression = _Regression(runs, int(keep.sum()), self.fit_offset, self.asymmetric)
+        x, residual = regression.solve(shape)
+        return shape, x, residual, int(alpha.size - keep.sum())
 
     # ---------------------------------------------------------------- prediction
     def _parameters(self) -> dict:
@@ -558,7 +595,9 @@ class GMSModel(CurrentModel):
         return 2 * len(self.alpha_) + 6 + 4 * int(self.asymmetric) + int(self.fit_offset)
 
     def _fit_statistics(self) -> dict:
-        return {"cost": self.cost_, "n_evaluations": self.n_evaluations_}
+        pruned = getattr(self, "n_pruned_", None)  # None: a file that predates the pruning
+        return {"cost": self.cost_, "n_evaluations": self.n_evaluations_,
+                **({} if pruned is None else {"n_pruned": pruned})}
 
     def _own_parameters(self) -> list[Parameter]:
         shared = [

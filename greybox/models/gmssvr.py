@@ -13,16 +13,18 @@ Two stages:
 By default (``target="residual"``) the SVR learns only the GMS stage's
 residual ``I - I_GMS`` and the prediction is ``I_GMS + SVR(...)``. The
 position input lets the kernel learn the dependence of the friction on the
-position along the screw that the GMS model lacks, and far from its training
-data, where an RBF expansion falls back to its intercept, the model falls
-back to the GMS physics (plus a constant). With ``target="current"`` the SVR
-learns the current itself, as the paper's eq. 8 is printed,
+position along the screw that the GMS model lacks. With ``target="current"``
+the SVR learns the current itself, as the paper's eq. 8 is printed,
 
     I = SVR(p, I_GMS, z_1, ..., z_N),
 
 with the GMS prediction as one input the kernel may correct in any
-direction; such a model collapses to a constant wherever the log leaves the
-(p, I_GMS, z) region of its training data. Both targets search the same
+direction. Far from its training data an RBF expansion falls back to its
+intercept (a constant, or the GMS physics plus a constant for the residual
+target); with ``handover=True`` (the default) the prediction is instead
+handed over to the GMS stage's alone, smoothly, within one kernel length
+scale of the box of the training inputs (:mod:`greybox.models.handover`),
+and is unchanged inside it. Both targets search the same
 intervals (:func:`greybox.models.svr.default_bounds`). The residual target
 was chosen on the training runs of a development family of truth axes
 (:mod:`greybox.studies.priors`): fitted on three quarters of dataset A and
@@ -53,6 +55,7 @@ from ..errors import LogError, ParameterError
 from ..estimator import check_runs
 from ..friction.gms import GMSModel
 from ..identify.progress import make_progress
+from .handover import hand_over
 from .svr import KernelRegressionModel
 
 __all__ = ["GMSSVRModel", "TARGETS"]
@@ -97,6 +100,13 @@ class GMSSVRModel(KernelRegressionModel):
         :func:`greybox.models.svr.default_bounds`.
     random_state : int, default 0
         Seed of subset choice and optimisation.
+    handover : bool, default True
+        Outside the box of the training inputs (p, I_GMS, z) hand the
+        prediction over from the corrected one to the GMS stage's, over one
+        kernel length scale (:mod:`greybox.models.handover`): the correction
+        never extrapolates on its own. Inside the box the prediction is the
+        fitted one. False: the correction everywhere (the only behaviour before
+        the setting existed, and that of model files written before it).
 
     Attributes
     ----------
@@ -125,10 +135,12 @@ class GMSSVRModel(KernelRegressionModel):
         Optimised hyperparameters that ended at an end of their search interval.
     n_train_ : int
         Size of the SVR training subset.
+    handover_width_ : float or None
+        Width of the hand-over [standardised unit] (None without it).
     """
 
     def __init__(self, *, gms=None, C=None, epsilon=None, gamma=None, target="residual", n_subset=2000,
-                 optimize=True, n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
+                 optimize=True, n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0, handover=True):
         self.gms = gms
         self.C = C
         self.epsilon = epsilon
@@ -141,6 +153,7 @@ class GMSSVRModel(KernelRegressionModel):
         self.cv_blocks = cv_blocks
         self.bounds = bounds
         self.random_state = random_state
+        self.handover = handover
 
     def __sklearn_is_fitted__(self) -> bool:
         """Fitted once the SVR stage is (the GMS stage alone is not a usable model)."""
@@ -305,10 +318,15 @@ class GMSSVRModel(KernelRegressionModel):
         return self._friction_of(run, inputs), end
 
     def _friction_of(self, run: AxisLog, inputs) -> np.ndarray:
-        """Friction [A] of a chunk whose SVR inputs are ``inputs``: the prediction less inertia and offset."""
+        """Friction [A] of a chunk whose SVR inputs are ``inputs``: the prediction less inertia and offset.
+
+        Outside the box of the training inputs the prediction is handed over to the GMS stage's
+        (:mod:`greybox.models.handover`).
+        """
         current = self._kernel_predict(inputs)
         if self.target == "residual":
             current = current + inputs[:, 1]
+        current = hand_over(inputs[:, 1], current, self._handover(inputs))
         return current - self.J_ * run.acceleration - self.offset_
 
     def predict_flag_chunk(self, log: AxisLog, state, region, *, sample_time: float):

@@ -35,7 +35,7 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from ..base import EFFORT, Parameter
+from ..base import EFFORT, LENGTH, Parameter
 from ..data.log import AxisLog
 from ..errors import ParameterError
 from ..estimator import CurrentModel
@@ -45,6 +45,7 @@ from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_seed
 from ..identify.progress import ProgressEvent
 from .chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
+from .handover import hand_over, handover_weight, handover_width
 from .rbf import rbf_expansion
 from .subset import coverage_subset
 
@@ -54,6 +55,7 @@ __all__ = [
     "SVRExpansion",
     "fit_svr_expansion",
     "inertia_offset_proxy",
+    "coulomb_viscous_proxy",
     "default_bounds",
     "HYPERPARAMETERS",
     "BOUNDED",
@@ -351,12 +353,13 @@ def _near_bound(value: float, interval: tuple[float, float], fraction: float = 0
     return bool(np.log(value) <= low + margin or np.log(value) >= high - margin)
 
 
-def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) -> tuple[float, float]:
-    """Inertia and offset from a Coulomb + viscous least-squares proxy.
+def coulomb_viscous_proxy(runs: Sequence[AxisLog], inertia: float | None = None
+                          ) -> tuple[float, float, float, float]:
+    """Inertia, offset, Coulomb level and viscous coefficient from a Coulomb + viscous least-squares proxy.
 
     Fits ``I ~ J a + F_c sgn(v) + mu v + offset`` over the samples with
     ``|v| > 0.01 max|v|`` of all runs (all samples if fewer than 4 move),
-    with ``J >= 0``.
+    with ``J``, ``F_c`` and ``mu`` non-negative.
 
     Parameters
     ----------
@@ -371,6 +374,10 @@ def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) 
         Inertia [A s^2/mm] (or [N s^2/mm] for force logs).
     offset : float
         Constant effort [A] (e.g. a weight share on an inclined axis).
+    coulomb : float
+        Coulomb level ``F_c`` [A].
+    viscous : float
+        Viscous coefficient ``mu`` [A s/mm].
     """
     v = np.concatenate([run.velocity for run in runs])
     a = np.concatenate([run.acceleration for run in runs])
@@ -386,11 +393,33 @@ def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) 
     if inertia is not None:
         design = design[:, :3]
     lower = np.full(design.shape[1], -np.inf)
+    lower[:2] = 0.0  # a friction level and a viscous coefficient are never negative
     if inertia is None:
-        lower[3] = 0.0  # an identified inertia is never negative
+        lower[3] = 0.0  # nor is an identified inertia
     coef, _ = bounded_lstsq(design, effort[moving], lower=lower)
     J = float(inertia) if inertia is not None else float(coef[3])
-    return J, float(coef[2])
+    return J, float(coef[2]), float(coef[0]), float(coef[1])
+
+
+def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) -> tuple[float, float]:
+    """Inertia and offset of :func:`coulomb_viscous_proxy`.
+
+    Parameters
+    ----------
+    runs : list of AxisLog
+        Prepared runs.
+    inertia : float, optional
+        Known J [A s^2/mm]; then only the other proxy terms are fitted.
+
+    Returns
+    -------
+    J : float
+        Inertia [A s^2/mm] (or [N s^2/mm] for force logs).
+    offset : float
+        Constant effort [A] (e.g. a weight share on an inclined axis).
+    """
+    J, offset, _, _ = coulomb_viscous_proxy(runs, inertia)
+    return J, offset
 
 
 class KernelRegressionModel(CurrentModel):
@@ -398,14 +427,16 @@ class KernelRegressionModel(CurrentModel):
 
     The subclass stores the SVR settings ``C``, ``epsilon``, ``gamma``,
     ``n_subset``, ``optimize``, ``n_calls``, ``cv_folds``, ``cv_blocks``,
-    ``bounds`` and ``random_state`` (see :class:`SVRCurrentModel`); this class
+    ``bounds``, ``random_state`` and ``handover`` (see :class:`SVRCurrentModel`); this class
     checks them, fits the expansion (:func:`fit_svr_expansion`) into the
     learned attributes ``input_mean_``, ``input_scale_``, ``support_vectors_``,
     ``dual_coef_``, ``intercept_``, ``epsilon_``, ``C_``, ``gamma_``,
     ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_``,
     ``n_train_``, ``input_weights_`` (the kernel's weight of each input, see
-    :class:`SVRExpansion`) and ``input_range_`` (the lowest and highest value of each
-    input over the training data, shape (2, n_features)), and evaluates it.
+    :class:`SVRExpansion`), ``input_range_`` (the lowest and highest value of each
+    input over the training data, shape (2, n_features)) and ``handover_width_`` (see
+    :mod:`greybox.models.handover`; None without the hand-over), and evaluates it.
+    The subclass weighs its correction by :meth:`_handover` and says what it hands over to.
     A subclass gives the inputs of a chunk of a run by ``_inputs_chunk(run, state, sample_time)``,
     and names in ``_weighted`` (``{setting: input column}``) the settings that weight an input in the kernel.
     """
@@ -427,7 +458,7 @@ class KernelRegressionModel(CurrentModel):
             if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= least):
                 raise ParameterError(f"{name} must be an integer of at least {least}, got {value!r}")
         check_seed(self.random_state)
-        self._check_flags("optimize")
+        self._check_flags("optimize", "handover")
         _check_bounds(self.bounds, names)
 
     def _fit_kernel(self, X, y, coverage, run_lengths: Sequence[int],
@@ -455,6 +486,7 @@ class KernelRegressionModel(CurrentModel):
         self.n_train_ = fit.n_train
         self.input_weights_ = fit.input_weights
         self.input_range_ = np.vstack((np.min(X, axis=0), np.max(X, axis=0)))
+        self.handover_width_ = handover_width(self.gamma_) if self.handover else None
 
     def _inputs_chunk(self, run: AxisLog, state, sample_time: float):  # pragma: no cover - abstract
         """Raw SVR inputs of a chunk of a run, shape (n, n_features), and the state after it."""
@@ -507,8 +539,8 @@ class KernelRegressionModel(CurrentModel):
             out["inputs"] = np.any((X < self.input_range_[0]) | (X > self.input_range_[1]), axis=1)
         return out
 
-    def _kernel_predict(self, X) -> np.ndarray:
-        """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
+    def _kernel_coordinates(self, X) -> np.ndarray:
+        """Raw inputs ``X``, shape (n, n_features), in the kernel's coordinates: standardised, times sqrt(weight)."""
         scaled = (np.asarray(X, dtype=np.float64) - self.input_mean_) / self.input_scale_
         weights = getattr(self, "input_weights_", None)  # None: a file that predates the weights (all 1)
         if weights is not None:
@@ -516,7 +548,24 @@ class KernelRegressionModel(CurrentModel):
                 raise ParameterError(f"input_weights_ must hold one positive weight per input "
                                      f"({np.size(self.input_scale_)}), got {weights!r}")
             scaled = scaled * np.sqrt(weights)
-        return rbf_expansion(scaled, self.support_vectors_, self.dual_coef_, self.intercept_, self.gamma_)
+        return scaled
+
+    def _kernel_predict(self, X) -> np.ndarray:
+        """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
+        return rbf_expansion(self._kernel_coordinates(X), self.support_vectors_, self.dual_coef_, self.intercept_,
+                             self.gamma_)
+
+    def _handover(self, X) -> np.ndarray | None:
+        """Weight of the correction at raw inputs ``X`` (:func:`greybox.models.handover.handover_weight`).
+
+        None for a model without the hand-over (fitted with ``handover=False``, or read from a file that
+        predates it): its correction applies everywhere, as it was fitted.
+        """
+        width = getattr(self, "handover_width_", None)
+        if width is None:
+            return None
+        box = self._kernel_coordinates(self.input_range_)
+        return handover_weight(self._kernel_coordinates(X), box[0], box[1], width)
 
     def _kernel_parameters(self) -> list[Parameter]:
         """Rows of the SVR stage for the parameter table."""
@@ -528,6 +577,9 @@ class KernelRegressionModel(CurrentModel):
               for name, column in self._weighted.items()),
             Parameter("n_support", int(self.dual_coef_.size), "-", "support vectors"),
             Parameter("intercept", self.intercept_, EFFORT, "SVR intercept"),
+            *([] if getattr(self, "handover_width_", None) is None else
+              [Parameter("handover_width", self.handover_width_, "standardised unit",
+                         "distance from the training inputs' box over which the correction is handed over")]),
         ]
 
     def _weight(self, name: str) -> float:
@@ -610,6 +662,15 @@ class SVRCurrentModel(KernelRegressionModel):
         :func:`default_bounds` (which scale with the spread of the target).
     random_state : int, default 0
         Seed of subset choice and optimisation.
+    handover : bool, default True
+        Outside the box of the training inputs (position, velocity) hand the
+        friction over from the SVR to the Coulomb + viscous proxy
+        ``F_c sgn(v) + mu v`` fitted with ``J`` and the offset, over one kernel
+        length scale (:mod:`greybox.models.handover`), so that beyond the
+        training speeds the friction grows linearly, as the viscous law, instead
+        of falling back to the SVR's intercept. Inside the box the prediction is
+        the SVR's. False: the SVR everywhere (the only behaviour before the
+        setting existed, and that of model files written before it).
 
     Attributes
     ----------
@@ -617,6 +678,11 @@ class SVRCurrentModel(KernelRegressionModel):
         Inertia [A s^2/mm].
     offset_ : float
         Constant current [A].
+    proxy_coulomb_, proxy_viscous_ : float
+        Coulomb level [A] and viscous coefficient [A s/mm] of the proxy, the friction handed over to
+        outside the training region; only with ``handover``.
+    handover_width_ : float or None
+        Width of the hand-over [standardised unit] (None without it).
     input_mean_, input_scale_ : ndarray, shape (2,)
         Standardisation of (position [mm], velocity [mm/s]).
     support_vectors_ : ndarray, shape (n_support, 2)
@@ -647,7 +713,7 @@ class SVRCurrentModel(KernelRegressionModel):
     _weighted = {"velocity_weight": 1}
 
     def __init__(self, *, inertia=None, C=None, epsilon=None, gamma=None, velocity_weight=None, n_subset=2000,
-                 optimize=True, n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0):
+                 optimize=True, n_calls=25, cv_folds=3, cv_blocks=12, bounds=None, random_state=0, handover=True):
         self.inertia = inertia
         self.C = C
         self.epsilon = epsilon
@@ -660,6 +726,7 @@ class SVRCurrentModel(KernelRegressionModel):
         self.cv_blocks = cv_blocks
         self.bounds = bounds
         self.random_state = random_state
+        self.handover = handover
 
     def _check_params(self) -> None:
         super()._check_params()
@@ -674,19 +741,34 @@ class SVRCurrentModel(KernelRegressionModel):
         return self._inputs(run), state
 
     def _fit_runs(self, runs, progress) -> None:
-        self.J_, self.offset_ = inertia_offset_proxy(runs, self.inertia)
+        self.J_, self.offset_, coulomb, viscous = coulomb_viscous_proxy(runs, self.inertia)
+        if self.handover:
+            self.proxy_coulomb_, self.proxy_viscous_ = coulomb, viscous
         X = np.concatenate([self._inputs(run) for run in runs])
         target = np.concatenate([run.effort - self.J_ * run.acceleration for run in runs]) - self.offset_
         self._fit_kernel(X, target, X, [len(run) for run in runs], progress)
 
     def _simulate(self, run, state, sample_time):
-        return self._kernel_predict(self._inputs(run)), None
+        X = self._inputs(run)
+        weight = self._handover(X)
+        proxy = None
+        if weight is not None:
+            proxy = self.proxy_coulomb_ * np.sign(run.velocity) + self.proxy_viscous_ * run.velocity
+        return hand_over(proxy, self._kernel_predict(X), weight), None
 
     def _n_params(self) -> int:
-        return int(self.dual_coef_.size) + 3  # dual coefficients, intercept, J, offset
+        # dual coefficients, intercept, J, offset (and the proxy's Coulomb level and viscous coefficient)
+        return int(self.dual_coef_.size) + 3 + 2 * int(getattr(self, "handover_width_", None) is not None)
 
     def _own_parameters(self) -> list[Parameter]:
-        return self._kernel_parameters()
+        if getattr(self, "handover_width_", None) is None:
+            return self._kernel_parameters()
+        return self._kernel_parameters() + [
+            Parameter("proxy_coulomb", self.proxy_coulomb_, EFFORT, "Coulomb level handed over to outside the "
+                                                                     "training region"),
+            Parameter("proxy_viscous", self.proxy_viscous_, f"{EFFORT} s/{LENGTH}", "viscous coefficient handed "
+                                                                                    "over to outside the training "
+                                                                                    "region")]
 
 
 #: Every name a search interval can be given for (``bounds=``) in the kernel models: the SVR
