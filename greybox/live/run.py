@@ -1,0 +1,176 @@
+"""``greybox live`` as one function: open the model, the source, the sink and the recording; run the stream.
+
+:func:`run_live` runs until the source ends (the end of stdin), an alarm with ``exit_on_alarm``, or the
+command is stopped: on SIGTERM or Ctrl-C (a :class:`KeyboardInterrupt` here) the recording's last file is
+written and closed, the sink closed and the stats written before the interrupt goes on to the command
+line, which exits with 143 (130 for Ctrl-C).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass
+from typing import Callable, Mapping, TextIO
+
+from ..errors import GreyboxError
+from ..models.chunked import DEFAULT_CHUNK_S
+from .broker import is_address, parse_address
+from .estimator import LiveEstimator
+from .limits import Limit, LimitWatch
+from .recording import DEFAULT_RECORD_S, Recorder
+from .session import LiveSession
+from .sinks import LineSink, MqttSink
+from .sources import LineSource, MqttSource
+from .stats import LiveStats
+
+__all__ = ["ALARM_STATUS", "LiveOutcome", "run_live"]
+
+#: Exit status of ``greybox live --exit-on-alarm`` after an alarm.
+ALARM_STATUS = 3
+
+#: Wall-clock seconds between writes of the stats file while the stream runs.
+STATS_EVERY_S = 10.0
+
+
+@dataclass(frozen=True)
+class LiveOutcome:
+    """How a live stream ended.
+
+    Attributes
+    ----------
+    stats : LiveStats
+        The counters.
+    status : int
+        Exit status: 0, or :data:`ALARM_STATUS` after an alarm with ``exit_on_alarm``.
+    recorded : list of pathlib.Path
+        Recording files written.
+    """
+
+    stats: LiveStats
+    status: int
+    recorded: list
+
+
+def _source(spec: str, stdin: TextIO, connect_timeout: float):
+    if spec == "-":
+        return LineSource(stdin)
+    if is_address(spec):
+        return MqttSource(parse_address(spec, "--source"), connect_timeout=connect_timeout)
+    raise GreyboxError(f"--source {spec}: give '-' (lines on stdin) or mqtt://HOST[:PORT]/TOPIC")
+
+
+def _sink(spec: str, stdout: TextIO, connect_timeout: float):
+    if spec == "-":
+        return LineSink(stdout)
+    if is_address(spec):
+        return MqttSink(parse_address(spec, "--sink"), connect_timeout=connect_timeout)
+    raise GreyboxError(f"--sink {spec}: give '-' (lines on stdout) or mqtt://HOST[:PORT]/TOPIC")
+
+
+def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None, record_dir=None,
+             record_s: float = DEFAULT_RECORD_S, limits: list[Limit] = (), hold_s: float = 0.0,
+             exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
+             tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
+             columns: Mapping[str, str] | None = None, axis: str | None = None, connect_timeout: float = 10.0,
+             say: Callable[[str], None] = print, stdin: TextIO | None = None,
+             stdout: TextIO | None = None) -> LiveOutcome:
+    """Estimate the process current (and force) of a live stream with a model trained on air cuts.
+
+    Parameters
+    ----------
+    model_path : path-like
+        Model file written by ``greybox train``.
+    source : str
+        ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt://HOST[:PORT]/TOPIC``.
+    sink : str, default "-"
+        ``-`` (JSON lines on ``stdout``) or ``mqtt://HOST[:PORT]/TOPIC``.
+    axis_config_path : path-like, optional
+        Axis file (TOML): the process force (torque) and the channel names.
+    record_dir : path-like, optional
+        Folder of the rolling Parquet recording.
+    record_s : float, default 60.0
+        Log seconds per recording file.
+    limits : list of Limit
+        Limits on output columns.
+    hold_s : float, default 0.0
+        Hold time [s] of the limits.
+    exit_on_alarm : bool, default False
+        End the stream at the first alarm (status :data:`ALARM_STATUS`).
+    stats_path : path-like, optional
+        JSON file of the counters, rewritten every 10 s and at the end.
+    sample_time : float, optional
+        Nominal step [s]; default the median step of the first samples.
+    tolerance : float, default 0.25
+        Time-step tolerance, a fraction of the nominal step.
+    cutoff_hz : float, optional
+        Derivative-filter cut-off [Hz].
+    chunk_s : float, default 60.0
+        Chunk length [s] of the model.
+    columns : mapping of str to str, optional
+        ``{canonical_name: column}`` for message columns not named by the convention (over the axis
+        file's channels).
+    axis : str, optional
+        Axis to take from messages holding several.
+    connect_timeout : float, default 10.0
+        Seconds to wait for the broker at the start.
+    say : callable, default print
+        ``say(line)`` for each line of text.
+    stdin, stdout : text file, optional
+        The streams of ``-`` (default ``sys.stdin``, ``sys.stdout``).
+
+    Returns
+    -------
+    LiveOutcome
+
+    Raises
+    ------
+    GreyboxError
+        For a model or axis file that cannot be read, a source or sink that cannot be opened, a limit on a
+        column the output lacks, or messages that do not fit the model (units, kind of axis).
+    KeyboardInterrupt
+        On SIGTERM or Ctrl-C, after the recording, the sink and the stats are closed.
+    """
+    from ..data.axis_config import read_axis_config
+    from ..persistence import load_model
+
+    model = load_model(model_path)
+    config = read_axis_config(axis_config_path) if axis_config_path else None
+    mapping = {**(config.channels if config else {}), **(columns or {})}
+    estimator = LiveEstimator(model, axis_config=config, sample_time=sample_time, tolerance=tolerance,
+                              cutoff_hz=cutoff_hz, chunk_s=chunk_s)
+    recorder = None if record_dir is None else Recorder(
+        record_dir, model=model, axis_config=config, chunk_s=chunk_s, every_s=record_s,
+        attrs={"model_file": str(model_path), "source": str(source)})
+    watch = LimitWatch(list(limits), hold_s=hold_s) if limits else None
+    stream = _source(source, stdin or sys.stdin, connect_timeout)
+    try:
+        out = _sink(sink, stdout or sys.stdout, connect_timeout)
+    except BaseException:
+        stream.close()
+        raise
+    session = LiveSession(estimator, out, say=say, limits=watch, recorder=recorder, mapping=mapping, axis=axis)
+    status, stopped = 0, True
+    last_stats = time.monotonic()
+    try:
+        for item in stream:
+            session.handle(item)
+            if session.alarmed and exit_on_alarm:
+                status = ALARM_STATUS
+                break
+            if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
+                session.stats.waiting = estimator.waiting
+                session.stats.write(stats_path)
+                last_stats = time.monotonic()
+        else:
+            session.finish()
+        stopped = status != 0
+    finally:
+        try:
+            session.close(stopped=stopped)
+            stream.close()
+        finally:
+            if stats_path is not None:
+                session.stats.write(stats_path)
+            say(session.stats.line())
+    return LiveOutcome(session.stats, status, list(recorder.written) if recorder is not None else [])
