@@ -146,8 +146,8 @@ def parse_csv_row(line: str, header: list[str]) -> dict[str, np.ndarray]:
 class Decoder:
     """The columns of each message of a stream: JSON messages, or CSV lines after a header line.
 
-    A payload starting with ``{`` or ``[`` is JSON; any other is a CSV line, the first of which is the
-    header. Lines starting with ``#`` are comments (a CSV log's metadata preamble).
+    A payload starting with ``{`` or ``[`` is JSON; any other is a CSV line, after a header that must be
+    the stream's first line. Lines starting with ``#`` are comments (a CSV log's metadata preamble).
 
     Attributes
     ----------
@@ -157,6 +157,7 @@ class Decoder:
 
     def __init__(self):
         self.header: list[str] | None = None
+        self._started = False
 
     def decode(self, payload: str | bytes) -> tuple[dict[str, np.ndarray], object] | None:
         """The columns and the sequence tag of one message; None for a CSV header or a comment.
@@ -179,9 +180,12 @@ class Decoder:
         text = payload.strip()
         if not text or text.startswith("#"):
             return None
+        first, self._started = not self._started, True
         if text[0] in "{[":
             return parse_json(text)
         if self.header is None:
+            if not first:
+                raise MessageError("not JSON (a CSV header must be the stream's first line)")
             self.header = csv_header(text)
             return None
         return parse_csv_row(text, self.header), None

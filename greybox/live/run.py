@@ -8,7 +8,10 @@ line, which exits with 143 (130 for Ctrl-C).
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass
 from typing import Callable, Mapping, TextIO
@@ -50,6 +53,56 @@ class LiveOutcome:
     stats: LiveStats
     status: int
     recorded: list
+
+
+class _Deferred:
+    """SIGTERM and Ctrl-C held back while a message is handled, then passed on to the handlers before.
+
+    A signal raises where the interpreter happens to be; in the middle of a message it would leave the
+    estimates, the recording and the counters out of step. Between messages (waiting for the next one)
+    it is passed on at once.
+    """
+
+    _SIGNALS = (signal.SIGTERM, signal.SIGINT)
+
+    def __init__(self):
+        self._busy = False
+        self._pending = None
+        self._previous: dict = {}
+
+    def __enter__(self) -> "_Deferred":
+        if threading.current_thread() is threading.main_thread():
+            for number in self._SIGNALS:
+                self._previous[number] = signal.signal(number, self._handler)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for number, previous in self._previous.items():
+            signal.signal(number, previous)
+
+    def _handler(self, signum, frame) -> None:
+        if self._busy:
+            self._pending = (signum, frame)
+        else:
+            self._forward(signum, frame)
+
+    def _forward(self, signum, frame) -> None:
+        previous = self._previous.get(signum)
+        if callable(previous):
+            previous(signum, frame)
+        raise KeyboardInterrupt()
+
+    @contextlib.contextmanager
+    def held(self):
+        """Hold the signals back while the block runs; pass on one that came meanwhile."""
+        self._busy = True
+        try:
+            yield
+        finally:
+            self._busy = False
+        if self._pending is not None:
+            pending, self._pending = self._pending, None
+            self._forward(*pending)
 
 
 def _source(spec: str, stdin: TextIO, connect_timeout: float):
@@ -152,19 +205,23 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     session = LiveSession(estimator, out, say=say, limits=watch, recorder=recorder, mapping=mapping, axis=axis)
     status, stopped = 0, True
     last_stats = time.monotonic()
+    deferred = _Deferred()
     try:
-        for item in stream:
-            session.handle(item)
-            if session.alarmed and exit_on_alarm:
-                status = ALARM_STATUS
-                break
-            if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
-                session.stats.waiting = estimator.waiting
-                session.stats.write(stats_path)
-                last_stats = time.monotonic()
-        else:
-            session.finish()
-        stopped = status != 0
+        with deferred:
+            for item in stream:
+                with deferred.held():
+                    session.handle(item)
+                if session.alarmed and exit_on_alarm:
+                    status = ALARM_STATUS
+                    break
+                if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
+                    session.stats.waiting = estimator.waiting
+                    session.stats.write(stats_path)
+                    last_stats = time.monotonic()
+            else:
+                with deferred.held():
+                    session.finish()
+            stopped = status != 0
     finally:
         try:
             session.close(stopped=stopped)

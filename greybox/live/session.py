@@ -125,9 +125,12 @@ class LiveSession:
             The command was stopped (SIGTERM, Ctrl-C): the samples waiting for their look-ahead are
             counted as lost.
         """
-        if stopped and self.estimator.waiting:
-            self.stats.lose("stopped before their look-ahead arrived", self.estimator.waiting)
-        self.stats.waiting = 0 if stopped else self.estimator.waiting
+        stats = self.stats
+        if stopped:
+            unaccounted = stats.samples_received - stats.samples_estimated - stats.skipped
+            if unaccounted:
+                stats.lose("stopped before their look-ahead arrived", unaccounted)
+        stats.waiting = 0 if stopped else self.estimator.waiting
         try:
             if self.recorder is not None:
                 self.recorder.close()
@@ -152,10 +155,10 @@ class LiveSession:
             self._event(event)
         if not out.results:
             return
-        self.stats.samples_estimated += out.n_samples
         parts = [result.columns() for result in out.results]
         columns = parts[0] if len(parts) == 1 else {name: np.concatenate([part[name] for part in parts])
                                                     for name in parts[0]}
+        self.stats.samples_estimated += out.n_samples
         self.sink.estimate(estimate_message(columns, seq))
         for run, result, part in zip(out.runs, out.results, parts):
             if run != self._run:  # the estimates of a new run: a new file, the limits re-armed
