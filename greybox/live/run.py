@@ -186,6 +186,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     """
     from ..data.axis_config import read_axis_config
     from ..persistence import load_model
+    from ..registry import model_kind
 
     model = load_model(model_path)
     config = read_axis_config(axis_config_path) if axis_config_path else None
@@ -203,6 +204,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         stream.close()
         raise
     session = LiveSession(estimator, out, say=say, limits=watch, recorder=recorder, mapping=mapping, axis=axis)
+    say(f"greybox live: {model_kind(model)} model {model_path}, reading "
+        f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
     status, stopped = 0, True
     last_stats = time.monotonic()
     deferred = _Deferred()

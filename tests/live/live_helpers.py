@@ -128,3 +128,90 @@ class Broker:
         return f"mqtt://127.0.0.1:{self.port}/{topic}"
 
 
+
+
+class Subscriber:
+    """A paho-mqtt client of the test that collects the messages of a topic filter."""
+
+    def __init__(self, port: int, topic: str):
+        import threading
+
+        import paho.mqtt.client as mqtt
+
+        self.messages: list[tuple[str, bytes, float]] = []
+        self.connections = 0
+        self._lock = threading.Lock()
+        self.client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2, client_id=f"test-{os.getpid()}-{topic}")
+        self.client.reconnect_delay_set(min_delay=1, max_delay=1)
+
+        def connected(client, userdata, flags, reason_code, properties=None):
+            client.subscribe(topic)
+
+        def subscribed(client, userdata, mid, reason_codes, properties=None):
+            with self._lock:
+                self.connections += 1
+
+        self.client.on_connect = connected
+        self.client.on_subscribe = subscribed
+        self.client.on_message = lambda client, userdata, message: self._add(message)
+        self.client.connect("127.0.0.1", port, keepalive=10)
+        self.client.loop_start()
+        wait_until(lambda: self.connections >= 1, "the test's subscriber to connect")
+
+    def _add(self, message) -> None:
+        with self._lock:
+            self.messages.append((message.topic, message.payload, time.time()))
+
+    def payloads(self, topic: str) -> list[str]:
+        with self._lock:
+            return [payload.decode() for name, payload, _ in self.messages if name == topic]
+
+    def publish(self, topic: str, payload: str) -> None:
+        self.client.publish(topic, payload.encode(), qos=0).wait_for_publish(5)
+
+    def close(self) -> None:
+        self.client.disconnect()
+        self.client.loop_stop()
+
+
+def wait_until(condition, what: str, timeout_s: float = 30.0) -> None:
+    """Wait (bounded) until ``condition()`` is true."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+        time.sleep(0.02)
+
+
+class LiveProcess:
+    """``greybox live`` in a subprocess, its stderr lines collected by a thread."""
+
+    def __init__(self, *args):
+        import sys
+        import threading
+
+        self.process = subprocess.Popen([sys.executable, "-m", "greybox", "live", *map(str, args)], text=True,
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        self.lines: list[str] = []
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
+
+    def _read(self) -> None:
+        for line in self.process.stderr:
+            self.lines.append(line.rstrip("\n"))
+
+    def said(self, words: str) -> bool:
+        return any(words in line for line in list(self.lines))
+
+    def stop(self, timeout_s: float = 30.0) -> int:
+        import signal
+
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGTERM)
+        try:
+            status = self.process.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            raise
+        self._reader.join(timeout=5)
+        return status

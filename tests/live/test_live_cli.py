@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 import pandas as pd
+import pytest
 from live_helpers import EXAMPLE_AXIS, joined, json_batches, run_cli
 
 #: Seconds a command under test may take before the test gives up on it.
@@ -23,6 +24,7 @@ def greybox(*args, **kwargs) -> subprocess.Popen:
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, **kwargs)
 
 
+@pytest.mark.slow
 def test_stdin_to_stdout_equals_predict(model_file, offline, cut_raw):
     path = model_file("gmssvr")
     process = greybox(path, "--source", "-", "--axis-config", EXAMPLE_AXIS)
@@ -56,6 +58,7 @@ def test_an_unreachable_broker_is_one_line(model_file, capsys):
     assert status == 2 and len(err) == 1 and "no broker answered within 1 s" in err[0]
 
 
+@pytest.mark.slow
 def test_sigterm_closes_the_recording_and_the_stats(model_file, cut_raw, tmp_path):
     path = model_file("gms")
     record, stats = tmp_path / "rec", tmp_path / "stats.json"
