@@ -39,7 +39,10 @@ class MessageError(GreyboxError):
 
 def _column(name: str, values) -> np.ndarray:
     """One column of a message as a float array; refuses text, nested lists and booleans."""
-    array = np.asarray(values, dtype=object).reshape(-1)
+    array = np.asarray(values, dtype=object)
+    if array.ndim > 1:
+        raise MessageError(f"column '{name}' holds nested lists, not numbers")
+    array = array.reshape(-1)
     out = np.empty(array.size)
     for k, value in enumerate(array):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
