@@ -39,6 +39,10 @@ class MessageError(GreyboxError):
 
 def _column(name: str, values) -> np.ndarray:
     """One column of a message as a float array; refuses text, nested lists and booleans."""
+    if type(values) in (int, float):
+        return np.array([values], dtype=np.float64)
+    if type(values) is list and all(type(value) in (int, float) for value in values):
+        return np.array(values, dtype=np.float64)
     array = np.asarray(values, dtype=object)
     if array.ndim > 1:
         raise MessageError(f"column '{name}' holds nested lists, not numbers")
@@ -245,8 +249,10 @@ def estimate_message(columns: Mapping[str, np.ndarray], seq=None) -> str:
     seq : object, optional
         The ``"seq"`` of the input message that completed these samples.
     """
-    out: dict = {name: [_number(v) for v in np.asarray(values, dtype=np.float64).tolist()]
-                 for name, values in columns.items()}
+    out: dict = {}
+    for name, values in columns.items():
+        values = np.asarray(values, dtype=np.float64)
+        out[name] = values.tolist() if np.isfinite(values).all() else [_number(v) for v in values.tolist()]
     if seq is not None:
         out[SEQUENCE_KEY] = seq
     return json.dumps(out, separators=(",", ":"))
