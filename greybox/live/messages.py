@@ -26,11 +26,17 @@ from ..data.log import AxisLog
 from ..data.units import log_from_columns
 from ..errors import GreyboxError, LogError
 
-__all__ = ["MessageError", "SEQUENCE_KEY", "parse_json", "parse_csv_row", "csv_header", "Decoder",
-           "message_log", "estimate_message"]
+__all__ = ["MessageError", "SEQUENCE_KEY", "MAX_MESSAGE_SAMPLES", "MAX_MESSAGE_BYTES", "parse_json",
+           "parse_csv_row", "csv_header", "Decoder", "message_log", "estimate_message"]
 
 #: Key of a message's sequence tag, echoed in the estimates it completes.
 SEQUENCE_KEY = "seq"
+
+#: Most samples one message may hold (a minute at 500 Hz is 30 000); a larger one is refused.
+MAX_MESSAGE_SAMPLES = 100_000
+
+#: Most bytes of one message.
+MAX_MESSAGE_BYTES = 64 << 20
 
 
 class MessageError(GreyboxError):
@@ -76,6 +82,8 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
         For text that is not JSON, not an object or a list of objects, columns of different lengths or
         values that are not numbers.
     """
+    if len(text) > MAX_MESSAGE_BYTES:
+        raise MessageError(f"the message holds {len(text)} bytes, more than {MAX_MESSAGE_BYTES}")
     try:
         value = json.loads(text)
     except (ValueError, UnicodeDecodeError) as exc:
@@ -101,6 +109,8 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
         raise MessageError("the message holds no samples")
     if len(lengths) > 1:
         raise MessageError(f"the columns have different lengths ({', '.join(map(str, sorted(lengths)))})")
+    if max(lengths) > MAX_MESSAGE_SAMPLES:
+        raise MessageError(f"the message holds {max(lengths)} samples, more than {MAX_MESSAGE_SAMPLES}")
     return columns, seq
 
 

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import live_helpers
 import pandas as pd
 import pytest
-from live_helpers import EXAMPLE_AXIS, QUICK, Broker, mosquitto_binary, run_cli
+from live_helpers import EXAMPLE_AXIS, QUICK, Broker, run_cli
 
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
@@ -69,7 +70,7 @@ def offline(live_root, cut_raw):
 @pytest.fixture
 def broker(tmp_path):
     """A running Mosquitto broker of its own; skips (naming the Debian package) when mosquitto is absent."""
-    binary = mosquitto_binary()
+    binary = live_helpers.mosquitto_binary()
     if binary is None:
         pytest.skip("the mosquitto broker is not installed (Debian/Ubuntu package 'mosquitto': "
                     "apt-get install mosquitto)")

@@ -87,3 +87,11 @@ def test_sigterm_closes_the_recording_and_the_stats(model_file, cut_raw, tmp_pat
     assert counts["lost"].get("stopped before their look-ahead arrived", 0) > 0
     assert "terminated (SIGTERM)" in err and "Traceback" not in err
     assert os.path.exists(stats)
+
+
+def test_broker_tests_skip_naming_the_package_without_mosquitto(monkeypatch, request):
+    import live_helpers
+
+    monkeypatch.setattr(live_helpers, "mosquitto_binary", lambda: None)
+    with pytest.raises(pytest.skip.Exception, match="package 'mosquitto'"):
+        request.getfixturevalue("broker")

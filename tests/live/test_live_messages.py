@@ -54,6 +54,8 @@ def test_a_non_json_line_in_a_json_stream_is_refused_not_taken_for_a_header():
     ('{"time_s": true, "position_mm": 1, "current_A": 0}', "holds True, not a number"),
     ('{"time_s": [[0]], "position_mm": 1, "current_A": 0}', "nested lists"),
     ("{}", "no samples"),
+    (json.dumps({"time_s": [0.0] * 100_001, "position_mm": [0.0] * 100_001, "current_A": [0.0] * 100_001}),
+     "100001 samples, more than 100000"),
 ])
 def test_malformed_json_is_refused(text, words):
     with pytest.raises(MessageError, match=words):
