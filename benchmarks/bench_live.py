@@ -15,6 +15,10 @@ All figures come from one run and are printed with the core count and the load o
 
     python benchmarks/bench_live.py --model x.gbm --seconds 20
 
+4. with ``--record-minutes M``: a synthetic cutting log of M minutes streamed through a session that
+   records it (rolling Parquet files of 60 s), against ``greybox predict`` on the same log: the largest
+   difference of the model current, and the resident memory after 10 % and at the end of the stream.
+
 Without ``--model`` a GMS+SVR model is fitted on data/X_A.mcap and data/X_B.mcap with fixed
 hyperparameters (as benchmarks/bench_gmssvr_predict.py does).
 """
@@ -109,6 +113,55 @@ def cpu_share(model_path, messages, axes: int, duration_s: float, step_s: float)
     return {"axes": axes, "stream_s": duration_s, "cpu_s": used, "share_of_one_core": used / duration_s}
 
 
+def _resident_mb() -> float:
+    with open("/proc/self/statm") as stream:
+        return int(stream.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+def recording(model_path, minutes: float, batch: int, folder: Path) -> dict:
+    import pandas as pd
+
+    from greybox.cli import main as greybox_main
+    from greybox.data.io import write_log
+    from greybox.live.estimator import LiveEstimator
+    from greybox.live.recording import Recorder
+    from greybox.live.session import LiveSession
+    from greybox.live.sinks import LineSink
+    from greybox.live.sources import Received
+    from greybox.persistence import load_model
+    from greybox.twin import make_dataset
+
+    log = make_dataset("X", "C", 7, duration_s=60.0 * minutes, cutting=True).replace(extras={})
+    log_path, table = folder / "long.parquet", folder / "long-predict.parquet"
+    write_log(log, log_path)
+    assert greybox_main(["predict", str(model_path), str(log_path), "--out", str(table), "--quiet"]) == 0
+    model = load_model(model_path)
+    recorder = Recorder(folder / "rec", model=model, chunk_s=60.0, every_s=60.0)
+    session = LiveSession(LiveEstimator(model, sample_time=log.sample_time), LineSink(_Null()),
+                          say=lambda line: None, recorder=recorder)
+    columns = {"time_s": log.time, "position_mm": log.position, "velocity_mm_s": log.velocity, "current_A": log.effort}
+    starts = range(0, len(log), batch)
+    memory = {}
+    started = time.perf_counter()
+    for seq, k in enumerate(starts):
+        message = json.dumps({name: values[k:k + batch].tolist() for name, values in columns.items()})
+        session.handle(Received(message, f"message {seq}", 0.0))
+        if seq == len(starts) // 10:
+            memory["resident_mb_at_10_percent"] = _resident_mb()
+    session.finish()
+    session.close()
+    elapsed = time.perf_counter() - started
+    memory["resident_mb_at_end"] = _resident_mb()
+    expected = pd.read_parquet(table, columns=["current_model_A"])["current_model_A"].to_numpy()
+    largest, offset = 0.0, 0
+    for path in recorder.written:
+        part = pd.read_parquet(path, columns=["current_model_A"])["current_model_A"].to_numpy()
+        largest = max(largest, float(abs(part - expected[offset:offset + part.size]).max()))
+        offset += part.size
+    return {"minutes": minutes, "samples": len(log), "recorded": offset, "files": len(recorder.written),
+            "largest_difference_A": largest, "stream_wall_s": elapsed, **memory}
+
+
 def _free_port() -> int:
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
@@ -185,6 +238,8 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=10, help="samples per message (default 10)")
     parser.add_argument("--axes", type=int, default=16, help="axes of the CPU-share run (default 16)")
     parser.add_argument("--core", type=int, default=0, help="core of the compute runs (default 0)")
+    parser.add_argument("--record-minutes", type=float, default=0.0,
+                        help="also stream and record a synthetic log of this many minutes (default 0: not)")
     args = parser.parse_args()
 
     from threadpoolctl import threadpool_limits
@@ -209,6 +264,8 @@ def main() -> None:
         finally:
             os.sched_setaffinity(0, affinity)
         figures["end_to_end"] = end_to_end(model_path, messages, Path(folder), args.batch, log.sample_time)
+        if args.record_minutes > 0:
+            figures["recording"] = recording(model_path, args.record_minutes, args.batch, Path(folder))
     figures.update({"model": str(args.model or "GMS+SVR fitted by the benchmark"), "log": args.log,
                     "seconds": log.duration, "lookahead_samples": lookahead,
                     "lookahead_s": lookahead * log.sample_time, "cpu_count": os.cpu_count(),
