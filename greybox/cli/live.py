@@ -20,7 +20,10 @@ def add_parser(subparsers) -> None:
         "or a batch) or CSV lines with the log column names (docs/live.md). Notes, alarms and the stats go to "
         "stderr, one line each.",
     )
-    parser.add_argument("model", metavar="MODEL", help="model file written by 'greybox train' (.gbm)")
+    parser.add_argument("model", metavar="MODEL",
+                        help="model file written by 'greybox train' (.gbm), or a machine model directory ('greybox "
+                        "train --axes'): one estimate per axis, from one topic per axis (topics ending in the axis "
+                        "name) or from messages of every axis's columns (X_position_mm, ...)")
     parser.add_argument("--source", required=True, metavar="SOURCE",
                         help="'-' (JSON or CSV lines on stdin) or mqtt://HOST[:PORT]/TOPIC")
     parser.add_argument("--sink", default="-", metavar="SINK",
@@ -28,6 +31,9 @@ def add_parser(subparsers) -> None:
                         "TOPIC/alarm)")
     parser.add_argument("--axis-config", metavar="TOML",
                         help="axis metadata: adds force_process_N (torque_process_Nm), channel names")
+    parser.add_argument("--machine", metavar="TOML",
+                        help="with a machine model: the machine file with each axis's channels and mechanics (adds "
+                        "each axis's force or torque)")
     parser.add_argument("--record", metavar="DIR",
                         help="also write the estimates to rolling Parquet files in DIR (the table of 'greybox "
                         "predict'), one per --record-s seconds of log time and per run, each written atomically")
@@ -71,7 +77,8 @@ def run(args: argparse.Namespace) -> int:
     from ..live.run import run_live
 
     outcome = run_live(
-        args.model, source=args.source, sink=args.sink, axis_config_path=args.axis_config, record_dir=args.record,
+        args.model, source=args.source, sink=args.sink, axis_config_path=args.axis_config, machine_path=args.machine,
+        record_dir=args.record,
         record_s=args.record_s, limits=[parse_limit(text) for text in args.limit],
         hold_s=parse_duration(args.limit_hold), exit_on_alarm=args.exit_on_alarm, stats_path=args.stats,
         sample_time=args.sample_time, tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz, chunk_s=args.chunk_s,

@@ -249,7 +249,7 @@ def _number(value: float):
     return value if math.isfinite(value) else None
 
 
-def estimate_message(columns: Mapping[str, np.ndarray], seq=None) -> str:
+def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | None = None) -> str:
     """The JSON text of one output message: the estimate's columns as lists, and the sequence tag.
 
     Parameters
@@ -258,6 +258,8 @@ def estimate_message(columns: Mapping[str, np.ndarray], seq=None) -> str:
         The output columns of the samples (``time_s``, ``current_process_A``, ``force_process_N``, ...).
     seq : object, optional
         The ``"seq"`` of the input message that completed these samples.
+    axis : str, optional
+        The axis of a machine the estimates are of (key ``"axis"``).
     """
     out: dict = {}
     for name, values in columns.items():
@@ -265,4 +267,6 @@ def estimate_message(columns: Mapping[str, np.ndarray], seq=None) -> str:
         out[name] = values.tolist() if np.isfinite(values).all() else [_number(v) for v in values.tolist()]
     if seq is not None:
         out[SEQUENCE_KEY] = seq
+    if axis is not None:
+        out["axis"] = axis
     return json.dumps(out, separators=(",", ":"))

@@ -21,6 +21,7 @@ from ..models.chunked import DEFAULT_CHUNK_S
 from .broker import is_address, parse_address
 from .estimator import LiveEstimator
 from .limits import Limit, LimitWatch
+from .machine import MachineSession
 from .recording import DEFAULT_RECORD_S, Recorder
 from .session import LiveSession
 from .sinks import LineSink, MqttSink
@@ -43,7 +44,7 @@ class LiveOutcome:
     Attributes
     ----------
     stats : LiveStats
-        The counters.
+        The counters (of a machine: its messages; each axis's are in its session).
     status : int
         Exit status: 0, or :data:`ALARM_STATUS` after an alarm with ``exit_on_alarm``.
     recorded : list of pathlib.Path
@@ -121,7 +122,66 @@ def _sink(spec: str, stdout: TextIO, connect_timeout: float):
     raise GreyboxError(f"--sink {spec}: give '-' (lines on stdout) or mqtt://HOST[:PORT]/TOPIC")
 
 
-def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None, record_dir=None,
+def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
+                  axis, source, say):
+    """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
+    from ..data.axis_config import read_axis_config
+    from ..persistence import load_model
+    from ..registry import model_kind
+
+    model = load_model(model_path)
+    config = read_axis_config(axis_config_path) if axis_config_path else None
+    mapping = {**(config.channels if config else {}), **(columns or {})}
+
+    def build(out):
+        recorder = None if record_dir is None else Recorder(
+            record_dir, model=model, axis_config=config, chunk_s=options["chunk_s"], every_s=record_s,
+            attrs={"model_file": str(model_path), "source": str(source)})
+        watch = LimitWatch(list(limits), hold_s=hold_s) if limits else None
+        session = LiveSession(LiveEstimator(model, axis_config=config, **options), out, say=say, limits=watch,
+                              recorder=recorder, mapping=mapping, axis=axis)
+        return session, model_kind(model), [recorder] if recorder is not None else []
+
+    return build
+
+
+def _machine_session(model_path, machine_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
+                     source, say):
+    """A function of the sink that builds the sessions of a machine model's axes: (session, kind, recorders)."""
+    from pathlib import Path
+
+    from ..data.machine_config import read_machine_config
+    from ..machine_model import load_machine
+    from ..registry import model_kind
+
+    if columns:
+        raise GreyboxError("--columns applies to one axis; give a machine's channel names in --machine TOML")
+    machine = load_machine(model_path)
+    described = read_machine_config(machine_path) if machine_path else None
+
+    def build(out):
+        sessions, recorders = {}, []
+        for axis, model in machine.models.items():
+            entry = described.axis(axis) if described is not None else None
+            config = entry.config if entry is not None else None
+            recorder = None if record_dir is None else Recorder(
+                Path(record_dir) / axis, model=model, axis_config=config, chunk_s=options["chunk_s"],
+                every_s=record_s, attrs={"model_file": str(Path(model_path) / f"{axis}.gbm"), "source": str(source)})
+            recorders += [recorder] if recorder is not None else []
+            sessions[axis] = LiveSession(
+                LiveEstimator(model, axis_config=config, **options), out,
+                say=lambda line, axis=axis: say(f"{axis}: {line}"),
+                limits=LimitWatch(list(limits), hold_s=hold_s) if limits else None, recorder=recorder,
+                mapping=dict(entry.channels) if entry is not None and entry.channels else None, axis=axis,
+                subtopic=axis)
+        kinds = sorted({model_kind(model) for model in machine.models.values()})
+        return MachineSession(sessions, say=say), f"machine ({', '.join(machine.axes)}: {', '.join(kinds)})", recorders
+
+    return build
+
+
+def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None, machine_path=None,
+             record_dir=None,
              record_s: float = DEFAULT_RECORD_S, limits: list[Limit] = (), hold_s: float = 0.0,
              exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
@@ -133,15 +193,18 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     Parameters
     ----------
     model_path : path-like
-        Model file written by ``greybox train``.
+        Model file written by ``greybox train``, or a machine model (a directory written by ``greybox train
+        --axes``): then one session per axis (:mod:`greybox.live.machine`).
     source : str
         ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt://HOST[:PORT]/TOPIC``.
     sink : str, default "-"
         ``-`` (JSON lines on ``stdout``) or ``mqtt://HOST[:PORT]/TOPIC``.
     axis_config_path : path-like, optional
         Axis file (TOML): the process force (torque) and the channel names.
+    machine_path : path-like, optional
+        With a machine model: the machine file (TOML) with each axis's channels and mechanics.
     record_dir : path-like, optional
-        Folder of the rolling Parquet recording.
+        Folder of the rolling Parquet recording (a sub-folder per axis of a machine).
     record_s : float, default 60.0
         Log seconds per recording file.
     limits : list of Limit
@@ -184,27 +247,29 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     KeyboardInterrupt
         On SIGTERM or Ctrl-C, after the recording, the sink and the stats are closed.
     """
-    from ..data.axis_config import read_axis_config
-    from ..persistence import load_model
-    from ..registry import model_kind
+    from ..machine_model import is_machine_model
 
-    model = load_model(model_path)
-    config = read_axis_config(axis_config_path) if axis_config_path else None
-    mapping = {**(config.channels if config else {}), **(columns or {})}
-    estimator = LiveEstimator(model, axis_config=config, sample_time=sample_time, tolerance=tolerance,
-                              cutoff_hz=cutoff_hz, chunk_s=chunk_s)
-    recorder = None if record_dir is None else Recorder(
-        record_dir, model=model, axis_config=config, chunk_s=chunk_s, every_s=record_s,
-        attrs={"model_file": str(model_path), "source": str(source)})
-    watch = LimitWatch(list(limits), hold_s=hold_s) if limits else None
+    options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s)
+    if is_machine_model(model_path):
+        build = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
+                                 limits=limits, hold_s=hold_s, columns=columns, source=source, say=say)
+    else:
+        if machine_path:
+            raise GreyboxError("--machine applies to a machine model (a directory written by 'greybox train "
+                               "--axes'); give one axis's mechanics with --axis-config")
+        build = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
+                              limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=say)
     stream = _source(source, stdin or sys.stdin, connect_timeout)
+    out = None
     try:
         out = _sink(sink, stdout or sys.stdout, connect_timeout)
+        session, kind, recorders = build(out)
     except BaseException:
         stream.close()
+        if out is not None:
+            out.close()
         raise
-    session = LiveSession(estimator, out, say=say, limits=watch, recorder=recorder, mapping=mapping, axis=axis)
-    say(f"greybox live: {model_kind(model)} model {model_path}, reading "
+    say(f"greybox live: {kind} model {model_path}, reading "
         f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
     status, stopped = 0, True
     last_stats = time.monotonic()
@@ -218,8 +283,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                     status = ALARM_STATUS
                     break
                 if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
-                    session.stats.waiting = estimator.waiting
-                    session.stats.write(stats_path)
+                    session.write_stats(stats_path)
                     last_stats = time.monotonic()
             else:
                 with deferred.held():
@@ -231,6 +295,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
             stream.close()
         finally:
             if stats_path is not None:
-                session.stats.write(stats_path)
-            say(session.stats.line())
-    return LiveOutcome(session.stats, status, list(recorder.written) if recorder is not None else [])
+                session.write_stats(stats_path)
+            for line in session.stats_line().splitlines():
+                say(line)
+    return LiveOutcome(session.stats, status, [path for recorder in recorders for path in recorder.written])

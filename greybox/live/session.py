@@ -55,6 +55,8 @@ class LiveSession:
         ``{canonical_name: column}`` for message columns not named by the convention.
     axis : str, optional
         Axis to take from messages holding several.
+    subtopic : str, optional
+        The axis of a machine's session: its output messages carry ``"axis"`` and go to ``<TOPIC>/<axis>``.
 
     Attributes
     ----------
@@ -66,7 +68,7 @@ class LiveSession:
 
     def __init__(self, estimator: LiveEstimator, sink, *, say: Callable[[str], None],
                  limits: LimitWatch | None = None, recorder: Recorder | None = None,
-                 mapping: Mapping[str, str] | None = None, axis: str | None = None):
+                 mapping: Mapping[str, str] | None = None, axis: str | None = None, subtopic: str | None = None):
         self.estimator = estimator
         self.sink = sink
         self.say = say
@@ -74,12 +76,14 @@ class LiveSession:
         self.recorder = recorder
         self.mapping = dict(mapping) if mapping else None
         self.axis = axis
+        self.subtopic = subtopic
         self.stats = LiveStats()
         self.alarmed = False
         self._decoder = Decoder()
         self._signature: tuple | None = None
         self._offline_since: float | None = None
         self._run = 0  # run of the last estimates
+        self._open = True
 
     def handle(self, item: Received | ConnectionChange) -> None:
         """Take one item of the source.
@@ -90,15 +94,35 @@ class LiveSession:
             A message, or a change of the broker connection.
         """
         if isinstance(item, ConnectionChange):
-            self._connection(item)
+            self.connection(item)
             return
         self.stats.messages += 1
         try:
             decoded = self._decoder.decode(item.payload)
-            if decoded is None:
-                return
-            columns, seq = decoded
-            log = message_log(columns, name=item.name, mapping=self.mapping, axis=self.axis)
+        except MessageError as exc:
+            self.stats.rejected += 1
+            self.say(f"{item.name}: skipped: {exc}")
+            return
+        if decoded is not None:
+            self.take(*decoded, name=item.name)
+
+    def take(self, columns: Mapping[str, np.ndarray], seq=None, *, name: str, select: bool = True) -> None:
+        """Take the columns of one decoded message.
+
+        Parameters
+        ----------
+        columns : mapping of str to ndarray
+            The message's columns (:meth:`greybox.live.messages.Decoder.decode`).
+        seq : object, optional
+            The message's sequence tag.
+        name : str
+            How the message is named in lines.
+        select : bool, default True
+            Take the session's ``axis`` from columns named ``<axis>_<quantity>_<unit>``; False for a
+            message of this axis alone (its own topic).
+        """
+        try:
+            log = message_log(columns, name=name, mapping=self.mapping, axis=self.axis if select else None)
             signature = _signature(log)
             if self._signature is None:
                 self._signature = signature
@@ -107,10 +131,30 @@ class LiveSession:
                                    f"{_describe(self._signature)}")
         except MessageError as exc:
             self.stats.rejected += 1
-            self.say(f"{item.name}: skipped: {exc}")
+            self.say(f"{name}: skipped: {exc}")
             return
         self.stats.samples_received += len(log)
         self._publish(self.estimator.step(log), seq)
+
+    def stats_line(self) -> str:
+        """The counters in one line."""
+        return self.stats.line()
+
+    def current_stats(self) -> LiveStats:
+        """The counters, with the samples waiting now."""
+        if self._open:
+            self.stats.waiting = self.estimator.waiting
+        return self.stats
+
+    def write_stats(self, path) -> None:
+        """Write the counters (as they are now) to a JSON file, atomically.
+
+        Parameters
+        ----------
+        path : path-like
+            The stats file.
+        """
+        self.current_stats().write(path)
 
     def finish(self) -> None:
         """The end of the stream: the samples still waiting are estimated as the end of a log."""
@@ -125,6 +169,7 @@ class LiveSession:
             The command was stopped (SIGTERM, Ctrl-C): the samples waiting for their look-ahead are
             counted as lost.
         """
+        self._open = False
         stats = self.stats
         if stopped:
             unaccounted = stats.samples_received - stats.samples_estimated - stats.skipped
@@ -138,17 +183,27 @@ class LiveSession:
             self.sink.close()
             self.stats.outputs_lost = self.sink.lost
 
-    def _connection(self, change: ConnectionChange) -> None:
+    def connection(self, change: ConnectionChange, *, quiet: bool = False) -> None:
+        """Count a loss or return of the broker connection, and say it.
+
+        Parameters
+        ----------
+        change : ConnectionChange
+            The change.
+        quiet : bool, default False
+            Count without saying (another session says it).
+        """
+        say = (lambda line: None) if quiet else self.say
         if not change.connected:
             self.stats.disconnections += 1
             self._offline_since = change.time_s
-            self.say("broker connection lost; reconnecting")
+            say("broker connection lost; reconnecting")
         else:
             away = change.time_s - self._offline_since if self._offline_since is not None else 0.0
             self.stats.offline_s += away
             self._offline_since = None
-            self.say(f"broker connection back after {away:.1f} s; messages of that time are missing "
-                     "(a gap in the time stamps re-initialises the model's state)")
+            say(f"broker connection back after {away:.1f} s; messages of that time are missing "
+                "(a gap in the time stamps re-initialises the model's state)")
 
     def _publish(self, out: StepOutput, seq) -> None:
         for event in out.events:
@@ -159,7 +214,7 @@ class LiveSession:
         columns = parts[0] if len(parts) == 1 else {name: np.concatenate([part[name] for part in parts])
                                                     for name in parts[0]}
         self.stats.samples_estimated += out.n_samples
-        self.sink.estimate(estimate_message(columns, seq))
+        self.sink.estimate(estimate_message(columns, seq, axis=self.subtopic), subtopic=self.subtopic)
         for run, result, part in zip(out.runs, out.results, parts):
             if run != self._run:  # the estimates of a new run: a new file, the limits re-armed
                 self._run = run
@@ -173,7 +228,7 @@ class LiveSession:
                 for alarm in self.limits.check(part):
                     self.alarmed = True
                     self.stats.alarms += 1
-                    self.sink.alarm(alarm.message())
+                    self.sink.alarm(alarm.message(), subtopic=self.subtopic)
                     self.say(alarm.line())
 
     def _event(self, event) -> None:

@@ -31,24 +31,28 @@ class LineSink:
         self.stream = stream
         self.lost = 0
 
-    def estimate(self, text: str) -> None:
+    def estimate(self, text: str, subtopic: str | None = None) -> None:
         """Write one estimate message as a line.
 
         Parameters
         ----------
         text : str
             JSON text.
+        subtopic : str, optional
+            Not used (the JSON names the axis of a machine).
         """
         self.stream.write(text + "\n")
         self.stream.flush()
 
-    def alarm(self, text: str) -> None:
+    def alarm(self, text: str, subtopic: str | None = None) -> None:
         """Write one alarm message as a line.
 
         Parameters
         ----------
         text : str
             JSON text.
+        subtopic : str, optional
+            Not used.
         """
         self.estimate(text)
 
@@ -81,30 +85,39 @@ class MqttSink:
     def __init__(self, address: BrokerAddress, *, connect_timeout: float = 10.0):
         self.address = address
         self.lost = 0
+        self._closed = False
         self.connection = Connection(address, connect_timeout=connect_timeout)
 
-    def estimate(self, text: str) -> None:
-        """Publish one estimate message.
+    def estimate(self, text: str, subtopic: str | None = None) -> None:
+        """Publish one estimate message on the topic (``<topic>/<subtopic>`` with a subtopic).
 
         Parameters
         ----------
         text : str
             JSON text.
+        subtopic : str, optional
+            The axis of a machine.
         """
-        if not self.connection.publish(self.address.topic, text):
+        topic = self.address.topic if subtopic is None else f"{self.address.topic}/{subtopic}"
+        if not self.connection.publish(topic, text):
             self.lost += 1
 
-    def alarm(self, text: str) -> None:
-        """Publish one alarm message on ``<topic>/alarm``.
+    def alarm(self, text: str, subtopic: str | None = None) -> None:
+        """Publish one alarm message on ``<topic>/alarm`` (``<topic>/<subtopic>/alarm`` with a subtopic).
 
         Parameters
         ----------
         text : str
             JSON text.
+        subtopic : str, optional
+            The axis of a machine.
         """
-        if not self.connection.publish(f"{self.address.topic}/alarm", text):
+        topic = self.address.topic if subtopic is None else f"{self.address.topic}/{subtopic}"
+        if not self.connection.publish(f"{topic}/alarm", text):
             self.lost += 1
 
     def close(self) -> None:
-        """Disconnect (after the queued messages are out)."""
-        self.connection.close()
+        """Disconnect (after the queued messages are out); closing again does nothing."""
+        if not self._closed:
+            self._closed = True
+            self.connection.close()

@@ -29,11 +29,14 @@ class Received:
         How errors name it, e.g. "line 12" or "message 12 on axis/X".
     arrived_s : float
         Arrival time, ``time.time()`` [s].
+    topic : str
+        The MQTT topic ("" for a line of a text stream).
     """
 
     payload: str | bytes
     name: str
     arrived_s: float
+    topic: str = ""
 
 
 @dataclass(frozen=True)
@@ -120,7 +123,7 @@ class MqttSource:
                 continue
             topic, payload, arrived_s = item
             self._count += 1
-            yield Received(payload, f"message {self._count} on {topic}", arrived_s)
+            yield Received(payload, f"message {self._count} on {topic}", arrived_s, topic)
 
     def close(self) -> None:
         """Disconnect from the broker."""
