@@ -30,6 +30,7 @@ import os
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # one core: before numba is imported
 
 import argparse  # noqa: E402
+import contextlib  # noqa: E402
 import io  # noqa: E402
 import json  # noqa: E402
 import shutil  # noqa: E402
@@ -134,7 +135,8 @@ def recording(model_path, minutes: float, batch: int, folder: Path) -> dict:
     log = make_dataset("X", "C", 7, duration_s=60.0 * minutes, cutting=True).replace(extras={})
     log_path, table = folder / "long.parquet", folder / "long-predict.parquet"
     write_log(log, log_path)
-    assert greybox_main(["predict", str(model_path), str(log_path), "--out", str(table), "--quiet"]) == 0
+    with contextlib.redirect_stdout(io.StringIO()):  # the benchmark prints its JSON line only
+        assert greybox_main(["predict", str(model_path), str(log_path), "--out", str(table), "--quiet"]) == 0
     model = load_model(model_path)
     recorder = Recorder(folder / "rec", model=model, chunk_s=60.0, every_s=60.0)
     session = LiveSession(LiveEstimator(model, sample_time=log.sample_time), LineSink(_Null()),
