@@ -22,6 +22,7 @@ well-defined for coarse logs.
 
 from __future__ import annotations
 
+import functools
 from typing import Iterable
 
 import numpy as np
@@ -74,8 +75,6 @@ def derivative_filter(sample_time: float, *, cutoff_hz: float | None = None, ord
     LogError
         For a cut-off not between 0 and the Nyquist frequency.
     """
-    from scipy.signal import butter
-
     nyquist = 0.5 / sample_time
     cutoff = default_cutoff(sample_time) if cutoff_hz is None else float(cutoff_hz)
     if not 0.0 < cutoff < nyquist:
@@ -83,7 +82,15 @@ def derivative_filter(sample_time: float, *, cutoff_hz: float | None = None, ord
                                f"{nyquist:g} Hz")
     if int(order) != order or order < 1:
         raise ValueError(f"filter order must be a positive integer, got {order!r}")
-    return butter(int(order), cutoff, fs=1.0 / sample_time, output="sos"), cutoff
+    return _butter_sos(int(order), cutoff, 1.0 / sample_time).copy(), cutoff
+
+
+@functools.lru_cache(maxsize=64)
+def _butter_sos(order: int, cutoff_hz: float, rate_hz: float) -> np.ndarray:
+    """Butterworth low-pass sections, designed once per (order, cut-off, rate): a live stream derives often."""
+    from scipy.signal import butter
+
+    return butter(order, cutoff_hz, fs=rate_hz, output="sos")
 
 
 #: Relative size below which the edge transient of the derivative filter counts as gone.

@@ -1,0 +1,279 @@
+"""Time ``greybox live``: compute per sample, CPU share of 16 axes, latency through a local Mosquitto broker.
+
+All figures come from one run and are printed with the core count and the load of the machine:
+
+1. compute: a GMS+SVR model's live session (decode the JSON message, estimate, encode the output)
+   over ``--seconds`` of a shipped log in messages of ``--batch`` samples, on one core (affinity set,
+   one BLAS and numba thread); the time of each message divided by its samples, percentiles over the
+   messages after the look-ahead has filled;
+2. CPU share of ``--axes`` axes at 500 Hz: as many sessions in one process, each fed the log; the
+   process CPU time divided by the stream's duration (the share of one core they need to keep up);
+3. end to end: a Mosquitto broker on a free loopback port, ``greybox live`` reading and writing it, the
+   log published at real time in batches of ``--batch`` (500 Hz, 50 messages/s); per message, the time
+   from its publication to the arrival of the output message it completes (percentiles). Each estimate
+   also waits for the look-ahead of the derivatives (printed), on top of that time.
+
+    python benchmarks/bench_live.py --model x.gbm --seconds 20
+
+4. with ``--record-minutes M``: a synthetic cutting log of M minutes streamed through a session that
+   records it (rolling Parquet files of 60 s), against ``greybox predict`` on the same log: the largest
+   difference of the model current, and the resident memory after 10 % and at the end of the stream.
+
+Without ``--model`` a GMS+SVR model is fitted on data/X_A.mcap and data/X_B.mcap with fixed
+hyperparameters (as benchmarks/bench_gmssvr_predict.py does).
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # one core: before numba is imported
+
+import argparse  # noqa: E402
+import contextlib  # noqa: E402
+import io  # noqa: E402
+import json  # noqa: E402
+import shutil  # noqa: E402
+import socket  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import threading  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "data"
+
+
+def _model(path: str | None, folder: Path) -> Path:
+    if path:
+        return Path(path)
+    from greybox.data.io import read_log
+    from greybox.data.prepare import prepare
+    from greybox.friction.gms import GMSModel
+    from greybox.models.gmssvr import GMSSVRModel
+    from greybox.persistence import save_model
+
+    train = prepare([read_log(DATA / "X_A.mcap"), read_log(DATA / "X_B.mcap")])
+    model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=100), optimize=False, C=0.5, epsilon=0.02, gamma=3.0,
+                        n_subset=2000).fit(train)
+    out = folder / "bench.gbm"
+    save_model(model, out)
+    return out
+
+
+def _messages(log, batch: int) -> list[str]:
+    columns = {"time_s": log.time, "position_mm": log.position, "velocity_mm_s": log.velocity,
+               "current_A": log.effort}
+    return [json.dumps({name: values[k:k + batch].tolist() for name, values in columns.items()} | {"seq": seq})
+            for seq, k in enumerate(range(0, len(log), batch))]
+
+
+class _Null(io.TextIOBase):
+    def write(self, text):
+        return len(text)
+
+
+def _session(model_path, step_s: float):
+    from greybox.live.estimator import LiveEstimator
+    from greybox.live.session import LiveSession
+    from greybox.live.sinks import LineSink
+    from greybox.persistence import load_model
+
+    estimator = LiveEstimator(load_model(model_path), sample_time=step_s)
+    return LiveSession(estimator, LineSink(_Null()), say=lambda line: None)
+
+
+def compute(model_path, messages, batch: int, lookahead: int, step_s: float) -> dict:
+    from greybox.live.sources import Received
+
+    session = _session(model_path, step_s)
+    times = []
+    for k, message in enumerate(messages):
+        item = Received(message, f"message {k}", 0.0)
+        started = time.perf_counter()
+        session.handle(item)
+        times.append(time.perf_counter() - started)
+    per_sample = np.array(times[lookahead // batch + 2:]) / batch * 1e6
+    return {"messages": len(per_sample), "batch": batch, "p50_us_per_sample": float(np.percentile(per_sample, 50)),
+            "p99_us_per_sample": float(np.percentile(per_sample, 99)), "max_us_per_sample": float(per_sample.max())}
+
+
+def cpu_share(model_path, messages, axes: int, duration_s: float, step_s: float) -> dict:
+    from greybox.live.sources import Received
+
+    sessions = [_session(model_path, step_s) for _ in range(axes)]
+    started = time.process_time()
+    for k, message in enumerate(messages):
+        for session in sessions:
+            session.handle(Received(message, f"message {k}", 0.0))
+    used = time.process_time() - started
+    return {"axes": axes, "stream_s": duration_s, "cpu_s": used, "share_of_one_core": used / duration_s}
+
+
+def _resident_mb() -> float:
+    with open("/proc/self/statm") as stream:
+        return int(stream.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+def recording(model_path, minutes: float, batch: int, folder: Path) -> dict:
+    import pandas as pd
+
+    from greybox.cli import main as greybox_main
+    from greybox.data.io import write_log
+    from greybox.live.estimator import LiveEstimator
+    from greybox.live.recording import Recorder
+    from greybox.live.session import LiveSession
+    from greybox.live.sinks import LineSink
+    from greybox.live.sources import Received
+    from greybox.persistence import load_model
+    from greybox.twin import make_dataset
+
+    log = make_dataset("X", "C", 7, duration_s=60.0 * minutes, cutting=True).replace(extras={})
+    log_path, table = folder / "long.parquet", folder / "long-predict.parquet"
+    write_log(log, log_path)
+    with contextlib.redirect_stdout(io.StringIO()):  # the benchmark prints its JSON line only
+        assert greybox_main(["predict", str(model_path), str(log_path), "--out", str(table), "--quiet"]) == 0
+    model = load_model(model_path)
+    recorder = Recorder(folder / "rec", model=model, chunk_s=60.0, every_s=60.0)
+    session = LiveSession(LiveEstimator(model, sample_time=log.sample_time), LineSink(_Null()),
+                          say=lambda line: None, recorder=recorder)
+    columns = {"time_s": log.time, "position_mm": log.position, "velocity_mm_s": log.velocity, "current_A": log.effort}
+    starts = range(0, len(log), batch)
+    memory = {}
+    started = time.perf_counter()
+    for seq, k in enumerate(starts):
+        message = json.dumps({name: values[k:k + batch].tolist() for name, values in columns.items()})
+        session.handle(Received(message, f"message {seq}", 0.0))
+        if seq == len(starts) // 10:
+            memory["resident_mb_at_10_percent"] = _resident_mb()
+    session.finish()
+    session.close()
+    elapsed = time.perf_counter() - started
+    memory["resident_mb_at_end"] = _resident_mb()
+    expected = pd.read_parquet(table, columns=["current_model_A"])["current_model_A"].to_numpy()
+    largest, offset = 0.0, 0
+    for path in recorder.written:
+        part = pd.read_parquet(path, columns=["current_model_A"])["current_model_A"].to_numpy()
+        largest = max(largest, float(abs(part - expected[offset:offset + part.size]).max()))
+        offset += part.size
+    return {"minutes": minutes, "samples": len(log), "recorded": offset, "files": len(recorder.written),
+            "largest_difference_A": largest, "stream_wall_s": elapsed, **memory}
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) -> dict:
+    import paho.mqtt.client as mqtt
+
+    binary = shutil.which("mosquitto", path=os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin"]))
+    if binary is None:
+        return {"skipped": "the mosquitto broker is not installed (Debian package 'mosquitto')"}
+    port = _free_port()
+    config = folder / "mosquitto.conf"
+    config.write_text(f"listener {port} 127.0.0.1\nallow_anonymous true\n")
+    broker = subprocess.Popen([binary, "-c", str(config)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    live = None
+    try:
+        deadline = time.monotonic() + 10
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=0.2).close()
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise RuntimeError("mosquitto did not start") from None
+                time.sleep(0.05)
+        arrived: dict = {}
+        ready = threading.Event()
+        client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2)
+        client.on_connect = lambda c, u, f, r, p=None: c.subscribe("process/X")
+        client.on_subscribe = lambda *args: ready.set()
+
+        def on_message(c, u, message):
+            arrived[json.loads(message.payload)["seq"]] = time.perf_counter()
+
+        client.on_message = on_message
+        client.connect("127.0.0.1", port)
+        client.loop_start()
+        ready.wait(10)
+        live = subprocess.Popen([sys.executable, "-m", "greybox", "live", str(model_path), "--source",
+                                 f"mqtt://127.0.0.1:{port}/axis/X", "--sink", f"mqtt://127.0.0.1:{port}/process/X",
+                                 "--sample-time", str(step_s)], stderr=subprocess.PIPE, text=True)
+        live.stderr.readline()  # connected
+        published = {}
+        start = time.perf_counter()
+        for seq, message in enumerate(messages):
+            due = start + (seq + 1) * batch * step_s
+            while time.perf_counter() < due:
+                time.sleep(min(0.001, max(0.0, due - time.perf_counter())))
+            published[seq] = time.perf_counter()
+            client.publish("axis/X", message)
+        time.sleep(1.0)
+        client.disconnect()
+        client.loop_stop()
+    finally:
+        if live is not None:
+            live.terminate()
+            live.wait(30)
+        broker.terminate()
+        broker.wait(10)
+    latency = np.array([arrived[seq] - published[seq] for seq in published if seq in arrived]) * 1e3
+    answered = len(latency)
+    return {"messages": len(published), "answered": answered, "rate_hz": 1 / step_s, "batch": batch,
+            "p50_ms": float(np.percentile(latency, 50)), "p99_ms": float(np.percentile(latency, 99)),
+            "max_ms": float(latency.max())}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--model", help="model file (default: a GMS+SVR fitted on data/X_A, X_B)")
+    parser.add_argument("--log", default=str(DATA / "X_C.mcap"), help="log to stream (default data/X_C.mcap)")
+    parser.add_argument("--seconds", type=float, default=20.0, help="seconds of the log to stream (default 20)")
+    parser.add_argument("--batch", type=int, default=10, help="samples per message (default 10)")
+    parser.add_argument("--axes", type=int, default=16, help="axes of the CPU-share run (default 16)")
+    parser.add_argument("--core", type=int, default=0, help="core of the compute runs (default 0)")
+    parser.add_argument("--record-minutes", type=float, default=0.0,
+                        help="also stream and record a synthetic log of this many minutes (default 0: not)")
+    args = parser.parse_args()
+
+    from threadpoolctl import threadpool_limits
+
+    from greybox.data.io import read_log
+    from greybox.data.prepare import derivative_margin
+    from greybox.data.prepare import trim as trim_log
+
+    with tempfile.TemporaryDirectory() as folder, threadpool_limits(limits=1):
+        model_path = _model(args.model, Path(folder))
+        log = read_log(args.log)
+        log = trim_log(log, None, float(log.time[0]) + args.seconds - 1e-9)
+        messages = _messages(log, args.batch)
+        lookahead = derivative_margin(log.sample_time)
+        affinity = os.sched_getaffinity(0)
+        os.sched_setaffinity(0, {args.core})
+        try:
+            step = log.sample_time
+            _ = compute(model_path, messages[:100], args.batch, lookahead, step)  # compile and warm up
+            figures = {"compute": compute(model_path, messages, args.batch, lookahead, step),
+                       "cpu_share": cpu_share(model_path, messages, args.axes, log.duration, step)}
+        finally:
+            os.sched_setaffinity(0, affinity)
+        figures["end_to_end"] = end_to_end(model_path, messages, Path(folder), args.batch, log.sample_time)
+        if args.record_minutes > 0:
+            figures["recording"] = recording(model_path, args.record_minutes, args.batch, Path(folder))
+    figures.update({"model": str(args.model or "GMS+SVR fitted by the benchmark"), "log": args.log,
+                    "seconds": log.duration, "lookahead_samples": lookahead,
+                    "lookahead_s": lookahead * log.sample_time, "cpu_count": os.cpu_count(),
+                    "load_average": os.getloadavg()})
+    print(json.dumps(figures))
+
+
+if __name__ == "__main__":
+    main()

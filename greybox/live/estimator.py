@@ -1,0 +1,241 @@
+"""The process current and force of a stream, message by message, as ``greybox predict`` gives them.
+
+:class:`LiveEstimator` takes the samples of each message, checks their time stamps
+(:class:`~greybox.live.timeline.Timeline`), derives velocity and acceleration as the whole log would get
+them (:class:`~greybox.live.lookahead.Lookahead`), and runs the model over the samples now complete from
+the state the previous ones left, through the same code that ``greybox predict`` streams a log with
+(:func:`greybox.evaluate.process.process_blocks`): process current, force, training-region flags. Fed
+the samples of a log, the estimates equal the table ``greybox predict`` writes for it.
+
+A gap in the time stamps ends the run: the samples waiting are finished as the end of a log, and the
+next run starts from the model's initial state, as the readers split a log at gaps.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Iterator
+
+from ..data.axis_config import AxisConfig
+from ..data.log import AxisLog
+from ..errors import LogError
+from ..evaluate.process import ProcessResult, ProcessTally, check_process_inputs, process_blocks
+from ..models.chunked import DEFAULT_CHUNK_S
+from .lookahead import Lookahead
+from .timeline import Dropped, Gap, Timeline
+
+__all__ = ["Lost", "RunStart", "StepOutput", "LiveEstimator"]
+
+
+@dataclass(frozen=True)
+class Lost:
+    """Samples received but never estimated.
+
+    Attributes
+    ----------
+    count : int
+        Samples lost.
+    time_s : float
+        Time of the first one [s].
+    reason : str
+        Why, in words.
+    """
+
+    count: int
+    time_s: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class RunStart:
+    """A run starts: the model's state is (re-)initialised.
+
+    Attributes
+    ----------
+    time_s : float
+        Time of the run's first sample [s].
+    index : int
+        Runs before it (0 for the first).
+    sample_time : float
+        Nominal step [s].
+    lookahead : int
+        Samples of look-ahead of the derivatives (0 when the messages carry them).
+    """
+
+    time_s: float
+    index: int
+    sample_time: float
+    lookahead: int
+
+
+@dataclass
+class StepOutput:
+    """What one message (or the end of the stream) gave.
+
+    Attributes
+    ----------
+    results : list of ProcessResult
+        Estimates of the samples completed, in time order (empty while their look-ahead is missing).
+    events : list
+        :class:`~greybox.live.timeline.Dropped`, :class:`~greybox.live.timeline.Gap`, :class:`Lost` and
+        :class:`RunStart`, in order.
+    runs : list of int
+        The run (0 for the first) of each result.
+    """
+
+    results: list = field(default_factory=list)
+    events: list = field(default_factory=list)
+    runs: list = field(default_factory=list)
+
+    @property
+    def n_samples(self) -> int:
+        """Samples estimated."""
+        return sum(len(result.time) for result in self.results)
+
+
+class _Run:
+    """One run: its look-ahead, and the process blocks fed one block at a time."""
+
+    def __init__(self, model, *, index: int, sample_time: float, axis_config, cutoff_hz, chunk_s, tally):
+        self.index = index
+        self.lookahead = Lookahead(sample_time=sample_time, cutoff_hz=cutoff_hz)
+        self.axis_config = axis_config
+        self._box: deque = deque()
+        self._results: Iterator[ProcessResult] = process_blocks(
+            model, self._mailbox(), sample_time=sample_time, axis_config=axis_config, chunk_s=chunk_s, tally=tally)
+        self._checked = False
+
+    def _mailbox(self) -> Iterator[AxisLog]:
+        while True:
+            yield self._box.popleft()
+
+    def estimate(self, block: AxisLog) -> ProcessResult:
+        if not self._checked:
+            check_process_inputs([block], self.axis_config)
+            self._checked = True
+        self._box.append(block)
+        return next(self._results)
+
+
+class LiveEstimator:
+    """The estimates of a stream of messages, with the model's state carried from message to message.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        A fitted model (trained on air cuts) of a registered kind.
+    axis_config : AxisConfig, optional
+        Drive-train constants; gives the process force (torque on a rotary axis).
+    sample_time : float, optional
+        Nominal step [s]; default the median step of the first samples
+        (:data:`~greybox.live.timeline.SETTLE_SAMPLES`).
+    tolerance : float, default 0.25
+        Time-step tolerance, a fraction of the nominal step: a longer step is a gap, a shorter one drops
+        the sample.
+    cutoff_hz : float, optional
+        Derivative-filter cut-off [Hz] (default as ``greybox predict``).
+    chunk_s : float, default 60.0
+        Chunk length [s] of the model within a message (as ``greybox predict --chunk-s``).
+
+    Attributes
+    ----------
+    tally : ProcessTally
+        Running figures of every sample estimated.
+    runs : int
+        Runs started (1 + gaps).
+    """
+
+    def __init__(self, model, *, axis_config: AxisConfig | None = None, sample_time: float | None = None,
+                 tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S):
+        self.model = model
+        self.axis_config = axis_config
+        self.cutoff_hz = cutoff_hz
+        self.chunk_s = float(chunk_s)
+        self.timeline = Timeline(sample_time=sample_time, tolerance=tolerance)
+        self.tally = ProcessTally()
+        self.runs = 0
+        self._run: _Run | None = None
+
+    @property
+    def lookahead(self) -> int:
+        """Samples of look-ahead of the current run (0 before the first run)."""
+        return 0 if self._run is None else self._run.lookahead.margin
+
+    @property
+    def waiting(self) -> int:
+        """Samples received and kept, not yet estimated."""
+        return 0 if self._run is None else self._run.lookahead.waiting
+
+    def step(self, log: AxisLog) -> StepOutput:
+        """Take the samples of one message; return the estimates now complete and what happened.
+
+        Parameters
+        ----------
+        log : AxisLog
+            The samples of one message (:func:`greybox.live.messages.message_log`).
+
+        Returns
+        -------
+        StepOutput
+        """
+        out = StepOutput()
+        for event in self.timeline.push(log):
+            self._event(event, out)
+        return out
+
+    def finish(self) -> StepOutput:
+        """End the stream: the samples still held or waiting are estimated as the end of a log.
+
+        Returns
+        -------
+        StepOutput
+        """
+        out = StepOutput()
+        for event in self.timeline.flush():
+            self._event(event, out)
+        self._end_run(out)
+        return out
+
+    def _event(self, event, out: StepOutput) -> None:
+        if isinstance(event, Dropped):
+            out.events.append(event)
+        elif isinstance(event, Gap):
+            self._end_run(out)
+            out.events.append(event)
+        else:
+            self._samples(event, out)
+
+    def _samples(self, samples: AxisLog, out: StepOutput) -> None:
+        if self._run is None:
+            self._run = _Run(self.model, index=self.runs, sample_time=self.timeline.nominal,
+                             axis_config=self.axis_config, cutoff_hz=self.cutoff_hz, chunk_s=self.chunk_s,
+                             tally=self.tally)
+            ready = self._run.lookahead.push(samples)
+            out.events.append(RunStart(float(samples.time[0]), self.runs, self.timeline.nominal,
+                                       self._run.lookahead.margin))
+            self.runs += 1
+        else:
+            ready = self._run.lookahead.push(samples)
+        if ready is not None:
+            out.results.append(self._run.estimate(ready))
+            out.runs.append(self._run.index)
+
+    def _end_run(self, out: StepOutput) -> None:
+        if self._run is None:
+            return
+        run, self._run = self._run, None
+        waiting = run.lookahead.waiting
+        try:
+            ready = run.lookahead.finish()
+        except LogError as exc:
+            out.events.append(Lost(waiting, float("nan"), f"run too short to derive: {exc.problem}"))
+            return
+        if ready is None:
+            return
+        if len(ready) < 2:
+            out.events.append(Lost(len(ready), float(ready.time[0]),
+                                   "a run's last sample alone (a model needs two samples)"))
+            return
+        out.results.append(run.estimate(ready))
+        out.runs.append(run.index)

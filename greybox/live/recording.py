@@ -1,0 +1,128 @@
+"""Recordings of a live stream: rolling Parquet files of the table ``greybox predict`` writes.
+
+The estimates go to ``DIR/live-<start>-<n>.parquet``, a new file every ``every_s`` seconds of log time
+and at the start of every run (after a gap), each written at once when it is complete through
+:func:`greybox.evaluate.process_io.write_process_blocks` (atomically: a file is there whole or not at all;
+no file is overwritten). Its columns and metadata are those of ``greybox predict``'s Parquet output, with
+the file's place in the stream under ``attrs["live"]``. Memory holds one file's estimates at most.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from ..data.axis_config import AxisConfig
+from ..errors import GreyboxError
+from ..evaluate.process import ProcessResult, ProcessTally, process_attrs
+from ..evaluate.process_io import write_process_blocks
+
+__all__ = ["DEFAULT_RECORD_S", "Recorder"]
+
+#: Log seconds per recording file by default.
+DEFAULT_RECORD_S = 60.0
+
+
+class Recorder:
+    """Writes the estimates of a stream into rolling Parquet files.
+
+    Parameters
+    ----------
+    directory : path-like
+        Folder of the files (created if missing).
+    model : CurrentModel
+        The model (its kind goes into the metadata).
+    axis_config : AxisConfig, optional
+        Drive-train constants used (into the metadata).
+    chunk_s : float
+        Chunk length [s] of the model (into the metadata).
+    every_s : float, default 60.0
+        Log seconds per file.
+    attrs : dict, optional
+        Further metadata entries (model file, source).
+
+    Attributes
+    ----------
+    written : list of pathlib.Path
+        Files written so far.
+
+    Raises
+    ------
+    GreyboxError
+        When the folder cannot be created.
+    """
+
+    def __init__(self, directory, *, model, axis_config: AxisConfig | None = None, chunk_s: float,
+                 every_s: float = DEFAULT_RECORD_S, attrs: dict | None = None):
+        self.directory = Path(directory)
+        try:
+            self.directory.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise GreyboxError(f"--record {directory}: cannot create the folder ({exc.strerror})") from None
+        if not self.directory.is_dir():
+            raise GreyboxError(f"--record {directory}: not a folder")
+        self.model = model
+        self.axis_config = axis_config
+        self.chunk_s = float(chunk_s)
+        self.every_s = float(every_s)
+        self.attrs = dict(attrs or {})
+        self.written: list[Path] = []
+        self._stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+        self._parts: list[ProcessResult] = []
+        self._start_s: float | None = None
+        self._run = 0
+
+    def add(self, result: ProcessResult) -> None:
+        """Take the estimates of consecutive samples; write the file once it spans ``every_s``.
+
+        Parameters
+        ----------
+        result : ProcessResult
+            Estimates of samples after those added before (of the same run).
+        """
+        if not len(result.time):
+            return
+        if self._start_s is None:
+            self._start_s = float(result.time[0])
+        self._parts.append(result)
+        if float(result.time[-1]) - self._start_s >= self.every_s:
+            self.close_file()
+
+    def new_run(self) -> None:
+        """A new run starts (after a gap): the current file is closed."""
+        self.close_file()
+        self._run += 1
+
+    def close_file(self) -> Path | None:
+        """Write the estimates held into the next file; None when none are held."""
+        if not self._parts:
+            return None
+        parts, self._parts, self._start_s = self._parts, [], None
+        first = parts[0]
+        tally = ProcessTally()
+        for part in parts:
+            tally.add(part)
+        attrs = process_attrs(self.model, axis_config=self.axis_config, interval=None, chunk_s=self.chunk_s,
+                              motion=first.motion, effort_unit=first.effort_unit, tally=tally)
+        attrs.pop("extrapolation", None)  # counted per file without the per-quantity flags: not comparable
+        attrs.update(self.attrs)
+        attrs["live"] = {"file": len(self.written), "run": self._run, "start_s": float(first.time[0]),
+                         "stop_s": float(parts[-1].time[-1]), "samples": int(sum(len(p.time) for p in parts))}
+        metadata = {"axis": first.axis, "dataset": first.dataset or "", "effort_unit": first.effort_unit,
+                    "attrs": attrs}
+        path = self._next_path()
+        write_process_blocks(parts, path, metadata=lambda: metadata)
+        self.written.append(path)
+        return path
+
+    def _next_path(self) -> Path:
+        index = len(self.written)
+        while True:
+            path = self.directory / f"live-{self._stamp}-{index:05d}.parquet"
+            if not path.exists():
+                return path
+            index += 1
+
+    def close(self) -> None:
+        """Write the estimates still held."""
+        self.close_file()

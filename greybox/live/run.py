@@ -1,0 +1,301 @@
+"""``greybox live`` as one function: open the model, the source, the sink and the recording; run the stream.
+
+:func:`run_live` runs until the source ends (the end of stdin), an alarm with ``exit_on_alarm``, or the
+command is stopped: on SIGTERM or Ctrl-C (a :class:`KeyboardInterrupt` here) the recording's last file is
+written and closed, the sink closed and the stats written before the interrupt goes on to the command
+line, which exits with 143 (130 for Ctrl-C).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from typing import Callable, Mapping, TextIO
+
+from ..errors import GreyboxError
+from ..models.chunked import DEFAULT_CHUNK_S
+from .broker import is_address, parse_address
+from .estimator import LiveEstimator
+from .limits import Limit, LimitWatch
+from .machine import MachineSession
+from .recording import DEFAULT_RECORD_S, Recorder
+from .session import LiveSession
+from .sinks import LineSink, MqttSink
+from .sources import LineSource, MqttSource
+from .stats import LiveStats
+
+__all__ = ["ALARM_STATUS", "LiveOutcome", "run_live"]
+
+#: Exit status of ``greybox live --exit-on-alarm`` after an alarm.
+ALARM_STATUS = 3
+
+#: Wall-clock seconds between writes of the stats file while the stream runs.
+STATS_EVERY_S = 10.0
+
+
+@dataclass(frozen=True)
+class LiveOutcome:
+    """How a live stream ended.
+
+    Attributes
+    ----------
+    stats : LiveStats
+        The counters (of a machine: its messages; each axis's are in its session).
+    status : int
+        Exit status: 0, or :data:`ALARM_STATUS` after an alarm with ``exit_on_alarm``.
+    recorded : list of pathlib.Path
+        Recording files written.
+    """
+
+    stats: LiveStats
+    status: int
+    recorded: list
+
+
+class _Deferred:
+    """SIGTERM and Ctrl-C held back while a message is handled, then passed on to the handlers before.
+
+    A signal raises where the interpreter happens to be; in the middle of a message it would leave the
+    estimates, the recording and the counters out of step. Between messages (waiting for the next one)
+    it is passed on at once.
+    """
+
+    _SIGNALS = (signal.SIGTERM, signal.SIGINT)
+
+    def __init__(self):
+        self._busy = False
+        self._pending = None
+        self._previous: dict = {}
+
+    def __enter__(self) -> "_Deferred":
+        if threading.current_thread() is threading.main_thread():
+            for number in self._SIGNALS:
+                self._previous[number] = signal.signal(number, self._handler)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for number, previous in self._previous.items():
+            signal.signal(number, previous)
+
+    def _handler(self, signum, frame) -> None:
+        if self._busy:
+            self._pending = (signum, frame)
+        else:
+            self._forward(signum, frame)
+
+    def _forward(self, signum, frame) -> None:
+        previous = self._previous.get(signum)
+        if callable(previous):
+            previous(signum, frame)
+        raise KeyboardInterrupt()
+
+    @contextlib.contextmanager
+    def held(self):
+        """Hold the signals back while the block runs; pass on one that came meanwhile."""
+        self._busy = True
+        try:
+            yield
+        finally:
+            self._busy = False
+        if self._pending is not None:
+            pending, self._pending = self._pending, None
+            self._forward(*pending)
+
+
+def _source(spec: str, stdin: TextIO, connect_timeout: float):
+    if spec == "-":
+        return LineSource(stdin)
+    if is_address(spec):
+        return MqttSource(parse_address(spec, "--source"), connect_timeout=connect_timeout)
+    raise GreyboxError(f"--source {spec}: give '-' (lines on stdin) or mqtt://HOST[:PORT]/TOPIC")
+
+
+def _sink(spec: str, stdout: TextIO, connect_timeout: float):
+    if spec == "-":
+        return LineSink(stdout)
+    if is_address(spec):
+        return MqttSink(parse_address(spec, "--sink"), connect_timeout=connect_timeout)
+    raise GreyboxError(f"--sink {spec}: give '-' (lines on stdout) or mqtt://HOST[:PORT]/TOPIC")
+
+
+def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
+                  axis, source, say):
+    """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
+    from ..data.axis_config import read_axis_config
+    from ..persistence import load_model
+    from ..registry import model_kind
+
+    model = load_model(model_path)
+    config = read_axis_config(axis_config_path) if axis_config_path else None
+    mapping = {**(config.channels if config else {}), **(columns or {})}
+
+    def build(out):
+        recorder = None if record_dir is None else Recorder(
+            record_dir, model=model, axis_config=config, chunk_s=options["chunk_s"], every_s=record_s,
+            attrs={"model_file": str(model_path), "source": str(source)})
+        watch = LimitWatch(list(limits), hold_s=hold_s) if limits else None
+        session = LiveSession(LiveEstimator(model, axis_config=config, **options), out, say=say, limits=watch,
+                              recorder=recorder, mapping=mapping, axis=axis)
+        return session, model_kind(model), [recorder] if recorder is not None else []
+
+    return build
+
+
+def _machine_session(model_path, machine_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
+                     source, say):
+    """A function of the sink that builds the sessions of a machine model's axes: (session, kind, recorders)."""
+    from pathlib import Path
+
+    from ..data.machine_config import read_machine_config
+    from ..machine_model import load_machine
+    from ..registry import model_kind
+
+    if columns:
+        raise GreyboxError("--columns applies to one axis; give a machine's channel names in --machine TOML")
+    machine = load_machine(model_path)
+    described = read_machine_config(machine_path) if machine_path else None
+
+    def build(out):
+        sessions, recorders = {}, []
+        for axis, model in machine.models.items():
+            entry = described.axis(axis) if described is not None else None
+            config = entry.config if entry is not None else None
+            recorder = None if record_dir is None else Recorder(
+                Path(record_dir) / axis, model=model, axis_config=config, chunk_s=options["chunk_s"],
+                every_s=record_s, attrs={"model_file": str(Path(model_path) / f"{axis}.gbm"), "source": str(source)})
+            recorders += [recorder] if recorder is not None else []
+            sessions[axis] = LiveSession(
+                LiveEstimator(model, axis_config=config, **options), out,
+                say=lambda line, axis=axis: say(f"{axis}: {line}"),
+                limits=LimitWatch(list(limits), hold_s=hold_s) if limits else None, recorder=recorder,
+                mapping=dict(entry.channels) if entry is not None and entry.channels else None, axis=axis,
+                subtopic=axis)
+        kinds = sorted({model_kind(model) for model in machine.models.values()})
+        return MachineSession(sessions, say=say), f"machine ({', '.join(machine.axes)}: {', '.join(kinds)})", recorders
+
+    return build
+
+
+def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None, machine_path=None,
+             record_dir=None,
+             record_s: float = DEFAULT_RECORD_S, limits: list[Limit] = (), hold_s: float = 0.0,
+             exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
+             tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
+             columns: Mapping[str, str] | None = None, axis: str | None = None, connect_timeout: float = 10.0,
+             say: Callable[[str], None] = print, stdin: TextIO | None = None,
+             stdout: TextIO | None = None) -> LiveOutcome:
+    """Estimate the process current (and force) of a live stream with a model trained on air cuts.
+
+    Parameters
+    ----------
+    model_path : path-like
+        Model file written by ``greybox train``, or a machine model (a directory written by ``greybox train
+        --axes``): then one session per axis (:mod:`greybox.live.machine`).
+    source : str
+        ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt://HOST[:PORT]/TOPIC``.
+    sink : str, default "-"
+        ``-`` (JSON lines on ``stdout``) or ``mqtt://HOST[:PORT]/TOPIC``.
+    axis_config_path : path-like, optional
+        Axis file (TOML): the process force (torque) and the channel names.
+    machine_path : path-like, optional
+        With a machine model: the machine file (TOML) with each axis's channels and mechanics.
+    record_dir : path-like, optional
+        Folder of the rolling Parquet recording (a sub-folder per axis of a machine).
+    record_s : float, default 60.0
+        Log seconds per recording file.
+    limits : list of Limit
+        Limits on output columns.
+    hold_s : float, default 0.0
+        Hold time [s] of the limits.
+    exit_on_alarm : bool, default False
+        End the stream at the first alarm (status :data:`ALARM_STATUS`).
+    stats_path : path-like, optional
+        JSON file of the counters, rewritten every 10 s and at the end.
+    sample_time : float, optional
+        Nominal step [s]; default the median step of the first samples.
+    tolerance : float, default 0.25
+        Time-step tolerance, a fraction of the nominal step.
+    cutoff_hz : float, optional
+        Derivative-filter cut-off [Hz].
+    chunk_s : float, default 60.0
+        Chunk length [s] of the model.
+    columns : mapping of str to str, optional
+        ``{canonical_name: column}`` for message columns not named by the convention (over the axis
+        file's channels).
+    axis : str, optional
+        Axis to take from messages holding several.
+    connect_timeout : float, default 10.0
+        Seconds to wait for the broker at the start.
+    say : callable, default print
+        ``say(line)`` for each line of text.
+    stdin, stdout : text file, optional
+        The streams of ``-`` (default ``sys.stdin``, ``sys.stdout``).
+
+    Returns
+    -------
+    LiveOutcome
+
+    Raises
+    ------
+    GreyboxError
+        For a model or axis file that cannot be read, a source or sink that cannot be opened, a limit on a
+        column the output lacks, or messages that do not fit the model (units, kind of axis).
+    KeyboardInterrupt
+        On SIGTERM or Ctrl-C, after the recording, the sink and the stats are closed.
+    """
+    from ..machine_model import is_machine_model
+
+    options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s)
+    if is_machine_model(model_path):
+        build = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
+                                 limits=limits, hold_s=hold_s, columns=columns, source=source, say=say)
+    else:
+        if machine_path:
+            raise GreyboxError("--machine applies to a machine model (a directory written by 'greybox train "
+                               "--axes'); give one axis's mechanics with --axis-config")
+        build = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
+                              limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=say)
+    stream = _source(source, stdin or sys.stdin, connect_timeout)
+    out = None
+    try:
+        out = _sink(sink, stdout or sys.stdout, connect_timeout)
+        session, kind, recorders = build(out)
+    except BaseException:
+        stream.close()
+        if out is not None:
+            out.close()
+        raise
+    say(f"greybox live: {kind} model {model_path}, reading "
+        f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
+    status, stopped = 0, True
+    last_stats = time.monotonic()
+    deferred = _Deferred()
+    try:
+        with deferred:
+            for item in stream:
+                with deferred.held():
+                    session.handle(item)
+                if session.alarmed and exit_on_alarm:
+                    status = ALARM_STATUS
+                    break
+                if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
+                    session.write_stats(stats_path)
+                    last_stats = time.monotonic()
+            else:
+                with deferred.held():
+                    session.finish()
+            stopped = status != 0
+    finally:
+        try:
+            session.close(stopped=stopped)
+            stream.close()
+        finally:
+            if stats_path is not None:
+                session.write_stats(stats_path)
+            for line in session.stats_line().splitlines():
+                say(line)
+    return LiveOutcome(session.stats, status, [path for recorder in recorders for path in recorder.written])

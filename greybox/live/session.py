@@ -1,0 +1,251 @@
+"""One live stream, message by message: read, estimate, publish, watch the limits, record, count.
+
+:class:`LiveSession` takes the items of a source (:mod:`greybox.live.sources`) one at a time. A message
+that cannot be used is counted and named in one line, and the stream goes on; the samples of a usable
+one go to the :class:`~greybox.live.estimator.LiveEstimator`, and the estimates they complete go out as
+one message to the sink, to the recorder and past the limits. Every event (samples dropped or lost, a
+gap, the broker away and back, an alarm) is said in one line.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Mapping
+
+import numpy as np
+
+from ..data.log import AxisLog
+from .estimator import LiveEstimator, Lost, RunStart, StepOutput
+from .limits import LimitWatch
+from .messages import Decoder, MessageError, estimate_message, message_log
+from .recording import Recorder
+from .sources import ConnectionChange, Received
+from .stats import LiveStats
+from .timeline import Dropped, Gap
+
+__all__ = ["LiveSession"]
+
+
+def _signature(log: AxisLog) -> tuple:
+    """What every message of a stream must agree on: the channels present, the units."""
+    return (log.velocity is not None, log.acceleration is not None, log.effort_unit, log.motion)
+
+
+def _describe(signature: tuple) -> str:
+    velocity, acceleration, unit, motion = signature
+    given = ["velocity"] * velocity + ["acceleration"] * acceleration
+    return f"{motion} axis, effort in {unit}, {' and '.join(given) if given else 'no velocity or acceleration'}"
+
+
+class LiveSession:
+    """The handling of one stream's messages.
+
+    Parameters
+    ----------
+    estimator : LiveEstimator
+        Carries the model's state.
+    sink : LineSink or MqttSink
+        Where the estimates and alarms go.
+    say : callable
+        ``say(line)`` for each line of text (notes, alarms, the stats).
+    limits : LimitWatch, optional
+        Limits on the estimates.
+    recorder : Recorder, optional
+        Rolling Parquet files of the estimates.
+    mapping : mapping of str to str, optional
+        ``{canonical_name: column}`` for message columns not named by the convention.
+    axis : str, optional
+        Axis to take from messages holding several.
+    subtopic : str, optional
+        The axis of a machine's session: its output messages carry ``"axis"`` and go to ``<TOPIC>/<axis>``.
+
+    Attributes
+    ----------
+    stats : LiveStats
+        The counters.
+    alarmed : bool
+        Whether an alarm was raised.
+    """
+
+    def __init__(self, estimator: LiveEstimator, sink, *, say: Callable[[str], None],
+                 limits: LimitWatch | None = None, recorder: Recorder | None = None,
+                 mapping: Mapping[str, str] | None = None, axis: str | None = None, subtopic: str | None = None):
+        self.estimator = estimator
+        self.sink = sink
+        self.say = say
+        self.limits = limits
+        self.recorder = recorder
+        self.mapping = dict(mapping) if mapping else None
+        self.axis = axis
+        self.subtopic = subtopic
+        self.stats = LiveStats()
+        self.alarmed = False
+        self._decoder = Decoder()
+        self._signature: tuple | None = None
+        self._offline_since: float | None = None
+        self._run = 0  # run of the last estimates
+        self._open = True
+
+    def handle(self, item: Received | ConnectionChange) -> None:
+        """Take one item of the source.
+
+        Parameters
+        ----------
+        item : Received or ConnectionChange
+            A message, or a change of the broker connection.
+        """
+        if isinstance(item, ConnectionChange):
+            self.connection(item)
+            return
+        self.stats.messages += 1
+        try:
+            decoded = self._decoder.decode(item.payload)
+        except MessageError as exc:
+            self.stats.rejected += 1
+            self.say(f"{item.name}: skipped: {exc}")
+            return
+        if decoded is not None:
+            self.take(*decoded, name=item.name)
+
+    def take(self, columns: Mapping[str, np.ndarray], seq=None, *, name: str, select: bool = True) -> None:
+        """Take the columns of one decoded message.
+
+        Parameters
+        ----------
+        columns : mapping of str to ndarray
+            The message's columns (:meth:`greybox.live.messages.Decoder.decode`).
+        seq : object, optional
+            The message's sequence tag.
+        name : str
+            How the message is named in lines.
+        select : bool, default True
+            Take the session's ``axis`` from columns named ``<axis>_<quantity>_<unit>``; False for a
+            message of this axis alone (its own topic).
+        """
+        try:
+            log = message_log(columns, name=name, mapping=self.mapping, axis=self.axis if select else None)
+            signature = _signature(log)
+            if self._signature is None:
+                self._signature = signature
+            elif signature != self._signature:
+                raise MessageError(f"the message carries {_describe(signature)}; the stream started with "
+                                   f"{_describe(self._signature)}")
+        except MessageError as exc:
+            self.stats.rejected += 1
+            self.say(f"{name}: skipped: {exc}")
+            return
+        self.stats.samples_received += len(log)
+        self._publish(self.estimator.step(log), seq)
+
+    def stats_line(self) -> str:
+        """The counters in one line."""
+        return self.stats.line()
+
+    def current_stats(self) -> LiveStats:
+        """The counters, with the samples waiting now."""
+        if self._open:
+            self.stats.waiting = self.estimator.waiting
+        return self.stats
+
+    def write_stats(self, path) -> None:
+        """Write the counters (as they are now) to a JSON file, atomically.
+
+        Parameters
+        ----------
+        path : path-like
+            The stats file.
+        """
+        self.current_stats().write(path)
+
+    def finish(self) -> None:
+        """The end of the stream: the samples still waiting are estimated as the end of a log."""
+        self._publish(self.estimator.finish(), None)
+
+    def close(self, *, stopped: bool = False) -> None:
+        """Write the recording's last file and close the sink.
+
+        Parameters
+        ----------
+        stopped : bool, default False
+            The command was stopped (SIGTERM, Ctrl-C): the samples waiting for their look-ahead are
+            counted as lost.
+        """
+        self._open = False
+        stats = self.stats
+        if stopped:
+            unaccounted = stats.samples_received - stats.samples_estimated - stats.skipped
+            if unaccounted:
+                stats.lose("stopped before their look-ahead arrived", unaccounted)
+        stats.waiting = 0 if stopped else self.estimator.waiting
+        try:
+            if self.recorder is not None:
+                self.recorder.close()
+        finally:
+            self.sink.close()
+            self.stats.outputs_lost = self.sink.lost
+
+    def connection(self, change: ConnectionChange, *, quiet: bool = False) -> None:
+        """Count a loss or return of the broker connection, and say it.
+
+        Parameters
+        ----------
+        change : ConnectionChange
+            The change.
+        quiet : bool, default False
+            Count without saying (another session says it).
+        """
+        say = (lambda line: None) if quiet else self.say
+        if not change.connected:
+            self.stats.disconnections += 1
+            self._offline_since = change.time_s
+            say("broker connection lost; reconnecting")
+        else:
+            away = change.time_s - self._offline_since if self._offline_since is not None else 0.0
+            self.stats.offline_s += away
+            self._offline_since = None
+            say(f"broker connection back after {away:.1f} s; messages of that time are missing "
+                "(a gap in the time stamps re-initialises the model's state)")
+
+    def _publish(self, out: StepOutput, seq) -> None:
+        for event in out.events:
+            self._event(event)
+        if not out.results:
+            return
+        parts = [result.columns() for result in out.results]
+        columns = parts[0] if len(parts) == 1 else {name: np.concatenate([part[name] for part in parts])
+                                                    for name in parts[0]}
+        self.stats.samples_estimated += out.n_samples
+        self.sink.estimate(estimate_message(columns, seq, axis=self.subtopic), subtopic=self.subtopic)
+        for run, result, part in zip(out.runs, out.results, parts):
+            if run != self._run:  # the estimates of a new run: a new file, the limits re-armed
+                self._run = run
+                if self.recorder is not None and run:
+                    self.recorder.new_run()
+                if self.limits is not None:
+                    self.limits.rearm()
+            if self.recorder is not None:
+                self.recorder.add(result)
+            if self.limits is not None:
+                for alarm in self.limits.check(part):
+                    self.alarmed = True
+                    self.stats.alarms += 1
+                    self.sink.alarm(alarm.message(), subtopic=self.subtopic)
+                    self.say(alarm.line())
+
+    def _event(self, event) -> None:
+        if isinstance(event, Dropped):
+            self.stats.drop(event.reason, event.count)
+            what = "not after" if event.reason == "backwards" else "too soon after"
+            self.say(f"{event.count} sample(s) dropped: t = {event.time_s:.9g} s {what} t = {event.after_s:.9g} s")
+        elif isinstance(event, Gap):
+            self.stats.gaps += 1
+            self.say(f"gap of {1e3 * event.step_s:.6g} ms before t = {event.time_s:.9g} s (about {event.missing} "
+                     "samples missing): a new run starts, the model's state re-initialised")
+        elif isinstance(event, Lost):
+            self.stats.lose(event.reason, event.count)
+            self.say(f"{event.count} sample(s) lost: {event.reason}")
+        elif isinstance(event, RunStart):
+            if event.index == 0:
+                delay = (f"; each estimate follows its sample by {event.lookahead} samples "
+                         f"({event.lookahead * event.sample_time:.3g} s), the look-ahead of the derivatives"
+                         if event.lookahead else "")
+                self.say(f"stream starts at t = {event.time_s:.9g} s, step {1e3 * event.sample_time:.6g} ms{delay}")

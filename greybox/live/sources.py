@@ -1,0 +1,130 @@
+"""Where the messages of a live stream come from: lines of a text stream (stdin) or an MQTT topic.
+
+A source is an iterable of :class:`Received` messages and :class:`ConnectionChange` events, in the order
+they happened; it ends when the stream does (end of the text stream; an MQTT source runs until the
+command is stopped).
+"""
+
+from __future__ import annotations
+
+import queue
+import time
+from dataclasses import dataclass
+from typing import Iterator, TextIO
+
+from .broker import BrokerAddress, Connection
+
+__all__ = ["Received", "ConnectionChange", "LineSource", "MqttSource"]
+
+
+@dataclass(frozen=True)
+class Received:
+    """One message as it arrived.
+
+    Attributes
+    ----------
+    payload : str or bytes
+        The message text.
+    name : str
+        How errors name it, e.g. "line 12" or "message 12 on axis/X".
+    arrived_s : float
+        Arrival time, ``time.time()`` [s].
+    topic : str
+        The MQTT topic ("" for a line of a text stream).
+    """
+
+    payload: str | bytes
+    name: str
+    arrived_s: float
+    topic: str = ""
+
+
+@dataclass(frozen=True)
+class ConnectionChange:
+    """The connection to the broker was lost (``connected`` False) or is back.
+
+    Attributes
+    ----------
+    connected : bool
+        The new state.
+    time_s : float
+        When, ``time.time()`` [s].
+    """
+
+    connected: bool
+    time_s: float
+
+
+class LineSource:
+    """Messages as lines of a text stream: JSON lines, or CSV lines after a header line.
+
+    Parameters
+    ----------
+    stream : text file
+        E.g. ``sys.stdin``.
+    name : str, default "stdin"
+        The stream's name in messages.
+    """
+
+    def __init__(self, stream: TextIO, *, name: str = "stdin"):
+        self.stream = stream
+        self.name = name
+
+    def __iter__(self) -> Iterator[Received]:
+        for number, line in enumerate(self.stream, start=1):
+            if line.strip():
+                yield Received(line, f"{self.name} line {number}", time.time())
+
+    def close(self) -> None:
+        """Nothing to release (the stream is the caller's)."""
+
+
+class MqttSource:
+    """Messages of an MQTT topic, taken in arrival order; connection losses and returns in between.
+
+    Parameters
+    ----------
+    address : BrokerAddress
+        Broker and topic (wildcards allowed).
+    connect_timeout : float, default 10.0
+        Seconds to wait for the broker at the start.
+    poll_s : float, default 0.2
+        How long the iteration waits for a message before checking again (the command stays responsive
+        to signals).
+
+    Raises
+    ------
+    GreyboxError
+        When the broker cannot be reached at the start.
+    """
+
+    def __init__(self, address: BrokerAddress, *, connect_timeout: float = 10.0, poll_s: float = 0.2):
+        self.address = address
+        self.poll_s = float(poll_s)
+        self._queue: queue.Queue = queue.Queue()
+        self._count = 0
+        self.connection = Connection(address, subscribe=address.topic, connect_timeout=connect_timeout,
+                                     on_message=self._message, on_state=self._state)
+
+    def _message(self, topic: str, payload: bytes, arrived_s: float) -> None:
+        self._queue.put((topic, payload, arrived_s))
+
+    def _state(self, connected: bool, time_s: float) -> None:
+        self._queue.put(ConnectionChange(connected, time_s))
+
+    def __iter__(self) -> Iterator[Received | ConnectionChange]:
+        while True:
+            try:
+                item = self._queue.get(timeout=self.poll_s)
+            except queue.Empty:
+                continue
+            if isinstance(item, ConnectionChange):
+                yield item
+                continue
+            topic, payload, arrived_s = item
+            self._count += 1
+            yield Received(payload, f"message {self._count} on {topic}", arrived_s, topic)
+
+    def close(self) -> None:
+        """Disconnect from the broker."""
+        self.connection.close()

@@ -1,0 +1,172 @@
+"""The time base of a live stream: the nominal step, and samples late, early, backwards or after a gap.
+
+Offline, a log must be uniform within a tolerance of its median step (:func:`greybox.data.validate.check_time`)
+and the models integrate at that step. Live, the nominal step is given (``--sample-time``) or taken as the
+median step of the first :data:`SETTLE_SAMPLES` samples; from then on every sample is compared with the
+last one kept:
+
+* a step within the tolerance of the nominal step: kept (jitter the readers accept too);
+* time standing still or going backwards: the sample is dropped and counted;
+* a step shorter than the tolerance allows: the sample is dropped and counted;
+* a step longer than the tolerance allows: a gap; the run ends there and a new one starts with the
+  sample (the model's state re-initialised, as the readers split a log at gaps).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..data.blocks import concatenate
+from ..data.log import AxisLog
+
+__all__ = ["SETTLE_SAMPLES", "Dropped", "Gap", "Timeline"]
+
+#: Samples whose median step is the nominal step when none is given.
+SETTLE_SAMPLES = 16
+
+
+@dataclass(frozen=True)
+class Dropped:
+    """Samples of a message dropped for their time stamps.
+
+    Attributes
+    ----------
+    count : int
+        Samples dropped.
+    time_s : float
+        Time stamp of the first one [s].
+    after_s : float
+        Time of the last sample kept before it [s].
+    reason : str
+        "backwards" (time standing still or going back) or "early" (a step shorter than the tolerance).
+    """
+
+    count: int
+    time_s: float
+    after_s: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class Gap:
+    """A step longer than the tolerance: the run ends before ``time_s``.
+
+    Attributes
+    ----------
+    time_s : float
+        Time of the first sample after the gap [s].
+    step_s : float
+        The step [s].
+    missing : int
+        Samples missing at the nominal step, about ``step_s / nominal - 1``.
+    """
+
+    time_s: float
+    step_s: float
+    missing: int
+
+
+class Timeline:
+    """Checks the time stamps of a stream sample by sample against a nominal step.
+
+    Parameters
+    ----------
+    sample_time : float, optional
+        Nominal step [s]; default the median step of the first :data:`SETTLE_SAMPLES` samples.
+    tolerance : float, default 0.25
+        Allowed deviation of a step from the nominal step, as a fraction of it (as in ``greybox predict``).
+
+    Attributes
+    ----------
+    nominal : float or None
+        The nominal step [s] once known.
+    """
+
+    def __init__(self, *, sample_time: float | None = None, tolerance: float = 0.25):
+        if not 0.0 < tolerance < 1.0:
+            raise ValueError(f"tolerance must lie in (0, 1), got {tolerance!r}")
+        self.nominal = None if sample_time is None else float(sample_time)
+        self.tolerance = float(tolerance)
+        self._held: list[AxisLog] = []  # samples before the nominal step is known
+        self._last: float | None = None
+
+    def push(self, log: AxisLog) -> list:
+        """The events of a message's samples, in order: kept samples (AxisLog), :class:`Dropped`, :class:`Gap`.
+
+        Parameters
+        ----------
+        log : AxisLog
+            The samples of one message.
+
+        Returns
+        -------
+        list
+            Until the nominal step is known, nothing (the samples are held); then the events of every
+            sample held or given.
+        """
+        if self.nominal is None:
+            self._held.append(log)
+            held = concatenate(self._held)
+            steps = np.diff(held.time)
+            steps = steps[steps > 0.0]
+            if steps.size < SETTLE_SAMPLES - 1:
+                return []
+            self.nominal = float(np.median(steps))
+            self._held = []
+            log = held
+        return self._events(log)
+
+    def flush(self) -> list:
+        """The events of samples still held at the end of the stream (fewer than :data:`SETTLE_SAMPLES`).
+
+        Their nominal step is their own median step; with fewer than two samples nothing is kept.
+        """
+        if self.nominal is not None or not self._held:
+            return []
+        held = concatenate(self._held)
+        self._held = []
+        steps = np.diff(held.time)
+        steps = steps[steps > 0.0]
+        if not steps.size:
+            return [Dropped(len(held), float(held.time[0]), float("nan"), "backwards")] if len(held) > 1 else \
+                [Dropped(1, float(held.time[0]), float("nan"), "alone")]
+        self.nominal = float(np.median(steps))
+        return self._events(held)
+
+    def _events(self, log: AxisLog) -> list:
+        low, high = (1.0 - self.tolerance) * self.nominal, (1.0 + self.tolerance) * self.nominal
+        events: list = []
+        keep = np.zeros(len(log), dtype=bool)
+        start = 0  # first sample of the current kept stretch
+        last = self._last
+
+        def close(stop: int) -> None:
+            if keep[start:stop].any():
+                events.append(log.select(np.flatnonzero(keep[start:stop]) + start))
+
+        for k, t in enumerate(log.time.tolist()):
+            if last is None:
+                keep[k], last = True, t
+                continue
+            step = t - last
+            if step <= 0.0 or step < low:
+                reason = "backwards" if step <= 0.0 else "early"
+                previous = events[-1] if events and isinstance(events[-1], Dropped) and k > 0 and not keep[k - 1] \
+                    else None
+                close(k)
+                start = k + 1
+                if previous is not None and previous.reason == reason:
+                    events[-1] = Dropped(previous.count + 1, previous.time_s, previous.after_s, reason)
+                else:
+                    events.append(Dropped(1, t, last, reason))
+                continue
+            if step > high:
+                close(k)
+                start = k
+                events.append(Gap(t, step, max(0, int(round(step / self.nominal)) - 1)))
+            keep[k], last = True, t
+        close(len(log))
+        self._last = last
+        return events

@@ -1,0 +1,57 @@
+"""The time base of a stream: the nominal step from the first samples, drops, gaps."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from greybox.data.log import AxisLog
+from greybox.live.timeline import SETTLE_SAMPLES, Dropped, Gap, Timeline
+
+
+def samples(times) -> AxisLog:
+    times = np.asarray(times, dtype=float)
+    return AxisLog(time=times, position=np.zeros(times.size), effort=np.zeros(times.size))
+
+
+def kept(events) -> np.ndarray:
+    return np.concatenate([event.time for event in events if isinstance(event, AxisLog)])
+
+
+def test_the_nominal_step_is_the_median_of_the_first_samples():
+    timeline = Timeline()
+    times = 0.002 * np.arange(SETTLE_SAMPLES)
+    assert timeline.push(samples(times[:5])) == []  # held until enough steps are in
+    events = timeline.push(samples(times[5:]))
+    assert abs(timeline.nominal - 0.002) < 1e-12
+    np.testing.assert_array_equal(kept(events), times)
+
+
+def test_backwards_early_and_gap():
+    timeline = Timeline(sample_time=0.002, tolerance=0.25)
+    events = timeline.push(samples([0.0, 0.002, 0.004, 0.003, 0.004, 0.0045, 0.006, 0.020, 0.022]))
+    kinds = [type(event).__name__ for event in events]
+    assert kinds == ["AxisLog", "Dropped", "Dropped", "AxisLog", "Gap", "AxisLog"]
+    assert events[1] == Dropped(2, 0.003, 0.004, "backwards")  # 3 ms and 4 ms again: both not after 4 ms
+    assert events[2].reason == "early" and events[2].count == 1
+    assert isinstance(events[4], Gap) and abs(events[4].step_s - 0.014) < 1e-12 and events[4].missing == 6
+    np.testing.assert_array_equal(kept(events), [0.0, 0.002, 0.004, 0.006, 0.020, 0.022])
+
+
+def test_jitter_within_the_tolerance_is_kept():
+    timeline = Timeline(sample_time=0.002, tolerance=0.25)
+    times = [0.0, 0.0021, 0.0039, 0.0062, 0.008]
+    np.testing.assert_array_equal(kept(timeline.push(samples(times))), times)
+
+
+def test_the_state_is_carried_across_messages():
+    timeline = Timeline(sample_time=0.002)
+    timeline.push(samples([0.0, 0.002]))
+    events = timeline.push(samples([0.002, 0.004]))
+    assert isinstance(events[0], Dropped) and events[0].after_s == 0.002
+
+
+def test_a_short_stream_is_flushed_at_its_own_step():
+    timeline = Timeline()
+    assert timeline.push(samples([0.0, 0.01, 0.02])) == []
+    events = timeline.flush()
+    assert timeline.nominal == 0.01 and len(kept(events)) == 3
