@@ -48,7 +48,8 @@ DEFAULT_CANDIDATES = (
     "lugre:asymmetric",
     "gms:offset",
     "gms:asymmetric",
-    "gmssvr",
+    "gmssvr:offset",
+    "gmssvr:asymmetric",
 )
 
 #: Candidates tried only when the runs show a gap: when a static model behind an identified backlash
