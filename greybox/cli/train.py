@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -245,7 +246,7 @@ def _run_auto(args: argparse.Namespace) -> int:
         runs += pieces
         groups += [str(path)] * len(pieces)
     started = time.perf_counter()
-    report = None if args.quiet else (lambda line: print(f"  {line}", flush=True))
+    report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
     model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.inertia,
                          workers=args.workers or os.cpu_count() or 1, progress=report)
     names = [Path(group).name for group in groups]
