@@ -23,6 +23,7 @@ from .base import EFFORT, LENGTH, ModelProtocol, Parameter
 from .data.log import AxisLog, as_log_list
 from .data.quantities import MOTIONS, Motion
 from .errors import LogError, ParameterError
+from .identify.intervals import check_intervals, with_intervals
 from .identify.progress import make_progress
 from .metrics import rmse
 
@@ -289,7 +290,8 @@ class CurrentModel(ModelProtocol):
         -------
         list of Parameter
             Units carry the effort unit the model was fitted on (A, N or Nm) and the
-            length unit of its motion (mm, or deg for a rotary axis).
+            length unit of its motion (mm, or deg for a rotary axis); rows carry their
+            95 % intervals when the model holds them (:mod:`greybox.identify.intervals`).
         """
         check_is_fitted(self)
         rows = self._own_parameters() + [
@@ -297,8 +299,8 @@ class CurrentModel(ModelProtocol):
             Parameter("offset", self.offset_, EFFORT, "constant effort"),
         ]
         unit, length = self.effort_unit_, self.units_.length
-        return [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit).replace(LENGTH, length), p.description)
-                for p in rows]
+        return with_intervals(self, [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit).replace(LENGTH, length),
+                                               p.description) for p in rows])
 
     @property
     def units_(self) -> Motion:
@@ -336,6 +338,7 @@ class CurrentModel(ModelProtocol):
                 if values.size and np.max(np.abs(values)) > MAX_PARAMETER_MAGNITUDE:
                     raise ParameterError(f"parameter {row.name} = {np.max(np.abs(values)):.3g} in magnitude, beyond "
                                          f"{MAX_PARAMETER_MAGNITUDE:g}: not a model of a feed axis")
+            check_intervals(self)
             step = float(self.sample_time_)
             if not (np.isfinite(step) and step > 0.0):
                 raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")
@@ -380,6 +383,7 @@ class CurrentModel(ModelProtocol):
         return run, self.initial_state() if state is None else state, step
 
     def _set_fit_info(self, runs: list[AxisLog]) -> None:
+        vars(self).pop("parameter_intervals_", None)  # intervals of an earlier fit are not this fit's
         self.effort_unit_ = runs[0].effort_unit
         self.motion_ = runs[0].motion
         self.sample_time_ = float(np.median([run.sample_time for run in runs]))

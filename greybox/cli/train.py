@@ -11,6 +11,8 @@ import numpy as np
 
 from ..atomic import check_output_path
 from ..errors import GreyboxError, ModelFileError
+from ..identify.intervals import METHODS as INTERVAL_METHODS
+from ..identify.intervals import attach_intervals
 from ..metrics import metrics_table
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
@@ -57,6 +59,13 @@ def add_parser(subparsers) -> None:
                         "model again, also those complete from an earlier run")
     add_model_arguments(parser, backlash=True)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
+    parser.add_argument("--intervals", choices=INTERVAL_METHODS, default="sandwich",
+                        help="95 %% intervals of the identified parameters, stored in the model file and printed "
+                        "with them: 'sandwich' (default) a cluster-robust linearisation over runs or time blocks, "
+                        "'bootstrap' a wild cluster bootstrap refitting the model --bootstrap times (slow), 'none' "
+                        "(see docs/intervals.md)")
+    parser.add_argument("--bootstrap", type=POSITIVE_INT, default=100, metavar="N",
+                        help="replicates of --intervals bootstrap (default 100)")
     fleet = parser.add_argument_group("fleets (one model per machine)")
     fleet.add_argument("--per-machine", action="store_true",
                        help="train one model per machine and axis, each on all that machine's logs (the machine of "
@@ -105,6 +114,12 @@ def _fit(model, args: argparse.Namespace, names, runs, second):
         model.fit(runs, progress=progress)
     else:
         model.fit_staged(runs, second, progress=progress)
+    if args.intervals != "none":
+        started = time.perf_counter()
+        attach_intervals(model, runs, method=args.intervals, n_bootstrap=args.bootstrap)
+        record = model.parameter_intervals_
+        print(f"95 % intervals by {args.intervals} over {record['n_clusters']} {record['clusters']} "
+              f"in {time.perf_counter() - started:.1f} s")
     return names, runs + second
 
 

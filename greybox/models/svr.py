@@ -530,6 +530,13 @@ class KernelRegressionModel(CurrentModel):
             Parameter("intercept", self.intercept_, EFFORT, "SVR intercept"),
         ]
 
+    def interval_notes(self) -> dict[str, str]:
+        """The kernel stage's rows: settings chosen by cross-validation and the expansion, not identified parameters."""
+        chosen = "hyperparameter chosen by cross-validation, not identified"
+        notes = dict.fromkeys(["C", "epsilon", "gamma", *self._weighted], chosen)
+        notes.update(n_support="a count of the kernel expansion", intercept="part of the kernel expansion")
+        return notes
+
     def _weight(self, name: str) -> float:
         """The fitted kernel weight of the setting ``name`` of ``_weighted`` (1 in a file that predates weights)."""
         weights = getattr(self, "input_weights_", None)
@@ -687,6 +694,11 @@ class SVRCurrentModel(KernelRegressionModel):
 
     def _own_parameters(self) -> list[Parameter]:
         return self._kernel_parameters()
+
+    def interval_notes(self) -> dict[str, str]:
+        """As the kernel stage's, and ``J``, ``offset`` fixed by a proxy fit before the kernel expansion."""
+        fixed = "fixed by a proxy fit before the kernel expansion"
+        return {**super().interval_notes(), "J": fixed, "offset": fixed}
 
 
 #: Every name a search interval can be given for (``bounds=``) in the kernel models: the SVR
