@@ -69,7 +69,9 @@ Flags (one phrase per parameter, ``""`` when none)
     linearisation, clipped to the bound.
 ``poorly determined``
     The 95 % interval reaches zero for a positive quantity or spans more
-    than a factor :data:`WIDE_FACTOR`: the data say little about it.
+    than a factor :data:`WIDE_FACTOR`: the data say little about it. Beyond
+    a factor :data:`UNBOUNDED_FACTOR` no interval is given
+    (``poorly determined: no bounded interval``).
 ``no interval: ...``
     Chosen rather than identified, or not varied by the method (the phrase
     says which).
@@ -95,6 +97,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import t as student_t
 
+from ..errors import GreyboxError, ParameterError
 from .cv import time_blocks
 
 __all__ = [
@@ -120,6 +123,8 @@ N_BLOCKS = 40
 NULL_TOLERANCE = 1e-10
 #: A positive parameter whose 95 % interval spans more than this factor is poorly determined.
 WIDE_FACTOR = 10.0
+#: A log-scale interval wider than this factor either way is not given.
+UNBOUNDED_FACTOR = 1e6
 #: Relative step of the central differences in the log-scale coordinates.
 LOG_STEP = 1e-3
 #: Name of the learned attribute that holds the intervals.
@@ -128,6 +133,7 @@ ATTRIBUTE = "parameter_intervals_"
 _NOT_IDENTIFIABLE = "not identifiable"
 _AT_BOUND = "at bound"
 _POOR = "poorly determined"
+_UNBOUNDED = "poorly determined: no bounded interval"
 _NOT_VARIED = "no interval: held fixed in the fit, or not varied by the linearised method"
 
 
@@ -373,15 +379,15 @@ def parameter_intervals(model, logs, *, method: str = "sandwich", n_bootstrap: i
 
     Raises
     ------
-    ValueError
-        On an unknown method or a non-positive number of replicates.
+    ParameterError
+        On an unknown method, fewer than 2 replicates, or more than half of the bootstrap refits failing.
     """
     from ..data.log import as_log_list
 
     if method not in METHODS[:2]:
-        raise ValueError(f"unknown interval method {method!r}; expected one of {METHODS[:2]}")
+        raise ParameterError(f"unknown interval method {method!r}; expected one of {METHODS[:2]}")
     if not (isinstance(n_bootstrap, (int, np.integer)) and n_bootstrap >= 2):
-        raise ValueError(f"n_bootstrap must be an integer >= 2, got {n_bootstrap!r}")
+        raise ParameterError(f"n_bootstrap must be an integer >= 2, got {n_bootstrap!r}")
     outer_rows = model.parameter_table()
     outer_notes = dict(model.interval_notes())
     stage, runs, names = _stage(model, as_log_list(logs))
@@ -439,8 +445,15 @@ def parameter_intervals(model, logs, *, method: str = "sandwich", n_bootstrap: i
             se = float(np.sqrt(max(g @ covariance @ g, 0.0)))
             v = value[i]
             if np.all(is_log[uses]) and v > 0.0:
-                lower[i], upper[i] = v * np.exp(-quantile * se / v), v * np.exp(quantile * se / v)
+                spread = quantile * se / v  # half-width on the log scale
+                if not spread < np.log(UNBOUNDED_FACTOR):
+                    flags[i] = _UNBOUNDED
+                    continue
+                lower[i], upper[i] = v * np.exp(-spread), v * np.exp(spread)
                 poor = upper[i] / lower[i] > WIDE_FACTOR
+            elif not np.isfinite(se):
+                flags[i] = _UNBOUNDED
+                continue
             else:
                 lower[i], upper[i] = v - quantile * se, v + quantile * se
                 poor = False
@@ -490,13 +503,18 @@ def _bootstrap(stage, runs, fitted, residuals, labels, result_rows, names, stage
         signs = rng.choice((-1.0, 1.0), size=n_clusters)
         effort = fitted + signs[labels] * residuals
         replicate_runs = [run.replace(effort=effort[a:b]) for run, a, b in zip(runs, edges[:-1], edges[1:])]
-        refit = clone(stage).fit(replicate_runs)
+        try:
+            refit = clone(stage).fit(replicate_runs)
+        except GreyboxError:  # a replicate the model refuses (e.g. an unstable search) is left out
+            continue
         for row in refit.parameter_table():
             if row.name in draws:
                 draws[row.name].append(_numbers(row.value))
         if progress is not None:
             progress(replicate + 1, n_bootstrap)
     tail = 100.0 * (1.0 - LEVEL) / 2.0
+    if min((len(values) for values in draws.values()), default=n_bootstrap) < max(2, n_bootstrap // 2):
+        raise ParameterError("more than half of the bootstrap refits failed: no bootstrap intervals")
     for name, values in draws.items():
         lower, upper, flags = result_rows[names.get(name, name)]
         if len({np.size(v) for v in values}) != 1 or values[0] is None:
@@ -505,11 +523,12 @@ def _bootstrap(stage, runs, fitted, residuals, labels, result_rows, names, stage
         lower[:], upper[:] = np.percentile(sample, tail, axis=0), np.percentile(sample, 100.0 - tail, axis=0)
         value = _numbers(stage_rows[name].value)
         for i in range(value.size):
-            if flags[i] in ("", _POOR):
-                positive = value[i] > 0.0
-                wide = upper[i] > WIDE_FACTOR * lower[i] if lower[i] > 0.0 else positive and lower[i] <= 0.0
-                flags[i] = _POOR if wide and positive else ""
-            elif flags[i] == _NOT_VARIED:
+            if flags[i] in ("", _POOR, _UNBOUNDED):
+                if value[i] > 0.0 and lower[i] > 0.0:
+                    flags[i] = _POOR if upper[i] > WIDE_FACTOR * lower[i] else ""
+                else:  # whether reaching zero matters (a positive quantity) the sandwich analysis knew
+                    flags[i] = _POOR if flags[i] else ""
+            elif flags[i] == _NOT_VARIED and upper[i] > lower[i]:
                 flags[i] = ""
 
 
