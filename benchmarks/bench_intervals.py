@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/bench_intervals.py time [--log data/X_A.mcap] [--model gms]
     python benchmarks/bench_intervals.py coverage [--seeds 20] [--duration 20]
+    python benchmarks/bench_intervals.py compare [--replicates 30] [--duration 20] [--seed 0]
 
 ``time`` fits ``--model`` on the log as ``greybox train`` does (default settings) and then computes
 the sandwich intervals; it prints both wall times, their ratio and the parameter table with the
@@ -11,7 +12,8 @@ intervals. ``coverage`` simulates a 3-element GMS axis of known parameters (forw
 noise of time constant 0.1 s on the current), fits a GMS model to each seed's run and counts how often
 each scalar parameter's 95 % sandwich interval contains the truth, and how often a parameter is
 flagged. A fit that ends in another local minimum than the truth's counts as a miss: the figure is the
-coverage of the whole procedure, search included. Ratios and shares, not absolutes, carry over to
+coverage of the whole procedure, search included. ``compare`` puts the sandwich and the bootstrap
+intervals of one such fit side by side. Ratios and shares, not absolutes, carry over to
 other machines.
 """
 
@@ -100,6 +102,23 @@ def bench_coverage(n_seeds: int, duration: float) -> None:
               f"{hits[name] / max(n_seeds - missing[name], 1):.3f}; flagged {flagged[name]}/{n_seeds}")
 
 
+def bench_compare(n_replicates: int, duration: float, seed: int) -> None:
+    """Widths of the sandwich and of the bootstrap intervals of a GMS fit to one simulated run."""
+    run = truth_run(seed, duration)
+    model = GMSModel(n_elements=3, random_state=seed).fit(run)
+    sandwich = {row.name: row for row in attach_intervals(model, run).parameter_table()}
+    started = time.perf_counter()
+    bootstrap = {row.name: row for row in attach_intervals(model, run, method="bootstrap",
+                                                            n_bootstrap=n_replicates).parameter_table()}
+    print(f"GMS on one simulated {duration:g} s run (seed {seed}); bootstrap of {n_replicates} refits in "
+          f"{time.perf_counter() - started:.0f} s")
+    print(f"  {'parameter':<10} {'truth':>10} {'value':>10} {'sandwich':>24} {'bootstrap':>24}")
+    for name in ("slip_rate", "sigma", "viscous", "s_0", "s_inf", "v_s", "J"):
+        a, b = sandwich[name], bootstrap[name]
+        print(f"  {name:<10} {TRUTH[name]:>10.4g} {a.value:>10.4g} {a.lower:>11.4g} {a.upper:>11.4g}  "
+              f"{b.lower:>11.4g} {b.upper:>11.4g}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="what", required=True)
@@ -109,11 +128,17 @@ def main() -> None:
     coverage = sub.add_parser("coverage")
     coverage.add_argument("--seeds", type=int, default=20)
     coverage.add_argument("--duration", type=float, default=20.0)
+    compare = sub.add_parser("compare")
+    compare.add_argument("--replicates", type=int, default=30)
+    compare.add_argument("--duration", type=float, default=20.0)
+    compare.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     if args.what == "time":
         bench_time(args.log, args.model)
-    else:
+    elif args.what == "coverage":
         bench_coverage(args.seeds, args.duration)
+    else:
+        bench_compare(args.replicates, args.duration, args.seed)
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ from greybox.discover.augment import AugmentedModel
 from greybox.errors import ModelFileError
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.friction.backlash import BacklashModel
-from greybox.identify.intervals import attach_intervals, cluster_labels, parameter_intervals
+from greybox.identify.intervals import attach_intervals, cluster_covariance, cluster_labels, parameter_intervals
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
@@ -148,6 +148,34 @@ def test_bootstrap_agrees_with_the_sandwich_on_a_linear_model():
         ratio = (bootstrap[name]["upper"] - bootstrap[name]["lower"]) / (sandwich[name]["upper"]
                                                                         - sandwich[name]["lower"])
         assert 0.7 < ratio < 1.4, (name, ratio)
+
+
+def test_jackknife_covariance_is_that_of_refits_leaving_each_cluster_out():
+    # linear least squares: leaving cluster g out moves the estimate by exactly -(A - A_g)^-1 X_g' r_g
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(600, 3))
+    y = x @ np.array([1.0, -2.0, 0.5]) + rng.normal(size=600)
+    labels = np.repeat(np.arange(12), 50)
+    estimate = np.linalg.lstsq(x, y, rcond=None)[0]
+    moves = np.array([np.linalg.lstsq(x[labels != g], y[labels != g], rcond=None)[0] - estimate
+                      for g in range(12)])
+    covariance, null = cluster_covariance(x, y - x @ estimate, labels)
+    np.testing.assert_allclose(covariance, 11 / 12 * moves.T @ moves, rtol=1e-9)
+    assert null.shape == (3, 0)
+    plain, _ = cluster_covariance(x, y - x @ estimate, labels, jackknife=False)
+    inverse = np.linalg.inv(x.T @ x)
+    scores = np.array([x[labels == g].T @ (y - x @ estimate)[labels == g] for g in range(12)])
+    np.testing.assert_allclose(plain, 12 / 11 * inverse @ scores.T @ scores @ inverse, rtol=1e-9)
+
+
+def test_a_direction_the_data_do_not_determine_is_the_null_space():
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(400, 2))
+    x = np.column_stack((x, x[:, 0] + x[:, 1]))  # the third column repeats the sum of the first two
+    covariance, null = cluster_covariance(x, rng.normal(size=400), np.repeat(np.arange(10), 40))
+    assert null.shape == (3, 1)
+    np.testing.assert_allclose(np.abs(null[:, 0]), np.array([1.0, 1.0, 1.0]) / np.sqrt(3.0), rtol=1e-9)
+    np.testing.assert_allclose(covariance @ null, 0.0, atol=1e-12)
 
 
 def test_clusters_are_whole_runs_when_there_are_many_else_time_blocks():
@@ -296,3 +324,17 @@ def test_train_without_intervals(tmp_path, capsys, commands):
                      "--intervals", "none"]) == 0
     assert "95 %" not in capsys.readouterr().out
     assert load_model(out).parameter_table()[0].lower is None
+
+
+def test_train_by_bootstrap_and_a_bootstrap_count_without_it(tmp_path, capsys, commands):
+    log = tmp_path / "run.csv"
+    write_log(_coulomb_run(0, 2_000), log)
+    out = tmp_path / "model.gbm"
+    assert cli.main(["train", "--model", "coulomb", "--train", str(log), "--out", str(out), "--quiet",
+                     "--intervals", "bootstrap", "--bootstrap", "20"]) == 0
+    assert "95 % intervals by bootstrap" in capsys.readouterr().out
+    assert load_model(out).parameter_intervals_["method"] == "bootstrap"
+    assert cli.main(["train", "--model", "coulomb", "--train", str(log), "--out", str(tmp_path / "other.gbm"),
+                     "--bootstrap", "20"]) == 2
+    error = capsys.readouterr().err
+    assert "--bootstrap N applies with --intervals bootstrap" in error and error.count("\n") == 1

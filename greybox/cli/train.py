@@ -64,7 +64,7 @@ def add_parser(subparsers) -> None:
                         "with them: 'sandwich' (default) a cluster-robust linearisation over runs or time blocks, "
                         "'bootstrap' a wild cluster bootstrap refitting the model --bootstrap times (slow), 'none' "
                         "(see docs/intervals.md)")
-    parser.add_argument("--bootstrap", type=POSITIVE_INT, default=100, metavar="N",
+    parser.add_argument("--bootstrap", type=POSITIVE_INT, metavar="N",
                         help="replicates of --intervals bootstrap (default 100)")
     fleet = parser.add_argument_group("fleets (one model per machine)")
     fleet.add_argument("--per-machine", action="store_true",
@@ -108,6 +108,8 @@ def _read_all(args: argparse.Namespace, axis=None) -> tuple[list, list, list]:
 def _fit(model, args: argparse.Namespace, names, runs, second):
     """Fit ``model`` as the options say; return the names and runs it was fitted on."""
     progress = None if args.quiet else True
+    if args.bootstrap is not None and args.intervals != "bootstrap":
+        raise GreyboxError("--bootstrap N applies with --intervals bootstrap")
     if args.stage2 and model.first_stage() is None:
         raise GreyboxError(f"option --stage2 does not apply to the {args.model} model: it has one stage")
     if not args.stage2:
@@ -116,7 +118,7 @@ def _fit(model, args: argparse.Namespace, names, runs, second):
         model.fit_staged(runs, second, progress=progress)
     if args.intervals != "none":
         started = time.perf_counter()
-        attach_intervals(model, runs, method=args.intervals, n_bootstrap=args.bootstrap)
+        attach_intervals(model, runs, method=args.intervals, n_bootstrap=args.bootstrap or 100)
         record = model.parameter_intervals_
         print(f"95 % intervals by {args.intervals} over {record['n_clusters']} {record['clusters']} "
               f"in {time.perf_counter() - started:.1f} s")
