@@ -256,6 +256,14 @@ def test_a_refit_drops_the_intervals_of_the_earlier_fit():
 
 
 # ------------------------------------------------------------------ model files
+def test_a_record_of_another_level_is_refused(tmp_path):
+    run = _coulomb_run(0, 2_000)
+    model = attach_intervals(CoulombModel().fit(run), run)
+    model.parameter_intervals_["level"] = 0.5
+    with pytest.raises(ModelFileError, match="level must be 0.95"):
+        load_model(save_model(model, tmp_path / "model.gbm"))
+
+
 def _tampered(tmp_path, change) -> str:
     run = _coulomb_run(0, 2_000)
     model = attach_intervals(CoulombModel().fit(run), run)

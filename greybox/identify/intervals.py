@@ -626,6 +626,8 @@ def check_intervals(model) -> None:
         raise ValueError(f"{ATTRIBUTE} must be an object with 'rows'")
     if record.get("method") not in METHODS[:2]:
         raise ValueError(f"{ATTRIBUTE}: unknown method {record.get('method')!r}")
+    if record.get("level") != LEVEL:
+        raise ValueError(f"{ATTRIBUTE}: level must be {LEVEL}, got {record.get('level')!r}")
     values = {row.name: row.value for row in model.parameter_table()}
     for name, entry in record["rows"].items():
         if name not in values:

@@ -532,7 +532,7 @@ class KernelRegressionModel(CurrentModel):
 
     def interval_notes(self) -> dict[str, str]:
         """The kernel stage's rows: settings chosen by cross-validation and the expansion, not identified parameters."""
-        chosen = "hyperparameter chosen by cross-validation, not identified"
+        chosen = "hyperparameter, set or chosen by cross-validation, not identified"
         notes = dict.fromkeys(["C", "epsilon", "gamma", *self._weighted], chosen)
         notes.update(n_support="a count of the kernel expansion", intercept="part of the kernel expansion")
         return notes
