@@ -159,10 +159,10 @@ def test_jackknife_covariance_is_that_of_refits_leaving_each_cluster_out():
     estimate = np.linalg.lstsq(x, y, rcond=None)[0]
     moves = np.array([np.linalg.lstsq(x[labels != g], y[labels != g], rcond=None)[0] - estimate
                       for g in range(12)])
-    covariance, null = cluster_covariance(x, y - x @ estimate, labels)
+    covariance, null, carried = cluster_covariance(x, y - x @ estimate, labels)
     np.testing.assert_allclose(covariance, 11 / 12 * moves.T @ moves, rtol=1e-9)
-    assert null.shape == (3, 0)
-    plain, _ = cluster_covariance(x, y - x @ estimate, labels, jackknife=False)
+    assert null.shape == (3, 0) and carried.shape == (3, 0)
+    plain, _, _ = cluster_covariance(x, y - x @ estimate, labels, jackknife=False)
     inverse = np.linalg.inv(x.T @ x)
     scores = np.array([x[labels == g].T @ (y - x @ estimate)[labels == g] for g in range(12)])
     np.testing.assert_allclose(plain, 12 / 11 * inverse @ scores.T @ scores @ inverse, rtol=1e-9)
@@ -172,10 +172,21 @@ def test_a_direction_the_data_do_not_determine_is_the_null_space():
     rng = np.random.default_rng(1)
     x = rng.normal(size=(400, 2))
     x = np.column_stack((x, x[:, 0] + x[:, 1]))  # the third column repeats the sum of the first two
-    covariance, null = cluster_covariance(x, rng.normal(size=400), np.repeat(np.arange(10), 40))
+    covariance, null, _ = cluster_covariance(x, rng.normal(size=400), np.repeat(np.arange(10), 40))
     assert null.shape == (3, 1)
     np.testing.assert_allclose(np.abs(null[:, 0]), np.array([1.0, 1.0, 1.0]) / np.sqrt(3.0), rtol=1e-9)
     np.testing.assert_allclose(covariance @ null, 0.0, atol=1e-12)
+
+
+def test_a_parameter_that_only_one_cluster_determines_gets_no_interval():
+    # runs as clusters, and only one of the 24 runs accelerates: nothing else tells the inertia
+    runs = [_coulomb_run(seed, 1_000, velocity=np.full(1_000, (10.0 + seed) * (-1) ** seed)) for seed in range(23)]
+    runs.append(_coulomb_run(99, 1_000))
+    model = attach_intervals(CoulombModel().fit(runs), runs)
+    assert model.parameter_intervals_["clusters"] == "runs"
+    rows = {row.name: row for row in model.parameter_table()}
+    assert rows["J"].flag == "poorly determined: rests on one run or block" and np.isnan(rows["J"].lower)
+    assert rows["coulomb_pos"].flag == "" and rows["viscous_pos"].flag == ""
 
 
 def test_clusters_are_whole_runs_when_there_are_many_else_time_blocks():

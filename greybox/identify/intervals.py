@@ -78,7 +78,9 @@ Flags (one phrase per parameter, ``""`` when none)
     The 95 % interval reaches zero for a positive quantity or spans more
     than a factor :data:`WIDE_FACTOR`: the data say little about it. Beyond
     a factor :data:`UNBOUNDED_FACTOR` no interval is given
-    (``poorly determined: no bounded interval``).
+    (``poorly determined: no bounded interval``), nor where a single cluster
+    alone determines the parameter (``poorly determined: rests on one run or
+    block``: the spread between clusters says nothing about it then).
 ``no interval: ...``
     Chosen rather than identified, or not varied by the method (the phrase
     says which).
@@ -141,6 +143,7 @@ _NOT_IDENTIFIABLE = "not identifiable"
 _AT_BOUND = "at bound"
 _POOR = "poorly determined"
 _UNBOUNDED = "poorly determined: no bounded interval"
+_ONE_CLUSTER = "poorly determined: rests on one run or block"
 _NOT_VARIED = "no interval: held fixed in the fit, or not varied by the linearised method"
 
 
@@ -349,6 +352,9 @@ def cluster_covariance(x: np.ndarray, residuals: np.ndarray, labels: np.ndarray,
     null : ndarray, shape (p, q)
         Orthonormal basis of the directions they do not (relative eigenvalue of ``A = X'X`` below
         :data:`NULL_TOLERANCE`).
+    carried : ndarray, shape (p, m)
+        Orthonormal basis of the determined directions that only one cluster determines (``A - A_g``
+        singular there): the clusters give no estimate of their variance.
     """
     n_clusters = int(labels.max()) + 1
     eigenvalues, vectors = np.linalg.eigh(x.T @ x)
@@ -357,19 +363,27 @@ def cluster_covariance(x: np.ndarray, residuals: np.ndarray, labels: np.ndarray,
     reduced = x @ basis  # coordinates along the determined directions: A = diag(eigenvalues[keep]) there
     scores = np.zeros((n_clusters, basis.shape[1]))
     np.add.at(scores, labels, reduced * residuals[:, None])
+    information = np.diag(eigenvalues[keep])
+    steps = np.empty_like(scores)
+    order = np.argsort(labels, kind="stable")
+    edges = np.searchsorted(labels[order], np.arange(n_clusters + 1))
+    carried = []  # directions that the data without one cluster do not determine
+    for g in range(n_clusters):
+        rows = reduced[order[edges[g]:edges[g + 1]]]
+        values, directions = np.linalg.eigh(information - rows.T @ rows)
+        kept = values > NULL_TOLERANCE * max(float(values.max(initial=0.0)), np.finfo(float).tiny)
+        carried.append(directions[:, ~kept])
+        steps[g] = directions[:, kept] @ ((directions[:, kept].T @ scores[g]) / values[kept])
     if jackknife:
-        information = np.diag(eigenvalues[keep])
-        steps = np.empty_like(scores)
-        order = np.argsort(labels, kind="stable")
-        edges = np.searchsorted(labels[order], np.arange(n_clusters + 1))
-        for g in range(n_clusters):
-            rows = reduced[order[edges[g]:edges[g + 1]]]
-            steps[g] = np.linalg.lstsq(information - rows.T @ rows, scores[g], rcond=NULL_TOLERANCE)[0]
         inner = (n_clusters - 1) / n_clusters * steps.T @ steps
     else:
         inverse = np.diag(1.0 / eigenvalues[keep])
         inner = n_clusters / max(n_clusters - 1, 1) * inverse @ scores.T @ scores @ inverse
-    return basis @ inner @ basis.T, null
+    carried = np.hstack(carried)
+    if carried.shape[1]:
+        u, singular, _ = np.linalg.svd(carried, full_matrices=False)
+        carried = u[:, singular > 1e-6]
+    return basis @ inner @ basis.T, null, basis @ carried
 
 
 def _stage(model, runs):
@@ -466,7 +480,7 @@ def parameter_intervals(model, logs, *, method: str = "sandwich", n_bootstrap: i
 
     scale = np.linalg.norm(jacobian, axis=0)
     scale[scale == 0.0] = 1.0
-    covariance, null = cluster_covariance(jacobian / scale, residuals, labels, jackknife=jackknife)
+    covariance, null, carried = cluster_covariance(jacobian / scale, residuals, labels, jackknife=jackknife)
     quantile = float(student_t.ppf(0.5 + LEVEL / 2.0, max(n_clusters - 1, 1)))
     is_log, bound, non_negative = coordinates.is_log(), coordinates.at_bound(), coordinates.non_negative()
 
@@ -490,6 +504,9 @@ def parameter_intervals(model, logs, *, method: str = "sandwich", n_bootstrap: i
                 continue
             if null.shape[1] and np.linalg.norm(g @ null) > 1e-2 * size:
                 flags[i] = _NOT_IDENTIFIABLE
+                continue
+            if carried.shape[1] and np.linalg.norm(g @ carried) > 1e-2 * size:
+                flags[i] = _ONE_CLUSTER
                 continue
             se = float(np.sqrt(max(g @ covariance @ g, 0.0)))
             v = value[i]
@@ -572,7 +589,7 @@ def _bootstrap(stage, runs, fitted, residuals, labels, result_rows, names, stage
         lower[:], upper[:] = np.percentile(sample, tail, axis=0), np.percentile(sample, 100.0 - tail, axis=0)
         value = _numbers(stage_rows[name].value)
         for i in range(value.size):
-            if flags[i] in ("", _POOR, _UNBOUNDED):
+            if flags[i] in ("", _POOR, _UNBOUNDED, _ONE_CLUSTER):
                 if value[i] > 0.0 and lower[i] > 0.0:
                     flags[i] = _POOR if upper[i] > WIDE_FACTOR * lower[i] else ""
                 else:  # whether reaching zero matters (a positive quantity) the sandwich analysis knew
