@@ -357,3 +357,16 @@ def test_train_by_bootstrap_and_a_bootstrap_count_without_it(tmp_path, capsys, c
                      "--bootstrap", "20"]) == 2
     error = capsys.readouterr().err
     assert "--bootstrap N applies with --intervals bootstrap" in error and error.count("\n") == 1
+
+
+def test_a_fleets_models_carry_intervals(tmp_path):
+    from greybox.fleet_train import train_jobs, train_model
+
+    log = tmp_path / "logs" / "machine_1" / "run.csv"
+    log.parent.mkdir(parents=True)
+    write_log(_coulomb_run(0, 3_000), log)
+    (job,) = train_jobs([log], CoulombModel(), str(tmp_path / "models"))
+    result = train_model(job)
+    assert result["status"] == "ok", result
+    rows = {row.name: row for row in load_model(tmp_path / "models" / result["output"]).parameter_table()}
+    assert rows["J"].lower < rows["J"].value < rows["J"].upper

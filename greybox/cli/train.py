@@ -199,6 +199,9 @@ def _run_per_machine(args: argparse.Namespace) -> int:
     from ..fleet_train import run_training, train_jobs
     from ._fleet import check_out_dir, fleet_progress, read_options, report_fleet
 
+    if args.intervals != "sandwich" or args.bootstrap is not None:
+        raise GreyboxError("--intervals and --bootstrap do not apply with --per-machine: a fleet's models get the "
+                           "sandwich intervals")
     for option, value in (("--stage2", args.stage2), ("--machine", args.machine)):
         if value:
             raise GreyboxError(f"{option} does not apply with --per-machine: every machine's model is fitted on "
