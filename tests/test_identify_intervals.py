@@ -357,6 +357,9 @@ def test_train_by_bootstrap_and_a_bootstrap_count_without_it(tmp_path, capsys, c
                      "--bootstrap", "20"]) == 2
     error = capsys.readouterr().err
     assert "--bootstrap N applies with --intervals bootstrap" in error and error.count("\n") == 1
+    assert cli.main(["train", "--model", "coulomb", "--train", str(log), "--out", str(tmp_path / "other.gbm"),
+                     "--intervals", "bootstrap", "--bootstrap", "1"]) == 2
+    assert "--bootstrap 1: a bootstrap needs at least 2 replicates" in capsys.readouterr().err
 
 
 def test_a_fleets_models_carry_intervals(tmp_path):

@@ -110,6 +110,8 @@ def _fit(model, args: argparse.Namespace, names, runs, second):
     progress = None if args.quiet else True
     if args.bootstrap is not None and args.intervals != "bootstrap":
         raise GreyboxError("--bootstrap N applies with --intervals bootstrap")
+    if args.bootstrap is not None and args.bootstrap < 2:
+        raise GreyboxError(f"--bootstrap {args.bootstrap}: a bootstrap needs at least 2 replicates")
     if args.stage2 and model.first_stage() is None:
         raise GreyboxError(f"option --stage2 does not apply to the {args.model} model: it has one stage")
     if not args.stage2:
