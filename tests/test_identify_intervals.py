@@ -13,11 +13,13 @@ from scipy.signal import lfilter
 
 import greybox.cli as cli
 from greybox import registry
+from greybox.base import Parameter
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.discover.augment import AugmentedModel
 from greybox.errors import ModelFileError
+from greybox.estimator import CurrentModel
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.friction.backlash import BacklashModel
 from greybox.identify.intervals import attach_intervals, cluster_covariance, cluster_labels, parameter_intervals
@@ -257,6 +259,30 @@ def test_chosen_hyperparameters_are_flagged_not_identified(train_runs):
     rows = {row.name: row for row in model.parameter_table()}
     assert "chosen by cross-validation" in rows["C"].flag and "chosen by cross-validation" in rows["gamma"].flag
     assert all(np.isnan(row.lower) and row.flag.startswith("no interval: ") for row in rows.values())
+
+
+class _ViscousModel(CurrentModel):
+    """A kind that offers no linear part: the intervals cannot vary anything of it."""
+
+    def _fit_runs(self, runs, progress):
+        v = np.concatenate([run.velocity for run in runs])
+        self.viscous_ = float(v @ np.concatenate([run.effort for run in runs]) / (v @ v))
+        self.J_, self.offset_ = 0.0, 0.0
+
+    def _simulate(self, run, state, sample_time):
+        return self.viscous_ * run.velocity, None
+
+    def _n_params(self):
+        return 1
+
+    def _own_parameters(self):
+        return [Parameter("viscous", self.viscous_, "A s/mm", "viscous coefficient")]
+
+
+def test_a_kind_without_a_linear_part_gets_flags_not_intervals():
+    run = _coulomb_run(0, 2_000)
+    rows = attach_intervals(_ViscousModel().fit(run), run).parameter_table()
+    assert all(np.isnan(row.lower) and row.flag.startswith("no interval") for row in rows)
 
 
 def test_a_refit_drops_the_intervals_of_the_earlier_fit():

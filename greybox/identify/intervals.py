@@ -498,7 +498,8 @@ def parameter_intervals(model, logs, *, method: str = "sandwich", n_bootstrap: i
         for i in range(value.size):
             g = gradient[i]
             size = float(np.linalg.norm(g))
-            uses = np.abs(derivatives[name][i]) > 1e-9 * max(float(np.max(np.abs(derivatives[name][i]))), 1e-300)
+            slopes = np.abs(derivatives[name][i])
+            uses = slopes > 1e-9 * max(float(np.max(slopes, initial=0.0)), 1e-300)
             if size == 0.0:
                 flags[i] = _NOT_VARIED
                 continue
