@@ -30,6 +30,9 @@ The protocol
 ``parameter_table()``
     Identified parameters with units and descriptions, for the command line,
     reports and benchmark protocols.
+``interval_coordinates()``, ``interval_notes()``, ``interval_stage(runs)``
+    What :mod:`greybox.identify.intervals` varies to give the parameters
+    their 95 % intervals, and why a parameter gets none.
 ``score(logs)``
     Negative RMSE, so that scikit-learn's model selection accepts the models.
 """
@@ -66,12 +69,22 @@ class Parameter:
         for a dimensionless number.
     description : str
         What the parameter is, in a few words.
+    lower, upper : float, ndarray or None
+        Ends of its 95 % interval in ``unit`` (the value's shape; NaN where there
+        is none); ``None`` when no intervals were computed
+        (:mod:`greybox.identify.intervals`).
+    flag : str
+        ``""``, or why the interval is missing or not to be trusted
+        (``"not identifiable"``, ``"at bound"``, ``"poorly determined"``, ``"no interval: ..."``).
     """
 
     name: str
     value: object
     unit: str
     description: str
+    lower: object = None
+    upper: object = None
+    flag: str = ""
 
 
 @dataclass(frozen=True)
@@ -229,3 +242,43 @@ class ModelProtocol(BaseEstimator):
     def parameter_table(self) -> list[Parameter]:
         """The identified parameters with units and descriptions."""
         raise NotImplementedError
+
+    def interval_coordinates(self) -> dict[str, str]:
+        """Nonlinear identified parameters, as learned attributes to vary for the parameter intervals.
+
+        The linear coefficients (:meth:`linear_part`) are varied anyway; this names the others:
+        ``{attribute: "log"}`` for a positive number varied on a log scale, ``{attribute: "simplex"}``
+        for a vector of positive fractions summing to 1 (varied in its logits).
+
+        Returns
+        -------
+        dict of str to str
+            Empty by default (no nonlinear parameters).
+        """
+        return {}
+
+    def interval_notes(self) -> dict[str, str]:
+        """Rows of :meth:`parameter_table` that get no interval, with the reason in a few words.
+
+        Returns
+        -------
+        dict of str to str
+            ``{row name: reason}``, e.g. ``{"C": "hyperparameter chosen by cross-validation"}``; empty by default.
+        """
+        return {}
+
+    def interval_stage(self, runs):
+        """The fitted stage whose least-squares problem identifies this model's parameters, if another model's.
+
+        Parameters
+        ----------
+        runs : list of AxisLog
+            The prepared runs the model was fitted on.
+
+        Returns
+        -------
+        None or (model, str, list of AxisLog)
+            ``None`` (default): the model identifies its own parameters. Else the fitted stage, the prefix
+            of its rows in this model's table (``"gms."``) and the runs the stage was fitted on.
+        """
+        return None

@@ -24,6 +24,7 @@ from .data.log import AxisLog, as_log_list
 from .data.quantities import MOTIONS, Motion
 from .errors import LogError, ParameterError
 from .identify.inertia import inertia_note
+from .identify.intervals import check_intervals, with_intervals
 from .identify.progress import make_progress
 from .identify.selection import check_selection_record
 from .metrics import rmse
@@ -336,7 +337,8 @@ class CurrentModel(ModelProtocol):
         -------
         list of Parameter
             Units carry the effort unit the model was fitted on (A, N or Nm) and the
-            length unit of its motion (mm, or deg for a rotary axis).
+            length unit of its motion (mm, or deg for a rotary axis); rows carry their
+            95 % intervals when the model holds them (:mod:`greybox.identify.intervals`).
         """
         check_is_fitted(self)
         rows = self._own_parameters() + [
@@ -344,8 +346,8 @@ class CurrentModel(ModelProtocol):
             Parameter("offset", self.offset_, EFFORT, "constant effort"),
         ]
         unit, length = self.effort_unit_, self.units_.length
-        return [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit).replace(LENGTH, length), p.description)
-                for p in rows]
+        return with_intervals(self, [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit).replace(LENGTH, length),
+                                               p.description) for p in rows])
 
     @property
     def units_(self) -> Motion:
@@ -390,6 +392,7 @@ class CurrentModel(ModelProtocol):
             notes = getattr(self, "notes_", [])
             if not (isinstance(notes, list) and all(isinstance(note, str) and len(note) <= 2000 for note in notes)):
                 raise ParameterError("notes_ must be a list of sentences (text of at most 2000 characters each)")
+            check_intervals(self)
             step = float(self.sample_time_)
             if not (np.isfinite(step) and step > 0.0):
                 raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")
@@ -434,6 +437,7 @@ class CurrentModel(ModelProtocol):
         return run, self.initial_state() if state is None else state, step
 
     def _set_fit_info(self, runs: list[AxisLog]) -> None:
+        vars(self).pop("parameter_intervals_", None)  # intervals of an earlier fit are not this fit's
         self.effort_unit_ = runs[0].effort_unit
         self.motion_ = runs[0].motion
         self.sample_time_ = float(np.median([run.sample_time for run in runs]))

@@ -32,6 +32,7 @@ import numpy as np
 
 from .errors import GreyboxError
 from .fleet import MODELS_FORMAT, attempt, log_stamp, machine_of, out_dir_of, partition, read_prepared, run_tasks
+from .identify.intervals import attach_intervals
 
 __all__ = ["TrainJob", "run_training", "train_jobs", "train_model"]
 
@@ -121,7 +122,7 @@ def _fit_and_save(job: TrainJob) -> dict:
 
     runs = [run for log in job.logs for run in read_prepared(log, job.read)]
     axis = partition(_axis_of(runs, job) or "-")
-    model = copy.deepcopy(job.model).fit(runs)
+    model = attach_intervals(copy.deepcopy(job.model).fit(runs), runs)  # sandwich: about 1 % of a GMS fit
     path = Path(job.out_dir) / job.machine / f"{axis}.gbm"
     path.parent.mkdir(parents=True, exist_ok=True)
     saved = load_model(save_model(model, path, overwrite=True))

@@ -53,6 +53,7 @@ def test_auto_chooses_by_held_out_logs_prints_and_keeps_the_table(logs, tmp_path
     assert model.selection_["chosen"] in ("coulomb", "stribeck:offset")
     assert f"trained {model.selection_['chosen']} (chosen by held-out runs)" in stdout
     assert len(model.selection_["candidates"][0]["fold_re"]) == 3
+    assert "95 % intervals by sandwich" in stdout and model.parameter_intervals_  # the chosen model's intervals
     status, stdout, _ = _main(capsys, "info", out)
     assert status == 0 and "model choice: 2 candidates" in stdout and "<- chosen" in stdout
     status, stdout, _ = _main(capsys, "info", "--json", out)

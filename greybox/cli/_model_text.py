@@ -37,8 +37,36 @@ def parameter_lines(model) -> list[str]:
     """
     rows = model.parameter_table()
     width = max([14, *(len(row.name) for row in rows)])
-    return [f"  {row.name:<{width}} = {format_value(row.value)} {row.unit if row.unit != '-' else ''}".rstrip()
-            for row in rows]
+    return [(f"  {row.name:<{width}} = {format_value(row.value)} {row.unit if row.unit != '-' else ''}".rstrip()
+             + interval_text(row)) for row in rows]
+
+
+def _ends(lower, upper) -> str:
+    """``lower .. upper`` of one element (``-`` for none)."""
+    return "-" if np.isnan(lower) or np.isnan(upper) else f"{lower:.4g} .. {upper:.4g}"
+
+
+def interval_text(row) -> str:
+    """``"  95 %: lower .. upper  [flag]"`` of a parameter row, ``""`` for a row without intervals.
+
+    Parameters
+    ----------
+    row : Parameter
+        A row of a parameter table (its ``lower``, ``upper`` and ``flag``).
+    """
+    if row.lower is None or row.upper is None:
+        return ""
+    lower = np.asarray(row.lower, dtype=float).ravel()
+    upper = np.asarray(row.upper, dtype=float).ravel()
+    if lower.size > _MAX_PRINTED:
+        ends = f"<{lower.size} intervals>"
+    elif np.all(np.isnan(lower)):
+        ends = ""
+    elif np.ndim(row.lower) == 0:
+        ends = _ends(lower[0], upper[0])
+    else:
+        ends = "[" + ", ".join(_ends(a, b) for a, b in zip(lower, upper)) + "]"
+    return (f"   95 %: {ends}" if ends else "") + (f"   [{row.flag}]" if row.flag else "")
 
 
 def fit_lines(model) -> list[str]:

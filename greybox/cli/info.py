@@ -130,13 +130,16 @@ def describe_model(path, model) -> dict:
     -------
     dict
         ``file``, ``kind``, ``motion``, ``effort_unit``, ``sample_time_ms``, ``parameters`` (``{name:
-        {"value", "unit"}}``), ``fit`` (the model's ``fit_summary``), ``notes`` (what the fit could not
-        settle) and ``selection`` (the table ``--model auto`` chose from, or None), NumPy values as lists
-        and numbers, NaN as None.
+        {"value", "unit"}}``, with ``lower_95``, ``upper_95`` and ``flag`` when the file holds intervals),
+        ``fit`` (the model's ``fit_summary``), ``notes`` (what the fit could not settle) and ``selection``
+        (the table ``--model auto`` chose from, or None), NumPy values as lists and numbers, NaN as None.
     """
     return {"file": str(path), "kind": model_kind(model), "motion": getattr(model, "motion_", "linear"),
             "effort_unit": model.effort_unit_, "sample_time_ms": 1e3 * float(model.sample_time_),
-            "parameters": {row.name: {"value": jsonable(row.value), "unit": row.unit}
+            "parameters": {row.name: {"value": jsonable(row.value), "unit": row.unit,
+                                      **({} if row.lower is None else {"lower_95": jsonable(row.lower),
+                                                                        "upper_95": jsonable(row.upper),
+                                                                        "flag": row.flag})}
                            for row in model.parameter_table()},
             "fit": jsonable(model.fit_summary()), "notes": model.fit_notes(),
             "selection": jsonable(getattr(model, "selection_", None))}

@@ -12,6 +12,8 @@ import numpy as np
 
 from ..atomic import check_output_path
 from ..errors import GreyboxError, ModelFileError
+from ..identify.intervals import METHODS as INTERVAL_METHODS
+from ..identify.intervals import attach_intervals
 from ..metrics import metrics_table
 from ..model_choice import DEFAULT_CANDIDATES
 from ..persistence import load_model, save_model
@@ -66,6 +68,13 @@ def add_parser(subparsers) -> None:
                         "model again, also those complete from an earlier run")
     add_model_arguments(parser, backlash=True)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
+    parser.add_argument("--intervals", choices=INTERVAL_METHODS, default="sandwich",
+                        help="95 %% intervals of the identified parameters, stored in the model file and printed "
+                        "with them: 'sandwich' (default) a cluster-robust linearisation over runs or time blocks, "
+                        "'bootstrap' a wild cluster bootstrap refitting the model --bootstrap times (slow), 'none' "
+                        "(see docs/intervals.md)")
+    parser.add_argument("--bootstrap", type=POSITIVE_INT, metavar="N",
+                        help="replicates of --intervals bootstrap (default 100)")
     fleet = parser.add_argument_group("fleets (one model per machine)")
     fleet.add_argument("--per-machine", action="store_true",
                        help="train one model per machine and axis, each on all that machine's logs (the machine of "
@@ -109,13 +118,33 @@ def _read_all(args: argparse.Namespace, axis=None) -> tuple[list, list, list]:
 def _fit(model, args: argparse.Namespace, names, runs, second):
     """Fit ``model`` as the options say; return the names and runs it was fitted on."""
     progress = None if args.quiet else True
+    _check_interval_options(args)
     if args.stage2 and model.first_stage() is None:
         raise GreyboxError(f"option --stage2 does not apply to the {args.model} model: it has one stage")
     if not args.stage2:
         model.fit(runs, progress=progress)
     else:
         model.fit_staged(runs, second, progress=progress)
+    _intervals(model, args, runs)
     return names, runs + second
+
+
+def _check_interval_options(args: argparse.Namespace) -> None:
+    """Refuse --bootstrap without --intervals bootstrap, or with fewer than 2 replicates."""
+    if args.bootstrap is not None and args.intervals != "bootstrap":
+        raise GreyboxError("--bootstrap N applies with --intervals bootstrap")
+    if args.bootstrap is not None and args.bootstrap < 2:
+        raise GreyboxError(f"--bootstrap {args.bootstrap}: a bootstrap needs at least 2 replicates")
+
+
+def _intervals(model, args: argparse.Namespace, runs) -> None:
+    """Attach the parameter intervals --intervals asks for (of the runs the model, or its first stage, saw)."""
+    if args.intervals != "none":
+        started = time.perf_counter()
+        attach_intervals(model, runs, method=args.intervals, n_bootstrap=args.bootstrap or 100)
+        record = model.parameter_intervals_
+        print(f"95 % intervals by {args.intervals} over {record['n_clusters']} {record['clusters']} "
+              f"in {time.perf_counter() - started:.1f} s")
 
 
 def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
@@ -192,6 +221,9 @@ def _run_per_machine(args: argparse.Namespace) -> int:
     from ..fleet_train import run_training, train_jobs
     from ._fleet import check_out_dir, fleet_progress, read_options, report_fleet
 
+    if args.intervals != "sandwich" or args.bootstrap is not None:
+        raise GreyboxError("--intervals and --bootstrap do not apply with --per-machine: a fleet's models get the "
+                           "sandwich intervals")
     for option, value in (("--stage2", args.stage2), ("--machine", args.machine)):
         if value:
             raise GreyboxError(f"{option} does not apply with --per-machine: every machine's model is fitted on "
@@ -237,6 +269,7 @@ def _run_auto(args: argparse.Namespace) -> int:
         if value:
             raise GreyboxError(f"{option} does not apply with --model auto: write a candidate's options into "
                                "--candidates, e.g. --candidates gms:asymmetric,backlash stribeck:offset")
+    _check_interval_options(args)
     out = Path(args.out)
     check_output_path(out, overwrite=args.force, protect=list(args.train), error=ModelFileError,
                       inputs_name="one of the training logs")
@@ -249,6 +282,7 @@ def _run_auto(args: argparse.Namespace) -> int:
     report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
     model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.inertia,
                          workers=args.workers or os.cpu_count() or 1, progress=report)
+    _intervals(model, args, runs)
     names = [Path(group).name for group in groups]
     predictions = _report_fit(model, names, runs, time.perf_counter() - started,
                               f"{model.selection_['chosen']} (chosen by held-out runs)")

@@ -213,16 +213,35 @@ class BacklashModel(CurrentModel):
 
     def _trial(self, runs, width, target, norm):
         """Cost and base model of one trial width: the base fitted with the measured gaps at standstill."""
+        base = self._base_template().fit(self._contact_runs(runs, width))
+        prediction = np.concatenate([_through_gaps(base, width, self.threshold_, run, None, run.sample_time,
+                                                   "_effort")[0] for run in runs])
+        return float(np.sum((prediction - target) ** 2) / norm), base
+
+    def _contact_runs(self, runs, width: float) -> list[AxisLog]:
+        """The runs as the base model is fitted on them: motion zeroed where the measured effort crosses the gap."""
         inputs = []
         for run in runs:
             start = BacklashState(np.nan, np.nan, 0, None, run_start=True)
             in_gap = gaps_of(run.position, run.effort, width, self.threshold_, start)[0] & (width > 0.0)
             inputs.append(run.replace(velocity=np.where(in_gap, 0.0, run.velocity),
                                       acceleration=np.where(in_gap, 0.0, run.acceleration)))
-        base = self._base_template().fit(inputs)
-        prediction = np.concatenate([_through_gaps(base, width, self.threshold_, run, None, run.sample_time,
-                                                   "_effort")[0] for run in runs])
-        return float(np.sum((prediction - target) ** 2) / norm), base
+        return inputs
+
+    def interval_stage(self, runs):
+        """The base model, fitted on the runs with the gaps at standstill, identifies the parameters but the width.
+
+        Parameters
+        ----------
+        runs : list of AxisLog
+            The prepared runs the model was fitted on.
+        """
+        return self.base_, "base.", self._contact_runs(runs, self.width_)
+
+    def interval_notes(self) -> dict[str, str]:
+        """The width is chosen on a grid (the base's intervals hold for it); the threshold is set from the data."""
+        return {"width": "chosen by a grid search (the base's intervals are for this width)",
+                "threshold": "set from the median effort, not identified"}
 
     # ---------------------------------------------------------------- prediction
     def initial_state(self) -> BacklashState:

@@ -120,12 +120,13 @@ class CoulombModel(CurrentModel):
         if self.asymmetric:
             positive, negative = (v > 0.0).astype(float), (v < 0.0).astype(float)
             return LinearPart.from_columns([a, positive, -negative, v * positive, v * negative],
-                                           ["J", "coulomb_pos", "coulomb_neg", "viscous_pos", "viscous_neg"])
+                                           ["J", "coulomb_pos", "coulomb_neg", "viscous_pos", "viscous_neg"],
+                                           non_negative=1)
         columns, names = [a, np.sign(v), v], ["J", "coulomb", "viscous"]
         if self.fit_offset:
             columns.append(np.ones(len(run)))
             names.append("offset")
-        return LinearPart.from_columns(columns, names)
+        return LinearPart.from_columns(columns, names, non_negative=1)  # J >= 0, as fit_coulomb holds it
 
     def linear_coefficients(self) -> np.ndarray:
         """``J, coulomb, viscous (, offset)``, or the five levels of the asymmetric model."""

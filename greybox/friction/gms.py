@@ -675,6 +675,17 @@ class GMSModel(CurrentModel):
         return gms_plant_law(alpha=p["alpha"], k=p["k"], sigma=p["sigma"], s_0=p["s_0"], s_inf=p["s_inf"],
                              v_s=p["v_s"], c=p["C"], mu=p["mu"], inertia=self.J_, offset=self.offset_)
 
+    def interval_coordinates(self) -> dict[str, str]:
+        """Element fractions (a simplex), slip rate and Stribeck curve (per direction if asymmetric)."""
+        names = ["slip_rate_", "s_0_", "s_inf_", "v_s_"]
+        if self.asymmetric:
+            names += ["s_0_neg_", "s_inf_neg_", "v_s_neg_"]
+        return {**({"alpha_": "simplex"} if len(self.alpha_) > 1 else {}), **dict.fromkeys(names, "log")}
+
+    def interval_notes(self) -> dict[str, str]:
+        """The fraction of a single element is 1 by definition."""
+        return {"alpha": "fixed: a single element"} if len(self.alpha_) == 1 else {}
+
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:
         """Columns ``z_1..z_N, w, v, a (, 1)`` at the fitted element shape (``w = sum_i alpha_i dz_i/dt``).

@@ -384,6 +384,13 @@ class LuGreModel(CurrentModel):
         """
         return lugre_plant_law(**self._law(), inertia=self.J_, offset=self.offset_)
 
+    def interval_coordinates(self) -> dict[str, str]:
+        """Bristle stiffness and the Stribeck curve (per direction if asymmetric), on a log scale."""
+        names = ["sigma0_", "coulomb_", "static_", "v_s_"]
+        if self.asymmetric:
+            names += ["coulomb_neg_", "static_neg_", "v_s_neg_"]
+        return dict.fromkeys(names, "log")
+
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:
         """Columns ``dz/dt, v, a (, 1)`` at the fitted bristle law; ``sigma0 z`` is the fixed part.

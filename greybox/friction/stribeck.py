@@ -141,6 +141,10 @@ class StribeckModel(CurrentModel):
             Parameter("viscous_neg", self.viscous_neg_, f"{EFFORT} s/{LENGTH}", "viscous coefficient, negative motion"),
         ]
 
+    def interval_coordinates(self) -> dict[str, str]:
+        """The Stribeck velocity (one per direction if asymmetric), on a log scale."""
+        return {"v_s_": "log", **({"v_s_neg_": "log"} if self.asymmetric else {})}
+
     # ---------------------------------------------------------------- linear part
     def linear_part(self, run) -> LinearPart:
         """Columns at the fitted ``v_s`` (:func:`~greybox.identify.static.stribeck_regressors`).

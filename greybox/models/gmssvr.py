@@ -362,6 +362,16 @@ class GMSSVRModel(KernelRegressionModel):
                  for p in self.gms_.parameter_table() if p.name not in ("J", "offset")]
         return stage + self._kernel_parameters()
 
+    def interval_stage(self, runs):
+        """The GMS stage, fitted alone on the first stage's runs, identifies the physical parameters.
+
+        Parameters
+        ----------
+        runs : list of AxisLog
+            The prepared runs the GMS stage was fitted on.
+        """
+        return self.gms_, "gms.", runs
+
     def gms_predict(self, logs: AxisLog | Iterable[AxisLog]) -> np.ndarray:
         """Current of the frozen GMS stage alone [A], the runs concatenated.
 

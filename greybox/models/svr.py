@@ -582,6 +582,13 @@ class KernelRegressionModel(CurrentModel):
                          "distance from the training inputs' box over which the correction is handed over")]),
         ]
 
+    def interval_notes(self) -> dict[str, str]:
+        """The kernel stage's rows: settings chosen by cross-validation and the expansion, not identified parameters."""
+        chosen = "hyperparameter, set or chosen by cross-validation, not identified"
+        notes = dict.fromkeys(["C", "epsilon", "gamma", *self._weighted], chosen)
+        notes.update(n_support="a count of the kernel expansion", intercept="part of the kernel expansion")
+        return notes
+
     def _weight(self, name: str) -> float:
         """The fitted kernel weight of the setting ``name`` of ``_weighted`` (1 in a file that predates weights)."""
         weights = getattr(self, "input_weights_", None)
@@ -769,6 +776,11 @@ class SVRCurrentModel(KernelRegressionModel):
             Parameter("proxy_viscous", self.proxy_viscous_, f"{EFFORT} s/{LENGTH}", "viscous coefficient handed "
                                                                                     "over to outside the training "
                                                                                     "region")]
+
+    def interval_notes(self) -> dict[str, str]:
+        """As the kernel stage's, and ``J``, ``offset`` fixed by a proxy fit before the kernel expansion."""
+        fixed = "fixed by a proxy fit before the kernel expansion"
+        return {**super().interval_notes(), "J": fixed, "offset": fixed}
 
 
 #: Every name a search interval can be given for (``bounds=``) in the kernel models: the SVR
