@@ -26,7 +26,7 @@ _MODEL_OPTIONS = (
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model options",
-                        settings: bool = True, backlash: bool = False) -> None:
+                        settings: bool = True, backlash: bool = False, offset_default: bool = False) -> None:
     """Add the options that set the hyperparameters of the model a command builds.
 
     Parameters
@@ -39,9 +39,20 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
         Also offer ``--set NAME=VALUE`` for any hyperparameter.
     backlash : bool, default False
         Also offer ``--backlash`` (a model behind an identified backlash).
+    offset_default : bool, default False
+        Fit a constant effort offset unless ``--no-offset`` (or ``--asymmetric``) is given: a current
+        sensor's offset, or the weight a vertical axis carries, is in every real drive's current, and a
+        model without it reads the offset as process force (``greybox train``).
     """
     group = parser.add_argument_group(title)
-    group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
+    if offset_default:
+        group.add_argument("--offset", action=argparse.BooleanOptionalAction, default=None,
+                           help="fit a constant effort offset (a current sensor's offset, an axis's weight): the "
+                           "default of the models that take one, except with --asymmetric; --no-offset leaves "
+                           "it out")
+        parser.set_defaults(offset_default=True)
+    else:
+        group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
     group.add_argument("--asymmetric", action="store_true",
                        help="direction-dependent friction: sliding levels, Stribeck curve and viscous "
                        "coefficient of their own for positive and negative motion (coulomb, stribeck, lugre, gms, "
@@ -68,7 +79,9 @@ def build_model(kind: str, args: argparse.Namespace):
     Options a command does not offer count as not given. An option the
     model does not take but its first stage does (``--asymmetric``,
     ``--elements``, ``--offset`` of gmssvr) is set on the first stage.
-    ``--backlash`` wraps the model in a :class:`BacklashModel`.
+    ``--backlash`` wraps the model in a :class:`BacklashModel`. With ``offset_default`` set on
+    ``args`` (:func:`add_model_arguments`), a model that takes an offset fits one unless ``--no-offset``
+    or ``--asymmetric`` says otherwise.
 
     Parameters
     ----------
@@ -89,6 +102,12 @@ def build_model(kind: str, args: argparse.Namespace):
     params, stage_params = {}, {}
     for option, attribute, name in _MODEL_OPTIONS:
         value = getattr(args, attribute, None)
+        if value is None and name == "fit_offset" and getattr(args, "offset_default", False) \
+                and not getattr(args, "asymmetric", False) \
+                and not any(setting.partition("=")[0].strip() in ("asymmetric", name)
+                            for setting in getattr(args, "set", None) or []):
+            takes = name in accepted or (stage is not None and name in stage.get_params(deep=False))
+            value = True if takes else None  # the default where the model takes an offset
         if value is None or value is False:
             continue
         if name in accepted:

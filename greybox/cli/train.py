@@ -14,6 +14,7 @@ from ..errors import GreyboxError, ModelFileError
 from ..metrics import metrics_table
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
+from ._advice import offset_note
 from ._build import add_model_arguments, build_model
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
@@ -55,7 +56,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--force", action="store_true",
                         help="overwrite MODEL (the machine model) if it exists; with --per-machine, train every "
                         "model again, also those complete from an earlier run")
-    add_model_arguments(parser, backlash=True)
+    add_model_arguments(parser, backlash=True, offset_default=True)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
     fleet = parser.add_argument_group("fleets (one model per machine)")
     fleet.add_argument("--per-machine", action="store_true",
@@ -143,6 +144,7 @@ def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
         print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     print("  (RE = RMSE / mean |effort|)")
     print("\n".join(model_lines(model)))
+    offset_note([run.effort for run in runs], predictions, unit)
     return predictions
 
 
