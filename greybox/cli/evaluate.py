@@ -12,6 +12,7 @@ from ..evaluate.regimes import REGIME_NAMES
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json
 from ..persistence import load_model
 from ._options import add_log_arguments, read_named_runs
+from ._provenance import warn_preparation
 
 
 def add_parser(subparsers) -> None:
@@ -81,8 +82,13 @@ def _print_records(records, unit: str, run_names) -> None:
 def run(args: argparse.Namespace) -> int:
     _check_outputs(args)
     names = _model_names(args.models)
-    models = dict(zip(names, (load_model(path) for path in args.models)))
+    loaded = dict(zip(names, (load_model(path, records=True) for path in args.models)))
+    models = {name: model for name, (model, _) in loaded.items()}
     runs, run_names = read_named_runs(args, args.test, _model_names(args.test))
+    for name, (_, records) in loaded.items():
+        for path in dict.fromkeys(args.test):
+            warn_preparation(records, args, [run for run in runs if run.source == str(path)] or runs,
+                             Path(path).name, name)
     units = dict.fromkeys(run.effort_unit for run in runs)
     if len(units) > 1:
         listed = ", ".join(f"{name} in {run.effort_unit}" for name, run in zip(run_names, runs))

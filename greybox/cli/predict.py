@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import GreyboxError
 from ._options import add_log_arguments
+from ._provenance import warn_preparation
 from ._types import FRACTION, POSITIVE_INT, non_negative, positive
 from ._window import add_window_argument, check_window
 
@@ -225,12 +226,16 @@ def run(args: argparse.Namespace) -> int:
     inputs = [args.model, args.log] + ([args.axis_config] if args.axis_config else []) + list(args.calibration or [])
     out = _check_outputs(args, inputs)
     config = read_axis_config(args.axis_config) if args.axis_config else None
-    model = load_model(args.model)
+    model, records = load_model(args.model, records=True)
     streamed = _streamed_log(args, config)
+    if streamed is not None:
+        warn_preparation(records, args, None, Path(args.log).name, Path(args.model).name)
     status = None if streamed is None else _run_streamed(args, model, streamed, config, out, inputs, run_started)
     if status is not None:
         return status
     runs = _read_runs(args, config.channels if config else {})
+    if streamed is None:
+        warn_preparation(records, args, runs, Path(args.log).name, Path(args.model).name)
     log_time = np.concatenate([run.time for run in runs])
     window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
     interval = _interval(args, model, lambda path: _read_runs(args, config.channels if config else {}, path))

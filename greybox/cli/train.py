@@ -18,6 +18,7 @@ from ._advice import offset_note
 from ._build import add_model_arguments, build_model
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
+from ._provenance import record_training
 from ._types import POSITIVE_INT
 
 
@@ -234,7 +235,8 @@ def run(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     names, runs = _fit(model, args, *_read_all(args))
     predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
-    save_model(model, out, overwrite=args.force)
+    records = record_training(args, inputs, names, runs, predictions)
+    save_model(model, out, overwrite=args.force, records=records)
     reloaded = load_model(out)
     if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):
         raise ModelFileError(f"{out}: the saved model does not reproduce the fitted model's predictions")
