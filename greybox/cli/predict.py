@@ -425,7 +425,13 @@ def _report_extrapolation(summary: dict, log_name: str) -> None:
         return
     parts = ", ".join(f"{name} {100 * share:.1f} %" for name, share in summary["by"].items())
     print(f"  outside the training region: {100 * summary['share']:.1f} % of the samples ({parts})")
-    if summary["share"] > summary["warn_above"]:
+    standstill = summary["by"].get("standstill", 0.0)
+    if standstill > 0.0:
+        print(f"note: {log_name}: {100 * standstill:.1f} % of the samples are at standstill, where a memoryless "
+              "model cannot know the friction the drive holds (flagged in the column outside_training, not "
+              "process force); gms, lugre and gmssvr carry it from the last motion", file=sys.stderr)
+    beyond = max([share for name, share in summary["by"].items() if name != "standstill"] or [0.0])
+    if summary["share"] > summary["warn_above"] and beyond > 0.0:
         print(f"note: {log_name}: {100 * summary['share']:.1f} % of the samples lie outside the positions, speeds "
               f"or inputs the model was trained on (more than {100 * summary['warn_above']:g} %): the model "
               "extrapolates there (column outside_training); train on air cuts that cover the cutting programme, "
