@@ -23,7 +23,7 @@ from ._notes import command_notes, error_message
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
 COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate",
-            "plan")
+            "plan", "examples")
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -10,7 +10,7 @@ from ..friction.backlash import BacklashModel
 from ..registry import model_class
 from ._types import POSITIVE_INT, SEED
 
-__all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting"]
+__all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting", "takes_hyperparameter"]
 
 
 class CommandLineError(GreyboxError):
@@ -71,6 +71,21 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
         group.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                            help="set any model hyperparameter, e.g. --set n_starts=8 or --set C=2.0 (repeatable; "
                            "VALUE is read as a JSON number, true, false or null, else as text)")
+
+
+def takes_hyperparameter(model, name: str) -> bool:
+    """Whether ``model`` or a model nested in it takes the hyperparameter ``name`` (so that its option applies).
+
+    Parameters
+    ----------
+    model : estimator
+        An unfitted or fitted model; its nested models (a first stage, the base behind a backlash) count.
+    name : str
+        Hyperparameter, e.g. ``"fit_offset"``.
+    """
+    stage = model.first_stage()
+    nested = stage.get_params(deep=True) if stage is not None else {}
+    return any(key == name or key.endswith("__" + name) for key in [*model.get_params(deep=True), *nested])
 
 
 def build_model(kind: str, args: argparse.Namespace):

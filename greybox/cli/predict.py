@@ -51,7 +51,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--axis-config", metavar="TOML",
                         help="axis metadata (torque constant, screw lead, gear ratio, efficiency driving and "
                         "back-driven, channel names); adds force_process_N (torque_process_Nm for a rotary axis), "
-                        "converted by the direction of the power flow (see examples/axis_x.toml, axis_c.toml)")
+                        "converted by the direction of the power flow (see examples/axis_x.toml, axis_c.toml; "
+                        "'greybox examples' writes them)")
     parser.add_argument("--machine", metavar="TOML",
                         help="with a machine model (a directory written by 'greybox train --axes'): the machine "
                         "file with each axis's channels and mechanics (see examples/machine.toml); adds each "

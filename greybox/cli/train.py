@@ -15,7 +15,7 @@ from ..metrics import metrics_table
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._advice import offset_note
-from ._build import add_model_arguments, build_model
+from ._build import add_model_arguments, build_model, takes_hyperparameter
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
 from ._provenance import record_training
@@ -145,7 +145,8 @@ def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
         print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     print("  (RE = RMSE / mean |effort|)")
     print("\n".join(model_lines(model)))
-    offset_note([run.effort for run in runs], predictions, unit)
+    if takes_hyperparameter(model, "fit_offset"):
+        offset_note([run.effort for run in runs], predictions, unit)
     return predictions
 
 
