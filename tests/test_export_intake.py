@@ -232,3 +232,13 @@ def test_a_motor_torque_trace_gives_the_injected_force_within_one_percent(export
                  "--out", str(out), "--quiet"]) == 0
     estimated, injected = _cut_force(out, exports["torque_cut"])
     assert estimated == pytest.approx(injected, rel=0.01)
+
+
+def test_runs_split_at_gaps_keep_their_file_name_in_the_training_table(exports, tmp_path, capsys):
+    table = pd.read_csv(exports["aircut_2"])
+    gappy = tmp_path / "gappy.csv"
+    table.drop(index=range(8000, 8100)).to_csv(gappy, index=False)
+    assert main(["train", "--model", "coulomb", "--train", str(gappy), "--out", str(tmp_path / "g.gbm"), "--quiet",
+                 "--resample", "0.002"]) == 0
+    rows = [line.strip() for line in capsys.readouterr().out.splitlines() if line.startswith("  gappy.csv")]
+    assert len(rows) == 2 and all(row.startswith(f"gappy.csv run {k} of 2 ") for k, row in zip((1, 2), rows)), rows

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..atomic import write_text_atomic
+from ..atomic import check_output_path, write_text_atomic
 from ..errors import GreyboxError
-from ..evaluate.records import evaluate_models, write_evaluation_report
+from ..evaluate.records import evaluate_models, write_evaluation_pdf, write_evaluation_report
 from ..evaluate.regimes import REGIME_NAMES
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json
 from ..persistence import load_model
@@ -21,12 +21,13 @@ def add_parser(subparsers) -> None:
         help="test saved models on logs and report their errors",
         description="Load model files, predict the current of every test log, and print RMSE, RE and NMSE per "
         "model, overall and per operating regime (low/high velocity, reversals, constant feed, acceleration). "
-        "With --out, also write a report: metrics.json/csv, tables.md, figures and index.html.",
+        "With --out, also write a report: metrics.json/csv, tables.md, figures and index.html (or one PDF file).",
     )
     parser.add_argument("models", nargs="+", metavar="MODEL", help="model files written by 'greybox train'")
     parser.add_argument("--test", required=True, nargs="+", metavar="LOG",
                         help="test logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat); their errors are pooled")
-    parser.add_argument("--out", metavar="DIR", help="write a report (tables, figures, HTML page) into DIR")
+    parser.add_argument("--out", metavar="DIR", help="write a report (tables, figures, HTML page) into DIR; "
+                        "DIR ending in .pdf: one PDF file of the tables and figures instead")
     parser.add_argument("--json", metavar="FILE", help="write the metric records (with regimes) to FILE")
     parser.add_argument("--force", action="store_true",
                         help="write into a non-empty DIR and replace an existing FILE")
@@ -43,7 +44,9 @@ def _model_names(paths) -> list[str]:
 def _check_outputs(args) -> None:
     """Refuse before any work when an output cannot or must not be written."""
     inputs = [Path(p) for p in list(args.models) + list(args.test)]
-    if args.out:
+    if args.out and Path(args.out).suffix.lower() == ".pdf":
+        check_output_path(args.out, overwrite=args.force, protect=inputs)
+    elif args.out:
         check_output_dir(args.out, force=args.force)
     if args.json:
         target = Path(args.json)
@@ -101,7 +104,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         path = write_text_atomic(args.json, records_json(records))
         print(f"wrote {path}")
-    if args.out:
+    if args.out and Path(args.out).suffix.lower() == ".pdf":
+        print(f"wrote {write_evaluation_pdf(args.out, records, predictions, runs, run_names)}")
+    elif args.out:
         files = write_evaluation_report(args.out, records, predictions, runs, run_names)
         print(f"wrote {files['html']}")
     return 0
