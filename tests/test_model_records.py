@@ -142,3 +142,20 @@ def test_unknown_records_are_skipped_on_loading_and_refused_on_saving(trained, t
 def test_the_record_check_refuses_missing_keys():
     with pytest.raises(ValueError, match="exactly"):
         check_training_record({"version": 1})
+
+
+def test_each_axis_of_a_machine_model_records_its_training(tmp_path):
+    from greybox.data.io import write_log
+    from greybox.data.log import AxisLog
+
+    logs = []
+    for axis, scale in (("X", 1.0), ("Y", 2.0)):
+        log = _log()
+        logs.append(AxisLog(time=log.time, position=scale * log.position, effort=scale * log.effort, axis=axis))
+    write_log(logs, tmp_path / "xy.csv")
+    assert main(["train", "--model", "coulomb", "--axes", "X,Y", "--train", str(tmp_path / "xy.csv"), "--out",
+                 str(tmp_path / "m"), "--quiet"]) == 0
+    for axis, scale in (("X", 1.0), ("Y", 2.0)):
+        _, records = load_model(tmp_path / "m" / f"{axis}.gbm", records=True)
+        assert records["training"]["files"][0]["name"] == "xy.csv"
+        assert records["training"]["ranges"]["position"][1] == pytest.approx(20.0 * scale, rel=0.01)

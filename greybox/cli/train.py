@@ -156,16 +156,17 @@ def _run_machine(args: argparse.Namespace) -> int:
     name, axes = _machine_axes(args)
     check_machine_output(args.out, [axis.name for axis in axes], overwrite=args.force)
     data = {axis.name: _read_all(args, axis) for axis in axes}  # every axis read before any training
-    models = {}
-    predictions = {}
+    models, predictions, records = {}, {}, {}
     for axis in axes:
         model = build_model(args.model, args)
         started = time.perf_counter()
         names, runs = _fit(model, args, *data[axis.name])
         predictions[axis.name] = (runs, _report_fit(model, names, runs, time.perf_counter() - started,
                                                     f"{args.model} for axis {axis.name}"))
+        records[axis.name] = record_training(args, list(args.train) + list(args.stage2 or ()), names, runs,
+                                             predictions[axis.name][1])
         models[axis.name] = model
-    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force)
+    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force, records=records)
     reloaded = load_machine(args.out)
     for axis, (runs, expected) in predictions.items():
         if not all(np.array_equal(reloaded.models[axis].predict(run), p) for run, p in zip(runs, expected)):
