@@ -144,7 +144,7 @@ def test_the_record_check_refuses_missing_keys():
         check_training_record({"version": 1})
 
 
-def test_each_axis_of_a_machine_model_records_its_training(tmp_path):
+def test_each_axis_of_a_machine_model_records_its_training(tmp_path, capsys):
     from greybox.data.io import write_log
     from greybox.data.log import AxisLog
 
@@ -159,3 +159,7 @@ def test_each_axis_of_a_machine_model_records_its_training(tmp_path):
         _, records = load_model(tmp_path / "m" / f"{axis}.gbm", records=True)
         assert records["training"]["files"][0]["name"] == "xy.csv"
         assert records["training"]["ranges"]["position"][1] == pytest.approx(20.0 * scale, rel=0.01)
+    assert main(["predict", str(tmp_path / "m"), str(tmp_path / "xy.csv"), "--out", str(tmp_path / "p.csv"),
+                 "--quiet", "--cutoff-hz", "20"]) == 0
+    warnings = [line for line in capsys.readouterr().err.splitlines() if line.startswith("warning")]
+    assert [("axis X" in line, "axis Y" in line) for line in warnings] == [(True, False), (False, True)]

@@ -393,6 +393,11 @@ def _run_machine(args: argparse.Namespace) -> int:
         return read_runs(args, path, columns=channels or None, axis=name)
 
     runs = {name: read(args.log, name) for name in machine.axes}
+    from ..persistence import load_model
+
+    for name in machine.axes:  # each axis's model file, its training record against the log's preparation
+        records = load_model(Path(args.model) / f"{name}.gbm", records=True)[1]
+        warn_preparation(records, args, runs[name], f"{Path(args.log).name} (axis {name})", f"{name}.gbm")
     log_time = np.concatenate([run.time for run in runs[machine.axes[0]]])
     window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
     intervals = {name: _interval(args, machine.models[name], lambda path, name=name: read(path, name))
