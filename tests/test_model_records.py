@@ -93,6 +93,15 @@ def test_files_without_records_still_load(tmp_path):
     assert records == {} and np.array_equal(loaded.predict(prepare([_log()])[0]), model.predict(prepare([_log()])[0]))
 
 
+def test_info_shows_the_region_of_a_file_without_a_record(tmp_path, capsys):
+    run = prepare([_log()])[0]
+    save_model(CoulombModel().fit(run), tmp_path / "old.gbm")
+    assert main(["info", str(tmp_path / "old.gbm")]) == 0
+    out = capsys.readouterr().out
+    assert "training region:" in out and "training:" not in out
+    assert f"position range [mm] = {run.position.min():.6g} .. {run.position.max():.6g}" in out
+
+
 def _log():
     from greybox.data.log import AxisLog
 

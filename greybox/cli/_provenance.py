@@ -137,3 +137,20 @@ def record_lines(records: dict) -> list[str]:
     for name, (low, high) in record["ranges"].items():
         lines.append(f"  {name + ' range':<14} = {low:.6g} .. {high:.6g}")
     return lines
+
+
+def region_lines(model) -> list[str]:
+    """The training region a model file holds without a training record (files written before it): the
+    ranges of position and velocity the model was fitted on, in its units; none for older files still.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        A fitted model.
+    """
+    units = model.units_
+    ranges = [(f"position range [{units.length}]", getattr(model, "position_range_mm_", None)),
+              (f"velocity range [{units.velocity_unit}]", getattr(model, "velocity_range_mm_s_", None))]
+    shown = [f"  {name} = {low:.6g} .. {high:.6g}" for name, pair in ranges if pair is not None
+             for low, high in [pair]]
+    return ["training region:", *shown] if shown else []

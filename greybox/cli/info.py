@@ -15,7 +15,7 @@ from ..persistence import load_model
 from ..registry import model_kind
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
-from ._provenance import record_lines
+from ._provenance import record_lines, region_lines
 
 #: Suffix of greybox model files by convention (any name works; a ZIP archive is taken for a model file too).
 MODEL_SUFFIX = ".gbm"
@@ -158,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
             print(json.dumps(summary))
         else:
             _print_model(shown[path], summary, model)
-            for line in record_lines(records):
+            for line in record_lines(records) or region_lines(model):
                 print(line)
     if logs:
         _print_logs(args, logs, [shown[path] for path in logs])
