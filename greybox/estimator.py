@@ -29,7 +29,7 @@ from .identify.progress import make_progress
 from .identify.selection import check_selection_record
 from .metrics import rmse
 
-__all__ = ["CurrentModel", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE"]
+__all__ = ["CurrentModel", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
 
 #: Largest magnitude of an identified parameter a model file may carry: currents of a feed axis are
 #: amperes, stiffnesses thousands of A/mm; 1e12 in any unit is a corrupt or hostile file.
@@ -37,6 +37,10 @@ MAX_PARAMETER_MAGNITUDE = 1e12
 
 #: Learned attributes that record the training region: name -> channel of the runs (range [mm] or [mm/s]).
 _REGION_CHANNELS = {"position_range_mm_": "position", "velocity_range_mm_s_": "velocity"}
+
+#: Speed below which a memoryless model's sample counts as standstill, as a share of the largest training
+#: speed [-]: flagged ``"standstill"`` by :meth:`CurrentModel.outside_training`.
+STANDSTILL_SHARE = 0.01
 
 
 def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
@@ -467,7 +471,10 @@ class CurrentModel(ModelProtocol):
         dict of str to ndarray of bool
             ``{"position": ..., "velocity": ...}``: True where the position [mm] or the velocity [mm/s]
             lies outside the range of the training runs (kernel models add ``"inputs"``, their input
-            space). Empty for a model loaded from a file that predates the record of the ranges.
+            space). A memoryless model (:meth:`initial_state` None: Coulomb, Stribeck, SVR) adds
+            ``"standstill"``: speeds below :data:`STANDSTILL_SHARE` of the largest training speed, where
+            the drive holds a friction left by the last motion that such a model cannot know. Empty for a
+            model loaded from a file that predates the record of the ranges.
         """
         flags, _ = self.outside_training_chunk(log, self.region_state(), sample_time=log.sample_time)
         return flags
@@ -506,6 +513,11 @@ class CurrentModel(ModelProtocol):
             if bounds is not None:
                 values = getattr(log, channel)
                 out[channel] = (values < bounds[0]) | (values > bounds[1])
+        speeds = getattr(self, "velocity_range_mm_s_", None)
+        if self.initial_state() is None and speeds is not None:
+            # a memoryless model gives the friction of the velocity alone: at rest the drive holds whatever
+            # friction the last motion left (up to the breakaway level), which it cannot know
+            out["standstill"] = np.abs(log.velocity) < STANDSTILL_SHARE * max(abs(speeds[0]), abs(speeds[1]))
         return out, state
 
     def _check_predict_runs(self, logs) -> list[AxisLog]:

@@ -128,7 +128,8 @@ def check_machine_output(directory: str | PathLike, axes, *, overwrite: bool = F
     return targets
 
 
-def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite: bool = False) -> list[Path]:
+def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite: bool = False,
+                 records: dict | None = None) -> list[Path]:
     """Write a machine model: one model file per axis, then the manifest.
 
     Parameters
@@ -139,6 +140,8 @@ def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite:
         Directory to write; created if missing (its parent must exist).
     overwrite : bool, default False
         Replace the files of an existing machine model in ``directory``.
+    records : dict, optional
+        ``{axis: records}``: the records of each axis's model file (:func:`greybox.persistence.save_model`).
 
     Returns
     -------
@@ -158,7 +161,7 @@ def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite:
     directory.mkdir(exist_ok=True)
     axes = {}
     for axis, model in machine.models.items():
-        save_model(model, targets[axis], overwrite=overwrite)
+        save_model(model, targets[axis], overwrite=overwrite, records=(records or {}).get(axis))
         axes[axis] = {"model": targets[axis].name, "kind": model_kind(model), "motion": model.units_.name}
     manifest = {"format": MACHINE_FORMAT, "format_version": MACHINE_FORMAT_VERSION,
                 "greybox_version": __version__, "name": machine.name, "axes": axes}

@@ -13,6 +13,13 @@ A model file is a ZIP archive (any file name; ``.gbm`` by convention) with
                    "params": {...},       # get_params(deep=False)
                    "attributes": {...}}}  # learned attributes (names ending in "_")
 
+``"records"`` (optional, beside ``"model"``)
+    Self-contained records about the model, each a JSON object under its name and checked on
+    saving and loading by the function :data:`RECORD_CHECKS` holds for that name: ``"training"``
+    (:func:`greybox.provenance.training_record`: training files, preparation, errors, ranges). A
+    record of a name this greybox does not know is skipped; one that fails its check refuses the
+    file. Files without records (older ones) load as before.
+
 ``arrays/NNN_<attribute>.npy``
     One NumPy ``.npy`` file per array, referenced from the JSON as
     ``{"__ndarray__": "arrays/NNN_<attribute>.npy"}`` and read back with
@@ -52,8 +59,12 @@ import numpy as np
 from . import registry
 from .atomic import atomic_output
 from .errors import GreyboxError, ModelFileError
+from .provenance import TRAINING_RECORD, check_training_record
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "save_model", "load_model"]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RECORD_CHECKS", "save_model", "load_model"]
+
+#: Check of each record a model file may hold, by name: returns the record or raises ValueError.
+RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
 
 #: Value of the ``format`` field of every model file.
 FORMAT_NAME = "greybox-model"
@@ -148,7 +159,28 @@ def _write_member(archive: zipfile.ZipFile, name: str, data: bytes) -> None:
     archive.writestr(info, data)
 
 
-def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
+def _checked_records(records, path: Path, action: str) -> dict:
+    """The records of a model file that this greybox knows, each checked; a malformed one is an error."""
+    if records is None:
+        return {}
+    if not isinstance(records, dict):
+        raise ModelFileError(f"{path}: records must be an object of named records")
+    checked = {}
+    for name, record in records.items():
+        check = RECORD_CHECKS.get(name)
+        if check is None:
+            if action == "save":
+                raise ModelFileError(f"{path}: cannot save the unknown record {name!r} "
+                                     f"(known: {', '.join(RECORD_CHECKS)})")
+            continue
+        try:
+            checked[name] = check(record)
+        except (ValueError, TypeError) as error:
+            raise ModelFileError(f"{path}: the {name} record is malformed: {error}") from None
+    return checked
+
+
+def save_model(model, path: str | PathLike, *, overwrite: bool = False, records: dict | None = None) -> Path:
     """Save a (fitted or unfitted) model to one file, atomically.
 
     Parameters
@@ -163,6 +195,8 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
         File to write (``.gbm`` by convention).
     overwrite : bool, default False
         Replace an existing file; otherwise an existing file is an error.
+    records : dict, optional
+        Records about the model by name (``{"training": ...}``), each checked by :data:`RECORD_CHECKS`.
 
     Returns
     -------
@@ -190,6 +224,9 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False) -> Path:
         "greybox_version": __version__,
         "model": encoder.estimator(model, "model"),
     }
+    checked = _checked_records(records, path, "save")
+    if checked:
+        document["records"] = checked
     text = json.dumps(document, indent=1, allow_nan=False)
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
@@ -317,19 +354,22 @@ def _check_members(archive: zipfile.ZipFile, path: Path) -> None:
         raise ModelFileError(f"{path}: members of {total} bytes in all, more than {MAX_TOTAL_BYTES}")
 
 
-def load_model(path: str | PathLike):
+def load_model(path: str | PathLike, *, records: bool = False):
     """Load a model saved by :func:`save_model`.
 
     Parameters
     ----------
     path : str or path-like
         Model file.
+    records : bool, default False
+        Also return the file's records (checked; ``{}`` for a file without any).
 
     Returns
     -------
-    estimator
+    estimator or (estimator, dict)
         A new instance of the saved model's class with its parameters and
         learned attributes restored; it predicts exactly what the saved one did.
+        With ``records``, the model and ``{name: record}``.
 
     Raises
     ------
@@ -366,6 +406,7 @@ def load_model(path: str | PathLike):
                     f"({document.get('greybox_version', 'unknown version')}); this greybox reads versions "
                     f"up to {FORMAT_VERSION}: upgrade greybox"
                 )
+            held = _checked_records(document.get("records"), path, "load")
             decoder = _Decoder(path, archive, version)
             try:
                 model = decoder.estimator(document.get("model"), "model")
@@ -391,4 +432,4 @@ def load_model(path: str | PathLike):
             raise ModelFileError(f"{path}: invalid {type(model).__name__} in the model file: {error}") from None
     if unused:
         raise ModelFileError(f"{path}: member {unused[0]} is not part of the model (no value refers to it)")
-    return model
+    return (model, held) if records else model

@@ -1,4 +1,8 @@
-"""Where a report's figures were measured: greybox and library versions, Python, machine, cores.
+"""Where a report's figures were measured, and how a model was made.
+
+:func:`provenance`: greybox and library versions, Python, machine, cores.
+:func:`training_record`: the training files (name, size, SHA-256), their preparation, the training
+errors and ranges, stored in every model file :mod:`greybox.persistence` writes for ``greybox train``.
 
 Every report greybox writes records this, so a figure can be traced to the
 versions and the machine that printed it (results of the Bayesian search and
@@ -7,12 +11,14 @@ of libsvm may move with library versions; timings move with the core count).
 
 from __future__ import annotations
 
+import math
 import os
 import platform
 import sys
 from importlib import metadata
 
-__all__ = ["LIBRARIES", "provenance", "provenance_line"]
+__all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "PREPARATION_KEYS", "file_identity",
+           "training_record", "check_training_record", "preparation_differences"]
 
 #: Libraries whose versions can move a figure or a timing.
 LIBRARIES = ("numpy", "scipy", "scikit-learn", "scikit-optimize", "pandas", "numba", "matplotlib", "pyarrow", "mcap")
@@ -62,3 +68,203 @@ def provenance_line(info: dict | None = None) -> str:
     libraries = ", ".join(f"{name} {version}" for name, version in info["libraries"].items())
     return (f"greybox {info['greybox']}, Python {info['python']}, {info['platform']}, {info['cpu_count']} cores; "
             f"{libraries}")
+
+
+# ------------------------------------------------------------------ how a model was made
+#: Name of the training record in a model file's records (:func:`greybox.persistence.save_model`).
+TRAINING_RECORD = "training"
+#: Version of the training record's layout.
+TRAINING_RECORD_VERSION = 1
+#: Keys of the training record's ``preparation``: the options that change what a model sees of a log.
+PREPARATION_KEYS = ("sample_time_s", "cutoff_hz", "resample_s", "max_gap_steps", "time_tolerance", "derived")
+#: Relative difference of a sample time or cut-off that counts as a different preparation.
+PREPARATION_TOLERANCE = 0.01
+_HEX = frozenset("0123456789abcdef")
+_MAX_FILES = 10_000
+
+
+def file_identity(path) -> dict:
+    """Name, size and SHA-256 of a file, to tell later whether a log is the one a model was trained on.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    dict
+        ``name`` (the file name without folders), ``bytes`` and ``sha256`` (hex digest of the content).
+    """
+    import hashlib
+
+    digest = hashlib.sha256()
+    size = 0
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+            size += len(block)
+    return {"name": os.path.basename(os.fspath(path)), "bytes": size, "sha256": digest.hexdigest()}
+
+
+def training_record(files, preparation: dict, runs, total: dict, ranges: dict) -> dict:
+    """The record of how a model was made, checked (:func:`check_training_record`), JSON-ready.
+
+    Parameters
+    ----------
+    files : list of dict
+        :func:`file_identity` of every training log.
+    preparation : dict
+        The preparation of the training runs, keys :data:`PREPARATION_KEYS`: the runs' sample time [s],
+        the derivative filter's cut-off [Hz] (the one used, default or given), ``resample_s`` [s] or None,
+        ``max_gap_steps``, ``time_tolerance`` (fraction) and ``derived`` (channels derived from the position).
+    runs : list of dict
+        Per training run: ``name``, ``samples``, ``rmse`` (in the effort unit) and ``re_percent``.
+    total : dict
+        The same figures over all runs, and ``unit`` (the effort unit).
+    ranges : dict
+        ``{channel: [low, high]}`` of the training runs (position, velocity, acceleration in the log's units).
+
+    Returns
+    -------
+    dict
+        ``{"version", "greybox", "files", "preparation", "runs", "training_error", "ranges"}``: the same
+        logs and options give the same record (no time stamps, no output name), so a model file stays
+        reproducible byte for byte.
+    """
+    record = {"version": TRAINING_RECORD_VERSION, "greybox": _version("greybox"),
+              "files": list(files), "preparation": dict(preparation), "runs": list(runs),
+              "training_error": dict(total), "ranges": {name: list(pair) for name, pair in ranges.items()}}
+    return check_training_record(record)
+
+
+def _number(value, where: str, *, optional: bool = False, positive: bool = False):
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{where} must be a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise ValueError(f"{where} must be positive, got {value!r}")
+    return value
+
+
+def _text(value, where: str, limit: int = 4096) -> str:
+    if not isinstance(value, str) or len(value) > limit:
+        raise ValueError(f"{where} must be text of at most {limit} characters")
+    return value
+
+
+def check_training_record(record) -> dict:
+    """Check a training record's layout and values (a model file is never trusted); return it.
+
+    Parameters
+    ----------
+    record : object
+        The record as read from a model file.
+
+    Returns
+    -------
+    dict
+        The same record.
+
+    Raises
+    ------
+    ValueError
+        Naming the first key that is missing, of the wrong type or out of range.
+    """
+    if not isinstance(record, dict):
+        raise ValueError("the record must be an object")
+    expected = {"version", "greybox", "files", "preparation", "runs", "training_error", "ranges"}
+    if set(record) != expected:
+        raise ValueError(f"the record must hold exactly {', '.join(sorted(expected))}")
+    if record["version"] != TRAINING_RECORD_VERSION:
+        raise ValueError(f"version {record['version']!r} is not {TRAINING_RECORD_VERSION}")
+    _text(record["greybox"], "greybox")
+    files = record["files"]
+    if not isinstance(files, list) or len(files) > _MAX_FILES:
+        raise ValueError(f"files must be a list of at most {_MAX_FILES}")
+    for k, entry in enumerate(files):
+        if not isinstance(entry, dict) or set(entry) != {"name", "bytes", "sha256"}:
+            raise ValueError(f"files[{k}] must hold name, bytes and sha256")
+        _text(entry["name"], f"files[{k}].name", 1024)
+        if isinstance(entry["bytes"], bool) or not isinstance(entry["bytes"], int) or entry["bytes"] < 0:
+            raise ValueError(f"files[{k}].bytes must be a non-negative integer")
+        digest = entry["sha256"]
+        if not isinstance(digest, str) or len(digest) != 64 or not set(digest) <= _HEX:
+            raise ValueError(f"files[{k}].sha256 must be 64 hex digits")
+    preparation = record["preparation"]
+    if not isinstance(preparation, dict) or set(preparation) != set(PREPARATION_KEYS):
+        raise ValueError(f"preparation must hold exactly {', '.join(PREPARATION_KEYS)}")
+    _number(preparation["sample_time_s"], "preparation.sample_time_s", positive=True)
+    _number(preparation["cutoff_hz"], "preparation.cutoff_hz", optional=True, positive=True)
+    _number(preparation["resample_s"], "preparation.resample_s", optional=True, positive=True)
+    _number(preparation["max_gap_steps"], "preparation.max_gap_steps", positive=True)
+    _number(preparation["time_tolerance"], "preparation.time_tolerance", positive=True)
+    derived = preparation["derived"]
+    if not isinstance(derived, list) or not all(name in ("velocity", "acceleration") for name in derived):
+        raise ValueError("preparation.derived must list velocity and/or acceleration")
+    runs = record["runs"]
+    if not isinstance(runs, list) or len(runs) > _MAX_FILES:
+        raise ValueError(f"runs must be a list of at most {_MAX_FILES}")
+    for k, entry in enumerate([*runs, record["training_error"]]):
+        where = f"runs[{k}]" if k < len(runs) else "training_error"
+        keys = {"name", "samples", "rmse", "re_percent"} if k < len(runs) else {"samples", "rmse", "re_percent",
+                                                                                 "unit"}
+        if not isinstance(entry, dict) or set(entry) != keys:
+            raise ValueError(f"{where} must hold {', '.join(sorted(keys))}")
+        _text(entry.get("name", entry.get("unit")), f"{where}.{'name' if k < len(runs) else 'unit'}", 1024)
+        if isinstance(entry["samples"], bool) or not isinstance(entry["samples"], int) or entry["samples"] < 0:
+            raise ValueError(f"{where}.samples must be a non-negative integer")
+        _number(entry["rmse"], f"{where}.rmse")
+        _number(entry["re_percent"], f"{where}.re_percent", optional=True)
+    ranges = record["ranges"]
+    if not isinstance(ranges, dict) or not set(ranges) <= {"position", "velocity", "acceleration"}:
+        raise ValueError("ranges must be an object of position, velocity and acceleration")
+    for name, pair in ranges.items():
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise ValueError(f"ranges.{name} must be [low, high]")
+        low, high = (_number(value, f"ranges.{name}") for value in pair)
+        if low > high:
+            raise ValueError(f"ranges.{name} has low {low} above high {high}")
+    return record
+
+
+def preparation_differences(trained: dict, used: dict) -> list[str]:
+    """How a log's preparation differs from the training logs' (empty when it does not).
+
+    Parameters
+    ----------
+    trained : dict
+        ``preparation`` of the model's training record.
+    used : dict
+        The same keys for the log at hand (:data:`PREPARATION_KEYS`).
+
+    Returns
+    -------
+    list of str
+        One phrase per difference, e.g. ``"cut-off 20 Hz (training 50 Hz; --cutoff-hz 50)"``.
+    """
+    differences = []
+
+    def differs(a, b) -> bool:
+        if a is None or b is None:
+            return a is not b
+        return abs(a - b) > PREPARATION_TOLERANCE * max(abs(a), abs(b))
+
+    if differs(used["cutoff_hz"], trained["cutoff_hz"]):
+        differences.append(f"derivative cut-off {used['cutoff_hz']:g} Hz (training {trained['cutoff_hz']:g} Hz; "
+                           f"--cutoff-hz {trained['cutoff_hz']:g})")
+    if differs(used["sample_time_s"], trained["sample_time_s"]):
+        option = (f"--resample {trained['sample_time_s']:g}" if trained["resample_s"] is None
+                  else f"--resample {trained['resample_s']:g}")
+        differences.append(f"sample time {used['sample_time_s'] * 1e3:g} ms (training "
+                           f"{trained['sample_time_s'] * 1e3:g} ms; {option})")
+    elif differs(used["resample_s"], trained["resample_s"]):
+        now, then = (f"--resample {value:g}" if value is not None else "no --resample"
+                     for value in (used["resample_s"], trained["resample_s"]))
+        differences.append(f"{now} (training {then})")
+    if sorted(used["derived"]) != sorted(trained["derived"]):
+        shown = ", ".join(used["derived"]) or "nothing"
+        differences.append(f"derived {shown} (training derived {', '.join(trained['derived']) or 'nothing'}: a "
+                           "logged velocity in one and not the other)")
+    return differences

@@ -81,7 +81,7 @@ def test_the_command_line_resamples_splits_with_a_note_and_names_resample_otherw
     captured = capsys.readouterr()
     assert status == 0, captured.err
     assert "note: gappy.csv: split into 2 runs at gaps longer than 5 steps (--max-gap)" in captured.err
-    assert "gappy.csv run 1/2" in captured.out and "gappy.csv run 2/2" in captured.out
+    assert "gappy.csv run 1 of 2" in captured.out and "gappy.csv run 2 of 2" in captured.out
     status = cli.main(["info", str(path), "--resample", "0.002", "--max-gap", "40"])
     assert status == 0 and "split" not in capsys.readouterr().err
     assert cli.main(["plot", str(path), "--resample", "0.002", "--out", str(tmp_path / "p.png")]) == 2

@@ -34,7 +34,8 @@ def test_the_region_is_the_range_of_the_training_runs_and_the_flags_follow_it(lo
     assert model.position_range_mm_ == [logs["A"].position.min(), logs["A"].position.max()]
     assert model.velocity_range_mm_s_ == [logs["A"].velocity.min(), logs["A"].velocity.max()]
     inside = model.outside_training(logs["A"])
-    assert set(inside) == {"position", "velocity"} and not any(mask.any() for mask in inside.values())
+    assert set(inside) == {"position", "velocity", "standstill"}  # a memoryless model flags standstill too
+    assert not inside["position"].any() and not inside["velocity"].any()
     far = model.outside_training(logs["D"])
     low, high = model.position_range_mm_
     np.testing.assert_array_equal(far["position"], (logs["D"].position < low) | (logs["D"].position > high))
@@ -63,9 +64,10 @@ def test_predict_reports_records_and_marks_the_samples_outside(logs, tmp_path, c
     captured = capsys.readouterr()
     assert status == 0, captured.err
     meta = json.loads(Path(str(out) + ".json").read_text())["attrs"]["extrapolation"]
-    assert meta["share"] > EXTRAPOLATION_WARNING_SHARE and set(meta["by"]) == {"position", "velocity"}
+    assert meta["share"] > EXTRAPOLATION_WARNING_SHARE and set(meta["by"]) == {"position", "velocity", "standstill"}
     assert f"outside the training region: {100 * meta['share']:.1f} % of the samples" in captured.out
-    note = [line for line in captured.err.splitlines() if line.startswith("note: cut.mcap:")]
+    note = [line for line in captured.err.splitlines()
+            if line.startswith("note: cut.mcap:") and "standstill" not in line]
     assert len(note) == 1 and "the model extrapolates there (column outside_training)" in note[0]
     import pandas as pd
 
@@ -90,10 +92,11 @@ def test_inside_the_window_there_is_no_note_and_every_format_carries_the_column(
     out = tmp_path / f"p{suffix}"
     status = cli.main(["predict", str(tmp_path / "m.gbm"), str(tmp_path / "cut.mcap"), "--out", str(out), "--quiet"])
     captured = capsys.readouterr()
-    assert status == 0 and "note:" not in captured.err
-    assert "outside the training region: 0.0 % of the samples" in captured.out
+    assert status == 0 and "extrapolates" not in captured.err
+    assert "(position 0.0 %, velocity 0.0 %, standstill" in captured.out
     flags = read_log(out, columns={"current_A": "current_measured_A"}).extras["outside_training"]
-    assert flags.size > 1000 and np.all(flags == 0.0)
+    standstill = model.outside_training(prepare([read_log(tmp_path / "cut.mcap")])[0])["standstill"]
+    assert flags.size > 1000 and np.array_equal(flags == 1.0, standstill)  # only the memoryless model's rests
 
 
 def test_a_model_file_without_a_region_still_predicts_and_says_so(logs, tmp_path, capsys):

@@ -65,7 +65,9 @@ def test_linear_and_rotary_units_together_are_refused(tmp_path):
     with pytest.raises(LogError, match=r"mix a linear and a rotary axis: 'position_deg' \(rotary\), "
                                        r"'velocity_mm_s' \(linear\)"):
         read_log(path)
-    path.write_text("time_s,position_mm,torque_Nm\n0,0,0\n0.002,1,1\n")
+    path.write_text("time_s,position_mm,force_N,velocity_deg_s\n0,0,0,0\n0.002,1,1,1\n")
+    read_log(path)  # a rotary velocity beside a linear position is a motor's speed: an extra channel
+    path.write_text("time_s,position_deg,force_N\n0,0,0\n0.002,1,1\n")
     with pytest.raises(LogError, match="mix a linear and a rotary axis"):
         read_log(path)
 

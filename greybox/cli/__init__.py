@@ -17,13 +17,14 @@ import os
 import signal
 import sys
 import threading
+import time
 
 from ..errors import GreyboxError
 from ._notes import command_notes, error_message
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
 COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate",
-            "plan", "live")
+            "plan", "live", "examples")
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -83,6 +84,21 @@ def _stopped(stop: KeyboardInterrupt, command: str) -> int:
     return 130
 
 
+def process_age_s() -> float | None:
+    """Seconds since this process started (Python's start-up and imports included), or None where unknown.
+
+    Read from Linux's ``/proc`` (the process's start in clock ticks since boot, against the uptime).
+    """
+    try:
+        with open("/proc/self/stat", encoding="ascii") as stream:
+            fields = stream.read().rsplit(")", 1)[1].split()
+        with open("/proc/uptime", encoding="ascii") as stream:
+            uptime = float(stream.read().split()[0])
+        return max(0.0, uptime - int(fields[19]) / os.sysconf("SC_CLK_TCK"))  # field 22: starttime
+    except (OSError, ValueError, IndexError, AttributeError):
+        return None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the ``greybox`` command and return its exit status.
 
@@ -91,6 +107,9 @@ def main(argv: list[str] | None = None) -> int:
     """
     parser = build_parser()
     args = parser.parse_args(argv)
+    age = process_age_s() if argv is None else None  # a command of its own: its start-up counts too
+    args.started_s = time.perf_counter() - (age or 0.0)
+    args.startup_counted = age is not None
     installed = threading.current_thread() is threading.main_thread()  # signals reach the main thread only
     previous = signal.signal(signal.SIGTERM, _terminate) if installed else None
     try:

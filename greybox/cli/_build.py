@@ -10,7 +10,7 @@ from ..friction.backlash import BacklashModel
 from ..registry import model_class
 from ._types import NON_NEGATIVE, POSITIVE_INT, SEED
 
-__all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting"]
+__all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting", "takes_hyperparameter"]
 
 
 class CommandLineError(GreyboxError):
@@ -27,7 +27,7 @@ _MODEL_OPTIONS = (
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model options",
-                        settings: bool = True, backlash: bool = False) -> None:
+                        settings: bool = True, backlash: bool = False, offset_default: bool = False) -> None:
     """Add the options that set the hyperparameters of the model a command builds.
 
     Parameters
@@ -40,9 +40,20 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
         Also offer ``--set NAME=VALUE`` for any hyperparameter.
     backlash : bool, default False
         Also offer ``--backlash`` (a model behind an identified backlash).
+    offset_default : bool, default False
+        Fit a constant effort offset unless ``--no-offset`` (or ``--asymmetric``) is given: a current
+        sensor's offset, or the weight a vertical axis carries, is in every real drive's current, and a
+        model without it reads the offset as process force (``greybox train``).
     """
     group = parser.add_argument_group(title)
-    group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
+    if offset_default:
+        group.add_argument("--offset", action=argparse.BooleanOptionalAction, default=None,
+                           help="fit a constant effort offset (a current sensor's offset, an axis's weight): the "
+                           "default of the models that take one, except with --asymmetric; --no-offset leaves "
+                           "it out")
+        parser.set_defaults(offset_default=True)
+    else:
+        group.add_argument("--offset", action="store_true", help="also fit a constant effort offset")
     group.add_argument("--asymmetric", action="store_true",
                        help="direction-dependent friction: sliding levels, Stribeck curve and viscous "
                        "coefficient of their own for positive and negative motion (coulomb, stribeck, lugre, gms, "
@@ -70,13 +81,30 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
                            "VALUE is read as a JSON number, true, false or null, else as text)")
 
 
+def takes_hyperparameter(model, name: str) -> bool:
+    """Whether ``model`` or a model nested in it takes the hyperparameter ``name`` (so that its option applies).
+
+    Parameters
+    ----------
+    model : estimator
+        An unfitted or fitted model; its nested models (a first stage, the base behind a backlash) count.
+    name : str
+        Hyperparameter, e.g. ``"fit_offset"``.
+    """
+    stage = model.first_stage()
+    nested = stage.get_params(deep=True) if stage is not None else {}
+    return any(key == name or key.endswith("__" + name) for key in [*model.get_params(deep=True), *nested])
+
+
 def build_model(kind: str, args: argparse.Namespace):
     """Return an unfitted model of ``kind`` with the hyperparameters given on the command line.
 
     Options a command does not offer count as not given. An option the
     model does not take but its first stage does (``--asymmetric``,
     ``--elements``, ``--offset`` of gmssvr) is set on the first stage.
-    ``--backlash`` wraps the model in a :class:`BacklashModel`.
+    ``--backlash`` wraps the model in a :class:`BacklashModel`. With ``offset_default`` set on
+    ``args`` (:func:`add_model_arguments`), a model that takes an offset fits one unless ``--no-offset``
+    or ``--asymmetric`` says otherwise.
 
     Parameters
     ----------
@@ -97,6 +125,12 @@ def build_model(kind: str, args: argparse.Namespace):
     params, stage_params = {}, {}
     for option, attribute, name in _MODEL_OPTIONS:
         value = getattr(args, attribute, None)
+        if value is None and name == "fit_offset" and getattr(args, "offset_default", False) \
+                and not getattr(args, "asymmetric", False) \
+                and not any(setting.partition("=")[0].strip() in ("asymmetric", name)
+                            for setting in getattr(args, "set", None) or []):
+            takes = name in accepted or (stage is not None and name in stage.get_params(deep=False))
+            value = True if takes else None  # the default where the model takes an offset
         if value is None or value is False:
             continue
         if name in accepted:

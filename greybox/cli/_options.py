@@ -98,7 +98,8 @@ def read_logs(args: argparse.Namespace, paths, *, prepare: bool = True) -> list[
 
 def read_named_runs(args: argparse.Namespace, paths, names, *, prepare: bool = True
                     ) -> tuple[list[AxisLog], list[str]]:
-    """Like :func:`read_logs`, with a name per run: the file's ``names`` entry, plus ``run k/n`` where split.
+    """Like :func:`read_logs`, with a name per run: the file's ``names`` entry, plus ``run k of n`` where split
+    (no slash, so that a file name taken of the label keeps it).
 
     Parameters
     ----------
@@ -123,7 +124,7 @@ def read_named_runs(args: argparse.Namespace, paths, names, *, prepare: bool = T
     for path, name in zip(paths, names):
         pieces = read_runs(args, path, columns=columns, prepare=prepare)
         runs += pieces
-        labels += [name] if len(pieces) == 1 else [f"{name} run {k}/{len(pieces)}" for k in
+        labels += [name] if len(pieces) == 1 else [f"{name} run {k} of {len(pieces)}" for k in
                                                     range(1, len(pieces) + 1)]
     return runs, labels
 

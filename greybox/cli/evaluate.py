@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..atomic import write_text_atomic
+from ..atomic import check_output_path, write_text_atomic
 from ..errors import GreyboxError
-from ..evaluate.records import evaluate_models, write_evaluation_report
+from ..evaluate.records import evaluate_models, write_evaluation_pdf, write_evaluation_report
 from ..evaluate.regimes import REGIME_NAMES
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json
 from ..persistence import load_model
 from ._options import add_log_arguments, read_named_runs
+from ._provenance import warn_preparation
 
 
 def add_parser(subparsers) -> None:
@@ -20,12 +21,13 @@ def add_parser(subparsers) -> None:
         help="test saved models on logs and report their errors",
         description="Load model files, predict the current of every test log, and print RMSE, RE and NMSE per "
         "model, overall and per operating regime (low/high velocity, reversals, constant feed, acceleration). "
-        "With --out, also write a report: metrics.json/csv, tables.md, figures and index.html.",
+        "With --out, also write a report: metrics.json/csv, tables.md, figures and index.html (or one PDF file).",
     )
     parser.add_argument("models", nargs="+", metavar="MODEL", help="model files written by 'greybox train'")
     parser.add_argument("--test", required=True, nargs="+", metavar="LOG",
                         help="test logs (CSV, Parquet, MCAP, TDMS or MATLAB .mat); their errors are pooled")
-    parser.add_argument("--out", metavar="DIR", help="write a report (tables, figures, HTML page) into DIR")
+    parser.add_argument("--out", metavar="DIR", help="write a report (tables, figures, HTML page) into DIR; "
+                        "DIR ending in .pdf: one PDF file of the tables and figures instead")
     parser.add_argument("--json", metavar="FILE", help="write the metric records (with regimes) to FILE")
     parser.add_argument("--force", action="store_true",
                         help="write into a non-empty DIR and replace an existing FILE")
@@ -42,7 +44,9 @@ def _model_names(paths) -> list[str]:
 def _check_outputs(args) -> None:
     """Refuse before any work when an output cannot or must not be written."""
     inputs = [Path(p) for p in list(args.models) + list(args.test)]
-    if args.out:
+    if args.out and Path(args.out).suffix.lower() == ".pdf":
+        check_output_path(args.out, overwrite=args.force, protect=inputs)
+    elif args.out:
         check_output_dir(args.out, force=args.force)
     if args.json:
         target = Path(args.json)
@@ -81,8 +85,13 @@ def _print_records(records, unit: str, run_names) -> None:
 def run(args: argparse.Namespace) -> int:
     _check_outputs(args)
     names = _model_names(args.models)
-    models = dict(zip(names, (load_model(path) for path in args.models)))
+    loaded = dict(zip(names, (load_model(path, records=True) for path in args.models)))
+    models = {name: model for name, (model, _) in loaded.items()}
     runs, run_names = read_named_runs(args, args.test, _model_names(args.test))
+    for name, (_, records) in loaded.items():
+        for path in dict.fromkeys(args.test):
+            warn_preparation(records, args, [run for run in runs if run.source == str(path)] or runs,
+                             Path(path).name, name)
     units = dict.fromkeys(run.effort_unit for run in runs)
     if len(units) > 1:
         listed = ", ".join(f"{name} in {run.effort_unit}" for name, run in zip(run_names, runs))
@@ -95,7 +104,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         path = write_text_atomic(args.json, records_json(records))
         print(f"wrote {path}")
-    if args.out:
+    if args.out and Path(args.out).suffix.lower() == ".pdf":
+        print(f"wrote {write_evaluation_pdf(args.out, records, predictions, runs, run_names)}")
+    elif args.out:
         files = write_evaluation_report(args.out, records, predictions, runs, run_names)
         print(f"wrote {files['html']}")
     return 0

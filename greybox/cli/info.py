@@ -15,6 +15,7 @@ from ..persistence import load_model
 from ..registry import model_kind
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
+from ._provenance import record_lines, region_lines
 
 #: Suffix of greybox model files by convention (any name works; a ZIP archive is taken for a model file too).
 MODEL_SUFFIX = ".gbm"
@@ -154,14 +155,16 @@ def _print_model(name: str, summary: dict, model) -> None:
 def run(args: argparse.Namespace) -> int:
     shown = dict(zip(args.logs, display_names(list(args.logs))))
     kinds = {path: is_model_file(path) for path in args.logs}
-    models = [(path, load_model(path)) for path in args.logs if kinds[path]]  # every model file checked first
+    models = [(path, *load_model(path, records=True)) for path in args.logs if kinds[path]]  # all checked first
     logs = [path for path in args.logs if not kinds[path]]
-    for path, model in models:
-        summary = describe_model(path, model)
+    for path, model, records in models:
+        summary = {**describe_model(path, model), **({"records": records} if records else {})}
         if args.json:
             print(json.dumps(summary))
         else:
             _print_model(shown[path], summary, model)
+            for line in record_lines(records) or region_lines(model):
+                print(line)
     if logs:
         _print_logs(args, logs, [shown[path] for path in logs])
     return 0

@@ -18,9 +18,11 @@ from ..metrics import metrics_table
 from ..model_choice import DEFAULT_CANDIDATES
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
-from ._build import add_model_arguments, build_model
+from ._advice import offset_note
+from ._build import add_model_arguments, build_model, takes_hyperparameter
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
+from ._provenance import record_training
 from ._types import POSITIVE_INT
 
 
@@ -66,7 +68,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--force", action="store_true",
                         help="overwrite MODEL (the machine model) if it exists; with --per-machine, train every "
                         "model again, also those complete from an earlier run")
-    add_model_arguments(parser, backlash=True)
+    add_model_arguments(parser, backlash=True, offset_default=True)
     parser.add_argument("--quiet", action="store_true", help="no progress display during the identification")
     parser.add_argument("--intervals", choices=INTERVAL_METHODS, default="sandwich",
                         help="95 %% intervals of the identified parameters, stored in the model file and printed "
@@ -182,6 +184,8 @@ def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
         print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     print("  (RE = RMSE / mean |effort|)")
     print("\n".join(model_lines(model)))
+    if takes_hyperparameter(model, "fit_offset"):
+        offset_note([run.effort for run in runs], predictions, unit)
     return predictions
 
 
@@ -191,16 +195,17 @@ def _run_machine(args: argparse.Namespace) -> int:
     name, axes = _machine_axes(args)
     check_machine_output(args.out, [axis.name for axis in axes], overwrite=args.force)
     data = {axis.name: _read_all(args, axis) for axis in axes}  # every axis read before any training
-    models = {}
-    predictions = {}
+    models, predictions, records = {}, {}, {}
     for axis in axes:
         model = build_model(args.model, args)
         started = time.perf_counter()
         names, runs = _fit(model, args, *data[axis.name])
         predictions[axis.name] = (runs, _report_fit(model, names, runs, time.perf_counter() - started,
                                                     f"{args.model} for axis {axis.name}"))
+        records[axis.name] = record_training(args, list(args.train) + list(args.stage2 or ()), names, runs,
+                                             predictions[axis.name][1])
         models[axis.name] = model
-    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force)
+    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force, records=records)
     reloaded = load_machine(args.out)
     for axis, (runs, expected) in predictions.items():
         if not all(np.array_equal(reloaded.models[axis].predict(run), p) for run, p in zip(runs, expected)):
@@ -286,13 +291,14 @@ def _run_auto(args: argparse.Namespace) -> int:
     names = [Path(group).name for group in groups]
     predictions = _report_fit(model, names, runs, time.perf_counter() - started,
                               f"{model.selection_['chosen']} (chosen by held-out runs)")
-    _save_checked(model, out, args.force, runs, predictions)
+    _save_checked(model, out, args.force, runs, predictions,
+                  record_training(args, list(args.train), names, runs, predictions))
     return 0
 
 
-def _save_checked(model, out: Path, overwrite: bool, runs, predictions) -> None:
-    """Save the model and check that the file predicts what the fitted model did."""
-    save_model(model, out, overwrite=overwrite)
+def _save_checked(model, out: Path, overwrite: bool, runs, predictions, records) -> None:
+    """Save the model with its records and check that the file predicts what the fitted model did."""
+    save_model(model, out, overwrite=overwrite, records=records)
     reloaded = load_model(out)
     if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):
         raise ModelFileError(f"{out}: the saved model does not reproduce the fitted model's predictions")
@@ -322,5 +328,5 @@ def run(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     names, runs = _fit(model, args, *_read_all(args))
     predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
-    _save_checked(model, out, args.force, runs, predictions)
+    _save_checked(model, out, args.force, runs, predictions, record_training(args, inputs, names, runs, predictions))
     return 0

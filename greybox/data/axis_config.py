@@ -6,7 +6,7 @@ axis, ``examples/axis_c.toml``)::
     name = "X"                        # optional: axis name
     torque_constant_Nm_per_A = 1.35   # motor torque constant k_t [Nm/A]
     screw_lead_mm = 10.0              # table travel per screw revolution h [mm]
-    gear_ratio = 1.0                  # motor revolutions per screw revolution i [-]
+    gear_ratio = 1.0                  # motor revolutions per screw revolution i [-] (default 1)
     efficiency_driving = 0.92         # motor drives the table against the load, 0 < eta <= 1 [-]
     efficiency_backdriven = 0.88      # the load drives the table along, the motor brakes [-]
 
@@ -34,6 +34,7 @@ The load (force or torque) these constants give is derived in :mod:`greybox.eval
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -74,6 +75,12 @@ _OPTIONAL = ("name", "motion")
 
 #: The quantity a linear axis needs and a rotary axis must not give.
 _SCREW = "screw_lead_mm"
+
+#: Values of an efficiency that read as a percentage of a real drive train (write x / 100 instead) [%].
+PERCENT_EFFICIENCY = (30.0, 100.0)
+
+#: Keys with a default: a motor coupled directly (gear ratio 1).
+DEFAULTS = {"gear_ratio": 1.0}
 
 #: Smallest plausible screw lead [mm]; a smaller value was most likely written in metres.
 MIN_LEAD_MM = 0.1
@@ -166,6 +173,10 @@ class AxisConfig:
         lossless = self.lossless_load_constant
         return lossless * self.efficiency_driving, lossless / self.efficiency_backdriven
 
+    def without_torque_constant(self) -> "AxisConfig":
+        """The same drive train for a log whose effort is the motor torque [Nm], not the current: ``k_t = 1``."""
+        return dataclasses.replace(self, torque_constant_Nm_per_A=1.0)
+
     def process_load(self, process_current_A, velocity):
         """Load the drive exerts on the axis for a process current [A], by the direction of power flow.
 
@@ -227,7 +238,11 @@ def _check_values(values: Mapping[str, object], where: str, names: Mapping[str, 
     for key in _EFFICIENCIES:
         efficiency = values[key]
         if efficiency > 1.0:
-            hint = f"; {efficiency:g} looks like a percentage, write {efficiency / 100:g}" if efficiency <= 100 else ""
+            if PERCENT_EFFICIENCY[0] <= efficiency <= PERCENT_EFFICIENCY[1]:
+                hint = f"; {efficiency:g} looks like a percentage, write {efficiency / 100:g}"
+            else:
+                hint = ("; an efficiency above 1 would make the drive train create power: write the share that "
+                        "arrives, about 0.9 for a ball screw")
             _fail(where, f"{names.get(key, key)} must be a fraction 0 < eta <= 1, got {efficiency:g}{hint}")
     lead = values.get(_SCREW, MIN_LEAD_MM)
     if lead < MIN_LEAD_MM:
@@ -323,6 +338,7 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
                 _fail(where, f"'{key}': {problem}; give the {words} as '{accepted}' (in {unit})")
             expected = ", ".join(list(QUANTITIES) + [SHARED_EFFICIENCY] + list(_OPTIONAL) + ["[channels]"])
             _fail(where, f"unknown key '{key}'; expected {expected}")
+    values = {**{key: value for key, value in DEFAULTS.items() if key in required}, **values}
     missing = [key for key in required if key not in values]
     if any(key in missing for key in _EFFICIENCIES) and not given:
         missing = [key for key in missing if key not in _EFFICIENCIES]

@@ -39,21 +39,74 @@ __all__ = ["read_csv", "write_csv"]
 _METADATA_TAG = "# greybox "
 
 
-def _preamble(path) -> tuple[int, dict, str]:
-    """Count leading comment lines, parse greybox metadata, return the header line."""
-    comments, metadata = 0, {}
+#: Lines looked at to find the header below a preamble.
+_HEAD_LINES = 200
+
+
+def _fields(line: str, delimiter: str) -> list[str]:
+    return [field.strip().strip('"') for field in line.rstrip("\r\n").split(delimiter)]
+
+
+def _number(text: str, decimal: str) -> bool:
+    try:
+        float(text.replace(decimal, ".") if decimal != "." else text)
+    except ValueError:
+        return False
+    return True
+
+
+def _layout(path) -> tuple[int, int | None, dict, str, str, str]:
+    """Where the header is and how the file is written.
+
+    Returns the header's line index (below ``#`` comments and a controller's preamble of other lines), the
+    index of a units row under it (or None), greybox metadata from a ``# greybox {...}`` comment, the header
+    line, the delimiter and the decimal mark.
+    """
+    metadata, lines = {}, []
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
-            for line in stream:
-                if not line.startswith("#"):
-                    return comments, metadata, line
+            for index, line in zip(range(_HEAD_LINES), stream):
                 if line.startswith(_METADATA_TAG):
                     metadata = parse_metadata(line[len(_METADATA_TAG):], path,
-                                              f"line {comments + 1}: greybox metadata")
-                comments += 1
+                                              f"line {index + 1}: greybox metadata")
+                lines.append(line)
     except UnicodeDecodeError as exc:
         raise LogError(path, f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None
-    return comments, metadata, ""
+    content = [(index, line) for index, line in enumerate(lines) if line.strip() and not line.startswith("#")]
+    if not content:
+        return len(lines), None, metadata, "", ",", "."
+    # the data rows set the delimiter and the number of fields; the header is the first line of that many
+    tail = [line for _, line in content[-5:]]
+    # tab or semicolon when every data row holds one (a decimal comma then makes commas of its own)
+    delimiter = next((mark for mark in ("\t", ";") if min(line.count(mark) for line in tail) > 0), ",")
+    width = min(line.count(delimiter) for line in tail)
+    header_at = next((k for k, (_, line) in enumerate(content) if line.count(delimiter) == width and width > 0), 0)
+    header_index, header = content[header_at]
+    rows = [line for _, line in content[header_at + 1:header_at + 3]]
+    decimal = "," if delimiter == ";" and any("," in line for line in rows[-1:]) else "."
+    units_index = None
+    if len(rows) == 2:
+        first, second = _fields(rows[0], delimiter), _fields(rows[1], delimiter)
+        if not any(_number(text, decimal) for text in first) and any(_number(text, decimal) for text in second):
+            units_index = content[header_at + 1][0]
+    return header_index, units_index, metadata, header, delimiter, decimal
+
+
+def _headers(header: str, units: str | None, delimiter: str) -> list[str]:
+    """The column names: the header's, each with the unit of a units row below it as ``name [unit]``."""
+    names = _fields(header, delimiter)
+    if units is not None:
+        written = _fields(units, delimiter)
+        names = [f"{name} [{unit.strip('[]()')}]" if unit.strip("[]()") else name
+                 for name, unit in zip(names, written + [""] * (len(names) - len(written)))]
+    seen: dict[str, int] = {}
+    for k, name in enumerate(names):  # a repeated header becomes name.1, name.2 (as pandas names them)
+        if name in seen:
+            seen[name] += 1
+            names[k] = f"{name}.{seen[name]}"
+        else:
+            seen[name] = 0
+    return names
 
 
 def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: float | None = None,
@@ -86,28 +139,36 @@ def read_csv(path, *, columns: Mapping[str, str] | None = None, sample_time: flo
         that do not give the required channels (see :func:`~greybox.data.units.log_from_columns`),
         and for a sidecar that is not a JSON object.
     """
-    comments, metadata, header = _preamble(path)
+    header_index, units_index, metadata, header, delimiter, decimal = _layout(path)
     sidecar = read_sidecar(path)
     if sidecar is not None:
         metadata = sidecar
     if not header.strip():
         raise LogError(path, "no header row (the file holds only comments or blank lines)")
-    delimiter = max((",", ";", "\t"), key=header.count)
-    decimal = "."
-    if delimiter == ";":
-        with open(path, encoding="utf-8-sig") as stream:
-            lines = [line for _, line in zip(range(comments + 2), stream)][comments + 1:]
-        if lines and "," in lines[0]:
-            decimal = ","
+    units = None
+    if units_index is not None:
+        with open(path, encoding="utf-8-sig", newline="") as stream:
+            units = next(line for index, line in enumerate(stream) if index == units_index)
+    skipped = set(range(header_index + 1)) | ({units_index} if units_index is not None else set())
     try:
         frame = pd.read_csv(
-            path, skiprows=comments, sep=delimiter, decimal=decimal, engine="c", low_memory=False, encoding="utf-8-sig"
+            path, skiprows=sorted(skipped), header=None, sep=delimiter, decimal=decimal, engine="c",
+            low_memory=False, encoding="utf-8-sig",
         )
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, csv.Error) as exc:
-        raise LogError(path, f"malformed CSV ({str(exc).strip().splitlines()[0]})") from None
+    except pd.errors.EmptyDataError:
+        raise LogError(path, "no data rows (the file holds only a header)") from None
+    except (pd.errors.ParserError, UnicodeDecodeError, csv.Error) as exc:
+        line = str(exc).strip().splitlines()[0]
+        raise LogError(path, f"malformed CSV ({line}); the header is line {header_index + 1} "
+                             f"({header.strip()[:60]!r}), delimiter {delimiter!r}") from None
+    names = _headers(header, units, delimiter)
+    if frame.shape[1] != len(names):
+        raise LogError(path, f"the rows hold {frame.shape[1]} fields, the header (line {header_index + 1}) "
+                             f"{len(names)}")
+    frame.columns = range(len(names))
     if frame.empty:
         raise LogError(path, "no data rows (the file holds only a header)")
-    table = {str(name).strip(): frame[name].to_numpy() for name in frame.columns}
+    table = {name: frame[k].to_numpy() for k, name in enumerate(names)}
     return log_from_columns(table, source=path, columns=columns, sample_time=sample_time, select=axis,
                             **metadata_fields(metadata, axis))
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import LogError
 from .log import AxisLog, as_log_list
-from .validate import check_finite, check_increasing, check_time, check_velocity_units
+from .validate import check_finite, check_increasing, check_time, check_time_units, check_velocity_units
 
 __all__ = ["MAX_GAP_STEPS", "default_cutoff", "derivative_filter", "derivative_margin", "derive", "resample",
            "split_at_gaps", "trim", "prepare"]
@@ -339,6 +339,7 @@ def prepare(
     prepared = []
     for run in as_log_list(logs):
         check_finite(run)
+        check_time_units(run.time, source=run.source or None)
         check_velocity_units(run)
         if sample_time is None:
             check_time(run.time, source=run.source or None, tolerance=tolerance)

@@ -34,7 +34,7 @@ from .log import AxisLog
 from .parquet_io import column_arrays, schema_fields, unreadable
 from .prepare import derivative_margin, derive
 from .units import log_from_columns, resolve_columns, select_axis
-from .validate import check_finite, check_increasing, check_time, check_velocity_units
+from .validate import check_finite, check_increasing, check_time, check_time_units, check_velocity_units
 
 __all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "median_step", "open_stream",
            "prepared_blocks"]
@@ -301,6 +301,8 @@ def prepared_blocks(log, *, tolerance: float = 0.25, cutoff_hz: float | None = N
     """
     source = log.path
     nominal = median_step(log.times, source) if sample_time is None else float(sample_time)
+    if sample_time is None:
+        check_time_units(np.array([0.0, nominal]), source=source)
     margin = derivative_margin(nominal, cutoff_hz=cutoff_hz)
     tail: AxisLog | None = None  # the last `margin` samples before the current block
     current: AxisLog | None = None

@@ -11,7 +11,10 @@ in :data:`UNIT_FACTORS`; the factor converts a value in that unit to the
 canonical unit of its motion. The units also tell the kind of axis
 (:mod:`greybox.data.quantities`): mm, m, um, N are a linear axis (canonical s,
 mm, mm/s, mm/s^2, A or N); deg, rad, rev, rpm, Nm a rotary one (canonical s,
-deg, deg/s, deg/s^2, A or Nm). A log mixing the two is an error. A column whose
+deg, deg/s, deg/s^2, A or Nm). The position's unit decides: beside a linear position a rotary velocity
+or acceleration is the motor's (an extra channel), and a torque the motor torque (the effort of a log
+without a current, :data:`MOTOR_TORQUE`); a rotary position with a linear velocity or a force is an error.
+Export headers in words (``Lageistwert [mm]``) are renamed first (:mod:`greybox.data.headers`). A column whose
 quantity is known but whose suffix looks like an unsupported unit
 (``position_inch``) is an error rather than a silently ignored channel; a
 suffix made of other words (``position_setpoint_mm``) makes the column an
@@ -27,6 +30,7 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import LogError
+from .headers import canonical_table, datetime_seconds
 from .log import AxisLog
 from .quantities import LINEAR, ROTARY
 
@@ -43,7 +47,12 @@ __all__ = [
     "several_axes_table",
     "unwrap_modulo",
     "log_from_columns",
+    "MOTOR_TORQUE",
 ]
+
+#: ``AxisLog.attrs`` key of a linear axis's log whose effort is the motor torque [Nm] read as a current with
+#: ``k_t = 1 Nm/A``; its value names the column. The force then follows from the axis file without its ``k_t``.
+MOTOR_TORQUE = "motor_torque_column"
 
 _DEG_PER_RAD = 180.0 / math.pi
 
@@ -154,6 +163,26 @@ def _motion(units: Mapping[str, tuple[str, str]], source) -> str:
     return next(iter(kinds.values()))[0] if kinds else "linear"
 
 
+def _motor_channels(found: dict, units: dict) -> None:
+    """On a linear axis (a position in a length unit), read the motor's own channels as a servo trace logs them.
+
+    A motor speed (``velocity_rpm``) or a rotary acceleration is not the table's: it stays an extra channel
+    and the table's velocity is derived from the position. A motor torque (``torque_Nm``) is the effort of a
+    log without a current, read as a current through ``k_t = 1 Nm/A`` (:data:`MOTOR_TORQUE`), and an extra
+    beside a current.
+    """
+    if "position" not in units or units["position"][1] in ROTARY_UNITS["position"]:
+        return
+    for quantity in ("velocity", "acceleration"):
+        if quantity in units and units[quantity][1] in ROTARY_UNITS[quantity]:
+            del found[quantity], units[quantity]
+    if "torque" in found:
+        torque = found.pop("torque")
+        del units["torque"]
+        if "current" not in found and "force" not in found:
+            found["current"] = torque
+
+
 def resolve_columns(
     names,
     *,
@@ -235,6 +264,7 @@ def resolve_columns(
         found[quantity] = (name, _unit_factor(quantity, unit, name, source))
         units[quantity] = (name, unit)
 
+    _motor_channels(found, units)
     efforts = [quantity for quantity in EFFORT_QUANTITIES if quantity in found]
     if len(efforts) > 1:
         mapped = [quantity for quantity in efforts
@@ -483,6 +513,8 @@ def log_from_columns(
     """
     if select is not None:
         table, axis = select_axis(table, select, source=source, columns=columns), select
+    mapped = {parsed[0] for parsed in map(parse_column_name, columns or {}) if parsed is not None}
+    table = canonical_table(table, source=source, keep=(columns or {}).values(), mapped=mapped)
     names = [n for n in table if n and not str(n).startswith("Unnamed: ")]
     found, motion = resolve_columns(
         names, source=source, columns=columns, with_time=time is None, effort_unit=effort_unit
@@ -494,6 +526,8 @@ def log_from_columns(
             return None
         column, factor = found[quantity]
         values = _numeric(table[column])
+        if values is None and quantity == "time":
+            values, factor = datetime_seconds(table[column], source=source, column=column), 1.0
         if values is None:
             raise LogError(source, f"column '{column}' ({quantity}) is not numeric{_first_text(table[column])}")
         return values * factor if factor != 1.0 else values
@@ -523,6 +557,10 @@ def log_from_columns(
         )
 
     effort = next(quantity for quantity in EFFORT_QUANTITIES if quantity in found)
+    attrs = dict(attrs or {})
+    if parse_column_name(found[effort][0]) is not None and parse_column_name(found[effort][0])[0] == "torque" \
+            and effort == "current":
+        attrs[MOTOR_TORQUE] = found[effort][0]
     position = channel("position")
     if motion == "rotary":
         position = unwrap_modulo(position, source)
@@ -545,7 +583,7 @@ def log_from_columns(
         dataset=dataset,
         source=str(source),
         extras=extras,
-        attrs=dict(attrs or {}),
+        attrs=attrs,
     )
 
 

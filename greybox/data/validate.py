@@ -7,15 +7,21 @@ import numpy as np
 from ..errors import LogError
 from .log import AxisLog
 
-__all__ = ["check_time", "check_increasing", "check_finite", "check_velocity_units", "UNIT_SLIPS"]
+__all__ = ["check_time", "check_increasing", "check_finite", "check_velocity_units", "check_time_units", "UNIT_SLIPS",
+           "SAMPLE_TIME_RANGE_S"]
+
+#: Plausible sample times of a drive log [s]: from a current loop's 62.5 us (16 kHz, with margin) to the
+#: 0.5 s of a slowly polled machine; a median step outside is a time column in the wrong unit.
+SAMPLE_TIME_RANGE_S = (1e-5, 0.5)
 
 #: Factors by which a logged velocity can disagree with d(position)/dt when one column's unit is wrong,
 #: and what the factor points to (the fix names the column's unit suffix, e.g. ``--columns position_m=NAME``),
 #: per kind of axis.
 _LINEAR_SLIPS = {
-    1000.0: "the position is probably in m under a mm name (position_m=NAME), or the velocity in um/s",
+    1000.0: "the position is probably in m under a mm name (position_m=NAME), or the velocity in um/s, or "
+            "the time in ms under an s name (time_ms=NAME)",
     1e-3: "the position is probably in um under a mm name (position_um=NAME), or the velocity in m/s "
-          "(velocity_m_s=NAME)",
+          "(velocity_m_s=NAME), or the time in s under an ms name (time_s=NAME)",
     60.0: "the velocity is probably in mm/min under a mm/s name (velocity_mm_min=NAME)",
     1.0 / 60.0: "the velocity is probably in mm/s under a mm/min name (velocity_mm_s=NAME)",
     1000.0 / 60.0: "the velocity is probably in mm/min while the position is in m, or in m/min mislabelled",
@@ -130,6 +136,37 @@ def check_increasing(time, *, source=None, start: int = 0) -> np.ndarray:
         raise LogError(source, f"time goes backwards at sample {k + start}: t = {time[k]:.9g} s after "
                                f"{time[k - 1]:.9g} s")
     return steps
+
+
+def check_time_units(time, *, source=None) -> None:
+    """Refuse a time base whose median step no drive log has: a time column in the wrong unit.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Sample times [s], strictly increasing (:func:`check_increasing`).
+    source : str or path-like, optional
+        File the times came from, named in the error message.
+
+    Raises
+    ------
+    LogError
+        When the median step lies outside :data:`SAMPLE_TIME_RANGE_S`; the message names the time column's
+        probable unit (ms or us written under an s name, or s under an ms name) and the name that fixes it.
+    """
+    time = np.asarray(time, dtype=np.float64)
+    if time.shape[0] < 2:
+        return
+    step = float(np.median(np.diff(time)))
+    low, high = SAMPLE_TIME_RANGE_S
+    if step > high:
+        unit = "ms" if step < 500.0 else "us"
+        raise LogError(source, f"the time steps by {step:.6g} s (a log of {time[-1] - time[0]:.6g} s): the time is "
+                               f"probably in {unit} under an s name; name the column time_{unit} (--columns "
+                               f"time_{unit}=NAME)")
+    if 0.0 < step < low:
+        raise LogError(source, f"the time steps by {step:.3g} s ({1.0 / step:.3g} Hz): the time is probably in s "
+                               "under an ms or us name; name the column time_s (--columns time_s=NAME)")
 
 
 def check_finite(log: AxisLog, *, start: int | None = None) -> None:

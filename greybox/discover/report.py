@@ -136,6 +136,8 @@ def plot_evidence(result: DiscoveryResult, path) -> Path:
         Image file to write; the format follows its extension.
     """
     plt = import_pyplot(path)
+    from matplotlib.patches import Patch
+
     n_steps = len(result.steps)
     figure, axes = plt.subplots(1, n_steps + 1, figsize=(4.5 * (n_steps + 1), 5), layout="constrained",
                                 squeeze=False)
@@ -154,7 +156,10 @@ def plot_evidence(result: DiscoveryResult, path) -> Path:
         ax.set_xlabel("explained fraction of the residual")
         ax.set_title(f"step {index + 1}: " + (f"adds {step.winner}" if step.winner else "nothing passes"),
                      fontsize=10)
-        ax.legend(fontsize=7, loc="lower right")
+        marks, _ = ax.get_legend_handles_labels()
+        ax.legend(handles=[Patch(color="C2", label="added in this step"), Patch(color="C1", label="passes, not added"),
+                           Patch(color="C0", label="does not pass"), *marks],
+                  fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)  # below the bars
         ax.grid(True, axis="x", alpha=0.3)
     ax = axes[0, -1]
     shown = next((i for i, step in enumerate(result.steps)
@@ -167,7 +172,8 @@ def plot_evidence(result: DiscoveryResult, path) -> Path:
     ax.set_xlabel(result.units.relabel("period [mm]"))
     ax.set_ylabel("explained fraction of the residual")
     ax.set_title(f"step {shown + 1}: period scans (dashed: pass level)", fontsize=10)
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)  # below the curves
     ax.grid(True, alpha=0.3)
     return save_figure(figure, path)
 

@@ -23,7 +23,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..data.log import AxisLog
-from .plots import import_pyplot, save_figure
+from .plots import finish_figure, import_pyplot, legend_outside
 from .report import MODEL_LABELS
 
 __all__ = ["MODEL_COLORS", "effort_name", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs"]
@@ -101,8 +101,8 @@ def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, ob
     panels : sequence of (title, runs, predictions)
         ``runs``: prepared runs whose ``effort`` is the measured current [A]
         (or force [N]); ``predictions``: ``{model: prediction}`` (concatenated or per run).
-    path : path-like
-        PNG file to write.
+    path : path-like or None
+        PNG file to write, or None to return the open figure (a page of a PDF report).
     title : str, optional
         Figure title; default "Absolute error of the modelled current" (or force).
 
@@ -131,7 +131,7 @@ def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, ob
         ax.set_title(panel_title)
         ax.grid(True, axis="y", alpha=0.3)
     figure.suptitle(title or f"Absolute error of the modelled {noun}")
-    return save_figure(figure, path)
+    return finish_figure(figure, path)
 
 
 def _zoom_window(run: AxisLog, width_s: float) -> tuple[float, float]:
@@ -157,8 +157,8 @@ def time_comparison(runs: Sequence[AxisLog], predictions: Mapping[str, object], 
         Prepared test runs; their ``effort`` is the measured current [A] (or force [N]).
     predictions : dict
         ``{model: prediction}`` (concatenated or per run) [A] (or [N]).
-    path : path-like
-        PNG file to write.
+    path : path-like or None
+        PNG file to write, or None to return the open figure (a page of a PDF report).
     names : sequence of str, optional
         Run names for the panel titles (default: the runs' dataset or source).
     zoom_s : float, default 4.0
@@ -198,9 +198,9 @@ def time_comparison(runs: Sequence[AxisLog], predictions: Mapping[str, object], 
             ax.set_xlabel("time [s]")
             ax.set_ylabel(f"{noun} [{unit}]")
             ax.grid(True, alpha=0.3)
-    axes[0, 0].legend(loc="upper right", fontsize="small", ncol=min(3, 1 + len(per_run)))
+    legend_outside(axes[0, -1])  # right of the top row: the same lines in both panels
     figure.suptitle(title or f"Measured and modelled {noun}")
-    return save_figure(figure, path)
+    return finish_figure(figure, path)
 
 
 def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, object], path: str | os.PathLike,
@@ -218,8 +218,8 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
         Prepared runs (position [mm or deg], velocity, measured current [A] or load [N or Nm]).
     predictions : dict
         ``{model: prediction}`` (concatenated or per run) [A] (or [N]).
-    path : path-like
-        PNG file to write.
+    path : path-like or None
+        PNG file to write, or None to return the open figure (a page of a PDF report).
     n_bins : int, default 40
         Number of equal-width position bins of the mean-residual lines.
     max_points : int, default 20000
@@ -250,10 +250,10 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
                                 sharex=True, sharey=True, layout="constrained")
     for ax, (model, prediction) in zip(axes.ravel(), predictions.items()):
         residual = measured - np.concatenate(split_runs(runs, prediction))
-        for _, mask, color, _ in directions:
+        for label, mask, color, _ in directions:
             index = np.flatnonzero(mask)
             shown = index[:: max(1, -(-index.size // max(1, max_points // 2)))]  # half the points each
-            ax.plot(position[shown], residual[shown], ".", ms=1, color=color, alpha=0.3)
+            ax.plot(position[shown], residual[shown], ".", ms=1, color=color, alpha=0.3, label=f"samples, v {label}")
         for label, mask, _, color in directions:
             index = np.flatnonzero(mask)
             counts = np.histogram(position[index], edges)[0]
@@ -269,6 +269,6 @@ def residual_vs_position(runs: Sequence[AxisLog], predictions: Mapping[str, obje
         ax.set_ylabel(f"measured - model [{unit}]")
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
-    axes[0, 0].legend(loc="upper right", fontsize="small")
+    legend_outside(axes[0, min(columns, n) - 1], markerscale=8)  # right of the top row
     figure.suptitle(title)
-    return save_figure(figure, path)
+    return finish_figure(figure, path)

@@ -19,7 +19,7 @@ from ..atomic import atomic_output
 from ..data.log import AxisLog
 
 __all__ = ["ENVELOPE_POINTS", "envelope", "envelope_indices", "plot_log", "save_figure", "import_pyplot",
-           "finish_figure", "window_title"]
+           "legend_outside", "finish_figure", "window_title"]
 
 #: Points drawn per line at most: the minimum and maximum of 2000 bins (an axis of the figures here
 #: spans about 900-1300 pixel columns at their size and resolution).
@@ -138,6 +138,30 @@ def import_pyplot(path: str | os.PathLike | None):
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def legend_outside(ax, handles=None, labels=None, **options):
+    """Draw the legend of ``ax`` to the right of its axes, outside the data it would otherwise cover.
+
+    The figures are drawn with the constrained layout, which makes room for it.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Axes whose labelled artists (or ``handles``) the legend explains.
+    handles, labels : list, optional
+        Artists and texts to show instead of those of ``ax`` (proxies for colours drawn without a label).
+    **options
+        Further :meth:`matplotlib.axes.Axes.legend` options (``ncol``, ``title``).
+
+    Returns
+    -------
+    matplotlib.legend.Legend
+    """
+    if handles is None:
+        handles, labels = ax.get_legend_handles_labels()
+    options = {"fontsize": "small", **options}
+    return ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, **options)
 
 
 def finish_figure(figure, path: str | os.PathLike | None):

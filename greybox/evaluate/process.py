@@ -63,6 +63,7 @@ from threadpoolctl import threadpool_limits
 from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog, as_log_list
 from ..data.quantities import MOTIONS, Motion
+from ..data.units import MOTOR_TORQUE
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from ..registry import model_kind
@@ -424,6 +425,8 @@ def _block_result(block: AxisLog, predicted: np.ndarray, regions: dict, axis_con
     """The process result of one prepared block from its prediction and training-region flags."""
     process = block.effort - predicted
     load = factors = load_bounds = half_width = None
+    if axis_config is not None and block.attrs.get(MOTOR_TORQUE):  # the effort is k_t I already
+        axis_config = axis_config.without_torque_constant()
     if block.effort_unit != "A":
         load = process
     elif axis_config is not None:

@@ -14,6 +14,7 @@ from .plots import (
     envelope_indices,
     finish_figure,
     import_pyplot,
+    legend_outside,
     window_title,
 )
 from .process import ProcessResult
@@ -53,7 +54,7 @@ def _mark_outside(ax, time, outside, max_points: int, label: str) -> None:
     flags = np.logical_or.reduceat(outside, starts) if starts.size < outside.size else outside
     ax.fill_between(time[starts], 0, 1, where=flags, step="post", transform=ax.get_xaxis_transform(),
                     color="tab:orange", alpha=0.15, lw=0, label=label)
-    ax.legend(loc="upper right", fontsize="small")
+    legend_outside(ax)
 
 
 def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *,
@@ -119,7 +120,7 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     line(ax_i, result.measured, lw=0.5, color="tab:gray", label=f"measured {noun}")
     line(ax_i, result.model, lw=0.8, color="tab:blue", label=f"model {noun} (inertia + friction)")
     ax_i.set_ylabel(f"{noun} [{unit}]")
-    ax_i.legend(loc="upper right", fontsize="small")
+    legend_outside(ax_i)
     coverage = result.attrs.get("interval", {}).get("coverage")
     band_label = f"{100 * coverage:g} % interval" if coverage else "interval"
     mean_samples = (max(1, int(round(mean_s / float(np.median(np.diff(result.time))))))
@@ -133,7 +134,7 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
         if mean_samples:
             line(ax, moving_mean(values, mean_samples), lw=1.2, color=dark, label=f"moving mean over {mean_s:g} s")
         ax.axhline(0.0, color="black", lw=0.5)
-        ax.legend(loc="upper right", fontsize="small")
+        legend_outside(ax)
 
     process_panel(ax_p, result.process, result.process_bounds, f"process {noun} = measured - model",
                   "tab:red", "darkred")
@@ -231,7 +232,7 @@ def plot_machine_process(result, path: str | os.PathLike | None = None, *,
         ax.axhline(0.0, color="black", lw=0.5)
         ax.set_ylabel(label, fontsize="small")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="small")
+        legend_outside(ax)
     axes[-1, 0].set_xlabel("time [s]")
     title = (f"machine {result.name}" if result.name else "machine") + f": axes {', '.join(result.results)}"
     figure.suptitle(title + window_title(window))

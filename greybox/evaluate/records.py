@@ -121,6 +121,80 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
     return records, predictions
 
 
+def _report_parts(records, predictions, runs, run_names, out_dir: Path | None):
+    """Figures (``(caption, path)``, or ``(caption, open figure)`` without ``out_dir``), tables, title and
+    introduction of the evaluation report."""
+    tests = "+".join(run_names)
+    noun, unit = effort_name(runs)
+    models = {name: p for name, p in predictions.items() if name != NOISE_FLOOR}
+
+    def target(name: str):
+        return None if out_dir is None else out_dir / name
+
+    figures = [
+        (f"Absolute error [{unit}] of each model on {tests} (boxes: quartiles, whiskers: 5th-95th percentile)",
+         error_boxplot([(f"test on {tests}", runs, predictions)], target("error_boxplot.png"))),
+        (f"Measured and modelled {noun} [{unit}] on {tests}",
+         time_comparison(runs, models, target("time_comparison.png"), names=run_names)),
+        (f"Measured minus modelled {noun} [{unit}] against position, by direction of motion, on {tests}",
+         residual_vs_position(runs, models, target("residual_position.png"))),
+    ]
+    tables = [evaluation_table(records, unit=unit)]
+    if len(runs) > 1:
+        tables.append(per_log_table(records, unit=unit))
+    tables.append(regime_table(records))
+    intro = f"Models tested on {tests}; the logs' effort is {noun} in {unit}."
+    return figures, tables, "greybox: model evaluation", intro
+
+
+def write_evaluation_pdf(path: str | os.PathLike, records: Sequence[Mapping], predictions: Mapping, runs,
+                         run_names: Sequence[str]) -> Path:
+    """The report of ``greybox evaluate`` as one PDF file a person can send: tables, then the figures.
+
+    Page 1 holds the title, the tables (as in ``tables.md``) and where the figures were measured
+    (:func:`greybox.provenance.provenance_line`); each figure follows on a page of its own, its caption
+    above it. Written with matplotlib's PDF backend, atomically.
+
+    Parameters
+    ----------
+    path : path-like
+        PDF file to write.
+    records, predictions, runs, run_names
+        As :func:`write_evaluation_report`.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    from ..atomic import atomic_output
+    from ..provenance import provenance_line
+    from .plots import import_pyplot
+
+    path = Path(path)
+    plt = import_pyplot(path)
+    figures, tables, title, intro = _report_parts(records, predictions, runs, run_names, None)
+    text = "\n\n".join([intro, *(table.to_markdown() for table in tables), provenance_line()])
+    pages = []
+    try:
+        first = plt.figure(figsize=(11.69, 8.27))  # A4 landscape [in]
+        first.text(0.04, 0.95, title, fontsize=14, weight="bold", va="top")
+        first.text(0.04, 0.90, text, family="monospace", fontsize=6.5, va="top", wrap=True)
+        pages.append(first)
+        for caption, figure in figures:
+            figure.suptitle(caption, fontsize=9)
+            pages.append(figure)
+        with atomic_output(path) as temporary:
+            with PdfPages(temporary, metadata={"Title": title, "Creator": "greybox evaluate"}) as document:
+                for page in pages:
+                    document.savefig(page)
+    finally:
+        for page in [*pages, *(figure for _, figure in figures if figure not in pages)]:
+            plt.close(page)
+    return path
+
+
 def write_evaluation_report(out_dir: str | os.PathLike, records: Sequence[Mapping], predictions: Mapping,
                             runs, run_names: Sequence[str]) -> dict[str, Path]:
     """The report of ``greybox evaluate``: error and regime tables, three figures, the HTML page.
@@ -145,23 +219,7 @@ def write_evaluation_report(out_dir: str | os.PathLike, records: Sequence[Mappin
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(exist_ok=True)
-    tests = "+".join(run_names)
-    noun, unit = effort_name(runs)
-    models = {name: p for name, p in predictions.items() if name != NOISE_FLOOR}
-    figures = [
-        (f"Absolute error [{unit}] of each model on {tests} (boxes: quartiles, whiskers: 5th-95th percentile)",
-         error_boxplot([(f"test on {tests}", runs, predictions)], out_dir / "error_boxplot.png")),
-        (f"Measured and modelled {noun} [{unit}] on {tests}",
-         time_comparison(runs, models, out_dir / "time_comparison.png", names=run_names)),
-        (f"Measured minus modelled {noun} [{unit}] against position, by direction of motion, on {tests}",
-         residual_vs_position(runs, models, out_dir / "residual_position.png")),
-    ]
-    tables = [evaluation_table(records, unit=unit)]
-    if len(runs) > 1:
-        tables.append(per_log_table(records, unit=unit))
-    tables.append(regime_table(records))
-    files = write_report(out_dir, records, tables, figures,
-                         title="greybox: model evaluation",
-                         intro=f"Models tested on {tests}; the logs' effort is {noun} in {unit}.")
+    figures, tables, title, intro = _report_parts(records, predictions, runs, run_names, out_dir)
+    files = write_report(out_dir, records, tables, figures, title=title, intro=intro)
     files["figures"] = [path for _, path in figures]
     return files

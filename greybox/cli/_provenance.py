@@ -1,0 +1,156 @@
+"""The training record a model file keeps (``greybox train``), and the warning of predict and evaluate when a
+log is prepared otherwise than the training logs (:mod:`greybox.provenance`)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from ..data.prepare import MAX_GAP_STEPS, default_cutoff
+from ..metrics import metrics_table
+from ..provenance import TRAINING_RECORD, file_identity, preparation_differences, training_record
+
+__all__ = ["preparation_of", "record_training", "warn_preparation"]
+
+
+def preparation_of(args: argparse.Namespace, runs) -> dict:
+    """The preparation of prepared ``runs`` read with the options ``args``.
+
+    The keys are :data:`~greybox.provenance.PREPARATION_KEYS`.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed log options (:func:`~greybox.cli._options.add_log_arguments`).
+    runs : list of AxisLog
+        The prepared runs; the first gives the sample time [s] and the derivative filter's cut-off [Hz].
+    """
+    filters = [run.attrs.get("derivative_filter") or {} for run in runs]
+    cutoff = filters[0].get("cutoff_hz")
+    return {"sample_time_s": float(runs[0].sample_time),
+            "cutoff_hz": None if cutoff is None else float(cutoff),
+            "resample_s": getattr(args, "resample", None),
+            "max_gap_steps": float(getattr(args, "max_gap", MAX_GAP_STEPS)),
+            "time_tolerance": float(args.time_tolerance),
+            "derived": sorted({name for entry in filters for name in entry.get("derived", ())})}
+
+
+def record_training(args: argparse.Namespace, files, names, runs, predictions) -> dict:
+    """The model file's records for a model fitted on ``runs``: ``{"training": record}``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed options of ``greybox train``.
+    files : list of str
+        The training log files.
+    names : list of str
+        A name per run.
+    runs, predictions : list
+        The prepared runs and the fitted model's effort for each [A, or N, Nm].
+    """
+    tables = [metrics_table(run.effort, prediction) for run, prediction in zip(runs, predictions)]
+    total = metrics_table(np.concatenate([run.effort for run in runs]), np.concatenate(predictions))
+
+    def figures(table) -> dict:
+        re = float(table["re"])
+        return {"samples": int(table["n"]), "rmse": float(table["rmse"]), "re_percent": re if np.isfinite(re) else None}
+
+    ranges = {}
+    for channel in ("position", "velocity", "acceleration"):
+        values = [getattr(run, channel) for run in runs if getattr(run, channel) is not None]
+        if values:
+            ranges[channel] = [float(min(v.min() for v in values)), float(max(v.max() for v in values))]
+    record = training_record([file_identity(path) for path in dict.fromkeys(files)], preparation_of(args, runs),
+                             [{"name": str(name), **figures(table)} for name, table in zip(names, tables)],
+                             {**figures(total), "unit": runs[0].effort_unit}, ranges)
+    return {TRAINING_RECORD: record}
+
+
+def warn_preparation(records: dict, args: argparse.Namespace, runs, log_name: str, model_name: str,
+                     stream=None) -> str | None:
+    """Print one ``warning:`` line when ``runs`` are prepared otherwise than the model's training logs.
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records (a file without a training record warns of nothing).
+    args : argparse.Namespace
+        Parsed log options.
+    runs : list of AxisLog or None
+        The prepared runs of the log; None when the log is streamed (then the options alone are compared,
+        at the training logs' sample time).
+    log_name, model_name : str
+        Names for the message.
+    stream : file-like, optional
+        Where to print; default stderr.
+
+    Returns
+    -------
+    str or None
+        The line printed.
+    """
+    record = records.get(TRAINING_RECORD)
+    if record is None:
+        return None
+    trained = record["preparation"]
+    if runs is None:
+        cutoff = args.cutoff_hz if args.cutoff_hz is not None else default_cutoff(trained["sample_time_s"])
+        used = {**trained, "cutoff_hz": float(cutoff), "resample_s": args.resample}
+    else:
+        used = preparation_of(args, runs)
+    differences = preparation_differences(trained, used)
+    if not differences:
+        return None
+    line = (f"warning: {log_name} is prepared otherwise than the training logs of {model_name}: "
+            + "; ".join(differences))
+    print(line, file=stream or sys.stderr)
+    return line
+
+
+def record_lines(records: dict) -> list[str]:
+    """The lines ``greybox info`` prints of a model file's training record (none for a file without one).
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records.
+    """
+    record = records.get(TRAINING_RECORD)
+    if record is None:
+        return []
+    prep = record["preparation"]
+    total = record["training_error"]
+    cutoff = "default" if prep["cutoff_hz"] is None else f"{prep['cutoff_hz']:g} Hz"
+    resample = "no --resample" if prep["resample_s"] is None else f"--resample {prep['resample_s']:g}"
+    re = "" if total["re_percent"] is None else f", RE {total['re_percent']:.3f} %"
+    lines = ["training:",
+             "  files          = " + ", ".join(f"{entry['name']} ({entry['bytes']} bytes, sha256 "
+                                               f"{entry['sha256'][:12]}...)" for entry in record["files"]),
+             f"  preparation    = step {prep['sample_time_s'] * 1e3:g} ms, cut-off {cutoff}, {resample}, "
+             f"max gap {prep['max_gap_steps']:g} steps, time tolerance {prep['time_tolerance']:g}, derived "
+             f"{', '.join(prep['derived']) or 'nothing'}",
+             f"  training error = RMSE {total['rmse']:.4g} {total['unit']}{re} over {total['samples']} samples "
+             f"({len(record['runs'])} run(s))"]
+    for name, (low, high) in record["ranges"].items():
+        lines.append(f"  {name + ' range':<14} = {low:.6g} .. {high:.6g}")
+    return lines
+
+
+def region_lines(model) -> list[str]:
+    """The training region a model file holds without a training record (files written before it): the
+    ranges of position and velocity the model was fitted on, in its units; none for older files still.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        A fitted model.
+    """
+    units = model.units_
+    ranges = [(f"position range [{units.length}]", getattr(model, "position_range_mm_", None)),
+              (f"velocity range [{units.velocity_unit}]", getattr(model, "velocity_range_mm_s_", None))]
+    shown = [f"  {name} = {low:.6g} .. {high:.6g}" for name, pair in ranges if pair is not None
+             for low, high in [pair]]
+    return ["training region:", *shown] if shown else []
