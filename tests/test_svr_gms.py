@@ -59,7 +59,8 @@ def test_beats_gms_alone_on_position_dependent_friction(fitted):
 def test_inputs_are_position_gms_current_and_states(fitted):
     model, train = fitted
     n_elements = len(model.gms_.alpha_)
-    assert model.input_names == ("position_mm", "gms_current_A") + tuple(f"z{i}_mm" for i in range(1, 5))
+    assert n_elements == 4 - model.gms_.n_pruned_  # elements without stiffness are pruned from the GMS stage
+    assert model.input_names == ("position_mm", "gms_current_A") + tuple(f"z{i}_mm" for i in range(1, n_elements + 1))
     assert model.support_vectors_.shape[1] == 2 + n_elements
     z, stick = model.states(train)
     assert z.shape == stick.shape == (sum(len(r) for r in train), n_elements)
