@@ -61,10 +61,11 @@ def axis_figure(trend, detector: ChangeDetector, path) -> Path:
         ax.set_ylabel(f"{feature}\n[{FEATURE_UNITS[feature]}]", fontsize=8)
         ax.tick_params(labelsize=7)
     axes[0, 0].legend(fontsize=7, ncol=5, loc="lower left", bbox_to_anchor=(0.0, 1.02))
-    axes[0, 0].set_title(f"{trend.machine} / {trend.axis}: friction fingerprint per day "
-                         f"(grey: baseline days)", fontsize=9, pad=18)
+    height = figure.get_figheight()
+    figure.suptitle(f"{trend.machine} / {trend.axis}: friction fingerprint per day (grey: baseline days)",
+                    fontsize=9, y=1.0 - 0.12 / height)
     figure.autofmt_xdate()
-    figure.subplots_adjust(left=0.11, right=0.98, bottom=0.08, top=1.0 - 0.9 / figure.get_figheight(), hspace=0.12)
+    figure.subplots_adjust(left=0.11, right=0.98, bottom=0.08, top=1.0 - 0.75 / height, hspace=0.12)
     saved = save_figure(figure, path, dpi=90)
     plt.close(figure)
     return saved
