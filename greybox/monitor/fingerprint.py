@@ -70,8 +70,11 @@ def unloaded_samples(residual, *, noise_A: float | None = None, factor: float = 
     residual : array_like, shape (n,)
         Measured minus predicted current of the reference model [A].
     noise_A : float, optional
-        Noise level [A] of the residual without load; by default estimated robustly as 1.4826 times the
-        median absolute deviation of the residual (valid when most samples are unloaded).
+        Noise level [A] of the residual without load; by default estimated from the sample-to-sample
+        changes of the residual, 1.4826 times their median absolute value over sqrt(2), which a sustained
+        process load (a step in, a step out) hardly moves. For noise correlated from sample to sample
+        this is an underestimate (by 23 % at the twin's lag-1 correlation 0.7): more samples are then
+        counted loaded, never fewer.
     factor : float, default 3.0
         Samples whose windowed RMS residual exceeds ``factor * noise_A`` are loaded.
     window : int, default 50
@@ -84,7 +87,7 @@ def unloaded_samples(residual, *, noise_A: float | None = None, factor: float = 
     """
     r = np.asarray(residual, dtype=float)
     if noise_A is None:
-        noise_A = 1.4826 * float(np.median(np.abs(r - np.median(r)))) if len(r) else 0.0
+        noise_A = 1.4826 * float(np.median(np.abs(np.diff(r)))) / np.sqrt(2.0) if len(r) > 1 else 0.0
     if not (np.isfinite(noise_A) and noise_A >= 0.0):
         raise ParameterError(f"noise level must be a non-negative current, got {noise_A} A")
     if not factor > 0.0 or int(window) < 1:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import datetime as dt
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
@@ -13,6 +14,7 @@ from greybox.data.io import read_log
 from greybox.monitor.fingerprint import FEATURES
 from greybox.monitor.history import read_history
 from greybox.monitor.workflow import fingerprint_file
+from greybox.persistence import load_model
 
 
 @pytest.fixture(scope="module")
@@ -145,3 +147,33 @@ def test_stable_axis_no_alarm(tmp_path, capsys):
     assert main(["monitor", *sorted(str(p) for p in logs.iterdir()), "--history", str(tmp_path / "h"),
                  "--out", str(tmp_path / "r")]) == 0
     assert "1 axes, 0 alarms" in capsys.readouterr().out
+
+
+def test_reference_model_leaves_out_a_process_load(twin_days, tmp_path, capsys):
+    """With --model, a process current added to part of a log is left out: the levels stay those of the air cut."""
+    from greybox.data.io import write_log
+    from greybox.data.prepare import prepare
+    from greybox.friction import CoulombModel
+    from greybox.persistence import save_model
+
+    source = sorted(twin_days.iterdir())[0]
+    log = read_log(source)
+    model_path = save_model(CoulombModel(asymmetric=True).fit(prepare(log)), tmp_path / "ref.gbx")
+    fast = int(np.flatnonzero(np.abs(prepare(log)[0].velocity) >= 15.0)[0])
+    load = np.zeros(len(log))
+    load[fast:fast + 1500] = 0.8  # 3 s of a process force during the fast moves
+    cut = tmp_path / "X_2026-05-01.mcap"
+    write_log(log.replace(effort=log.effort + load), cut)
+    plain = pq.read_table(fingerprint_file(source, tmp_path / "h0")[0])
+    blind = pq.read_table(fingerprint_file(cut, tmp_path / "h1")[0])
+    masked = pq.read_table(fingerprint_file(cut, tmp_path / "h2", model=load_model(model_path))[0])
+    assert masked.column("n_samples")[0].as_py() < blind.column("n_samples")[0].as_py() - 1000
+    for name in ("sliding_pos", "sliding_neg"):
+        error_masked = abs(masked.column(name)[0].as_py() - plain.column(name)[0].as_py())
+        error_blind = abs(blind.column(name)[0].as_py() - plain.column(name)[0].as_py())
+        assert error_masked < 0.5 * error_blind, name
+    garbage = tmp_path / "garbage.gbx"
+    garbage.write_bytes(b"not a model")
+    assert main(["monitor", str(cut), "--model", str(garbage), "--history", str(tmp_path / "h3"),
+                 "--out", str(tmp_path / "r")]) == 2
+    assert "garbage.gbx" in _error(capsys)
