@@ -24,7 +24,7 @@ from ._notes import command_notes, error_message
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
 COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate",
-            "plan", "live", "examples")
+            "plan", "live", "examples", "monitor")
 
 
 class OneLineParser(argparse.ArgumentParser):

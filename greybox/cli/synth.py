@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import GreyboxError
+from ..twin.ageing import DRIFT_KINDS, Drift, synthesize_history
 from ..twin.cutting import CuttingSpec
 from ..twin.datasets import ESSENTIAL_TRUTH_CHANNELS, SAMPLE_TIME_S, dataset_motion, synthesize
 from ..twin.effects import EFFECTS, effect_parameters
@@ -80,6 +81,18 @@ def add_parser(subparsers) -> None:
                         help="write each dataset of all axes to one file DIR/<dataset>.FORMAT (csv, parquet or "
                         "mcap), as a machine logs its axes together (columns X_position_mm, Y_current_A, ...; "
                         "MCAP: a channel per axis), every axis cut to the shortest")
+    parser.add_argument("--history", type=POSITIVE_INT, metavar="DAYS",
+                        help="write an ageing machine instead: one short air-move log per axis and day, "
+                             "DIR/<axis>_<YYYY-MM-DD>.mcap, with a day-to-day spread and the --drift given "
+                             "(for greybox monitor)")
+    parser.add_argument("--drift", action="append", default=[], metavar="KIND:START:RATE",
+                        help="with --history: a drift of every axis from day START (counted from 0) at RATE (a "
+                             "fraction of the friction level per day); KIND: " + "; ".join(DRIFT_KINDS.values())
+                             + " (repeatable)")
+    parser.add_argument("--start-date", metavar="YYYY-MM-DD", default="2026-01-01",
+                        help="with --history: the date of day 0 (default %(default)s)")
+    parser.add_argument("--machine", metavar="NAME", default="twin",
+                        help="with --history: the machine name written to the logs (default %(default)s)")
     parser.add_argument("--force", action="store_true",
                         help="write into a non-empty DIR, overwriting files of the same name")
     parser.set_defaults(run=run)
@@ -239,7 +252,38 @@ def _run_family(args: argparse.Namespace, datasets, cutting) -> int:
     return 0
 
 
+def _run_history(args: argparse.Namespace) -> int:
+    """``synth --history DAYS``: the ageing twin's daily air-move logs."""
+    import datetime as dt
+
+    given = [flag for flag, value in (("--family", args.family), ("--plan", args.plan), ("--effect", args.effect),
+                                      ("--cutting", args.cutting), ("--duration", args.duration),
+                                      ("--one-file", args.one_file)) if value]
+    if given:
+        raise GreyboxError(f"--history writes the daily air moves of the ageing twin; {', '.join(given)} "
+                           "does not apply")
+    if not args.axis:
+        raise GreyboxError("--history needs the axes (--axis X, Y, C or several)")
+    try:
+        start = dt.date.fromisoformat(args.start_date)
+    except ValueError:
+        raise GreyboxError(f"--start-date {args.start_date!r}: expected a day YYYY-MM-DD") from None
+    drifts = [Drift.parse(text) for text in args.drift]
+    axes = list(dict.fromkeys(a.strip().upper() for a in args.axis if a.strip()))
+    _check_out_dir(args)
+    synthesize_history(axes, args.history, args.seed, args.out, drifts, start_date=start, machine=args.machine,
+                       truth_channels=ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None,
+                       progress=print)
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.history is not None:
+        return _run_history(args)
+    given = [flag for flag, value in (("--drift", args.drift), ("--start-date", args.start_date != "2026-01-01"),
+                                      ("--machine", args.machine != "twin")) if value]
+    if given:
+        raise GreyboxError(f"{', '.join(given)} needs --history DAYS")
     datasets = list(dict.fromkeys(d.strip().upper() for d in args.datasets if d.strip()))
     cutting = None
     if args.cutting:

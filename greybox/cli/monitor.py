@@ -1,0 +1,48 @@
+"""``greybox monitor``: friction fingerprints of logs into a history, change detection, a dashboard."""
+
+from __future__ import annotations
+
+import argparse
+
+from ._types import NumberRange
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "monitor",
+        help="fingerprint axis logs into a history, detect friction changes, write a dashboard",
+        description=(
+            "Fit each log's friction fingerprint (sliding and break-away level per direction, viscous "
+            "coefficient, residual noise, with 95 %% intervals) on its stretches without process load, add it to "
+            "the Parquet history DIR (machine/axis/date; a log already there is not fitted again), run a CUSUM "
+            "change detector per feature against the first days' baseline and write the dashboard "
+            "OUT/index.html, the axes most severe first. A log's day is its 'date' attribute or the YYYY-MM-DD "
+            "in its file name."
+        ),
+    )
+    parser.add_argument("logs", nargs="*", metavar="LOG", help="axis logs (any supported format), current in A")
+    parser.add_argument("--history", required=True, metavar="DIR", help="fingerprint history (created if missing)")
+    parser.add_argument("--out", required=True, metavar="DIR", help="directory of the dashboard index.html")
+    parser.add_argument("--machine", metavar="NAME",
+                        help="machine name of the logs (default: each log's 'machine' attribute)")
+    parser.add_argument("--axis", metavar="NAME", help="axis to read from files of several axes")
+    parser.add_argument("--model", metavar="FILE",
+                        help="reference model of the axis (greybox train): fit only where its residual stays "
+                             "within its noise (default: every log is an air cut)")
+    parser.add_argument("--baseline-days", type=NumberRange(int, low=3), default=28, metavar="N",
+                        help="first days with a fingerprint that set each feature's baseline (default %(default)s)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..monitor.workflow import run_monitor
+
+    result = run_monitor(args.logs, args.history, args.out, machine=args.machine, axis=args.axis,
+                         model_path=args.model, baseline_days=args.baseline_days, progress=print)
+    trends = result.detector.trends_
+    print(f"{result.fitted} logs fingerprinted, {result.known} already in the history; "
+          f"{len(trends)} axes, {len(result.detector.alarms_)} alarms")
+    for alarm in result.detector.alarms_:
+        print(f"alarm: {alarm.describe()}")
+    print(f"dashboard -> {result.page}")
+    return 0

@@ -1,0 +1,1 @@
+"""Friction fingerprints from production logs, their history (Parquet), change detection and the dashboard."""

@@ -1,0 +1,119 @@
+"""The plant dashboard: one static HTML page of the axes, most severe first.
+
+The page (``index.html``, readable in a browser without a server; figures embedded) has a table of the
+axes sorted by severity, a table of the alarms, and per axis a figure of every feature over the days:
+the daily value with its bootstrap interval, the baseline band (mean +- 2 standard deviations) over the
+baseline days, and the start and detection day of each alarm.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..evaluate.html import write_html
+from ..evaluate.plots import import_pyplot, save_figure
+from ..evaluate.table import Table
+from .detect import ChangeDetector
+from .fingerprint import FEATURE_UNITS
+
+__all__ = ["axis_figure", "write_report"]
+
+
+def axis_figure(trend, detector: ChangeDetector, path) -> Path:
+    """Write the figure of one axis' features over the days as a PNG.
+
+    Parameters
+    ----------
+    trend : AxisTrend
+        The axis (:attr:`ChangeDetector.trends_`).
+    detector : ChangeDetector
+        The fitted detector (its baseline length).
+    path : path-like
+        PNG file to write.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    plt = import_pyplot(path)
+    features = list(trend.baseline)
+    figure, axes = plt.subplots(len(features), 1, figsize=(9, 1.7 * len(features) + 0.6), sharex=True,
+                                squeeze=False)
+    dates = np.array(trend.dates, dtype="datetime64[D]")
+    n_base = min(detector.baseline_days, len(dates))
+    alarms = {}
+    for alarm in trend.alarms:
+        alarms.setdefault(alarm.feature, []).append(alarm)
+    for ax, feature in zip(axes[:, 0], features):
+        mean, sd = trend.baseline[feature]
+        ax.fill_between(dates, trend.lower[feature], trend.upper[feature], color="#1f77b4", alpha=0.2, lw=0,
+                        label="95 % interval")
+        ax.plot(dates, trend.values[feature], ".-", color="#1f77b4", lw=1, label="daily value")
+        ax.axhspan(mean - 2 * sd, mean + 2 * sd, color="#2ca02c", alpha=0.15, lw=0, label="baseline +- 2 sd")
+        ax.axvspan(dates[0], dates[n_base - 1], color="#999999", alpha=0.08, lw=0)
+        for alarm in alarms.get(feature, []):
+            ax.axvline(np.datetime64(alarm.start, "D"), color="#ff7f0e", ls="--", lw=1, label="change start")
+            ax.axvline(np.datetime64(alarm.detected, "D"), color="#d62728", lw=1.5, label="alarm")
+        ax.set_ylabel(f"{feature}\n[{FEATURE_UNITS[feature]}]", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[0, 0].legend(fontsize=7, ncol=5, loc="lower left", bbox_to_anchor=(0.0, 1.02))
+    height = figure.get_figheight()
+    figure.suptitle(f"{trend.machine} / {trend.axis}: friction fingerprint per day (grey: baseline days)",
+                    fontsize=9, y=1.0 - 0.12 / height)
+    figure.autofmt_xdate()
+    figure.subplots_adjust(left=0.11, right=0.98, bottom=0.08, top=1.0 - 0.75 / height, hspace=0.12)
+    saved = save_figure(figure, path, dpi=90)
+    plt.close(figure)
+    return saved
+
+
+def write_report(detector: ChangeDetector, out_dir) -> Path:
+    """Write the dashboard ``out_dir/index.html`` of a fitted detector.
+
+    Parameters
+    ----------
+    detector : ChangeDetector
+        Fitted on the history.
+    out_dir : path-like
+        Directory of the page (created if missing); ``index.html`` in it is replaced.
+
+    Returns
+    -------
+    Path
+        The page written.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for trend in detector.trends_:
+        first = trend.alarms[0] if trend.alarms else None
+        rows.append([trend.machine, trend.axis, str(len(trend.dates)),
+                     f"{trend.dates[0].isoformat()} to {trend.dates[-1].isoformat()}", f"{trend.severity:.2f}",
+                     first.describe().split(": ", 1)[1] if first else "none",
+                     "stale: retrain (greybox train) on recent air moves" if first else "current"])
+    axes_table = Table("Axes, most severe first", ["machine", "axis", "days", "period", "severity", "first alarm",
+                                                    "model"], rows,
+                       [f"Severity: largest CUSUM sum over its calibrated threshold h = {detector.threshold_:.2f} "
+                        "(1 or more: an alarm). "
+                        f"Baseline: the first {detector.baseline_days} days of each axis."])
+    alarm_rows = [[a.machine, a.axis, a.feature, a.direction, a.start.isoformat(), a.detected.isoformat(),
+                   f"{a.shift:+.1f}", "" if not np.isfinite(a.p_value) else f"{a.p_value:.2g}"]
+                  for a in detector.alarms_]
+    alarm_table = Table("Alarms", ["machine", "axis", "feature", "direction", "start", "detected",
+                                   "shift [sd]", "p"], alarm_rows or [["none", "", "", "", "", "", "", ""]],
+                        ["shift: mean change since the start in baseline standard deviations; p: one-sided Welch "
+                         "t-test of the days since the start against the baseline days."])
+    with tempfile.TemporaryDirectory() as scratch:
+        figures = []
+        for i, trend in enumerate(detector.trends_):
+            png = axis_figure(trend, detector, Path(scratch) / f"axis_{i}.png")
+            figures.append((f"{trend.machine} / {trend.axis} (severity {trend.severity:.2f})", png))
+        return write_html(out / "index.html", title="Friction fingerprints", tables=[axes_table, alarm_table],
+                          figures=figures, embed=True,
+                          intro="Per axis and day: sliding and break-away friction levels per direction, viscous "
+                                "coefficients and residual noise, fitted on the logs' stretches without process "
+                                "load, with 95 % block-bootstrap intervals.")

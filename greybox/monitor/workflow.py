@@ -1,0 +1,178 @@
+"""``greybox monitor``: fingerprint logs into the history, detect changes, write the dashboard."""
+
+from __future__ import annotations
+
+import datetime as dt
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Sequence
+
+from ..data.io import read_log
+from ..data.prepare import prepare
+from ..errors import GreyboxError, LogError
+from .detect import ChangeDetector
+from .fingerprint import FrictionFingerprint, unloaded_samples
+from .history import append_fingerprint, file_sha256, has_log, read_history, row_path
+from .report import write_report
+
+__all__ = ["MonitorResult", "fingerprint_file", "log_date", "run_monitor"]
+
+_DATE_IN_NAME = re.compile(r"(\d{4}-\d{2}-\d{2})")
+
+
+def log_date(log, path) -> dt.date:
+    """The day of a log: its ``date`` attribute (ISO), else the first ``YYYY-MM-DD`` in its file name.
+
+    Parameters
+    ----------
+    log : AxisLog
+        The log read from ``path``.
+    path : path-like
+        Its file.
+
+    Raises
+    ------
+    LogError
+        If neither gives a valid date.
+    """
+    text = log.attrs.get("date") if isinstance(log.attrs, dict) else None
+    found = _DATE_IN_NAME.search(Path(path).name)
+    text = text or (found.group(1) if found else None)
+    if not text:
+        raise LogError(path, "no date: the log has no 'date' attribute and its name no YYYY-MM-DD")
+    try:
+        return dt.date.fromisoformat(str(text)[:10])
+    except ValueError:
+        raise LogError(path, f"date {text!r} is not a valid YYYY-MM-DD day") from None
+
+
+def fingerprint_file(path, history, *, machine: str | None = None, axis: str | None = None, model=None,
+                     fingerprint: FrictionFingerprint | None = None) -> tuple[Path, bool]:
+    """Fingerprint one log file into the history, unless the same file is there already.
+
+    Parameters
+    ----------
+    path : path-like
+        Log file (any supported format), motor current in A.
+    history : path-like
+        History directory.
+    machine : str, optional
+        Machine name; default the log's ``machine`` attribute.
+    axis : str, optional
+        Axis to read from a file of several axes (and its name); default the log's own axis.
+    model : estimator, optional
+        Reference model of the axis: only the samples where its residual stays within its noise are fitted
+        (:func:`~greybox.monitor.fingerprint.unloaded_samples`); without it the whole log is taken as an air cut.
+    fingerprint : FrictionFingerprint, optional
+        Settings of the fit; default :class:`FrictionFingerprint()`.
+
+    Returns
+    -------
+    (Path, bool)
+        The history file of the log's row, and whether it was fitted now (False: already in the history).
+    """
+    if Path(path).is_file():  # a log already in the history under the machine and axis asked for: not read again
+        known = has_log(history, file_sha256(path))
+        if known is not None and machine in (None, known.parts[-4][len("machine="):]) \
+                and axis in (None, known.parts[-3][len("axis="):]):
+            return known, False
+    log = read_log(path, axis=axis) if axis is not None else read_log(path)
+    machine = machine or (log.attrs.get("machine") if isinstance(log.attrs, dict) else None)
+    if not machine:
+        raise LogError(path, "no machine name: the log has no 'machine' attribute; give --machine")
+    name = axis or log.axis
+    if not name:
+        raise LogError(path, "no axis name in the log; give --axis")
+    if log.effort_unit != "A":
+        raise LogError(path, f"effort in {log.effort_unit}: fingerprints are of motor current in A")
+    date = log_date(log, path)
+    sha = file_sha256(path)
+    target = row_path(history, str(machine), str(name), date, sha)
+    if has_log(history, sha) == target:
+        return target, False
+    runs = prepare(log)
+    unloaded = None
+    if model is not None:
+        unloaded = []
+        for run in runs:
+            residual = run.effort - model.predict(run)
+            unloaded.append(unloaded_samples(residual))
+    fitted = (fingerprint or FrictionFingerprint()).fit(runs, unloaded=unloaded)
+    written = append_fingerprint(history, machine=str(machine), axis=str(name), date=date, sha256=sha,
+                                 source=Path(path).name, n_samples=fitted.n_samples_, values=fitted.values_,
+                                 lower=fitted.lower_, upper=fitted.upper_)
+    return written, True
+
+
+@dataclass
+class MonitorResult:
+    """What ``greybox monitor`` did.
+
+    Parameters
+    ----------
+    fitted : int
+        Logs fingerprinted now.
+    known : int
+        Logs already in the history (not fitted again).
+    detector : ChangeDetector
+        The detector fitted on the whole history.
+    page : Path
+        The dashboard written.
+    """
+
+    fitted: int
+    known: int
+    detector: ChangeDetector
+    page: Path
+
+
+def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
+                model_path=None, baseline_days: int = 28,
+                progress: Callable[[str], None] | None = None) -> MonitorResult:
+    """Fingerprint ``logs`` into ``history``, detect changes over the whole history, write the dashboard.
+
+    Parameters
+    ----------
+    logs : sequence of path-like
+        Log files (may be empty: then only the history is analysed).
+    history : path-like
+        History directory (created if missing).
+    out_dir : path-like
+        Directory of the dashboard ``index.html``.
+    machine : str, optional
+        Machine name of every log; default each log's ``machine`` attribute.
+    axis : str, optional
+        Axis to read from files of several axes.
+    model_path : path-like, optional
+        Reference model file (``greybox train``) to find the stretches without process load.
+    baseline_days : int, default 28
+        Days that set each feature's baseline.
+    progress : callable, optional
+        Called with one line per log.
+
+    Returns
+    -------
+    MonitorResult
+    """
+    detector = ChangeDetector(baseline_days=baseline_days)
+    detector._check_params()  # refuse bad options before any work
+    if Path(history).exists() and not Path(history).is_dir():
+        raise GreyboxError(f"{history}: history is a file, not a directory")
+    model = None
+    if model_path is not None:
+        from ..persistence import load_model
+
+        model = load_model(model_path)
+    fitted = known = 0
+    for path in logs:
+        row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model)
+        fitted, known = fitted + new, known + (not new)
+        if progress is not None:
+            progress(f"{path}: {'fingerprinted' if new else 'already in the history'} -> {row}")
+    table = read_history(history)
+    if table.num_rows == 0:
+        raise GreyboxError(f"{history}: the history holds no fingerprints; give logs to fingerprint")
+    detector.fit(table)
+    page = write_report(detector, out_dir)
+    return MonitorResult(fitted, known, detector, page)

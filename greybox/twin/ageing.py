@@ -1,0 +1,246 @@
+"""A twin that ages: one short daily air-move log per axis, with friction drifting from a given day.
+
+Every day the axis runs the same air-move programme inside its measurement window (back and forth at
+four feeds, :func:`air_move_trajectory`); its truth plant is the default one with two changes:
+
+- a day-to-day spread (temperature, lubricant state): the friction levels (every Maxwell-slip element's
+  breakaway current) are scaled by ``exp(N(0, LEVEL_SPREAD))`` and the viscous coefficient by
+  ``exp(N(0, VISCOUS_SPREAD))``, drawn from the seed and the day;
+- the drifts (:class:`Drift`), from their start day on, scale the friction levels by
+  ``1 + rate * (day - start)`` (lubrication loss: the levels rise) or ``1 - rate * (day - start)``
+  (preload loss: they fall; never below :data:`MIN_LEVEL_FACTOR`). ``none`` changes nothing (the spread
+  alone).
+
+A level change scales the sliding and the static level alike (the ratio of the two is the plant's).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..errors import GreyboxError
+from .axes import axis_geometry
+from .datasets import make_dataset, stored
+from .motion import MotionProfile
+from .plant import default_plant_parameters
+from .trajectories import MM_MIN, Trajectory
+
+__all__ = ["DRIFT_KINDS", "Drift", "air_move_trajectory", "aged_log", "synthesize_history"]
+
+#: Drift kinds and what each does to the truth plant.
+DRIFT_KINDS = {
+    "lubrication": "lubrication loss: the friction levels rise by RATE (a fraction) per day from day START",
+    "preload": "preload loss: the friction levels fall by RATE (a fraction) per day from day START",
+    "none": "stable: only the day-to-day spread",
+}
+#: Standard deviation of the log of the daily friction-level factor (1 % spread).
+LEVEL_SPREAD = 0.01
+#: Standard deviation of the log of the daily viscous factor (3 % spread: viscosity follows temperature).
+VISCOUS_SPREAD = 0.03
+#: Smallest factor a preload loss takes the friction levels to.
+MIN_LEVEL_FACTOR = 0.2
+#: Feeds [mm/min] of the daily air moves, slowest first.
+AIR_MOVE_FEEDS_MM_MIN = (60.0, 300.0, 900.0, 1500.0, 2400.0)
+#: Dataset label of the daily logs (it seeds their noise with the day's seed).
+HISTORY_DATASET = "H"
+
+
+@dataclass(frozen=True)
+class Drift:
+    """A friction drift of the ageing twin.
+
+    Parameters
+    ----------
+    kind : {"lubrication", "preload", "none"}
+        Kind of drift (:data:`DRIFT_KINDS`).
+    start_day : int, default 0
+        First day (counted from 0) on which the drift acts.
+    rate : float, default 0.0
+        Relative change of the friction levels per day [1/day], at least 0.
+    """
+
+    kind: str
+    start_day: int = 0
+    rate: float = 0.0
+
+    def __post_init__(self):
+        if self.kind not in DRIFT_KINDS:
+            raise GreyboxError(f"unknown drift kind {self.kind!r}; choose from {', '.join(DRIFT_KINDS)}")
+        if isinstance(self.start_day, bool) or not isinstance(self.start_day, (int, np.integer)) \
+                or self.start_day < 0:
+            raise GreyboxError(f"drift start day must be a non-negative integer, got {self.start_day!r}")
+        if not (np.isfinite(self.rate) and self.rate >= 0.0):
+            raise GreyboxError(f"drift rate must be a non-negative fraction per day, got {self.rate!r}")
+
+    @classmethod
+    def parse(cls, text: str) -> "Drift":
+        """A drift from ``KIND:START:RATE`` (``none`` alone is accepted too).
+
+        Parameters
+        ----------
+        text : str
+            E.g. ``"lubrication:30:0.01"``: from day 30 the levels rise by 1 % of their value per day.
+
+        Raises
+        ------
+        GreyboxError
+            If the text is not of that form.
+        """
+        parts = [part.strip() for part in str(text).split(":")]
+        if parts == ["none"]:
+            return cls("none")
+        if len(parts) != 3:
+            raise GreyboxError(f"drift {text!r}: expected KIND:START:RATE, e.g. lubrication:30:0.01")
+        try:
+            start, rate = int(parts[1]), float(parts[2])
+        except ValueError:
+            raise GreyboxError(f"drift {text!r}: START must be a whole day and RATE a number") from None
+        return cls(parts[0], start, rate)
+
+    def level_factor(self, day: int) -> float:
+        """Factor of the friction levels on ``day`` (1 before the start).
+
+        Parameters
+        ----------
+        day : int
+            Day, counted from 0.
+        """
+        elapsed = max(0, int(day) - int(self.start_day))
+        if self.kind == "lubrication":
+            return 1.0 + self.rate * elapsed
+        if self.kind == "preload":
+            return max(MIN_LEVEL_FACTOR, 1.0 - self.rate * elapsed)
+        return 1.0
+
+
+def air_move_trajectory(axis: str, feeds_mm_min: Sequence[float] = AIR_MOVE_FEEDS_MM_MIN,
+                        cruise_s: float = 1.0, dwell_s: float = 0.2) -> Trajectory:
+    """The daily air moves: from the window centre, back and forth at each feed.
+
+    Each move cruises about ``cruise_s`` at its feed (its distance limited to the measurement window),
+    first towards negative positions, then back.
+
+    Parameters
+    ----------
+    axis : {"X", "Y", "C"}
+        Axis of the twin.
+    feeds_mm_min : sequence of float
+        Feeds [mm/min], in the order run.
+    cruise_s : float, default 1.0
+        Cruise time [s] per move (before the window limit).
+    dwell_s : float, default 0.2
+        Dwell [s] at the start and after every move.
+    """
+    geometry = axis_geometry(axis)
+    low, high = geometry.window_mm
+    profile = MotionProfile(geometry.window_centre_mm)
+    profile.hold(dwell_s)
+    for feed in feeds_mm_min:
+        speed = feed * MM_MIN
+        distance = min(speed * cruise_s + profile.limits.ramps_distance([speed]), 0.45 * (high - low))
+        for step in (-distance, distance):
+            profile.move(step, [speed])
+            profile.hold(dwell_s)
+    return Trajectory(profile, {"kind": "daily air moves", "feeds_mm_min": [float(f) for f in feeds_mm_min],
+                                "duration_s": profile.duration_s})
+
+
+def _day_seed(seed: int, day: int, axis: str) -> int:
+    """A seed of its own for each day and axis."""
+    return int(np.random.SeedSequence([int(seed), int(day), ord(axis[0])]).generate_state(1)[0])
+
+
+def aged_log(axis: str, day: int, seed: int, drifts: Sequence[Drift] = (), *,
+             start_date: dt.date = dt.date(2026, 1, 1), machine: str = "twin"):
+    """The air-move log of ``axis`` on ``day`` of the ageing twin.
+
+    Parameters
+    ----------
+    axis : {"X", "Y", "C"}
+        Axis of the twin.
+    day : int
+        Day, counted from 0.
+    seed : int
+        Seed of the history (spread and noise of every day follow from it).
+    drifts : sequence of Drift
+        Drifts acting on the axis; their level factors multiply.
+    start_date : datetime.date, default 2026-01-01
+        Calendar date of day 0.
+    machine : str, default "twin"
+        Machine name written to the log's attributes.
+
+    Returns
+    -------
+    AxisLog
+        With ``attrs`` ``date`` (ISO), ``machine``, ``day`` and ``drift`` (the kinds, starts, rates and the
+        day's level factor).
+    """
+    geometry = axis_geometry(axis)
+    rng = np.random.default_rng(_day_seed(seed, day, geometry.name))
+    plant = default_plant_parameters(geometry.name)
+    level = float(np.exp(rng.normal(0.0, LEVEL_SPREAD))) * float(np.prod([d.level_factor(day) for d in drifts]))
+    viscous = float(np.exp(rng.normal(0.0, VISCOUS_SPREAD)))
+    plant = plant.replace(breakaway_A=tuple(level * b for b in plant.breakaway_A),
+                          viscous_A_s_mm=viscous * plant.viscous_A_s_mm)
+    log = make_dataset(geometry.name, HISTORY_DATASET, _day_seed(seed, day, geometry.name),
+                       plant=plant, trajectory=air_move_trajectory(geometry.name))
+    date = start_date + dt.timedelta(days=int(day))
+    attrs = {**log.attrs, "date": date.isoformat(), "machine": machine, "day": int(day),
+             "drift": {"drifts": [{"kind": d.kind, "start_day": int(d.start_day), "rate": float(d.rate)}
+                                  for d in drifts], "level_factor": level, "viscous_factor": viscous}}
+    return log.replace(attrs=attrs)
+
+
+def synthesize_history(axes: Sequence[str], days: int, seed: int, out_dir, drifts: Sequence[Drift] = (), *,
+                       start_date: dt.date = dt.date(2026, 1, 1), machine: str = "twin",
+                       truth_channels: Sequence[str] | None = None,
+                       progress: Callable[[str], None] | None = None) -> list[Path]:
+    """Write ``days`` daily air-move logs per axis as ``out_dir/<axis>_<date>.mcap``.
+
+    Parameters
+    ----------
+    axes : sequence of str
+        Axes of the twin.
+    days : int
+        Number of days (at least 1).
+    seed : int
+        Seed of the history.
+    out_dir : path-like
+        Output directory (created if missing).
+    drifts : sequence of Drift
+        Drifts acting on every axis.
+    start_date : datetime.date, default 2026-01-01
+        Calendar date of day 0.
+    machine : str, default "twin"
+        Machine name written to the logs.
+    truth_channels : sequence of str, optional
+        Truth channels kept (:func:`greybox.twin.datasets.stored`); all by default.
+    progress : callable, optional
+        Called with one line per axis written.
+
+    Returns
+    -------
+    list of Path
+        The files written, day by day.
+    """
+    from ..data.io import write_log
+
+    if isinstance(days, bool) or not isinstance(days, (int, np.integer)) or days < 1:
+        raise GreyboxError(f"days must be a positive whole number, got {days!r}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for axis in axes:
+        for day in range(days):
+            log = aged_log(axis, day, seed, drifts, start_date=start_date, machine=machine)
+            path = out / f"{log.axis}_{log.attrs['date']}.mcap"
+            write_log(stored(log, truth_channels), path)
+            written.append(path)
+        if progress is not None:
+            progress(f"{axis}: {days} daily air-move logs from {start_date.isoformat()} -> {out}")
+    return written

@@ -1,0 +1,114 @@
+"""Change detection (greybox.monitor.detect): CUSUM sums, alarms naming feature, direction, start."""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import numpy as np
+import pyarrow as pa
+import pytest
+
+from greybox.errors import ParameterError
+from greybox.monitor.detect import ChangeDetector, calibrated_threshold, cusum
+from greybox.monitor.fingerprint import FEATURES
+from greybox.monitor.history import SCHEMA
+
+DAY0 = dt.date(2026, 1, 1)
+
+
+def _table(series: dict, axis="X", machine="m", default=None) -> pa.Table:
+    """A history table of one axis: one row per day, ``series[feature]`` or ``default`` (a noise series)."""
+    n = len(next(iter(series.values()))) if series else len(default)
+    rows = {"schema_version": [1] * n, "machine": [machine] * n, "axis": [axis] * n,
+            "date": [DAY0 + dt.timedelta(days=i) for i in range(n)], "log_sha256": [f"{i:064x}" for i in range(n)],
+            "source": ["log"] * n, "n_samples": [1000] * n}
+    rng = np.random.default_rng(1)
+    for name in FEATURES:
+        values = np.asarray(series.get(name, rng.normal(1.0, 0.01, n) if default is None else default), float)
+        rows[name], rows[f"{name}_lo"], rows[f"{name}_hi"] = values, values - 0.02, values + 0.02
+    return pa.Table.from_pydict(rows, schema=SCHEMA)
+
+
+def _reference_cusum(z, k, h):
+    """The CUSUM recursion written out with lists."""
+    up, low, s_up, s_low = [], [], 0.0, 0.0
+    for value in z:
+        s_up = max(0.0, s_up + value - k)
+        s_low = max(0.0, s_low - value - k)
+        up.append(s_up)
+        low.append(s_low)
+    return up, low
+
+
+def test_cusum_agrees_with_its_recursion():
+    z = np.random.default_rng(3).normal(0.2, 1.0, 300)
+    up, low = cusum(z, k=0.5, h=5.0)
+    ref_up, ref_low = _reference_cusum(z, 0.5, 5.0)
+    np.testing.assert_allclose(up, ref_up)
+    np.testing.assert_allclose(low, ref_low)
+    assert np.all(cusum([10.0, -10.0], clip=3.0)[0] == [2.5, 0.0])
+
+
+def _alternating(n):
+    return 1.0 + 0.01 * (-1.0) ** np.arange(n)  # baseline mean 1, sd ~0.0104
+
+
+def test_step_rise_named_with_its_start_and_day_of_detection():
+    x = _alternating(40)
+    x[26:] += 0.03  # +2.9 sd from day 26 (day 25 is a low day: the upper sum is 0 there)
+    detector = ChangeDetector(baseline_days=14, h=5.0).fit(_table({"sliding_neg": x}, default=_alternating(40)))
+    (alarm,) = detector.alarms_
+    assert (alarm.feature, alarm.direction, alarm.axis) == ("sliding_neg", "rises", "X")
+    assert alarm.start == DAY0 + dt.timedelta(days=26)
+    # z alternates 3.9 (clipped to 3) / 1.9 sd: 2.5 + 1.4 + 2.5 above the allowance 0.5 reach h = 5 on the third day
+    assert alarm.detected == DAY0 + dt.timedelta(days=28)
+    assert 2.0 < alarm.shift < 4.0 and alarm.p_value < 0.05  # three days since the start
+    assert "sliding_neg rises since 2026-01-27" in alarm.describe()
+    assert detector.trends_[0].severity >= 1.0
+
+
+def test_fall_and_severity_order():
+    x = _alternating(40)
+    x[20:] -= 0.05
+    stable = _table({}, axis="Y", default=_alternating(40))
+    falling = _table({"breakaway_pos": x}, axis="X", default=_alternating(40))
+    detector = ChangeDetector(baseline_days=14).fit(pa.concat_tables([stable, falling]))
+    assert [t.axis for t in detector.trends_] == ["X", "Y"]  # most severe first
+    assert [(a.feature, a.direction) for a in detector.alarms_] == [("breakaway_pos", "falls")]
+    assert detector.trends_[1].severity < 1.0 and not detector.trends_[1].alarms
+
+
+def test_one_odd_day_is_no_alarm():
+    x = _alternating(40)
+    x[30] += 1.0  # one wild day: clipped to 3 sd, 2.5 above the allowance, below h = 5
+    assert not ChangeDetector(baseline_days=14, h=5.0).fit(_table({"noise": x}, default=_alternating(40))).alarms_
+
+
+def test_calibrated_threshold_holds_its_false_alarm_rate():
+    rng = np.random.default_rng(2024)  # stable axes drawn apart from the calibration's own seed
+    axes = [_table({name: rng.normal(1.0, 0.02, 28 + 365) for name in FEATURES}, axis=f"A{i}") for i in range(60)]
+    detector = ChangeDetector(baseline_days=28, false_alarms_per_year=1.0).fit(pa.concat_tables(axes))
+    assert detector.threshold_ == pytest.approx(
+        calibrated_threshold(baseline_days=28, n_features=len(FEATURES)))
+    per_axis_year = len(detector.alarms_) / 60
+    assert 0.4 < per_axis_year < 1.8  # 1 asked; 60 axis-years leave a Monte-Carlo spread of about +-0.3
+    textbook = ChangeDetector(baseline_days=28, h=5.0).fit(pa.concat_tables(axes))
+    assert len(textbook.alarms_) / 60 > 2.0 * per_axis_year  # why h is calibrated
+
+
+def test_threshold_rises_with_a_shorter_baseline_and_fewer_alarms():
+    short = calibrated_threshold(baseline_days=14, n_features=7)
+    long = calibrated_threshold(baseline_days=56, n_features=7)
+    rare = calibrated_threshold(baseline_days=56, n_features=7, false_alarms_per_year=0.1)
+    assert short > long and rare > long > 5.0
+
+
+def test_too_few_days_no_alarm_and_bad_settings():
+    x = _alternating(10)
+    x[5:] += 1.0
+    detector = ChangeDetector(baseline_days=14, h=5.0).fit(_table({"sliding_pos": x}, default=_alternating(10)))
+    assert detector.alarms_ == [] and detector.trends_[0].severity == 0.0
+    with pytest.raises(ParameterError, match="baseline_days"):
+        ChangeDetector(baseline_days=2).fit(_table({"sliding_pos": x}))
+    with pytest.raises(ParameterError, match="unknown features bogus"):
+        ChangeDetector(features=["bogus"]).fit(_table({"sliding_pos": x}))
