@@ -349,7 +349,8 @@ def test_train_and_info_print_and_store_the_intervals(tmp_path, capsys, commands
     log = tmp_path / "run.csv"
     write_log(_coulomb_run(0, 5_000), log)
     out = tmp_path / "model.gbm"
-    assert cli.main(["train", "--model", "coulomb", "--no-offset", "--train", str(log), "--out", str(out), "--quiet"]) == 0
+    assert cli.main(["train", "--model", "coulomb", "--no-offset", "--train", str(log), "--out", str(out),
+                     "--quiet"]) == 0
     trained = capsys.readouterr().out
     assert re.search(r"95 % intervals by sandwich over \d+ time blocks", trained)
     assert [line for line in trained.splitlines() if line.strip().startswith("J ")][0].count("95 %:") == 1
