@@ -22,7 +22,7 @@ _MODEL_OPTIONS = (
     ("--asymmetric", "asymmetric", "asymmetric"),
     ("--elements", "elements", "n_elements"),
     ("--model-seed", "model_seed", "random_state"),
-    ("--inertia", "inertia", "inertia"),
+    ("--inertia", "model_inertia", "inertia"),
 )
 
 
@@ -61,10 +61,10 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
     group.add_argument("--elements", type=POSITIVE_INT, metavar="N",
                        help="number of Maxwell-slip elements (gms and the GMS stage of gmssvr; default 4)")
     inertia = group.add_mutually_exclusive_group()
-    inertia.add_argument("--inertia", type=NON_NEGATIVE, metavar="J",
+    inertia.add_argument("--inertia", dest="model_inertia", type=NON_NEGATIVE, metavar="J",
                          help="known inertia J in effort s^2/length (A s^2/mm, N s^2/mm = t, Nm s^2/deg), e.g. from "
                          "the drive's commissioning: the model identifies no inertia of its own (default: identified)")
-    inertia.add_argument("--load-side", dest="inertia", action="store_const", const=0.0,
+    inertia.add_argument("--load-side", dest="model_inertia", action="store_const", const=0.0,
                          help="the effort is measured at the load (a force or torque sensor on the device), so no "
                          "inertia lies between the sensor and the friction: J = 0 (the same as --inertia 0)")
     if backlash:

@@ -285,7 +285,7 @@ def _run_auto(args: argparse.Namespace) -> int:
         groups += [str(path)] * len(pieces)
     started = time.perf_counter()
     report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
-    model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.inertia,
+    model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.model_inertia,
                          workers=args.workers or os.cpu_count() or 1, progress=report)
     _intervals(model, args, runs)
     names = [Path(group).name for group in groups]
