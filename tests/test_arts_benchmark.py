@@ -26,6 +26,10 @@ from greybox.model_choice import choose_model
 from greybox.studies import arts as bench
 from greybox.studies import auto
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[1]
 SCRIPT = REPO / "scripts" / "arts_benchmark.py"
 

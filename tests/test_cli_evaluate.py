@@ -18,6 +18,10 @@ from greybox.metrics import rmse
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(autouse=True)
 def commands(monkeypatch):

@@ -13,6 +13,10 @@ from greybox.friction import CoulombModel
 from greybox.friction.backlash import BacklashModel
 from greybox.persistence import load_model
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 # Coulomb + viscous + offset truth: J [A s^2/mm], Fc [A], Fv [A s/mm], offset [A]
 TRUTH = {"J_": 2e-3, "coulomb_pos_": 1.2, "viscous_pos_": 0.015, "offset_": -0.3}
 

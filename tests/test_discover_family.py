@@ -14,6 +14,10 @@ import pytest
 from greybox.studies.discovery_family import ACCEPTED_NULL_VERDICTS, run_family_case, summarise_family
 from greybox.studies.hysteresis_axis import FamilyCase
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 DURATION_S = 20.0
 
 

@@ -21,6 +21,10 @@ from greybox.friction import CoulombModel, GMSModel
 from greybox.studies.discovery import StudyCase, case_logs
 from greybox.studies.hysteresis_axis import FamilyCase, family_logs
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 DURATION_S = 20.0
 
 

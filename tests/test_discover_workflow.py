@@ -21,6 +21,10 @@ from greybox.friction import CoulombModel
 from greybox.studies.discovery import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
 from greybox.twin import CurrentNoise
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 DURATION_S = 20.0
 
 

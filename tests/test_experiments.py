@@ -24,6 +24,10 @@ from greybox.studies.experiments import (
 )
 from greybox.twin import make_dataset
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 #: Fast model settings for the tests: few GMS starts, fixed (default) SVR hyperparameters.
 FAST = {
     "coulomb": {},

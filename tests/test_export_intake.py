@@ -20,6 +20,10 @@ from greybox.errors import GreyboxError, LogError
 from greybox.evaluate.process import predict_process
 from greybox.friction import CoulombModel
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def exports(tmp_path_factory):

@@ -20,6 +20,10 @@ from greybox.friction import StribeckModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
 
 

@@ -21,6 +21,10 @@ from greybox.metrics import metrics_table
 from greybox.persistence import load_model
 from greybox.twin import make_dataset
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 #: A short GMS identification (one start, 100 iterations): seconds per model, the same for fleet and plain runs.
 QUICK = ["--model", "gms", "--set", "n_starts=1", "--set", "max_iter=100", "--quiet"]
 

@@ -12,6 +12,10 @@ from greybox.friction.gms import simulate_gms
 from greybox.friction.reference import backlash_gap_reference
 from greybox.friction.signals import STEP, motion_log, velocity_profile
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 TRUTH = {"alpha": np.array([0.3, 0.7]), "k": np.array([60.0, 20.0]), "sigma": 0.0, "s_0": 0.03, "s_inf": 0.025,
          "v_s": 5.0, "C": 2.0, "mu": 0.004}
 WIDTH = 0.4  # mm

@@ -26,6 +26,10 @@ from greybox.identify.intervals import attach_intervals, cluster_covariance, clu
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 #: Truth of the linear-in-parameters simulation: J [A s^2/mm], Coulomb level [A], viscous [A s/mm].
 TRUTH = {"J": 2e-3, "coulomb_pos": 0.8, "viscous_pos": 0.01}
 STEP = 0.002

@@ -31,6 +31,10 @@ from greybox.models.chunked import predict_chunked
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 #: Quick settings of every kind a model file may hold (short searches, no Bayesian optimisation).
 CASES = {
     "coulomb": lambda: CoulombModel(fit_offset=True),

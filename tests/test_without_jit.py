@@ -14,6 +14,10 @@ from pathlib import Path
 
 import pytest
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[1]
 
 #: Test files of the compiled kernels: GMS and LuGre, SVR kernel sums, plant laws, JSON numbers and MCAP

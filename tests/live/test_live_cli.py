@@ -15,6 +15,10 @@ import pandas as pd
 import pytest
 from live_helpers import EXAMPLE_AXIS, joined, json_batches, run_cli
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 #: Seconds a command under test may take before the test gives up on it.
 TIMEOUT_S = 60
 

@@ -16,6 +16,10 @@ from greybox.monitor.history import read_history
 from greybox.monitor.workflow import fingerprint_file
 from greybox.persistence import load_model
 
+#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: `pytest -m slow` runs them, as .ci/run does.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def twin_days(tmp_path_factory):
