@@ -9,7 +9,7 @@ from sklearn.base import clone
 
 from greybox.data.log import AxisLog
 from greybox.errors import LogError
-from greybox.models.svr import SVRCurrentModel, default_bounds, inertia_offset_proxy
+from greybox.models.svr import SVRCurrentModel, coulomb_viscous_proxy, default_bounds
 
 J_TRUE = 2e-4  # A s^2/mm
 OFFSET_TRUE = 0.1  # A
@@ -37,17 +37,17 @@ def test_proxy_recovers_inertia_and_offset_of_a_coulomb_viscous_axis():
     # Replace the smooth tanh by an exact Coulomb step: the proxy then is the truth.
     runs = [r.replace(effort=J_TRUE * r.acceleration + 0.8 * np.sign(r.velocity) + 0.003 * r.velocity
                       + OFFSET_TRUE) for r in runs]
-    J, offset = inertia_offset_proxy(runs)
+    J, offset = coulomb_viscous_proxy(runs)[:2]
     assert J == pytest.approx(J_TRUE, rel=1e-9)
     assert offset == pytest.approx(OFFSET_TRUE, rel=1e-9)
-    J, offset = inertia_offset_proxy(runs, inertia=3e-4)
+    J, offset = coulomb_viscous_proxy(runs, inertia=3e-4)[:2]
     assert J == 3e-4
 
 
 def test_proxy_inertia_is_never_negative():
     runs = [sweep_run(s, ripple=0.0, noise=0.0) for s in (1, 2)]
     runs = [r.replace(effort=-J_TRUE * r.acceleration + 0.8 * np.sign(r.velocity) + OFFSET_TRUE) for r in runs]
-    J, offset = inertia_offset_proxy(runs)
+    J, offset = coulomb_viscous_proxy(runs)[:2]
     assert J == 0.0
     assert np.isfinite(offset)
 

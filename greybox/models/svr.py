@@ -54,7 +54,6 @@ __all__ = [
     "SVRCurrentModel",
     "SVRExpansion",
     "fit_svr_expansion",
-    "inertia_offset_proxy",
     "coulomb_viscous_proxy",
     "default_bounds",
     "HYPERPARAMETERS",
@@ -399,27 +398,6 @@ def coulomb_viscous_proxy(runs: Sequence[AxisLog], inertia: float | None = None
     coef, _ = bounded_lstsq(design, effort[moving], lower=lower)
     J = float(inertia) if inertia is not None else float(coef[3])
     return J, float(coef[2]), float(coef[0]), float(coef[1])
-
-
-def inertia_offset_proxy(runs: Sequence[AxisLog], inertia: float | None = None) -> tuple[float, float]:
-    """Inertia and offset of :func:`coulomb_viscous_proxy`.
-
-    Parameters
-    ----------
-    runs : list of AxisLog
-        Prepared runs.
-    inertia : float, optional
-        Known J [A s^2/mm]; then only the other proxy terms are fitted.
-
-    Returns
-    -------
-    J : float
-        Inertia [A s^2/mm] (or [N s^2/mm] for force logs).
-    offset : float
-        Constant effort [A] (e.g. a weight share on an inclined axis).
-    """
-    J, offset, _, _ = coulomb_viscous_proxy(runs, inertia)
-    return J, offset
 
 
 class KernelRegressionModel(CurrentModel):
