@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_svr_model import FIXED, sweep_run
+from svr_runs import FIXED, sweep_run
 
 from greybox import persistence, registry
 from greybox.models.svr import SVRCurrentModel
@@ -24,7 +24,7 @@ def test_saved_and_loaded_model_predicts_identically(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("target", ["residual", "current"])
 def test_grey_box_model_with_nested_gms_stage_round_trips(tmp_path, monkeypatch, target):
-    from test_svr_gms import SVR_FIXED, gms_run, quick_gms
+    from svr_runs import SVR_FIXED, gms_run, quick_gms
 
     from greybox.friction.gms import GMSModel
     from greybox.models.gmssvr import GMSSVRModel

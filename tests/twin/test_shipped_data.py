@@ -10,7 +10,7 @@ import pytest
 from greybox.data.io import read_log
 from greybox.twin import make_dataset
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[2] / "data"
 SHIPPED_SEED = 2024
 REGENERATE = "greybox synth --axis X Y --out data --seed 2024 --truth essential"
 

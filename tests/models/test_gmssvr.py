@@ -4,34 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from multisine import multisine_motion
 from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
+from svr_runs import RIPPLE_A, SVR_FIXED, gms_run, quick_gms
 
-from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
-from greybox.friction.gms import GMSModel, simulate_gms
+from greybox.friction.gms import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
-
-TRUTH_GMS = dict(alpha=np.array([0.1, 0.2, 0.3, 0.4]), k=np.full(4, 80.0), C=2.0, sigma=0.01,
-                 s_0=0.01, s_inf=0.006, v_s=5.0, mu=0.003)
-RIPPLE_A = 0.3  # amplitude of the position-dependent friction the GMS model cannot represent
-
-
-def gms_run(seed, n=20000, ripple=RIPPLE_A, noise=0.02):
-    """Multi-sine motion; current = inertia + GMS friction + ripple(position) + noise."""
-    rng = np.random.default_rng(seed)
-    t, p, v, a = multisine_motion(rng, n)
-    friction, _ = simulate_gms(v, 0.002, **TRUTH_GMS)
-    current = 2e-4 * a + friction + ripple * np.sin(2 * np.pi * p / 150.0) + noise * rng.standard_normal(n)
-    return AxisLog(time=t, position=p, effort=current, velocity=v, acceleration=a)
-
-
-def quick_gms():
-    return GMSModel(n_starts=1, max_iter=60)
-
-
-SVR_FIXED = dict(C=3.0, epsilon=0.01, gamma=1.0, optimize=False, n_subset=800)
 
 
 def rmse(a, b):

@@ -17,7 +17,7 @@ from greybox.friction import GMSModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"
 FORCE_PER_AMP = 1.35 * 2 * math.pi * 0.9 / 0.010  # examples/axis_x.toml, driving [N/A]
 FORCE_PER_AMP_BACKDRIVEN = 1.35 * 2 * math.pi / 0.85 / 0.010  # the same file, back-driven [N/A]
 

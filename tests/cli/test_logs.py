@@ -13,7 +13,7 @@ import pytest
 from greybox.cli import main
 from greybox.data.io import write_log
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 GOOD_CSV = "time_s,position_mm,current_A\n" + "".join(f"{0.002 * k:.3f},{0.01 * k},{0.1}\n" for k in range(400))
 

@@ -255,7 +255,7 @@ def test_writer_refuses_what_mcap_cannot_hold(tmp_path, make_log):
 def _doc_text():
     from pathlib import Path
 
-    return (Path(__file__).resolve().parents[1] / "docs" / "log-formats.md").read_text(encoding="utf-8")
+    return (Path(__file__).resolve().parents[2] / "docs" / "log-formats.md").read_text(encoding="utf-8")
 
 
 def test_documented_schema_is_the_written_schema():

@@ -13,7 +13,7 @@ from greybox.cli.examples import EXAMPLE_FILES
 from greybox.data.axis_config import read_axis_config
 from greybox.data.machine_config import read_machine_config
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def test_the_example_files_are_package_data():

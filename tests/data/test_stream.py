@@ -22,7 +22,7 @@ from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"
 
 
 def _blocks_of(values: np.ndarray, size: int):

@@ -22,7 +22,7 @@ from greybox.persistence import save_model
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"
 
 
 def _read_table(path: Path) -> pd.DataFrame:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from test_svr_model import FIXED, sweep_run
+from svr_runs import FIXED, sweep_run
 
 from greybox import persistence, registry
 from greybox.errors import ParameterError

@@ -13,7 +13,7 @@ import pytest
 from greybox.errors import GreyboxError
 from greybox.studies.cutting import cutting_validation
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "cutting_validation.py"
 DATA = REPO / "data"
 AXIS_CONFIG = REPO / "examples" / "axis_x.toml"

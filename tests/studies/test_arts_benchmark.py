@@ -30,7 +30,7 @@ from greybox.studies import auto
 #: `pytest -m slow` runs them, as .ci/run does.
 pytestmark = pytest.mark.slow
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "arts_benchmark.py"
 
 #: Samples per file and displacement amplitude [mm] per file (the data's README; test12 is velocity-limited).

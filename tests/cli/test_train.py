@@ -240,7 +240,7 @@ def test_gmssvr_stages_take_their_own_logs(tmp_path, capsys):
 
 
 def test_parameter_lines_align_their_equals_signs_whatever_the_longest_name():
-    from test_svr_model import FIXED, sweep_run
+    from svr_runs import FIXED, sweep_run
 
     from greybox.cli._model_text import parameter_lines
     from greybox.models.svr import SVRCurrentModel

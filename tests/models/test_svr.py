@@ -6,26 +6,11 @@ import numpy as np
 import pytest
 from multisine import multisine_motion
 from sklearn.base import clone
+from svr_runs import FIXED, J_TRUE, OFFSET_TRUE, sweep_run
 
 from greybox.data.log import AxisLog
 from greybox.errors import LogError
 from greybox.models.svr import SVRCurrentModel, coulomb_viscous_proxy, default_bounds
-
-J_TRUE = 2e-4  # A s^2/mm
-OFFSET_TRUE = 0.1  # A
-
-
-def sweep_run(seed, n=6000, dt=0.002, ripple=0.3, noise=0.02):
-    """Multi-sine motion over ~0..400 mm; current = inertia + friction + ripple(p) + offset."""
-    rng = np.random.default_rng(seed)
-    t, p, v, a = multisine_motion(rng, n, dt)
-    friction = 0.8 * np.tanh(v / 30.0) + 0.003 * v + ripple * np.sin(2 * np.pi * p / 150.0)
-    current = J_TRUE * a + friction + OFFSET_TRUE + noise * rng.standard_normal(n)
-    return AxisLog(time=t, position=p, effort=current,
-                   velocity=v, acceleration=a, extras={"truth_friction_A": friction})
-
-
-FIXED = dict(C=3.0, epsilon=0.01, gamma=5.0, optimize=False, n_subset=800)
 
 
 def rmse(a, b):

@@ -15,7 +15,7 @@ from greybox.evaluate.process import predict_process
 from greybox.friction import CoulombModel
 from greybox.twin import make_dataset
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"
 
 VALID = """
 name = "Z"

@@ -24,7 +24,7 @@ from greybox.twin import make_dataset
 #: `pytest -m slow` runs them, as .ci/run does.
 pytestmark = pytest.mark.slow
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "axis_x.toml"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ import json
 import shutil
 
 import pytest
-from test_svr_model import FIXED, sweep_run
+from svr_runs import FIXED, sweep_run
 
 from greybox.cli import main
 from greybox.data.io import write_log

@@ -159,7 +159,7 @@ def test_plan_options_are_checked(tmp_path, capsys):
 def cli_example(name: str):
     from pathlib import Path
 
-    return Path(__file__).resolve().parents[1] / "examples" / name
+    return Path(__file__).resolve().parents[2] / "examples" / name
 
 
 def test_fanuc_numbers_carry_a_point_and_rotary_programs_turn_by_increments():

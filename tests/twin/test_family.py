@@ -210,5 +210,5 @@ def test_the_documented_ranges_are_the_drawn_ranges():
 
     from greybox.twin.family import ranges_markdown
 
-    docs = (Path(__file__).resolve().parents[1] / "docs" / "synthetic-axis.md").read_text()
+    docs = (Path(__file__).resolve().parents[2] / "docs" / "synthetic-axis.md").read_text()
     assert ranges_markdown() in docs
