@@ -22,7 +22,7 @@ from sklearn.utils.validation import check_is_fitted
 from .base import EFFORT, LENGTH, ModelProtocol, Parameter
 from .data.log import AxisLog, as_log_list
 from .data.quantities import MOTIONS, Motion
-from .errors import LogError, ParameterError
+from .errors import LogError, ParameterError, Setting
 from .identify.inertia import inertia_note
 from .identify.intervals import check_intervals, with_intervals
 from .identify.progress import make_progress
@@ -95,8 +95,8 @@ def check_inertia(value) -> None:
         return
     if not (isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_))
             and np.isfinite(value) and value >= 0.0):
-        raise ParameterError(f"inertia must be None (identified) or a finite, non-negative inertia in "
-                             f"effort s^2/length (0 for an effort measured at the load), got {value!r}")
+        raise ParameterError(Setting("inertia", assign=False), " must be None (identified) or a finite, non-negative "
+                             "inertia in effort s^2/length (0 for an effort measured at the load), got ", repr(value))
 
 
 class CurrentModel(ModelProtocol):
@@ -537,7 +537,7 @@ class CurrentModel(ModelProtocol):
         for name in names:
             value = getattr(self, name)
             if not isinstance(value, (bool, np.bool_)):
-                raise ParameterError(f"{name} must be True or False, got {value!r}")
+                raise ParameterError(Setting(name, assign=False), f" must be True or False, got {value!r}")
 
     # ---------------------------------------------------------------- hooks
     def _check_params(self) -> None:

@@ -51,7 +51,7 @@ def test_a_table_of_several_axes_names_them(tmp_path):
     columns = pd.read_csv(path, nrows=1).columns
     assert columns[0] == "time_s" and {"X_position_mm", "Y_current_A", "C_position_deg"} <= set(columns)
     assert axes_in_columns(columns) == ["X", "Y", "C"]
-    with pytest.raises(LogError, match=r"holds several axes \(X, Y, C\); choose one with --axis"):
+    with pytest.raises(LogError, match=r"holds several axes \(X, Y, C\); choose one with axis='X'"):
         read_log(path)
     with pytest.raises(LogError, match="no columns of axis 'Z' .* the axes in the file: X, Y, C"):
         read_log(path, axis="Z")

@@ -20,7 +20,7 @@ import threading
 import time
 
 from ..errors import GreyboxError
-from ._notes import command_notes, error_message
+from ._spelling import command_notes, error_message
 
 #: Sub-command modules, in the order ``greybox --help`` lists them.
 COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate",

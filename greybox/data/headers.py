@@ -19,7 +19,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ..errors import LogError
+from ..errors import LogError, Setting
 
 __all__ = ["QUANTITY_WORDS", "UNIT_SPELLINGS", "TIMESTAMP_WORDS", "canonical_header", "canonical_table",
            "datetime_seconds", "split_unit"]
@@ -152,8 +152,8 @@ def canonical_table(table: Mapping[str, object], *, source, keep=(), mapped=()) 
             continue
         if name in renamed.values():
             other = next(old for old, new in renamed.items() if new == name)
-            raise LogError(source, f"the columns '{other}' and '{header}' both read as {name}; choose one with "
-                                   f"columns={{'{name}': ...}} (--columns {name}=NAME)")
+            raise LogError(source, f"the columns '{other}' and '{header}' both read as {name}; choose one with ",
+                           Setting("columns", {name: ...}))
         renamed[header] = name
     return {renamed.get(header, header): values for header, values in table.items()}
 

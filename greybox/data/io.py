@@ -70,7 +70,7 @@ def format_of(path, fmt: str | None = None) -> str:
         if suffix in suffixes:
             return name
     known = ", ".join(s for suffixes in FORMATS.values() for s in suffixes)
-    raise LogError(path, f"unknown log file extension '{suffix}'; known: {known} (or give the format explicitly)")
+    raise LogError(path, f"unknown log file extension '{suffix}'; known: {known}")
 
 
 def _handler(fmt: str, index: int):

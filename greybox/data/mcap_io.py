@@ -34,7 +34,7 @@ from typing import Iterator, Mapping, Sequence
 import numpy as np
 from numba import njit
 
-from ..errors import LogError
+from ..errors import LogError, Setting
 from ..threads import shared_pool
 from .blocks import CannotStream, reblock
 from .json_numbers import parse_flat_objects
@@ -415,7 +415,8 @@ def _choose(channels: Mapping[int, _Channel], topic: str | None, path) -> _Chann
         raise LogError(path, "the MCAP file has no channels")
     if topic is None:
         if len(channels) > 1:
-            raise LogError(path, f"the MCAP file has several channels; choose one with topic= ({topics})")
+            raise LogError(path, "the MCAP file has several channels; choose one with ", Setting("topic"),
+                           f" ({topics})")
         return next(iter(channels.values()))
     for channel in channels.values():
         if channel.topic == topic:

@@ -33,7 +33,7 @@ from .blocks import concatenate, reblock
 from .log import AxisLog
 from .parquet_io import column_arrays, schema_fields, unreadable
 from .prepare import derivative_margin, derive
-from .units import log_from_columns, resolve_columns, select_axis
+from .units import NO_TIME_COLUMN, log_from_columns, resolve_columns, select_axis
 from .validate import check_finite, check_increasing, check_time, check_time_units, check_velocity_units
 
 __all__ = ["DEFAULT_BLOCK_SAMPLES", "STREAM_SUFFIXES", "ParquetLog", "median_step", "open_stream",
@@ -154,8 +154,7 @@ class ParquetLog:
             [name for name in selected if name and not str(name).startswith("Unnamed: ")], source=self.path,
             columns=self.columns, effort_unit=self._metadata.get("effort_unit"))
         if "time" not in found:
-            raise LogError(self.path, "no time column (time_s or time_ms, or map one with columns={'time_s': ...}); "
-                                      "for logs without time stamps give the sample time (--sample-time)")
+            raise LogError(self.path, *NO_TIME_COLUMN)
         self._time_column, self._time_factor = found["time"]
         self.axis = axis if axis is not None else str(self._metadata.get("axis", ""))
 

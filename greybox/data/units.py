@@ -29,7 +29,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ..errors import LogError
+from ..errors import LogError, Setting
 from .headers import canonical_table, datetime_seconds
 from .log import AxisLog
 from .quantities import LINEAR, ROTARY
@@ -133,20 +133,25 @@ def known_column(name: str) -> bool:
     return parsed is not None and parsed[1] in UNIT_FACTORS[parsed[0]]
 
 
+#: The message of a log without time stamps or a sample time.
+NO_TIME_COLUMN = ("no time column (time_s or time_ms, or map one with ", Setting("columns", {"time_s": ...}),
+                  "); for logs without time stamps give the sample time (", Setting("sample_time"), ")")
+
+
 def _unit_factor(quantity: str, unit: str | None, column: str, source) -> float:
     units = UNIT_FACTORS[quantity]
     if unit is None:
         raise LogError(
             source,
-            f"column '{column}' has no unit suffix; name it e.g. '{CANONICAL_NAMES[quantity]}' "
-            f"or map it with columns={{'{CANONICAL_NAMES[quantity]}': '{column}'}}",
+            f"column '{column}' has no unit suffix; name it e.g. '{CANONICAL_NAMES[quantity]}' or map it with ",
+            Setting("columns", {CANONICAL_NAMES[quantity]: column}),
         )
     if unit not in units:
         known = ", ".join(f"{quantity}_{u}" for u in units)
         raise LogError(
             source,
             f"unknown unit '{unit}' in column '{column}'; known: {known} (if '{column}' is not the {quantity}, "
-            f"name the {quantity} column with columns={{'{CANONICAL_NAMES[quantity]}': ...}})",
+            f"name the {quantity} column with ", Setting("columns", {CANONICAL_NAMES[quantity]: ...}), ")",
         )
     return units[unit]
 
@@ -159,7 +164,7 @@ def _motion(units: Mapping[str, tuple[str, str]], source) -> str:
         listed = ", ".join(f"'{column}' ({kind})" for kind, column in kinds.values())
         raise LogError(source, f"the columns mix a linear and a rotary axis: {listed}; a linear axis logs mm, mm/s "
                                "and N, a rotary one deg (or rad, rev), deg/s (or rad/s, rpm) and Nm: give every "
-                               "column its unit with columns=")
+                               "column its unit with ", Setting("columns"))
     return next(iter(kinds.values()))[0] if kinds else "linear"
 
 
@@ -276,26 +281,27 @@ def resolve_columns(
         if chosen is None:
             listed = [f"a {quantity} column ('{found[quantity][0]}')" for quantity in efforts]
             listed = ", ".join(listed[:-1]) + " and " + listed[-1]
-            raise LogError(source, f"both {listed}; choose the effort with columns={{'current_A': ...}} or "
-                                   f"columns={{'{CANONICAL_NAMES[efforts[-1]]}': ...}}")
+            raise LogError(source, f"both {listed}; choose the effort with ", Setting("columns", {"current_A": ...}),
+                           " or ", Setting("columns", {CANONICAL_NAMES[efforts[-1]]: ...}))
         for quantity in efforts:
             if quantity != chosen:
                 del found[quantity], units[quantity]
     axes = axes_in_columns(names)
     if "position" not in found and axes:
-        raise LogError(source, f"the file holds several axes ({', '.join(axes)}); choose one with --axis "
-                               f"(axis= in Python), e.g. --axis {axes[0]}")
+        raise LogError(source, f"the file holds several axes ({', '.join(axes)}); choose one with ",
+                       Setting("axis", axes[0]))
     if "position" not in found:
         raise LogError(
             source,
-            f"missing required column 'position_mm' (axis position; or position_m/position_um, position_deg/"
-            f"position_rad for a rotary axis, or map one with columns=); columns in the file: {_listing(names)}",
+            "missing required column 'position_mm' (axis position; or position_m/position_um, position_deg/"
+            "position_rad for a rotary axis, or map one with ", Setting("columns"),
+            f"); columns in the file: {_listing(names)}",
         )
     if not any(quantity in found for quantity in EFFORT_QUANTITIES):
         raise LogError(
             source,
-            f"missing required column 'current_A' (motor current; or force_N / torque_Nm for logs of the load, "
-            f"or map one with columns=); columns in the file: {_listing(names)}",
+            "missing required column 'current_A' (motor current; or force_N / torque_Nm for logs of the load, "
+            "or map one with ", Setting("columns"), f"); columns in the file: {_listing(names)}",
         )
     return found, _motion(units, source)
 
@@ -534,26 +540,27 @@ def log_from_columns(
 
     if time is not None:
         if sample_time is not None:
-            raise LogError(source, "this format carries its own time stamps; "
-                                   "sample_time applies only to files without a time column")
+            raise LogError(source, "this format carries its own time stamps; ", Setting("sample_time", assign=False),
+                           " applies only to files without a time column")
         time_s = np.asarray(time, dtype=np.float64)
     elif "time" in found:
         if sample_time is not None:
             raise LogError(
                 source,
-                f"the file has a time column ('{found['time'][0]}'); sample_time applies only to files without one",
+                f"the file has a time column ('{found['time'][0]}'); ", Setting("sample_time", assign=False),
+                " applies only to files without one",
             )
         time_s = channel("time")
     elif sample_time is not None:
         if not np.isfinite(sample_time) or sample_time <= 0:
-            raise LogError(source, f"sample_time must be a positive number of seconds, got {sample_time!r}")
+            raise LogError(source, Setting("sample_time", assign=False),
+                           f" must be a positive number of seconds, got {sample_time!r}")
         n = len(np.asarray(table[found["position"][0]]))
         time_s = np.arange(n, dtype=np.float64) * float(sample_time)
     else:
         raise LogError(
             source,
-            "no time column (time_s or time_ms, or map one with columns={'time_s': ...}); "
-            "for logs without time stamps give the sample time (sample_time=, --sample-time)",
+            *NO_TIME_COLUMN,
         )
 
     effort = next(quantity for quantity in EFFORT_QUANTITIES if quantity in found)

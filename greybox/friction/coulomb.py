@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base import EFFORT, LENGTH, LinearPart, Parameter
-from ..errors import ParameterError
+from ..errors import ParameterError, Setting
 from ..estimator import CurrentModel
 from ..identify.initial import check_motion, samples_at_speed
 from ..identify.static import check_direction_settings, fit_coulomb
@@ -79,7 +79,8 @@ class CoulombModel(CurrentModel):
         self._check_flags("asymmetric", "fit_offset")
         check_direction_settings(self.asymmetric, self.fit_offset)
         if not (np.isfinite(self.min_speed) and self.min_speed >= 0.0):
-            raise ParameterError(f"min_speed must be a non-negative speed, got {self.min_speed} mm/s")
+            raise ParameterError(Setting("min_speed", assign=False),
+                                 f" must be a non-negative speed, got {self.min_speed} mm/s")
 
     def _fit_runs(self, runs, progress) -> None:
         check_motion(runs)

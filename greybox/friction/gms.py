@@ -24,7 +24,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..base import EFFORT, LENGTH, LinearPart, Parameter
-from ..errors import ParameterError
+from ..errors import ParameterError, Setting
 from ..estimator import CurrentModel
 from ..identify.initial import (
     DEFAULT_DEFLECTION_MM,
@@ -471,7 +471,7 @@ class GMSModel(CurrentModel):
     def _check_params(self) -> None:
         n = self.n_elements
         if not (isinstance(n, (int, np.integer)) and not isinstance(n, bool) and n >= 1):
-            raise ParameterError(f"n_elements must be a positive integer, got {n!r}")
+            raise ParameterError(Setting("n_elements", assign=False), f" must be a positive integer, got {n!r}")
         self._check_flags("asymmetric", "fit_offset", "staged")
         check_direction_settings(self.asymmetric, self.fit_offset)
         check_search_settings(self)

@@ -27,7 +27,7 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 from threadpoolctl import threadpool_limits
 
-from ..errors import ParameterError
+from ..errors import ParameterError, Setting
 from .progress import ProgressEvent
 
 __all__ = ["METHODS", "SearchResult", "local_search", "multistart", "multistart_results"]
@@ -114,7 +114,7 @@ def check_search_settings(model) -> None:
     for name in ("n_starts", "max_iter"):
         value = getattr(model, name)
         if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= 1):
-            raise ParameterError(f"{name} must be a positive integer, got {value!r}")
+            raise ParameterError(Setting(name, assign=False), f" must be a positive integer, got {value!r}")
     check_seed(model.random_state, allow_none=True)
 
 
@@ -123,7 +123,7 @@ def check_seed(seed, *, name: str = "random_state", allow_none: bool = False) ->
     if seed is None and allow_none:
         return
     if not (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0):
-        raise ParameterError(f"{name} must be a non-negative integer seed, got {seed!r}")
+        raise ParameterError(Setting(name, assign=False), f" must be a non-negative integer seed, got {seed!r}")
 
 
 def _check_bounds(x0, lower, upper):

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from threadpoolctl import threadpool_limits
 
-from ..errors import ParameterError
+from ..errors import ParameterError, Setting
 from .linear import bounded_lstsq
 
 __all__ = ["check_direction_settings", "fit_coulomb", "fit_stribeck", "stribeck_regressors", "velocity_range"]
@@ -53,8 +53,9 @@ def check_direction_settings(asymmetric: bool, fit_offset: bool) -> None:
         Whether the model fits a constant offset [A].
     """
     if asymmetric and fit_offset:
-        raise ParameterError("an offset and direction-dependent friction levels are not separately "
-                             "identifiable: choose asymmetric or fit_offset, not both")
+        raise ParameterError("an offset and direction-dependent friction levels are not separately identifiable: "
+                             "choose ", Setting("asymmetric", assign=False), " or ",
+                             Setting("fit_offset", assign=False), ", not both")
 
 
 def velocity_range(velocity: np.ndarray) -> tuple[float, float]:

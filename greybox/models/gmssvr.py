@@ -51,7 +51,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..base import Parameter
 from ..data.log import AxisLog
-from ..errors import LogError, ParameterError
+from ..errors import LogError, ParameterError, Setting
 from ..estimator import check_runs
 from ..friction.gms import GMSModel
 from ..identify.progress import make_progress
@@ -265,7 +265,7 @@ class GMSSVRModel(KernelRegressionModel):
             check_is_fitted(gms)
             self.gms_ = copy.deepcopy(gms)
         elif not hasattr(self, "gms_"):
-            raise ParameterError("no GMS stage: call fit_gms first, or pass a fitted GMSModel as gms=")
+            raise ParameterError("no GMS stage: call fit_gms first, or pass a fitted GMSModel as ", Setting("gms"))
         runs = check_runs(logs)
         for run in runs:
             if run.effort_unit != self.gms_.effort_unit_:

@@ -37,7 +37,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..base import EFFORT, LENGTH, Parameter
 from ..data.log import AxisLog
-from ..errors import ParameterError
+from ..errors import ParameterError, Setting, SettingWarning
 from ..estimator import CurrentModel
 from ..identify.bayes import minimize_log_uniform
 from ..identify.cv import blocked_folds
@@ -228,7 +228,7 @@ def fit_svr_expansion(
     SVRExpansion
     """
     if not isinstance(random_state, (int, np.integer)) or isinstance(random_state, bool):
-        raise ParameterError(f"random_state must be an integer seed, got {random_state!r}")
+        raise ParameterError(Setting("random_state", assign=False), f" must be an integer seed, got {random_state!r}")
     X = np.asarray(X, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     n_features = X.shape[1]
@@ -308,10 +308,10 @@ def fit_svr_expansion(
         cv_rmse = min(t["objective"] for t in trials)
         at_bounds = [name for name in free if _near_bound(hyper[name], search[name])]
         if at_bounds:
-            warnings.warn(
+            warnings.warn(SettingWarning(
                 f"{stage}: {', '.join(f'{n} = {hyper[n]:.3g}' for n in at_bounds)} ended at the end of "
-                "its search interval; the optimum may lie outside (widen it with bounds=)",
-                UserWarning, stacklevel=3)
+                "its search interval; the optimum may lie outside (widen it with ", Setting("bounds", keys=at_bounds),
+                ")"), stacklevel=3)
     else:
         for name in free:
             hyper[name] = 1.0 if name in weighted else _default_value(name, target_std, n_features)
@@ -434,7 +434,8 @@ class KernelRegressionModel(CurrentModel):
         for name, least in (("n_subset", 2), ("n_calls", 1), ("cv_folds", 2), ("cv_blocks", 2)):
             value = getattr(self, name)
             if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= least):
-                raise ParameterError(f"{name} must be an integer of at least {least}, got {value!r}")
+                raise ParameterError(Setting(name, assign=False),
+                                     f" must be an integer of at least {least}, got {value!r}")
         check_seed(self.random_state)
         self._check_flags("optimize", "handover")
         _check_bounds(self.bounds, names)

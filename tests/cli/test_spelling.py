@@ -1,4 +1,4 @@
-"""Messages of the command speak the command line: options instead of Python keywords, warnings as one-line notes."""
+"""Messages of the command speak the command line: settings spelt as options from one table, warnings as notes."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import warnings
 import pytest
 
 import greybox.cli as cli
-from greybox.cli._notes import command_notes, error_message, option_words
+from greybox.cli._spelling import OPTIONS, command_notes, error_message, spell, spelt
 from greybox.data.io import write_log
-from greybox.errors import GreyboxError, ParameterError
+from greybox.errors import GreyboxError, LogError, ParameterError, Setting, SettingWarning
 from greybox.persistence import load_model
 from greybox.twin import make_dataset
 
@@ -70,7 +70,8 @@ def test_warnings_become_one_note_each_in_command_words(capsys):
     before = warnings.showwarning
     with command_notes(args) as notes:
         for _ in range(3):
-            warnings.warn("gms: use asymmetric=True\n  or widen the search with bounds=", UserWarning, stacklevel=1)
+            warnings.warn(SettingWarning("gms: use ", Setting("asymmetric", True), "\n  or widen the search with ",
+                                         Setting("bounds")), stacklevel=1)
         warnings.warn("overflow encountered in exp", RuntimeWarning, stacklevel=1)
     err = capsys.readouterr().err
     assert err.splitlines() == [
@@ -81,36 +82,65 @@ def test_warnings_become_one_note_each_in_command_words(capsys):
 
 def test_error_message_of_a_command_without_set():
     args = argparse.Namespace(command="discover")  # discover offers no --set
-    error = ParameterError("n_starts must be a positive integer, got 0")
+    error = ParameterError(Setting("n_starts", assign=False), " must be a positive integer, got 0")
+    assert str(error) == "n_starts must be a positive integer, got 0"  # Python's spelling
     assert error_message(error, args) == ("n_starts (--set n_starts=VALUE of greybox train) must be a positive "
                                           "integer, got 0")
     plain = GreyboxError("data/x.csv: column 'position_mm' has NaN\n at t = 1 s")
     assert error_message(plain, args) == "data/x.csv: column 'position_mm' has NaN at t = 1 s"
 
 
-@pytest.mark.parametrize("text, expected", [
-    ("use asymmetric=True or fit_offset=True", "use --asymmetric or --offset"),
-    ("fit_offset=False keeps it", "no --offset keeps it"),
-    ("n_elements=4 is the default", "--elements 4 is the default"),
-    ("give n_elements=", "give --elements N"),
-    ("random_state must be an integer seed", "--model-seed must be an integer seed"),
-    ("try C=2.0", "try --set C=2.0"),
-    ("max_iter is too small", "--set max_iter is too small"),
-    # words that are not the Python spelling of a hyperparameter stay
-    ("C = 0.1 ended at the end", "C = 0.1 ended at the end"),
-    ("inertia must be finite, got nan", "inertia must be finite, got nan"),
-    ("RMSE=3 A, gms.n_elements_ = 4", "RMSE=3 A, gms.n_elements_ = 4"),
-    ("--columns position_mm=X1", "--columns position_mm=X1"),
-    ("asymmetric Coulomb levels", "asymmetric Coulomb levels"),
+@pytest.mark.parametrize("setting, python, option", [
+    (Setting("asymmetric", True), "asymmetric=True", "--asymmetric"),
+    (Setting("fit_offset", False), "fit_offset=False", "no --offset"),
+    (Setting("fit_offset", assign=False), "fit_offset", "--offset"),
+    (Setting("n_elements", 4), "n_elements=4", "--elements 4"),
+    (Setting("n_elements"), "n_elements=", "--elements N"),
+    (Setting("random_state", assign=False), "random_state", "--model-seed"),
+    (Setting("C", 2.0), "C=2.0", "--set C=2.0"),
+    (Setting("max_iter", assign=False), "max_iter", "--set max_iter"),
+    (Setting("bounds", keys=("C", "gamma")), "bounds=", "--set bounds='{\"C\": [LOW, HIGH], \"gamma\": [LOW, HIGH]}'"),
+    (Setting("columns", {"time_s": ...}), "columns={'time_s': ...}", "--columns time_s=COLUMN"),
+    (Setting("columns", {"position_mm": "X1"}), "columns={'position_mm': 'X1'}", "--columns position_mm=X1"),
+    (Setting("columns"), "columns=", "--columns NAME=COLUMN"),
+    (Setting("sample_time", assign=False), "sample_time", "--sample-time"),
+    (Setting("topic"), "topic=", "--topic TOPIC"),
+    (Setting("axis", "X"), "axis='X'", "--axis X"),
 ])
-def test_option_words(text, expected):
-    assert option_words(text) == expected
+def test_a_setting_is_spelt_in_python_by_the_library_and_as_its_option_by_the_command(setting, python, option):
+    assert str(setting) == python
+    assert spell(setting) == option
 
 
-def test_bare_flag_name_is_the_option_only_in_a_message_about_parameters():
-    text = "choose asymmetric or fit_offset, not both"
-    assert option_words(text, parameters=True) == "choose --asymmetric or --offset, not both"
-    assert option_words(text) == "choose asymmetric or --offset, not both"
+def test_text_around_the_settings_is_kept_as_it_is():
+    """No word of the text is rewritten, even one that looks like a keyword: only the Setting parts are."""
+    parts = ["RMSE=3 A, gms.n_elements_ = 4; asymmetric Coulomb levels; fit_offset=True; ", Setting("fit_offset", True)]
+    assert spelt(parts) == "RMSE=3 A, gms.n_elements_ = 4; asymmetric Coulomb levels; fit_offset=True; --offset"
+
+
+def test_every_model_option_of_the_commands_is_in_the_one_table():
+    from greybox.cli._build import _MODEL_OPTIONS
+
+    assert {name: OPTIONS[name].flag for _, _, name in _MODEL_OPTIONS} == {
+        "fit_offset": "--offset", "asymmetric": "--asymmetric", "n_elements": "--elements",
+        "random_state": "--model-seed", "inertia": "--inertia"}
+
+
+def test_a_refused_combination_names_both_settings_in_python_and_both_options_on_the_command_line():
+    from greybox.friction import CoulombModel
+
+    with pytest.raises(ParameterError) as caught:
+        CoulombModel(asymmetric=True, fit_offset=True).fit([])
+    assert "choose asymmetric or fit_offset, not both" in str(caught.value)
+    message = error_message(caught.value, argparse.Namespace(command="train", set=[]))
+    assert "choose --asymmetric or --offset, not both" in message
+
+
+def test_a_log_error_spells_the_reading_options():
+    error = LogError("a.csv", "no time column (map one with ", Setting("columns", {"time_s": ...}), ")")
+    assert str(error) == "a.csv: no time column (map one with columns={'time_s': ...})"
+    assert error_message(error, argparse.Namespace(command="info")) == (
+        "a.csv: no time column (map one with --columns time_s=COLUMN)")
 
 
 @pytest.mark.parametrize("content, option", [
@@ -129,8 +159,9 @@ def test_log_errors_name_the_reading_options(tmp_path, capsys, content, option):
 def test_a_velocity_weight_at_its_bound_names_it_in_the_set_bounds_example(capsys):
     args = argparse.Namespace(command="train", set=[])
     with command_notes(args):
-        warnings.warn("SVR hyperparameters: velocity_weight = 9.9e+03 ended at the end of its search interval; "
-                      "the optimum may lie outside (widen it with bounds=)", UserWarning, stacklevel=1)
+        warnings.warn(SettingWarning("SVR hyperparameters: velocity_weight = 9.9e+03 ended at the end of its search "
+                                     "interval; the optimum may lie outside (widen it with ",
+                                     Setting("bounds", keys=("velocity_weight",)), ")"), stacklevel=1)
     err = capsys.readouterr().err
     assert "--set bounds='{\"velocity_weight\": [LOW, HIGH]}'" in err, err
     assert "SVR hyperparameters: velocity_weight = 9.9e+03 ended" in err  # a reported value stays as it is
