@@ -145,7 +145,7 @@ def train_model(job: TrainJob) -> dict:
     dict
         ``machine``, ``status`` (``ok`` or ``failed``), ``axis``, ``output`` (the model file, relative to
         the output directory), ``runs``, ``samples``, ``effort_unit``, the training ``rmse`` [A or N] and
-        ``re`` [%] of the saved model on all its runs (RE = RMSE / mean |effort|), ``seconds``,
+        ``re`` [%] of the saved model on all its runs (``RE = RMSE / mean(|effort|)``), ``seconds``,
         ``peak_rss_mb``, and for a failure its ``error`` (one line). Never raises for a bad log.
     """
     return {"machine": job.machine, **attempt(f"machine {job.machine}", lambda: _fit_and_save(job))}

@@ -7,15 +7,15 @@ samples: none of these metrics depends on the order of the samples.
 
 The names are the ones used in every greybox report (see ``DESIGN.md``):
 
-========  ==============================================  =============
-name      definition                                      unit
-========  ==============================================  =============
-RMSE      ``sqrt(mean((y_hat - y)**2))``                  unit of ``y``
-RE        ``100 * RMSE / mean(|y|)``                      %
-NMSE      ``100 * mean((y_hat - y)**2) / var(y)``         %
-relerr    ``100 * ||y - y_hat|| / ||y||``                 %
-max_error ``max(|y_hat - y|)``                            unit of ``y``
-========  ==============================================  =============
+=========  ==============================================  =============
+name       definition                                      unit
+=========  ==============================================  =============
+RMSE       ``sqrt(mean((y_hat - y)**2))``                  unit of ``y``
+RE         ``100 * RMSE / mean(|y|)``                      %
+NMSE       ``100 * mean((y_hat - y)**2) / var(y)``         %
+relerr     ``100 * ||y - y_hat|| / ||y||``                 %
+max_error  ``max(|y_hat - y|)``                            unit of ``y``
+=========  ==============================================  =============
 
 RE follows Rüppel et al. (2024) except for its denominator: the paper divides
 by the mean of the current, which is close to zero for an axis that moves both
@@ -83,7 +83,7 @@ def rmse(y, y_hat) -> float:
 
 
 def relative_error(y, y_hat) -> float:
-    """Relative error RE = RMSE / mean(|y|), in %.
+    """Relative error ``RE = RMSE / mean(|y|)``, in %.
 
     The denominator is the mean *absolute* measured effort, not the mean of
     the signed effort printed by Rüppel et al. (2024), which is close to zero

@@ -17,20 +17,20 @@ values beyond: a trend is not extrapolated), ``t`` the time since
 the start of the run and ``x``, ``v``, ``a`` position [mm], velocity [mm/s]
 and acceleration [mm/s^2]:
 
-========================== =========================================== ================
-name                       columns                                     shape
-========================== =========================================== ================
-direction_asymmetry        ``max(f, 0)``, ``v max(d, 0)``              -
-constant_offset            ``1``                                       -
-position_trend             ``u f``, ``(3 u^2 - 1) / 2 * f``            -
-position_periodic_friction ``sin(2 pi x / P) f``, ``cos(2 pi x / P) f`` ``P`` [mm]
-position_periodic_force    ``sin(2 pi x / P)``, ``cos(2 pi x / P)``    ``P`` [mm]
-thermal_drift              ``(1 - exp(-t / tau)) f``                   ``tau`` [s]
-inertia_mismatch           ``a``                                       -
-viscous_friction           ``v``                                       -
-stribeck                   ``exp(-|v| / v_s) d``                       ``v_s`` [mm/s]
-load_dependent_friction    ``|a| f``                                   -
-========================== =========================================== ================
+========================== ============================================== ================
+name                       columns                                        shape
+========================== ============================================== ================
+direction_asymmetry        ``max(f, 0)``, ``v max(d, 0)``                 -
+constant_offset            ``1``                                          -
+position_trend             ``u f``, ``(3 u^2 - 1) / 2 * f``               -
+position_periodic_friction ``sin(2 pi x / P) f``, ``cos(2 pi x / P) f``   ``P`` [mm]
+position_periodic_force    ``sin(2 pi x / P)``, ``cos(2 pi x / P)``       ``P`` [mm]
+thermal_drift              ``(1 - exp(-t / tau)) f``                      ``tau`` [s]
+inertia_mismatch           ``a``                                          -
+viscous_friction           ``v``                                          -
+stribeck                   ``exp(-|v| / v_s) d``                          ``v_s`` [mm/s]
+load_dependent_friction    ``|a| f``                                      -
+========================== ============================================== ================
 
 The names are those of the synthetic axis's hidden effects
 (:data:`greybox.twin.EFFECTS`), plus ``stribeck`` and

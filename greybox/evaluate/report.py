@@ -8,7 +8,7 @@ side (``train`` or ``test``), as made by
      "rmse": 0.071, "re": 7.2, "logs": "C", "n": 60552, "nmse": ..., "max_error": ...,
      "per_log": {"C": {"n": ..., "rmse": ..., "re": ...}}}
 
-with RMSE in A and RE in %. RE is RMSE / mean(|I|): the paper divides by
+with RMSE in A and RE in %. RE is ``RMSE / mean(|I|)``: the paper divides by
 the mean of the current, which is close to zero for an axis that moves both
 ways, so the mean *absolute* current is used (see ``DESIGN.md``).
 

@@ -11,7 +11,7 @@ least-squares fit of the current to a Coulomb + viscous proxy,
 
     I ~ J a + F_c sgn(v) + mu v + offset,
 
-over the samples in motion (|v| above 1 % of the largest speed, so that
+over the samples in motion (``|v|`` above 1 % of the largest speed, so that
 ``sgn(v)`` is defined). Only ``J`` and ``offset`` are kept; the SVR then
 learns all of the friction, ``f = I - J a - offset``, including its
 Coulomb, viscous and position-dependent parts. ``J a`` has to be taken out

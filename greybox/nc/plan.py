@@ -8,12 +8,14 @@ lubricant and warm the screw, so that the recording does not start on a cold axi
 
 1. warm-up: ``warmup_strokes`` times back and forth over the travel at ``warmup_feed``;
 2. dataset A, about ``duration_a_s`` seconds inside the window, alternating
+
    - random moves: 1-3 feeds each (log-uniform in ``feed``), written as consecutive feed
      moves in one direction (the control changes the feed on the fly), reversals, and
      now and then a short dwell;
    - sinusoidal motion ``x = c + a sin(w t)`` around the window centre, 3-6 periods, as short
      feed moves (24 per period) whose feed is the mean speed over the move, the peak speed
      log-uniform in ``feed`` and the peak acceleration ``a w^2`` within ``max_acceleration``;
+
 3. dataset B: for each of ``sweep_feeds``, once back and forth over the travel, dwelling at
    each end.
 

@@ -176,9 +176,9 @@ def _spread(values) -> dict:
 
 
 def summarise(rows: list[dict]) -> dict:
-    """Per model and conversion: median, 90th percentile and largest |mean force error| per pass, and the RMS error.
+    """Per model and conversion: median, 90th percentile and largest absolute mean force error per pass; RMS error.
 
-    ``met`` judges GMS+SVR with the axis file: the median |mean force error| of each pass within
+    ``met`` judges GMS+SVR with the axis file: the median absolute mean force error of each pass within
     :data:`TARGET_PCT`, with the share of members within it.
 
     Parameters

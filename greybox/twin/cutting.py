@@ -2,7 +2,7 @@
 
 The tool is engaged while the axis feeds in the cutting direction across the
 workpiece. The cutting force opposes the feed, so the drive supplies an extra
-current in the direction of motion:
+current in the direction of motion::
 
     I_p = sgn(v) * c(v) * e(x) * I_c * (|v| / v_ref)^p * (1 + q (pi/2 |sin(pi f_z t)| - 1))
 

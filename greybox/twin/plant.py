@@ -15,7 +15,7 @@ displacement and is clamped at its breakaway deflection:
 ``D_i`` [mm] are spread logarithmically (0.1-5 um) and the breakaway currents
 ``k_i D_i`` follow a log-normal weighting over the elements. All breakaway
 levels are weakened by a Stribeck ratio that follows the velocity through a
-first-order lag of time constant ``tau`` (frictional lag):
+first-order lag of time constant ``tau`` (frictional lag)::
 
     rho(v) = r_c + (1 - r_c) exp(-(|v| / v_s)^delta),   tau dr/dt = rho(v) - r.
 
