@@ -351,7 +351,8 @@ def out_dir_of(jobs: Sequence, nothing: str) -> str:
     Parameters
     ----------
     jobs : sequence
-        Jobs with an ``out_dir`` attribute (:class:`FleetJob`, or those of ``greybox train --per-machine``).
+        Jobs with an ``out_dir`` attribute (:class:`greybox.predict.fleet.FleetJob`, or those of
+        ``greybox train --per-machine``).
     nothing : str
         Error message for no job at all.
 
