@@ -284,14 +284,14 @@ class ModelFile:
         config = read_axis_config(request.axis_config) if request.axis_config else None
         model, records = load_model(self.path, records=True)
         read = request.read
-        channels = config.channels if config else {}
+        columns = {**(config.channels if config else {}), **(read.get("columns") or {})} or None  # the file's names
         names = (Path(log).name, Path(self.path).name)
         calibrated: list = []
 
         def interval() -> ProcessInterval | None:  # computed once, whether the log streams or not
             if not calibrated:
                 calibrated.append(request.interval(
-                    model, lambda path: read_prepared(path, read, columns=channels, notify=request.notify)))
+                    model, lambda path: read_prepared(path, read, columns=columns, notify=request.notify)))
             return calibrated[0]
 
         figures = {"axis_file": Path(request.axis_config).name if request.axis_config else None,
@@ -299,7 +299,7 @@ class ModelFile:
         attrs = {"model_file": self.path, "log_file": str(log)}
         streamed = None
         if not request.plot:
-            streamed = open_stream(log, columns={**channels, **(read.get("columns") or {})} or None,
+            streamed = open_stream(log, columns=columns,
                                    topic=read.get("topic"), axis=read.get("axis"), sample_time=read.get("sample_time"),
                                    resample=read.get("resample"))
         if streamed is not None:
@@ -307,7 +307,7 @@ class ModelFile:
             done = self._stream(model, streamed, config, request, inputs, attrs, interval, figures)
             if done is not None:
                 return done
-        runs = read_prepared(log, read, columns=channels, notify=request.notify)
+        runs = read_prepared(log, read, columns=columns, notify=request.notify)
         if streamed is None:
             request.warn(preparation_warning(records, read, runs, *names))
         return self._whole(model, runs, log, config, request, inputs, attrs, interval, figures)
