@@ -1,58 +1,38 @@
-"""A plant's worth of logs on dask.distributed: the engine of fleet runs, and ``greybox predict`` over many logs.
+"""A plant's worth of logs on dask.distributed: the engine of every fleet run.
 
 :func:`expand_logs` turns files, directories (searched recursively for log files) and glob patterns
-into the list of logs. :func:`run_tasks` is the one engine of every fleet run (``greybox predict`` here,
-``greybox train --per-machine`` in :mod:`greybox.fleet_train`): it runs one task per job on a Dask
-cluster, by default a local cluster of processes, one per core and one thread each, or the cluster of a
-scheduler address, so that the same command runs on a laptop and on a cluster; it skips the jobs
-complete from an earlier run, reports a job that fails and goes on, and writes ``OUT/_manifest.json``.
-
-:func:`run_fleet` predicts each log and writes its process table to a Parquet dataset partitioned like
-the plant::
-
-    OUT/machine=<folder of the log>/axis=<axis>/log=<file stem>/part-0.parquet
-
-(``pyarrow.dataset.dataset(OUT, partitioning="hive")`` reads it whole, with the partition columns).
-The manifest records what ran: every log with its status (``ok``, ``skipped``, ``failed`` with its
-one-line error), output, samples, seconds and the worker's peak memory, its model file and the file's
-SHA-256, the versions of greybox and its libraries, the cluster and the wall time. A re-run skips every
-log whose output is complete: listed ``ok`` in the manifest for the same model file (hash) and the same
-log file (size and modification time), its output still there, also after a run that was killed (the
-manifest is saved while the fleet runs). Every file is written atomically. The model is one model file,
-or a directory of models written by ``greybox train --per-machine``, from which each log gets its
-machine's model (:func:`machine_models`).
+into the list of logs. :func:`run_tasks` is the one engine of every fleet run (``greybox predict`` over
+many logs in :mod:`greybox.predict.fleet`, ``greybox train --per-machine`` in :mod:`greybox.fleet_train`):
+it runs one task per job on a Dask cluster, by default a local cluster of processes, one per core and one
+thread each, or the cluster of a scheduler address, so that the same command runs on a laptop and on a
+cluster; it skips the jobs complete from an earlier run, reports a job that fails and goes on, and writes
+``OUT/_manifest.json``, saved while the fleet runs so that a re-run after a run that was killed skips what
+is done. Every file is written atomically. :func:`fleet_summary` is the report of a finished fleet.
 """
 
 from __future__ import annotations
 
 import contextlib
 import glob
-import hashlib
 import json
 import os
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterator, Mapping, Sequence
 
 from .atomic import write_text_atomic
+from .data.io import LOG_SUFFIXES
 from .errors import GreyboxError
 
-__all__ = ["LOG_SUFFIXES", "MANIFEST", "MODELS_FORMAT", "SAVE_EVERY_S", "FleetJob", "attempt", "expand_logs",
-           "fleet_jobs", "log_stamp", "machine_models", "machine_of", "out_dir_of", "partition", "predict_log",
-           "read_manifest", "read_prepared", "run_fleet", "run_tasks"]
-
-#: File extensions taken as logs when a directory is given.
-LOG_SUFFIXES = (".csv", ".parquet", ".pq", ".mcap", ".mat", ".tdms")
+__all__ = ["LOG_SUFFIXES", "MANIFEST", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_out_dir", "expand_logs",
+           "fleet_summary", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared",
+           "run_tasks"]
 
 #: Name of the manifest in the output directory (a leading "_": dataset readers skip it).
 MANIFEST = "_manifest.json"
 
 #: ``format`` of the manifest of a directory of models written by ``greybox train --per-machine``.
 MODELS_FORMAT = "greybox-fleet-models"
-
-#: ``format`` of the manifest of a fleet prediction.
-PREDICT_FORMAT = "greybox-fleet"
 
 #: Least time between two saves of the manifest while a fleet runs [s]: the jobs finished so far are kept
 #: for a re-run when a run is killed.
@@ -140,7 +120,8 @@ def log_stamp(path: str | os.PathLike) -> dict:
     return {"size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
 
 
-def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None = None) -> list:
+def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None = None,
+                  notify: Callable[[str], None] | None = None) -> list:
     """Read and prepare one log as ``greybox predict`` and ``greybox train`` do: its runs (AxisLog).
 
     Parameters
@@ -154,6 +135,8 @@ def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None
         take their defaults.
     columns : mapping, optional
         Column mapping under ``read["columns"]`` (an axis file's channels).
+    notify : callable, optional
+        ``notify(line)`` with a ``note:`` line naming the gaps where the log was split into runs.
     """
     from .data.io import read_log
     from .data.prepare import MAX_GAP_STEPS, prepare
@@ -161,10 +144,16 @@ def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None
     columns = {**(columns or {}), **(read.get("columns") or {})} or None
     resample = read.get("resample")
     tolerance = read.get("time_tolerance", 0.25)
+    max_gap = read.get("max_gap", MAX_GAP_STEPS)
     log = read_log(path, columns=columns, topic=read.get("topic"), sample_time=read.get("sample_time"),
                    axis=read.get("axis"), time_tolerance=None if resample else tolerance)
-    return prepare([log], cutoff_hz=read.get("cutoff_hz"), sample_time=resample, tolerance=tolerance,
-                   max_gap_steps=read.get("max_gap", MAX_GAP_STEPS))
+    runs = prepare([log], cutoff_hz=read.get("cutoff_hz"), sample_time=resample, tolerance=tolerance,
+                   max_gap_steps=max_gap)
+    if len(runs) > 1 and notify is not None:
+        starts = ", ".join(f"{run.attrs['split']['start_s']:.6g}" for run in runs[1:])
+        notify(f"note: {Path(path).name}: split into {len(runs)} runs at gaps longer than {max_gap:g} steps "
+               f"(--max-gap); the runs after the first start at t = {starts} s")
+    return runs
 
 
 def attempt(label: str, work: Callable[[], dict]) -> dict:
@@ -362,7 +351,8 @@ def out_dir_of(jobs: Sequence, nothing: str) -> str:
     Parameters
     ----------
     jobs : sequence
-        Jobs with an ``out_dir`` attribute (:class:`FleetJob`, or those of ``greybox train --per-machine``).
+        Jobs with an ``out_dir`` attribute (:class:`greybox.predict.fleet.FleetJob`, or those of
+        ``greybox train --per-machine``).
     nothing : str
         Error message for no job at all.
 
@@ -377,6 +367,57 @@ def out_dir_of(jobs: Sequence, nothing: str) -> str:
     if len(outs) != 1:
         raise GreyboxError("a fleet run has one output directory")
     return outs.pop()
+
+
+def check_out_dir(out: str | os.PathLike, inputs=()) -> Path:
+    """The output directory of a fleet run: a directory or a path not yet taken, none of the ``inputs``; resolved.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The output directory asked for.
+    inputs : iterable of str or path-like, default ()
+        Input paths of the run; the output directory must not be one of them.
+
+    Raises
+    ------
+    GreyboxError
+        For a path that is a file or one of the inputs.
+    """
+    path = Path(out)
+    if path.exists() and not path.is_dir():
+        raise GreyboxError(f"{path}: exists and is not a directory; the output of a fleet run is a directory")
+    if any(path.resolve() == Path(item).resolve() for item in inputs):
+        raise GreyboxError(f"--out {path}: is one of the inputs; choose another output directory")
+    return path.resolve()
+
+
+def fleet_summary(manifest: dict, items: str, verb: str, describe: Callable[[dict], str]) -> tuple[list[str], int]:
+    """The summary line of a finished fleet and a line per failed job; the exit status (2 if any job failed).
+
+    Parameters
+    ----------
+    manifest : dict
+        Written by :func:`run_tasks`.
+    items : str
+        Its list of entries (``"logs"``, ``"models"``), also the noun of the summary.
+    verb : str
+        What an ``ok`` job did (``"predicted"``, ``"trained"``).
+    describe : callable
+        The line of a failed entry.
+
+    Returns
+    -------
+    (list of str, int)
+        The lines and the exit status.
+    """
+    counts = manifest["counts"]
+    cluster = manifest["cluster"]
+    where = f" on {cluster['workers']} worker(s) of {cluster['scheduler']}" if cluster["workers"] else ""
+    lines = [f"fleet: {counts['ok']} {verb}, {counts['skipped']} skipped (complete from an earlier run), "
+             f"{counts['failed']} failed of {len(manifest[items])} {items} in {manifest['seconds']:.1f} s{where}"]
+    lines += [f"  failed: {describe(entry)}" for entry in manifest[items] if entry["status"] == "failed"]
+    return lines, 2 if counts["failed"] else 0
 
 
 @contextlib.contextmanager
@@ -422,240 +463,3 @@ def _run_on_cluster(task: Callable, todo: list, scheduler: str | None, workers: 
             finish(index[future.key], future.result() if error is None else
                    {"status": "failed", "error": f"lost on the cluster: {type(error).__name__}: {error}"})
         return info
-
-
-@dataclass(frozen=True)
-class FleetJob:
-    """One log of a fleet prediction: what to read, with which model, and where the outputs go.
-
-    Parameters
-    ----------
-    log : str
-        Log file.
-    machine : str
-        Machine the log belongs to (its folder's name), the first partition level.
-    model : str
-        Model file.
-    out_dir : str
-        Root of the Parquet dataset.
-    axis_config : str, optional
-        Axis file (force or torque).
-    read : dict
-        Options of reading and preparing the log (:func:`read_prepared`).
-    chunk_s : float
-        Chunk length of the prediction [s].
-    """
-
-    log: str
-    machine: str
-    model: str
-    out_dir: str
-    axis_config: str | None = None
-    read: dict = field(default_factory=dict)
-    chunk_s: float = 60.0
-
-
-def machine_models(directory: str | os.PathLike) -> dict[str, dict[str, str]]:
-    """The models of a directory written by ``greybox train --per-machine``: ``{machine: {axis: model file}}``.
-
-    Only the models its manifest lists as trained (``ok`` or ``skipped``) whose file is there count.
-
-    Parameters
-    ----------
-    directory : str or path-like
-        Output directory of ``greybox train --per-machine``, with its manifest.
-
-    Raises
-    ------
-    GreyboxError
-        For a directory without such a manifest.
-    """
-    directory = Path(directory)
-    document = read_manifest(directory, MODELS_FORMAT)
-    if not document:
-        raise GreyboxError(f"{directory}: a directory without the {MANIFEST} of 'greybox train --per-machine'; "
-                           "give a model file or a directory of models it wrote")
-    table: dict[str, dict[str, str]] = {}
-    for entry in document.get("models", []):
-        if isinstance(entry, dict) and entry.get("status") in ("ok", "skipped") and \
-                isinstance(entry.get("output"), str) and (directory / entry["output"]).is_file():
-            table.setdefault(str(entry.get("machine")), {})[str(entry.get("axis"))] = str(directory / entry["output"])
-    return table
-
-
-def model_of_log(directory: str | os.PathLike, log: str | os.PathLike, axis: str | None = None) -> str:
-    """The model file of ``log``'s machine (the name of its folder) in a directory of ``greybox train --per-machine``.
-
-    Raises
-    ------
-    GreyboxError
-        For a directory without that manifest, a machine without a model, or (without ``axis``) a machine
-        with models of several axes.
-    """
-    return _model_for(Path(log), machine_of(Path(log)), machine_models(directory), str(directory), axis)
-
-
-def _model_for(log: Path, machine: str, models: dict[str, dict[str, str]], directory: str, axis: str | None) -> str:
-    """The model file of ``log``'s machine in a models directory (of ``axis`` where it has several)."""
-    by_axis = models.get(machine)
-    if not by_axis:
-        known = ", ".join(sorted(models)) or "none"
-        raise GreyboxError(f"{log}: no trained model of machine {machine} in {directory} (machines: {known})")
-    if axis is not None:
-        if axis not in by_axis:
-            raise GreyboxError(f"{log}: --axis {axis}: machine {machine} has models of axes "
-                               f"{', '.join(sorted(by_axis))}")
-        return by_axis[axis]
-    if len(by_axis) > 1:
-        raise GreyboxError(f"{log}: machine {machine} has models of axes {', '.join(sorted(by_axis))} in {directory}; "
-                           "give --axis NAME (one fleet per axis)")
-    return next(iter(by_axis.values()))
-
-
-def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: str | None = None,
-               read: dict | None = None, chunk_s: float = 60.0) -> list[FleetJob]:
-    """One job per log; the machine is the name of the log's folder.
-
-    ``model`` is one model file for every log, or a directory written by ``greybox train --per-machine``:
-    each log then gets its machine's model (of ``read["axis"]`` where the machine has several).
-
-    Parameters
-    ----------
-    logs : sequence of path-like
-        Log files (:func:`expand_logs`); each one's folder names its machine.
-    model : str
-        Model file, or directory of models of ``greybox train --per-machine``.
-    out_dir : str
-        Root of the Parquet dataset the jobs write.
-    axis_config : str, optional
-        Axis file (force or torque) used for every log.
-    read : dict, optional
-        Options of reading and preparing the logs (:func:`read_prepared`); its ``axis`` also picks the
-        model in a models directory.
-    chunk_s : float, default 60.0
-        Chunk length of the prediction [s].
-
-    Raises
-    ------
-    GreyboxError
-        For a models directory without a model of a log's machine (or axis).
-    """
-    read = dict(read or {})
-    if os.path.isdir(model):
-        models = machine_models(model)
-        chosen = [_model_for(Path(log), machine_of(log), models, model, read.get("axis")) for log in logs]
-    else:
-        chosen = [str(model)] * len(logs)
-    return [FleetJob(str(log), machine_of(log), path, str(out_dir), axis_config, read, float(chunk_s))
-            for log, path in zip(logs, chosen)]
-
-
-def _file_hash(path: str) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
-def predict_log(job: FleetJob) -> dict:
-    """Predict one log and write its process table; the task each worker runs.
-
-    Parameters
-    ----------
-    job : FleetJob
-        The log, its model and options, and the dataset it is written to.
-
-    Returns
-    -------
-    dict
-        ``log``, ``machine``, ``status`` (``ok`` or ``failed``), ``output``, ``axis``, ``samples``,
-        ``seconds``, ``peak_rss_mb`` (of the worker process so far), and for a failure its ``error``
-        (one line). Never raises for a bad log.
-    """
-    return {"log": job.log, "machine": job.machine, **attempt(job.log, lambda: _predict_and_write(job))}
-
-
-def _predict_and_write(job: FleetJob) -> dict:
-    """The table ``greybox predict`` writes for the job's log, streamed where ``predict`` streams it."""
-    from .data.axis_config import read_axis_config
-    from .evaluate.process import predict_process
-    from .evaluate.process_io import write_process
-    from .persistence import load_model
-
-    config = read_axis_config(job.axis_config) if job.axis_config else None
-    model = load_model(job.model)
-    attrs = {"model_file": job.model, "log_file": job.log}
-    streamed = _stream_and_write(job, model, config, attrs)
-    if streamed is not None:
-        return streamed
-    runs = read_prepared(job.log, job.read, columns=config.channels if config else None)
-    result = predict_process(model, runs, axis_config=config, chunk_s=job.chunk_s)
-    result.attrs.update(attrs)
-    target, axis = _partition(job, result.axis)
-    path = write_process(result, target, overwrite=True)  # the table `predict` writes
-    return {"output": str(path), "axis": axis, "samples": len(result.time)}
-
-
-def _partition(job: FleetJob, axis: str) -> tuple[Path, str]:
-    """The job's table in the dataset (its directory made), and the name of its axis partition."""
-    name = partition(axis or "-")
-    target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={name}" / f"log={partition(Path(job.log).stem)}"
-    target.mkdir(parents=True, exist_ok=True)
-    return target / "part-0.parquet", name
-
-
-def _stream_and_write(job: FleetJob, model, config, attrs: dict) -> dict | None:
-    """Predict and write the log block by block (:mod:`greybox.data.stream`); None if it is to be read whole."""
-    from .data.blocks import CannotStream
-    from .data.stream import open_stream
-    from .evaluate.process_stream import stream_process
-
-    read = job.read
-    columns = {**(config.channels if config else {}), **(read.get("columns") or {})} or None
-    log = open_stream(job.log, columns=columns, topic=read.get("topic"), axis=read.get("axis"),
-                      sample_time=read.get("sample_time"), resample=read.get("resample"))
-    if log is None:
-        return None
-    target, axis = _partition(job, log.axis or (config.name if config is not None else ""))
-    try:
-        done = stream_process(model, log, target, axis_config=config, chunk_s=job.chunk_s,
-                              tolerance=read.get("time_tolerance", 0.25), cutoff_hz=read.get("cutoff_hz"),
-                              attrs=attrs, overwrite=True)
-    except CannotStream:
-        return None
-    return {"output": str(target), "axis": axis, "samples": done.tally.n_samples}
-
-
-def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers: int | None = None,
-              force: bool = False, progress: Callable[[int, int, dict], None] | None = None) -> dict:
-    """Predict every job's log on a Dask cluster and write the manifest (:func:`run_tasks`).
-
-    Parameters
-    ----------
-    jobs : sequence of FleetJob
-        All with the same output directory (:func:`fleet_jobs`).
-    scheduler, workers, force, progress
-        The cluster, whether to predict again the logs complete from an earlier run, and the progress
-        callback, as in :func:`run_tasks`.
-
-    Returns
-    -------
-    dict
-        The manifest (also written to ``OUT/_manifest.json``).
-
-    Raises
-    ------
-    GreyboxError
-        When the scheduler cannot be reached or the jobs disagree on the output directory.
-    """
-    out_dir = out_dir_of(jobs, "no log to predict")
-    files = {job.model for job in jobs} | {job.axis_config for job in jobs if job.axis_config}
-    hashes = {path: _file_hash(path) for path in files}
-    fingerprints = [{"log": job.log, "model": job.model, "model_sha256": hashes[job.model], **log_stamp(job.log),
-                     "axis_config_sha256": hashes.get(job.axis_config), "read": job.read, "chunk_s": job.chunk_s}
-                    for job in jobs]  # an option or axis file changed: the log is predicted again
-    header = {"format": PREDICT_FORMAT, "format_version": 2, "axis_config": jobs[0].axis_config,
-              "read": jobs[0].read, "chunk_s": jobs[0].chunk_s}
-    return run_tasks(predict_log, jobs, fingerprints, out_dir=out_dir, header=header, items="logs",
-                     scheduler=scheduler, workers=workers, force=force, progress=progress)

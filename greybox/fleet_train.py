@@ -18,7 +18,7 @@ With axes to read from logs of several (``--axes``) there is one task per machin
 per machine, whose logs must all be of one axis, the model named after it (``-`` where the logs name
 none). A re-run skips every model whose entry is ``ok`` for the same logs (size and modification time),
 kind, hyperparameters and reading options, its file still there. ``greybox predict OUT LOG... --out DIR``
-predicts each log with its machine's model (:func:`greybox.fleet.fleet_jobs`).
+predicts each log with its machine's model (:func:`greybox.predict.fleet.fleet_jobs`).
 """
 
 from __future__ import annotations

@@ -268,3 +268,60 @@ def preparation_differences(trained: dict, used: dict) -> list[str]:
         differences.append(f"derived {shown} (training derived {', '.join(trained['derived']) or 'nothing'}: a "
                            "logged velocity in one and not the other)")
     return differences
+
+
+def preparation_of(runs, read) -> dict:
+    """The preparation of prepared ``runs`` read with the options ``read``: :data:`PREPARATION_KEYS`.
+
+    Parameters
+    ----------
+    runs : list of AxisLog
+        The prepared runs; the first gives the sample time [s] and the derivative filter's cut-off [Hz].
+    read : mapping
+        Options of reading and preparing (:func:`greybox.fleet.read_prepared`): ``resample`` [s],
+        ``max_gap`` [steps], ``time_tolerance`` (fraction of the step); missing ones take their defaults.
+    """
+    from .data.prepare import MAX_GAP_STEPS
+
+    filters = [run.attrs.get("derivative_filter") or {} for run in runs]
+    cutoff = filters[0].get("cutoff_hz")
+    return {"sample_time_s": float(runs[0].sample_time),
+            "cutoff_hz": None if cutoff is None else float(cutoff),
+            "resample_s": read.get("resample"),
+            "max_gap_steps": float(read.get("max_gap", MAX_GAP_STEPS)),
+            "time_tolerance": float(read.get("time_tolerance", 0.25)),
+            "derived": sorted({name for entry in filters for name in entry.get("derived", ())})}
+
+
+def preparation_warning(records: dict, read, runs, log_name: str, model_name: str) -> str | None:
+    """The ``warning:`` line when ``runs`` are prepared otherwise than the model's training logs, else None.
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records (a file without a training record warns of nothing).
+    read : mapping
+        Options of reading and preparing (:func:`preparation_of`; also ``cutoff_hz`` [Hz]).
+    runs : list of AxisLog or None
+        The prepared runs of the log; None when the log is streamed (then the options alone are compared,
+        at the training logs' sample time).
+    log_name, model_name : str
+        Names for the message.
+    """
+    from .data.prepare import default_cutoff
+
+    record = records.get(TRAINING_RECORD)
+    if record is None:
+        return None
+    trained = record["preparation"]
+    if runs is None:
+        cutoff = read.get("cutoff_hz")
+        cutoff = cutoff if cutoff is not None else default_cutoff(trained["sample_time_s"])
+        used = {**trained, "cutoff_hz": float(cutoff), "resample_s": read.get("resample")}
+    else:
+        used = preparation_of(runs, read)
+    differences = preparation_differences(trained, used)
+    if not differences:
+        return None
+    return (f"warning: {log_name} is prepared otherwise than the training logs of {model_name}: "
+            + "; ".join(differences))

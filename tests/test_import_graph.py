@@ -15,8 +15,12 @@ rules (DESIGN.md, "Layout"):
   model (``greybox.friction``, ``greybox.models``): a truth plant built from
   the models it tests would flatter them;
 - the physical and current models (``greybox.friction``, ``greybox.models``)
-  import nothing of the layers above them: ``evaluate``, ``discover``,
-  ``studies``, ``control``, ``cli``.
+  import nothing of the layers above them: ``evaluate``, ``predict``,
+  ``discover``, ``studies``, ``control``, ``cli``;
+- prediction (``greybox.predict``) sits above the models, the data and
+  ``evaluate`` (metrics, regimes, figures), which import nothing of it, and
+  below its users, which it imports nothing of: ``live``, ``monitor``,
+  ``discover``, ``control``, ``studies``, ``cli``.
 
 An import names a module (``import greybox.twin.plant``, ``from ..twin import
 plant``) or a package's ``__init__`` (``from ..twin import make_dataset``).
@@ -41,7 +45,11 @@ PACKAGE_DIR = Path(__file__).resolve().parents[1] / "greybox"
 #: Packages that may import the synthetic twin (besides the twin itself).
 TWIN_USERS = ("greybox.control", "greybox.studies", "greybox.cli")
 #: Layers the models must not depend on.
-ABOVE_MODELS = ("greybox.evaluate", "greybox.discover", "greybox.studies", "greybox.control", "greybox.cli")
+ABOVE_MODELS = ("greybox.evaluate", "greybox.predict", "greybox.discover", "greybox.studies", "greybox.control",
+                "greybox.cli")
+#: Layers prediction must not depend on (they use it, or stand beside it).
+ABOVE_PREDICT = ("greybox.live", "greybox.monitor", "greybox.discover", "greybox.control", "greybox.studies",
+                 "greybox.cli")
 
 
 def _within(module: str, package: str) -> bool:
@@ -251,6 +259,15 @@ def test_the_models_import_nothing_of_the_layers_above_them(graph):
                       lambda m: _within(m, "greybox.friction") or _within(m, "greybox.models"),
                       lambda t: any(_within(t, p) for p in ABOVE_MODELS))
     assert not found, "friction/ and models/ depend on a layer above them:\n" + "\n".join(found)
+
+
+def test_prediction_imports_nothing_of_its_users_and_evaluate_nothing_of_prediction(graph):
+    assert "greybox.predict.run" in graph  # the one entry point of prediction
+    found = forbidden(graph, lambda m: _within(m, "greybox.predict"),
+                      lambda t: any(_within(t, p) for p in ABOVE_PREDICT))
+    assert not found, "greybox/predict/ depends on a layer above it:\n" + "\n".join(found)
+    found = forbidden(graph, lambda m: _within(m, "greybox.evaluate"), lambda t: _within(t, "greybox.predict"))
+    assert not found, "greybox/evaluate/ (metrics, reports, figures) depends on prediction:\n" + "\n".join(found)
 
 
 # ---------------------------------------------------------------- the checker itself

@@ -20,10 +20,10 @@ from greybox.data.prepare import prepare
 from greybox.data.validate import check_velocity_units
 from greybox.errors import GreyboxError, LogError, ParameterError
 from greybox.evaluate.plots import plot_log
-from greybox.evaluate.process import predict_process
-from greybox.evaluate.process_plot import plot_process
 from greybox.friction import StribeckModel
 from greybox.persistence import load_model, save_model
+from greybox.predict.plot import plot_process
+from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 
 EXAMPLE_C = Path(__file__).resolve().parents[1] / "examples" / "axis_c.toml"

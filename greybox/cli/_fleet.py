@@ -8,8 +8,6 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from ..errors import GreyboxError
-
 __all__ = ["check_out_dir", "fleet_progress", "read_options", "report_fleet"]
 
 
@@ -30,7 +28,7 @@ def read_options(args: argparse.Namespace) -> dict:
 
 
 def check_out_dir(out: str, inputs=()) -> Path:
-    """``--out`` of a fleet run: a directory or a path not yet taken, none of the ``inputs``; return it resolved.
+    """``--out`` of a fleet run, resolved (:func:`greybox.fleet.check_out_dir`).
 
     Parameters
     ----------
@@ -38,18 +36,10 @@ def check_out_dir(out: str, inputs=()) -> Path:
         The ``--out`` path given on the command line.
     inputs : iterable of str or Path, default ()
         Input paths of the run; the output directory must not be one of them.
-
-    Raises
-    ------
-    GreyboxError
-        For a path that is a file or one of the inputs.
     """
-    path = Path(out)
-    if path.exists() and not path.is_dir():
-        raise GreyboxError(f"{path}: exists and is not a directory; the output of a fleet run is a directory")
-    if any(path.resolve() == Path(item).resolve() for item in inputs):
-        raise GreyboxError(f"--out {path}: is one of the inputs; choose another output directory")
-    return path.resolve()
+    from ..fleet import check_out_dir as checked
+
+    return checked(out, inputs)
 
 
 def fleet_progress(noun: str, quiet: bool, label: Callable[[dict], str]) -> Callable[[int, int, dict], None]:
@@ -82,7 +72,7 @@ def fleet_progress(noun: str, quiet: bool, label: Callable[[dict], str]) -> Call
 
 
 def report_fleet(manifest: dict, items: str, verb: str, describe: Callable[[dict], str]) -> int:
-    """Print the fleet's summary line and its failures; return the exit status (2 if any job failed).
+    """Print the fleet's summary line and its failures (:func:`greybox.fleet.fleet_summary`); the exit status.
 
     Parameters
     ----------
@@ -95,12 +85,9 @@ def report_fleet(manifest: dict, items: str, verb: str, describe: Callable[[dict
     describe : callable
         The line of a failed entry.
     """
-    counts = manifest["counts"]
-    cluster = manifest["cluster"]
-    where = f" on {cluster['workers']} worker(s) of {cluster['scheduler']}" if cluster["workers"] else ""
-    print(f"fleet: {counts['ok']} {verb}, {counts['skipped']} skipped (complete from an earlier run), "
-          f"{counts['failed']} failed of {len(manifest[items])} {items} in {manifest['seconds']:.1f} s{where}")
-    for entry in manifest[items]:
-        if entry["status"] == "failed":
-            print(f"  failed: {describe(entry)}")
-    return 2 if counts["failed"] else 0
+    from ..fleet import fleet_summary
+
+    lines, status = fleet_summary(manifest, items, verb, describe)
+    for line in lines:
+        print(line)
+    return status

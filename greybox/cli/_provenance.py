@@ -8,17 +8,22 @@ import sys
 
 import numpy as np
 
-from ..data.prepare import MAX_GAP_STEPS, default_cutoff
+from ..data.prepare import MAX_GAP_STEPS
 from ..metrics import metrics_table
-from ..provenance import TRAINING_RECORD, file_identity, preparation_differences, training_record
+from ..provenance import TRAINING_RECORD, file_identity, preparation_warning, training_record
+from ..provenance import preparation_of as prepared_as
 
 __all__ = ["preparation_of", "record_training", "warn_preparation"]
 
 
-def preparation_of(args: argparse.Namespace, runs) -> dict:
-    """The preparation of prepared ``runs`` read with the options ``args``.
+def _read_options(args: argparse.Namespace) -> dict:
+    """The preparation options in ``args`` (:func:`greybox.provenance.preparation_of`), defaults where absent."""
+    return {"resample": getattr(args, "resample", None), "max_gap": getattr(args, "max_gap", MAX_GAP_STEPS),
+            "time_tolerance": args.time_tolerance, "cutoff_hz": getattr(args, "cutoff_hz", None)}
 
-    The keys are :data:`~greybox.provenance.PREPARATION_KEYS`.
+
+def preparation_of(args: argparse.Namespace, runs) -> dict:
+    """The preparation of prepared ``runs`` read with the options ``args`` (:func:`greybox.provenance.preparation_of`).
 
     Parameters
     ----------
@@ -27,14 +32,7 @@ def preparation_of(args: argparse.Namespace, runs) -> dict:
     runs : list of AxisLog
         The prepared runs; the first gives the sample time [s] and the derivative filter's cut-off [Hz].
     """
-    filters = [run.attrs.get("derivative_filter") or {} for run in runs]
-    cutoff = filters[0].get("cutoff_hz")
-    return {"sample_time_s": float(runs[0].sample_time),
-            "cutoff_hz": None if cutoff is None else float(cutoff),
-            "resample_s": getattr(args, "resample", None),
-            "max_gap_steps": float(getattr(args, "max_gap", MAX_GAP_STEPS)),
-            "time_tolerance": float(args.time_tolerance),
-            "derived": sorted({name for entry in filters for name in entry.get("derived", ())})}
+    return prepared_as(runs, _read_options(args))
 
 
 def record_training(args: argparse.Namespace, files, names, runs, predictions) -> dict:
@@ -90,23 +88,11 @@ def warn_preparation(records: dict, args: argparse.Namespace, runs, log_name: st
     Returns
     -------
     str or None
-        The line printed.
+        The line printed (:func:`greybox.provenance.preparation_warning`).
     """
-    record = records.get(TRAINING_RECORD)
-    if record is None:
-        return None
-    trained = record["preparation"]
-    if runs is None:
-        cutoff = args.cutoff_hz if args.cutoff_hz is not None else default_cutoff(trained["sample_time_s"])
-        used = {**trained, "cutoff_hz": float(cutoff), "resample_s": args.resample}
-    else:
-        used = preparation_of(args, runs)
-    differences = preparation_differences(trained, used)
-    if not differences:
-        return None
-    line = (f"warning: {log_name} is prepared otherwise than the training logs of {model_name}: "
-            + "; ".join(differences))
-    print(line, file=stream or sys.stderr)
+    line = preparation_warning(records, _read_options(args), runs, log_name, model_name)
+    if line is not None:
+        print(line, file=stream or sys.stderr)
     return line
 
 

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import math
 
-from ..errors import GreyboxError
 from ._types import FINITE
 
 __all__ = ["add_window_argument", "check_window"]
@@ -32,7 +30,7 @@ def add_window_argument(parser: argparse.ArgumentParser, flag: str = "--window")
 
 
 def check_window(window, time, flag: str = "--window", name: str = "the log") -> tuple[float, float] | None:
-    """Return the window ``(start, end)`` [s], or None; refuse one that is empty, reversed or off the log.
+    """Return the window ``(start, end)`` [s], or None (:func:`greybox.evaluate.plots.check_window`).
 
     Parameters
     ----------
@@ -44,19 +42,7 @@ def check_window(window, time, flag: str = "--window", name: str = "the log") ->
         Option name, for the message.
     name : str
         The log, for the message.
-
-    Raises
-    ------
-    GreyboxError
-        If START or END is not finite, START >= END, or no sample lies in the window.
     """
-    if window is None:
-        return None
-    start, end = (float(v) for v in window)
-    text = f"{flag} {start:g} {end:g}"
-    if not (math.isfinite(start) and math.isfinite(end)) or start >= end:
-        raise GreyboxError(f"{text}: give START < END, both finite, in seconds of log time")
-    first, last = float(time[0]), float(time[-1])
-    if not ((time >= start) & (time <= end)).any():
-        raise GreyboxError(f"{text}: no sample in the window; {name} runs from {first:g} to {last:g} s")
-    return start, end
+    from ..evaluate.plots import check_window as checked
+
+    return checked(window, time, flag, name)

@@ -29,7 +29,7 @@ same efficiency. The ``[channels]`` table is the column mapping of ``greybox.dat
 (``{canonical_name: name_in_file}``; the canonical name may carry any supported
 unit, e.g. ``position_um``).
 
-The load (force or torque) these constants give is derived in :mod:`greybox.evaluate.process`.
+The load (force or torque) these constants give is derived in :mod:`greybox.predict.process`.
 """
 
 from __future__ import annotations
@@ -168,7 +168,7 @@ class AxisConfig:
         Driving: the motor pushes the table against the load and the share
         ``eta_d`` of its power reaches the table. Back-driven: the load pushes
         the table along and the share ``eta_b`` of the table's power reaches
-        the motor (:mod:`greybox.evaluate.process` derives both).
+        the motor (:mod:`greybox.predict.process` derives both).
         """
         lossless = self.lossless_load_constant
         return lossless * self.efficiency_driving, lossless / self.efficiency_backdriven

@@ -31,10 +31,13 @@ from .log import AxisLog
 from .units import CANONICAL_NAMES, known_column
 from .validate import check_finite, check_increasing, check_time
 
-__all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS"]
+__all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS", "LOG_SUFFIXES"]
 
 #: File extensions of each format.
 FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",), "mat": (".mat",), "tdms": (".tdms",)}
+
+#: Every extension of a log file, in the order of :data:`FORMATS` (what a directory of logs is searched for).
+LOG_SUFFIXES = tuple(suffix for suffixes in FORMATS.values() for suffix in suffixes)
 
 # format -> (module, reader, writer or None, reader options)
 _HANDLERS = {

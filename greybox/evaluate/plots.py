@@ -10,6 +10,7 @@ themselves.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -17,9 +18,10 @@ import numpy as np
 
 from ..atomic import atomic_output
 from ..data.log import AxisLog
+from ..errors import GreyboxError
 
-__all__ = ["ENVELOPE_POINTS", "envelope", "envelope_indices", "plot_log", "save_figure", "import_pyplot",
-           "legend_outside", "finish_figure", "window_title"]
+__all__ = ["ENVELOPE_POINTS", "check_window", "envelope", "envelope_indices", "plot_log", "save_figure",
+           "import_pyplot", "legend_outside", "finish_figure", "window_title"]
 
 #: Points drawn per line at most: the minimum and maximum of 2000 bins (an axis of the figures here
 #: spans about 900-1300 pixel columns at their size and resolution).
@@ -109,6 +111,37 @@ def envelope(time, values, max_points: int = ENVELOPE_POINTS) -> tuple[np.ndarra
     high = np.minimum(starts + np.argmax(bins, axis=1), values.size - 1)
     index = np.column_stack((np.minimum(low, high), np.maximum(low, high))).ravel()
     return time[index], values[index]
+
+
+def check_window(window, time, flag: str = "--window", name: str = "the log") -> tuple[float, float] | None:
+    """Return the window ``(start, end)`` [s], or None; refuse one that is empty, reversed or off the log.
+
+    Parameters
+    ----------
+    window : sequence of two floats or None
+        The option's value.
+    time : ndarray
+        The log's time [s].
+    flag : str, default "--window"
+        Option name, for the message.
+    name : str
+        The log, for the message.
+
+    Raises
+    ------
+    GreyboxError
+        If START or END is not finite, START >= END, or no sample lies in the window.
+    """
+    if window is None:
+        return None
+    start, end = (float(v) for v in window)
+    text = f"{flag} {start:g} {end:g}"
+    if not (math.isfinite(start) and math.isfinite(end)) or start >= end:
+        raise GreyboxError(f"{text}: give START < END, both finite, in seconds of log time")
+    first, last = float(time[0]), float(time[-1])
+    if not ((time >= start) & (time <= end)).any():
+        raise GreyboxError(f"{text}: no sample in the window; {name} runs from {first:g} to {last:g} s")
+    return start, end
 
 
 def window_title(window: tuple[float, float] | None) -> str:

@@ -4,7 +4,7 @@
 (:class:`~greybox.live.timeline.Timeline`), derives velocity and acceleration as the whole log would get
 them (:class:`~greybox.live.lookahead.Lookahead`), and runs the model over the samples now complete from
 the state the previous ones left, through the same code that ``greybox predict`` streams a log with
-(:func:`greybox.evaluate.process.process_blocks`): process current, force, training-region flags. Fed
+(:func:`greybox.predict.process.process_blocks`): process current, force, training-region flags. Fed
 the samples of a log, the estimates equal the table ``greybox predict`` writes for it.
 
 A gap in the time stamps ends the run: the samples waiting are finished as the end of a log, and the
@@ -20,8 +20,8 @@ from typing import Iterator
 from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog
 from ..errors import LogError
-from ..evaluate.process import ProcessResult, ProcessTally, check_process_inputs, process_blocks
 from ..models.chunked import DEFAULT_CHUNK_S
+from ..predict.process import ProcessResult, ProcessTally, check_process_inputs, process_blocks
 from .lookahead import Lookahead
 from .timeline import Dropped, Gap, Timeline
 

@@ -11,7 +11,7 @@ header, :mod:`greybox.data.units`):
 
 A message may carry ``"seq"`` (any JSON number or string); the estimates it completes carry it back, so a
 publisher can match them. An output message (:func:`estimate_message`) holds the columns ``greybox
-predict`` writes (:meth:`greybox.evaluate.process.ProcessResult.columns`) for the samples it completes.
+predict`` writes (:meth:`greybox.predict.process.ProcessResult.columns`) for the samples it completes.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 The estimates go to ``DIR/live-<start>-<n>.parquet``, a new file every ``every_s`` seconds of log time
 and at the start of every run (after a gap), each written at once when it is complete through
-:func:`greybox.evaluate.process_io.write_process_blocks` (atomically: a file is there whole or not at all;
+:func:`greybox.predict.output.write_process_blocks` (atomically: a file is there whole or not at all;
 no file is overwritten). Its columns and metadata are those of ``greybox predict``'s Parquet output, with
 the file's place in the stream under ``attrs["live"]``. Memory holds one file's estimates at most.
 """
@@ -14,8 +14,8 @@ from pathlib import Path
 
 from ..data.axis_config import AxisConfig
 from ..errors import GreyboxError
-from ..evaluate.process import ProcessResult, ProcessTally, process_attrs
-from ..evaluate.process_io import write_process_blocks
+from ..predict.output import write_process_blocks
+from ..predict.process import ProcessResult, ProcessTally, process_attrs
 
 __all__ = ["DEFAULT_RECORD_S", "Recorder"]
 

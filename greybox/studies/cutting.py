@@ -13,7 +13,7 @@ Protocol:
    in training), with a seed other than the shipped data's. The cut strength
    (mean process current at 1000 mm/min, full engagement) is swept over
    ``--strengths``; ``--strength`` is the one of the detailed table;
-3. :func:`greybox.evaluate.process.predict_process` gives the process current
+3. :func:`greybox.predict.process.predict_process` gives the process current
    and force (axis metadata ``examples/axis_x.toml``); it is compared with
    the log's ``truth_process_A`` (and the force this truth implies);
 4. the air-cut test RMSE is the model's RMSE on the shipped air cut of the
@@ -56,10 +56,10 @@ from ..data.io import read_log
 from ..data.prepare import prepare
 from ..errors import GreyboxError
 from ..evaluate.plots import finish_figure, import_pyplot
-from ..evaluate.process import predict_process
 from ..evaluate.report import MODEL_LABELS as LABELS
 from ..metrics import rmse
 from ..models.chunked import predict_chunked
+from ..predict.process import predict_process
 from ..provenance import provenance, provenance_line
 from ..registry import MODEL_CLASSES
 from ..twin import make_dataset
@@ -395,7 +395,7 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
                 f"process RMSE {row['process_rmse_A']:.4f} A  r {swept}  "
                 f"|process error - air residual| <= {row['air_identity_A'] * 1e3:.2f} mA")
             if plot_dir:
-                from ..evaluate.process_plot import plot_process
+                from ..predict.plot import plot_process
 
                 plot_process(result, plot_dir / f"predict_{kind}_X_{case.dataset}.png")
 

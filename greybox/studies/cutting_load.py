@@ -18,7 +18,7 @@ Protocol, for each member:
    directions) is cut with :data:`CUT`: the force opposes the motion on the
    cutting stroke (the drive pushes against it: driving) and pushes the table
    along on the return stroke (climb milling: the screw is back-driven);
-3. :func:`greybox.evaluate.process.predict_process` with the member's axis
+3. :func:`greybox.predict.process.predict_process` with the member's axis
    file gives the process force; per pass direction, the mean over the samples
    in cut is compared with the mean of ``truth_process_force_N`` (error in %
    of the true mean), and over the whole cut the RMS error in % of the RMS
@@ -27,7 +27,7 @@ Protocol, for each member:
    direction of the power flow), shows what the direction-aware conversion
    removes.
 
-4. the interval of the process force (:mod:`greybox.evaluate.interval`,
+4. the interval of the process force (:mod:`greybox.predict.interval`,
    nominal :data:`COVERAGE`) is calibrated on held-out air cuts two ways: on
    the member's dataset C (other motion: steps and sines in the 50 mm window)
    and on the cutting programme run once more as an air cut (dataset D
@@ -53,10 +53,10 @@ import numpy as np
 
 from ..atomic import write_text_atomic
 from ..data.prepare import prepare
-from ..evaluate.interval import calibrate_interval
-from ..evaluate.process import predict_process
 from ..evaluate.report import MODEL_LABELS
 from ..metrics import rmse
+from ..predict.interval import calibrate_interval
+from ..predict.process import predict_process
 from ..twin.cutting import CuttingSpec
 from ..twin.family import draw_member, member_dataset
 from .experiments import EXPERIMENTS, MODEL_SETTINGS, Experiment, run_experiments

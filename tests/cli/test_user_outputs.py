@@ -326,9 +326,9 @@ def test_process_picture_title_names_the_dataset(predict_files):
     matplotlib.use("Agg")
     from greybox.data.io import read_log
     from greybox.data.prepare import prepare
-    from greybox.evaluate.process import predict_process
-    from greybox.evaluate.process_plot import plot_process
     from greybox.persistence import load_model
+    from greybox.predict.plot import plot_process
+    from greybox.predict.process import predict_process
 
     log = prepare([read_log(predict_files["log"])])[0]
     steps = []

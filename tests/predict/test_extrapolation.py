@@ -12,10 +12,10 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
-from greybox.evaluate.process import EXTRAPOLATION_WARNING_SHARE, predict_process
 from greybox.friction import GMSModel, StribeckModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import load_model, save_model
+from greybox.predict.process import EXTRAPOLATION_WARNING_SHARE, predict_process
 from greybox.twin import make_dataset
 
 SMALL_SVR = dict(n_subset=200, n_calls=3, cv_folds=2, cv_blocks=4)
@@ -75,7 +75,7 @@ def test_predict_reports_records_and_marks_the_samples_outside(logs, tmp_path, c
     assert table["outside_training"].mean() == pytest.approx(meta["share"])
 
     matplotlib.use("Agg")
-    from greybox.evaluate.process_plot import plot_process
+    from greybox.predict.plot import plot_process
 
     result = predict_process(model, prepare([make_dataset("X", "D", seed=34)])[0])
     figure = plot_process(result)

@@ -11,8 +11,8 @@ import pytest
 from greybox.data.axis_config import AxisConfig, parse_axis_config, read_axis_config
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.evaluate.process import predict_process
 from greybox.friction import CoulombModel
+from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"

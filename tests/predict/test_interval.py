@@ -14,11 +14,11 @@ from greybox.data.axis_config import read_axis_config
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.evaluate.interval import INTERVAL_CLASSES, _conformal_half_width, calibrate_interval, interval_classes
-from greybox.evaluate.process import predict_process
 from greybox.evaluate.regimes import RegimeThresholds, regime_masks
 from greybox.friction import LuGreModel
 from greybox.persistence import save_model
+from greybox.predict.interval import INTERVAL_CLASSES, _conformal_half_width, calibrate_interval, interval_classes
+from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
 
@@ -90,7 +90,7 @@ def test_bounds_of_force_follow_the_conversion_and_hold_the_estimate(fitted):
                                   "force_process_N", "force_process_lower_N", "force_process_upper_N"]
 
     matplotlib.use("Agg")
-    from greybox.evaluate.process_plot import plot_process
+    from greybox.predict.plot import plot_process
 
     figure = plot_process(result)
     labels = [collection.get_label() for collection in figure.axes[2].collections]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from greybox.data.prepare import prepare
-from greybox.evaluate.process import predict_process
 from greybox.friction import GMSModel
+from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 
 #: Resolution of the logged current [A]: the cut and air-cut logs differ by the process current up to it.
@@ -34,8 +34,8 @@ def test_thinned_picture_keeps_single_sample_peaks():
     import matplotlib.pyplot
 
     matplotlib.use("Agg")
-    from greybox.evaluate.process import ProcessResult
-    from greybox.evaluate.process_plot import envelope_indices, plot_process
+    from greybox.predict.plot import envelope_indices, plot_process
+    from greybox.predict.process import ProcessResult
 
     n = 10_001
     time = np.arange(n) * 0.002
@@ -55,7 +55,7 @@ def test_thinned_picture_keeps_single_sample_peaks():
 
 
 def test_moving_mean_is_centred_and_exact_at_the_ends():
-    from greybox.evaluate.process_plot import moving_mean
+    from greybox.predict.plot import moving_mean
 
     values = np.array([1.0, 2.0, 3.0, 4.0, 10.0])
     np.testing.assert_allclose(moving_mean(values, 3), [1.5, 2.0, 3.0, 17 / 3, 7.0])
@@ -71,8 +71,8 @@ def test_process_panel_draws_the_moving_mean():
     import matplotlib.pyplot
 
     matplotlib.use("Agg")
-    from greybox.evaluate.process import ProcessResult
-    from greybox.evaluate.process_plot import plot_process
+    from greybox.predict.plot import plot_process
+    from greybox.predict.process import ProcessResult
 
     n = 2000
     time = np.arange(n) * 0.002

@@ -12,9 +12,9 @@ from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.estimator import STANDSTILL_SHARE
-from greybox.evaluate.process import predict_process
 from greybox.friction import GMSModel, StribeckModel
 from greybox.persistence import save_model
+from greybox.predict.process import predict_process
 
 HELD_A = 0.7
 

@@ -1,7 +1,7 @@
 """The process share of every axis of a machine, and the resultant process force of its linear axes.
 
 ``greybox predict`` with a machine model (:mod:`greybox.machine_model`) runs
-:func:`~greybox.evaluate.process.predict_process` on each axis and joins the
+:func:`~greybox.predict.process.predict_process` on each axis and joins the
 results on one time base: the first axis's time stamps. Axes logged on the
 same clock (one CSV, a TDMS group) share them already; channels with their
 own stamps (one MCAP channel per axis) are interpolated linearly onto the
@@ -139,7 +139,7 @@ def predict_machine(models: Mapping[str, object], runs: Mapping[str, Sequence[Ax
     ------
     GreyboxError
         When ``runs`` lacks an axis of ``models``, or the errors of
-        :func:`~greybox.evaluate.process.predict_process` (named by axis).
+        :func:`~greybox.predict.process.predict_process` (named by axis).
     """
     missing = [axis for axis in models if axis not in runs]
     if missing:

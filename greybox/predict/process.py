@@ -110,7 +110,7 @@ class ProcessResult:
         JSON-able description (model kind and file, chunk length, axis constants, interval).
     half_width : ndarray or None
         Half-width of the calibrated interval of the process current per sample [A] (or [N], [Nm]),
-        :class:`~greybox.evaluate.interval.ProcessInterval`; None without calibration.
+        :class:`~greybox.predict.interval.ProcessInterval`; None without calibration.
     load_bounds : (ndarray, ndarray) or None
         Lower and upper bound of the process force [N] (torque [Nm]) of a current log, the current's
         bounds converted like the current; None without calibration or without axis metadata.
@@ -486,7 +486,7 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
     axis_config : AxisConfig, optional
         Drive-train constants; gives ``load`` for a current log. Its kind of axis must be the log's.
     interval : ProcessInterval, optional
-        Calibrated half-widths (:func:`~greybox.evaluate.interval.calibrate_interval`); gives the bounds
+        Calibrated half-widths (:func:`~greybox.predict.interval.calibrate_interval`); gives the bounds
         of the process current and force.
     chunk_s : float, default 60.0
         The model runs over chunks of this length [s], carrying its state

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .plots import (
+from ..evaluate.plots import (
     ENVELOPE_POINTS,
     band_envelope,
     envelope,
@@ -72,7 +72,7 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     Parameters
     ----------
     result : ProcessResult
-        Output of :func:`greybox.evaluate.process.predict_process`.
+        Output of :func:`greybox.predict.process.predict_process`.
     path : path-like, optional
         Write the figure there (PNG, SVG or PDF by extension) and close it.
     max_points : int, default :data:`~greybox.evaluate.plots.ENVELOPE_POINTS`
@@ -180,7 +180,7 @@ def plot_machine_process(result, path: str | os.PathLike | None = None, *,
     Parameters
     ----------
     result : MachineProcessResult
-        Output of :func:`greybox.evaluate.machine_process.predict_machine`.
+        Output of :func:`greybox.predict.machine.predict_machine`.
     path : path-like, optional
         Write the figure there (PNG, SVG or PDF by extension) and close it.
     max_points : int, default :data:`~greybox.evaluate.plots.ENVELOPE_POINTS`

@@ -33,10 +33,14 @@ import numpy as np
 from ..data.log import AxisLog, as_log_list
 from ..data.quantities import MOTIONS
 from ..errors import GreyboxError
+from ..evaluate.regimes import RegimeThresholds, regime_masks
 from ..models.chunked import predict_chunked
-from .regimes import RegimeThresholds, regime_masks
 
-__all__ = ["INTERVAL_CLASSES", "ProcessInterval", "interval_classes", "calibrate_interval"]
+__all__ = ["DEFAULT_COVERAGE", "INTERVAL_CLASSES", "MIN_CLASS_SAMPLES", "ProcessInterval", "interval_classes",
+           "calibrate_interval"]
+
+#: Nominal coverage of the bounds when calibration logs are given without a coverage.
+DEFAULT_COVERAGE = 0.95
 
 #: The classes of samples that get their own half-width, in the order a sample is assigned.
 INTERVAL_CLASSES = ("reversal", "acceleration", "constant_feed", "other")
@@ -127,7 +131,7 @@ class ProcessInterval:
                 "calibration_logs": list(self.sources)}
 
 
-def calibrate_interval(model, logs: AxisLog | Sequence[AxisLog], *, coverage: float = 0.95,
+def calibrate_interval(model, logs: AxisLog | Sequence[AxisLog], *, coverage: float = DEFAULT_COVERAGE,
                        chunk_s: float = 60.0) -> ProcessInterval:
     """Half-widths of the process-current interval from a model's residuals on held-out air cuts.
 

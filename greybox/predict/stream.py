@@ -1,13 +1,13 @@
 """The process table of a log of any length, read, predicted and written block by block.
 
 :func:`stream_process` does for a log that :func:`greybox.data.stream.open_stream` reads block by block
-what :func:`~greybox.evaluate.process.predict_process` followed by
-:func:`~greybox.evaluate.process_io.write_process` does for a log in memory, with the same table and
+what :func:`~greybox.predict.process.predict_process` followed by
+:func:`~greybox.predict.output.write_process` does for a log in memory, with the same table and
 metadata, while holding a few blocks of the log at a time: the log is prepared block by block
 (:func:`greybox.data.stream.prepared_blocks`), each block predicted from the state the previous one
-ended in (:func:`~greybox.evaluate.process.process_blocks`) and written as it comes
-(:func:`~greybox.evaluate.process_io.write_process_blocks`); the figures ``greybox predict`` prints are
-counted on the way (:class:`~greybox.evaluate.process.ProcessTally`).
+ended in (:func:`~greybox.predict.process.process_blocks`) and written as it comes
+(:func:`~greybox.predict.output.write_process_blocks`); the figures ``greybox predict`` prints are
+counted on the way (:class:`~greybox.predict.process.ProcessTally`).
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from ..data.axis_config import AxisConfig
 from ..data.stream import median_step, prepared_blocks
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from .interval import ProcessInterval
+from .output import write_process_blocks
 from .process import ProcessTally, check_process_inputs, process_attrs, process_blocks
-from .process_io import write_process_blocks
 
 __all__ = ["StreamedProcess", "stream_process"]
 
@@ -76,7 +76,7 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
     log : ParquetLog or McapLog
         The cutting log (:func:`greybox.data.stream.open_stream`).
     out : str or path-like
-        Output table; see :func:`~greybox.evaluate.process_io.write_process_blocks`.
+        Output table; see :func:`~greybox.predict.output.write_process_blocks`.
     axis_config : AxisConfig, optional
         Drive-train constants; gives the process force.
     interval : ProcessInterval, optional

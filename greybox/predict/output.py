@@ -1,6 +1,6 @@
 """Writing the process table of ``greybox predict``: CSV, Parquet or MCAP, atomically.
 
-The columns are those of :meth:`greybox.evaluate.process.ProcessResult.columns`
+The columns are those of :meth:`greybox.predict.process.ProcessResult.columns`
 (``time_s``, ``current_measured_A``, ``current_model_A``, ``current_process_A``,
 ``force_process_N`` with axis metadata, ``position_mm``, ``velocity_mm_s``; for a rotary
 axis ``torque_process_Nm``, ``position_deg``, ``velocity_deg_s``).
@@ -212,7 +212,7 @@ def write_process(result: ProcessResult, path, *, overwrite: bool = False, prote
     Parameters
     ----------
     result : ProcessResult
-        What :func:`greybox.evaluate.process.predict_process` returned.
+        What :func:`greybox.predict.process.predict_process` returned.
     path : str or path-like
         Output file (.csv, .parquet/.pq or .mcap). A CSV file's metadata go
         to its sidecar ``<path>.json``, written atomically as well.
@@ -241,7 +241,7 @@ def write_process_blocks(results: Iterable[ProcessResult], path, *, metadata: Ca
     Parameters
     ----------
     results : iterable of ProcessResult
-        Consecutive blocks of one result (:func:`greybox.evaluate.process.process_blocks`); taken one at
+        Consecutive blocks of one result (:func:`greybox.predict.process.process_blocks`); taken one at
         a time, so that a generator computes each block as it is written.
     path : str or path-like
         Output file (.csv, .parquet/.pq or .mcap; an MCAP file is written once all blocks are in).
