@@ -22,8 +22,8 @@ import numpy as np
 
 from greybox.data import prepare, read_log
 from greybox.data.axis_config import read_axis_config
-from greybox.predict.process import predict_process
 from greybox.friction.lugre import LuGreModel
+from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 
 root = Path("../..")  # the repository (the gallery runs from docs/examples)
