@@ -8,11 +8,13 @@ import sys
 
 import numpy as np
 
+from ..data.effort import EFFORT_UNITS, check_one_effort, convert_effort
 from ..data.prepare import MAX_GAP_STEPS, default_cutoff
+from ..errors import GreyboxError
 from ..metrics import metrics_table
 from ..provenance import TRAINING_RECORD, file_identity, preparation_differences, training_record
 
-__all__ = ["preparation_of", "record_training", "warn_preparation"]
+__all__ = ["align_effort", "model_quantity", "preparation_of", "record_training", "warn_preparation"]
 
 
 def preparation_of(args: argparse.Namespace, runs) -> dict:
@@ -51,6 +53,7 @@ def record_training(args: argparse.Namespace, files, names, runs, predictions) -
     runs, predictions : list
         The prepared runs and the fitted model's effort for each [A, or N, Nm].
     """
+    quantity = check_one_effort(runs)
     tables = [metrics_table(run.effort, prediction) for run, prediction in zip(runs, predictions)]
     total = metrics_table(np.concatenate([run.effort for run in runs]), np.concatenate(predictions))
 
@@ -65,7 +68,7 @@ def record_training(args: argparse.Namespace, files, names, runs, predictions) -
             ranges[channel] = [float(min(v.min() for v in values)), float(max(v.max() for v in values))]
     record = training_record([file_identity(path) for path in dict.fromkeys(files)], preparation_of(args, runs),
                              [{"name": str(name), **figures(table)} for name, table in zip(names, tables)],
-                             {**figures(total), "unit": runs[0].effort_unit}, ranges)
+                             {**figures(total), "unit": EFFORT_UNITS[quantity], "quantity": quantity}, ranges)
     return {TRAINING_RECORD: record}
 
 
@@ -126,12 +129,14 @@ def record_lines(records: dict) -> list[str]:
     cutoff = "default" if prep["cutoff_hz"] is None else f"{prep['cutoff_hz']:g} Hz"
     resample = "no --resample" if prep["resample_s"] is None else f"--resample {prep['resample_s']:g}"
     re = "" if total["re_percent"] is None else f", RE {total['re_percent']:.3f} %"
+    quantity = total.get("quantity")
     lines = ["training:",
              "  files          = " + ", ".join(f"{entry['name']} ({entry['bytes']} bytes, sha256 "
                                                f"{entry['sha256'][:12]}...)" for entry in record["files"]),
              f"  preparation    = step {prep['sample_time_s'] * 1e3:g} ms, cut-off {cutoff}, {resample}, "
              f"max gap {prep['max_gap_steps']:g} steps, time tolerance {prep['time_tolerance']:g}, derived "
              f"{', '.join(prep['derived']) or 'nothing'}",
+             *([f"  effort         = {quantity} [{total['unit']}]"] if quantity else []),
              f"  training error = RMSE {total['rmse']:.4g} {total['unit']}{re} over {total['samples']} samples "
              f"({len(record['runs'])} run(s))"]
     for name, (low, high) in record["ranges"].items():
@@ -154,3 +159,65 @@ def region_lines(model) -> list[str]:
     shown = [f"  {name} = {low:.6g} .. {high:.6g}" for name, pair in ranges if pair is not None
              for low, high in [pair]]
     return ["training region:", *shown] if shown else []
+
+
+def model_quantity(records: dict, model) -> str:
+    """What the model's effort is (:func:`~greybox.data.effort.effort_quantity`), from its training record.
+
+    A file without the record's ``quantity`` (written before it) is taken as fitted to a current, or to the
+    load its effort unit names.
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records.
+    model : CurrentModel
+        The fitted model (its ``effort_unit_`` and ``units_``).
+    """
+    quantity = (records.get(TRAINING_RECORD) or {}).get("training_error", {}).get("quantity")
+    if quantity is not None:
+        return quantity
+    return "current" if model.effort_unit_ == "A" else model.units_.load
+
+
+def align_effort(records: dict, model, runs, axis_config, log_name: str, model_name: str, stream=None) -> list:
+    """The runs of a log in the effort quantity the model was trained on, with a one-line note when converted.
+
+    A current log predicted by a model trained on a motor torque (or the other way round) is converted
+    through the torque constant of the axis file (:func:`~greybox.data.effort.convert_effort`); without an
+    axis file, or for quantities no constant links, it is refused in one line.
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records.
+    model : CurrentModel
+        The fitted model.
+    runs : list of AxisLog
+        The prepared runs of the log.
+    axis_config : AxisConfig or None
+        The axis file (--axis-config), whose torque constant [Nm/A] converts.
+    log_name, model_name : str
+        Names for the messages.
+    stream : file-like, optional
+        Where to print the note; default stderr.
+
+    Returns
+    -------
+    list of AxisLog
+    """
+    want = model_quantity(records, model)
+    have = check_one_effort(runs, f"the runs of {log_name}")
+    if have == want:
+        return list(runs)
+    convertible = {have, want} == {"current", "motor torque"}
+    if not convertible or axis_config is None:
+        how = ("give the axis file (--axis-config) whose torque constant converts one into the other"
+               if convertible else "predict it with a model trained on that quantity")
+        raise GreyboxError(f"{log_name}: its effort is a {have} [{EFFORT_UNITS[have]}], {model_name} was trained on "
+                           f"a {want} [{EFFORT_UNITS[want]}]; {how}")
+    k_t = axis_config.torque_constant_Nm_per_A
+    print(f"note: {log_name}: its {have} [{EFFORT_UNITS[have]}] is converted into the {want} "
+          f"[{EFFORT_UNITS[want]}] {model_name} was trained on, through the torque constant {k_t:g} Nm/A of the "
+          "axis file", file=stream or sys.stderr)
+    return convert_effort(runs, want, k_t)

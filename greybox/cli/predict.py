@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import GreyboxError
 from ._options import add_log_arguments
-from ._provenance import warn_preparation
+from ._provenance import align_effort, model_quantity, warn_preparation
 from ._types import FRACTION, POSITIVE_INT, non_negative, positive
 from ._window import add_window_argument, check_window
 
@@ -163,23 +163,28 @@ def _print_result(result, args: argparse.Namespace, interval, axis_file: str | N
 
     tally = ProcessTally()
     tally.add(result)
-    _print_figures(tally, result.effort_unit, result.units, result.load_constants, result.attrs["extrapolation"],
+    _print_figures(tally, result.quantity, result.units, result.load_constants, result.attrs["extrapolation"],
                    args, interval, axis_file)
 
 
-def _print_figures(tally, unit: str, units, load_constants, extrapolation: dict, args: argparse.Namespace,
+def _print_figures(tally, quantity: str, units, load_constants, extrapolation: dict, args: argparse.Namespace,
                    interval, axis_file: str | None) -> None:
-    """The console lines of one axis's figures (a :class:`~greybox.evaluate.process.ProcessTally`)."""
-    noun = "current" if unit == "A" else units.load
+    """The console lines of one axis's figures (a :class:`~greybox.evaluate.process.ProcessTally`); the load's
+    figures leave out the samples at standstill (:attr:`~greybox.evaluate.process.ProcessResult.standstill`)."""
+    from ..data.effort import EFFORT_UNITS
+
+    noun, unit = quantity, EFFORT_UNITS[quantity]
     print(f"  {noun:<8} rms measured {tally.rms('measured'):.4g} {unit}, model {tally.rms('model'):.4g} "
           f"{unit}, process {tally.rms('process'):.4g} {unit}, largest |process| {tally.largest['process']:.4g} {unit}")
-    if unit == "A" and load_constants is not None:
+    if quantity in ("current", "motor torque") and load_constants is not None:
         driving, backdriven = load_constants
-        per_ampere = f"{units.load_unit}/A"
+        per_ampere = f"{units.load_unit}/{unit}"
         factors = (f"{driving:.6g} {per_ampere}" if driving == backdriven
                    else f"{driving:.6g} {per_ampere} driving, {backdriven:.6g} {per_ampere} back-driven")
-        print(f"  {units.load:<8} rms process {tally.rms('load'):.4g} {units.load_unit}, "
-              f"largest |process| {tally.largest['load']:.4g} {units.load_unit} "
+        standing = tally.n_samples - tally.n_moving
+        where = f" of the {tally.n_moving} samples in motion (standstill left out)" if standing else ""
+        print(f"  {units.load:<8} rms process {tally.rms('load_moving'):.4g} {units.load_unit}, "
+              f"largest |process| {tally.largest['load_moving']:.4g} {units.load_unit}{where} "
               f"({factors} from {axis_file})")
     _report_extrapolation(extrapolation, Path(args.log).name)
     if interval is not None:
@@ -229,17 +234,22 @@ def run(args: argparse.Namespace) -> int:
     config = read_axis_config(args.axis_config) if args.axis_config else None
     model, records = load_model(args.model, records=True)
     streamed = _streamed_log(args, config)
+    if streamed is not None and _first_quantity(streamed) != model_quantity(records, model):
+        streamed = None  # read whole, to convert its effort (align_effort)
     if streamed is not None:
         warn_preparation(records, args, None, Path(args.log).name, Path(args.model).name)
     status = None if streamed is None else _run_streamed(args, model, streamed, config, out, inputs, run_started)
     if status is not None:
         return status
     runs = _read_runs(args, config.channels if config else {})
+    runs = align_effort(records, model, runs, config, Path(args.log).name, Path(args.model).name)
     if streamed is None:
         warn_preparation(records, args, runs, Path(args.log).name, Path(args.model).name)
     log_time = np.concatenate([run.time for run in runs])
     window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
-    interval = _interval(args, model, lambda path: _read_runs(args, config.channels if config else {}, path))
+    interval = _interval(args, model, lambda path: align_effort(
+        records, model, _read_runs(args, config.channels if config else {}, path), config, Path(path).name,
+        Path(args.model).name))
     started = time.perf_counter()
     result = predict_process(model, runs, axis_config=config, interval=interval, chunk_s=args.chunk_s,
                              progress=_progress(float(log_time[-1]), args.quiet))
@@ -264,6 +274,13 @@ def _done_line(args: argparse.Namespace, started: float, elapsed: float) -> str:
     Python's start-up and the imports when greybox ran as a command of its own (then said so)."""
     startup = ", start-up included" if getattr(args, "startup_counted", False) else ""
     return f"done in {time.perf_counter() - started:.2f} s wall{startup} (model {elapsed:.2f} s)"
+
+
+def _first_quantity(log) -> str:
+    """What the effort of a log opened block by block is (:func:`~greybox.data.effort.effort_quantity`)."""
+    from ..data.effort import effort_quantity
+
+    return effort_quantity(next(iter(log.blocks(1))))
 
 
 def _streamed_log(args: argparse.Namespace, config):
@@ -312,8 +329,10 @@ def _run_streamed(args: argparse.Namespace, model, log, config, out: Path, input
     print(f"predicted {Path(args.log).name} with the {attrs['model_kind']} model {Path(args.model).name}: "
           f"{done.tally.n_samples} samples, {done.duration:.1f} s, {done.n_chunks} chunk(s) of {args.chunk_s:g} s"
           + (f", dataset {dataset}" if dataset else "") + ", read and written block by block")
+    if config is not None and attrs["effort"]["quantity"] == "motor torque":  # the effort is k_t I already
+        config = config.without_torque_constant()
     load_constants = config.load_constants if config is not None and done.metadata["effort_unit"] == "A" else None
-    _print_figures(done.tally, done.metadata["effort_unit"], MOTIONS[done.motion], load_constants,
+    _print_figures(done.tally, attrs["effort"]["quantity"], MOTIONS[done.motion], load_constants,
                    attrs["extrapolation"], args, interval, Path(args.axis_config).name if args.axis_config else None)
     from ..evaluate.process_io import output_paths
 
@@ -441,8 +460,8 @@ def _report_extrapolation(summary: dict, log_name: str) -> None:
     standstill = summary["by"].get("standstill", 0.0)
     if standstill > 0.0:
         print(f"note: {log_name}: {100 * standstill:.1f} % of the samples are at standstill, where a memoryless "
-              "model cannot know the friction the drive holds (flagged in the column outside_training, not "
-              "process force); gms, lugre and gmssvr carry it from the last motion", file=sys.stderr)
+              "model cannot know the friction the drive holds (flagged in the column standstill and left out of "
+              "the process force figures); gms, lugre and gmssvr carry it from the last motion", file=sys.stderr)
     beyond = max([share for name, share in summary["by"].items() if name != "standstill"] or [0.0])
     if summary["share"] > summary["warn_above"] and beyond > 0.0:
         print(f"note: {log_name}: {100 * summary['share']:.1f} % of the samples lie outside the positions, speeds "
