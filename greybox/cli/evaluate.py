@@ -93,17 +93,17 @@ def run(args: argparse.Namespace) -> int:
         for path in dict.fromkeys(args.test):
             warn_preparation(records, args, [run for run in runs if run.source == str(path)] or runs,
                              Path(path).name, name)
-    quantity = check_one_effort(runs, "the --test logs")
+    units = dict.fromkeys(run.effort_unit for run in runs)
+    if len(units) > 1:
+        listed = ", ".join(f"{name} in {run.effort_unit}" for name, run in zip(run_names, runs))
+        raise GreyboxError(f"--test: the logs carry effort in different units ({listed}); evaluate them apart")
+    quantity = check_one_effort(runs, "--test: the logs", "evaluate them apart")  # a current and a motor torque
     for name, (model, records) in loaded.items():
         if model_quantity(records, model) != quantity:
             trained = model_quantity(records, model)
             raise GreyboxError(f"{name} was trained on a {trained} [{EFFORT_UNITS[trained]}], the --test logs carry "
                                f"a {quantity} [{EFFORT_UNITS[quantity]}]; evaluate it on logs of its quantity "
                                "(greybox predict --axis-config converts a current and a motor torque)")
-    units = dict.fromkeys(run.effort_unit for run in runs)
-    if len(units) > 1:
-        listed = ", ".join(f"{name} in {run.effort_unit}" for name, run in zip(run_names, runs))
-        raise GreyboxError(f"--test: the logs carry effort in different units ({listed}); evaluate them apart")
     unit = EFFORT_UNITS[quantity]
     records, predictions = evaluate_models(models, runs, run_names)
     print(f"evaluated {len(models)} model(s) on {len(runs)} log(s), {sum(len(r) for r in runs)} samples, "

@@ -91,7 +91,9 @@ def _name(run) -> str:
     return Path(run.source).name if run.source else "a log without a file name"
 
 
-def check_one_effort(runs, what: str = "the training logs") -> str:
+def check_one_effort(runs, what: str = "the training logs",
+                     advice: str = "a model is fitted to one: train on logs of one quantity (or map the other "
+                                   "column with --columns)") -> str:
     """The one effort quantity of ``runs``; an error naming the files when they mix quantities.
 
     Parameters
@@ -100,6 +102,8 @@ def check_one_effort(runs, what: str = "the training logs") -> str:
         The runs (their ``source`` names the file in the message).
     what : str, default "the training logs"
         What the runs are, for the message.
+    advice : str, optional
+        What to do instead, the end of the message (by default, for training logs).
 
     Returns
     -------
@@ -119,8 +123,7 @@ def check_one_effort(runs, what: str = "the training logs") -> str:
     if len(found) > 1:
         listed = "; ".join(f"{quantity} [{EFFORT_UNITS[quantity]}]: {', '.join(names)}"
                            for quantity, names in found.items())
-        raise GreyboxError(f"{what} mix effort quantities ({listed}); a model is fitted to one: train on logs of "
-                           "one quantity (or map the other column with --columns)")
+        raise GreyboxError(f"{what} mix effort quantities ({listed}); {advice}")
     return next(iter(found))
 
 

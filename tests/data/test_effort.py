@@ -140,3 +140,10 @@ def test_evaluate_refuses_a_model_of_another_quantity(exports, torque_model, cap
     status = main(["evaluate", str(torque_model), "--test", str(exports["aircut_1"])])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "motor torque" in err[0] and "current" in err[0]
+
+
+def test_evaluate_refuses_test_logs_of_a_current_and_a_torque(exports, torque_model, capsys):
+    status = main(["evaluate", str(torque_model), "--test", str(exports["torque_aircut"]), str(exports["aircut_1"])])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "torque_aircut.csv" in err[0] and "aircut_1.csv" in err[0]
+    assert "evaluate them apart" in err[0]
