@@ -416,6 +416,9 @@ def _run_machine(args: argparse.Namespace) -> int:
 
     for name in machine.axes:  # each axis's model file, its training record against the log's preparation
         records = load_model(Path(args.model) / f"{name}.gbm", records=True)[1]
+        runs[name] = align_effort(records, machine.models[name], runs[name],
+                                  described[name].config if name in described else None,
+                                  f"{Path(args.log).name} (axis {name})", f"{name}.gbm")
         warn_preparation(records, args, runs[name], f"{Path(args.log).name} (axis {name})", f"{name}.gbm")
     log_time = np.concatenate([run.time for run in runs[machine.axes[0]]])
     window = check_window(args.plot_window, log_time, "--plot-window", Path(args.log).name)
