@@ -17,8 +17,10 @@ import platform
 import sys
 from importlib import metadata
 
+from .data.effort import EFFORT_UNITS
+
 __all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "PREPARATION_KEYS", "file_identity",
-           "training_record", "check_training_record", "preparation_differences"]
+           "training_record", "check_training_record", "preparation_differences", "model_quantity"]
 
 #: Libraries whose versions can move a figure or a timing.
 LIBRARIES = ("numpy", "scipy", "scikit-learn", "scikit-optimize", "pandas", "numba", "matplotlib", "pyarrow", "mcap")
@@ -79,6 +81,8 @@ TRAINING_RECORD_VERSION = 1
 PREPARATION_KEYS = ("sample_time_s", "cutoff_hz", "resample_s", "max_gap_steps", "time_tolerance", "derived")
 #: Relative difference of a sample time or cut-off that counts as a different preparation.
 PREPARATION_TOLERANCE = 0.01
+#: What a training record's effort may be (``training_error.quantity``).
+EFFORT_QUANTITY_NAMES = tuple(EFFORT_UNITS)
 _HEX = frozenset("0123456789abcdef")
 _MAX_FILES = 10_000
 
@@ -121,7 +125,8 @@ def training_record(files, preparation: dict, runs, total: dict, ranges: dict) -
     runs : list of dict
         Per training run: ``name``, ``samples``, ``rmse`` (in the effort unit) and ``re_percent``.
     total : dict
-        The same figures over all runs, and ``unit`` (the effort unit).
+        The same figures over all runs, ``unit`` (the effort unit) and ``quantity`` (what the effort is:
+        one of :data:`EFFORT_QUANTITY_NAMES`; optional, files written before it lack it).
     ranges : dict
         ``{channel: [low, high]}`` of the training runs (position, velocity, acceleration in the log's units).
 
@@ -210,6 +215,10 @@ def check_training_record(record) -> dict:
         where = f"runs[{k}]" if k < len(runs) else "training_error"
         keys = {"name", "samples", "rmse", "re_percent"} if k < len(runs) else {"samples", "rmse", "re_percent",
                                                                                  "unit"}
+        if k == len(runs) and isinstance(entry, dict) and "quantity" in entry:  # files since the effort's quantity
+            keys = keys | {"quantity"}
+            if entry["quantity"] not in EFFORT_QUANTITY_NAMES:
+                raise ValueError(f"training_error.quantity must be one of {', '.join(EFFORT_QUANTITY_NAMES)}")
         if not isinstance(entry, dict) or set(entry) != keys:
             raise ValueError(f"{where} must hold {', '.join(sorted(keys))}")
         _text(entry.get("name", entry.get("unit")), f"{where}.{'name' if k < len(runs) else 'unit'}", 1024)
@@ -325,3 +334,22 @@ def preparation_warning(records: dict, read, runs, log_name: str, model_name: st
         return None
     return (f"warning: {log_name} is prepared otherwise than the training logs of {model_name}: "
             + "; ".join(differences))
+
+
+def model_quantity(records: dict, model) -> str:
+    """What the model's effort is (:func:`~greybox.data.effort.effort_quantity`), from its training record.
+
+    A file without the record's ``quantity`` (written before it) is taken as fitted to a current, or to the
+    load its effort unit names.
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records.
+    model : CurrentModel
+        The fitted model (its ``effort_unit_`` and ``units_``).
+    """
+    quantity = (records.get(TRAINING_RECORD) or {}).get("training_error", {}).get("quantity")
+    if quantity is not None:
+        return quantity
+    return "current" if model.effort_unit_ == "A" else model.units_.load

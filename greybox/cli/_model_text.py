@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..data.effort import shown_unit
+
 #: Arrays and lists longer than this are summarised by their shape, not printed.
 _MAX_PRINTED = 12
 
@@ -27,17 +29,21 @@ def format_value(value) -> str:
     return str(value)
 
 
-def parameter_lines(model) -> list[str]:
+def parameter_lines(model, quantity: str | None = None) -> list[str]:
     """Lines ``name = value unit`` of the model's parameter table (see ``parameter_table``), aligned.
 
     Parameters
     ----------
     model : CurrentModel
         A fitted model.
+    quantity : str, optional
+        What the model's effort is (:func:`~greybox.data.effort.effort_quantity`): a motor torque shows the
+        units written in A in Nm (``A s/mm`` as ``Nm s/mm``).
     """
     rows = model.parameter_table()
     width = max([14, *(len(row.name) for row in rows)])
-    return [(f"  {row.name:<{width}} = {format_value(row.value)} {row.unit if row.unit != '-' else ''}".rstrip()
+    return [(f"  {row.name:<{width}} = {format_value(row.value)} "
+             f"{shown_unit(row.unit, quantity) if row.unit != '-' else ''}".rstrip()
              + interval_text(row)) for row in rows]
 
 
@@ -107,16 +113,18 @@ def selection_lines(record: dict) -> list[str]:
     return lines
 
 
-def model_lines(model) -> list[str]:
+def model_lines(model, quantity: str | None = None) -> list[str]:
     """The ``parameters:`` and ``fit:`` sections of a fitted model, as ``greybox train`` and ``info`` print them.
 
     Parameters
     ----------
     model : CurrentModel
         A fitted model.
+    quantity : str, optional
+        What the model's effort is, for the parameters' units (see :func:`parameter_lines`).
     """
     notes = model.fit_notes()
     record = getattr(model, "selection_", None)  # only a model chosen by --model auto has one
-    return ["parameters:", *parameter_lines(model), "fit:", *fit_lines(model),
+    return ["parameters:", *parameter_lines(model, quantity), "fit:", *fit_lines(model),
             *(["notes:"] + [f"  - {note}" for note in notes] if notes else []),
             *(selection_lines(record) if record is not None else [])]

@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 
+from ..data.effort import EFFORT_UNITS, check_one_effort
 from ..data.prepare import MAX_GAP_STEPS
 from ..metrics import metrics_table
 from ..provenance import TRAINING_RECORD, file_identity, preparation_warning, training_record
@@ -49,6 +50,7 @@ def record_training(args: argparse.Namespace, files, names, runs, predictions) -
     runs, predictions : list
         The prepared runs and the fitted model's effort for each [A, or N, Nm].
     """
+    quantity = check_one_effort(runs)
     tables = [metrics_table(run.effort, prediction) for run, prediction in zip(runs, predictions)]
     total = metrics_table(np.concatenate([run.effort for run in runs]), np.concatenate(predictions))
 
@@ -63,7 +65,7 @@ def record_training(args: argparse.Namespace, files, names, runs, predictions) -
             ranges[channel] = [float(min(v.min() for v in values)), float(max(v.max() for v in values))]
     record = training_record([file_identity(path) for path in dict.fromkeys(files)], preparation_of(args, runs),
                              [{"name": str(name), **figures(table)} for name, table in zip(names, tables)],
-                             {**figures(total), "unit": runs[0].effort_unit}, ranges)
+                             {**figures(total), "unit": EFFORT_UNITS[quantity], "quantity": quantity}, ranges)
     return {TRAINING_RECORD: record}
 
 
@@ -112,12 +114,14 @@ def record_lines(records: dict) -> list[str]:
     cutoff = "default" if prep["cutoff_hz"] is None else f"{prep['cutoff_hz']:g} Hz"
     resample = "no --resample" if prep["resample_s"] is None else f"--resample {prep['resample_s']:g}"
     re = "" if total["re_percent"] is None else f", RE {total['re_percent']:.3f} %"
+    quantity = total.get("quantity")
     lines = ["training:",
              "  files          = " + ", ".join(f"{entry['name']} ({entry['bytes']} bytes, sha256 "
                                                f"{entry['sha256'][:12]}...)" for entry in record["files"]),
              f"  preparation    = step {prep['sample_time_s'] * 1e3:g} ms, cut-off {cutoff}, {resample}, "
              f"max gap {prep['max_gap_steps']:g} steps, time tolerance {prep['time_tolerance']:g}, derived "
              f"{', '.join(prep['derived']) or 'nothing'}",
+             *([f"  effort         = {quantity} [{total['unit']}]"] if quantity else []),
              f"  training error = RMSE {total['rmse']:.4g} {total['unit']}{re} over {total['samples']} samples "
              f"({len(record['runs'])} run(s))"]
     for name, (low, high) in record["ranges"].items():

@@ -6,11 +6,13 @@ import argparse
 from pathlib import Path
 
 from ..atomic import check_output_path, write_text_atomic
+from ..data.effort import EFFORT_UNITS, check_one_effort
 from ..errors import GreyboxError
 from ..evaluate.records import evaluate_models, write_evaluation_pdf, write_evaluation_report
 from ..evaluate.regimes import REGIME_NAMES
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json
 from ..persistence import load_model
+from ..provenance import model_quantity
 from ._options import add_log_arguments, read_named_runs
 from ._provenance import warn_preparation
 
@@ -96,7 +98,14 @@ def run(args: argparse.Namespace) -> int:
     if len(units) > 1:
         listed = ", ".join(f"{name} in {run.effort_unit}" for name, run in zip(run_names, runs))
         raise GreyboxError(f"--test: the logs carry effort in different units ({listed}); evaluate them apart")
-    unit = runs[0].effort_unit
+    quantity = check_one_effort(runs, "--test: the logs", "evaluate them apart")  # a current and a motor torque
+    for name, (model, records) in loaded.items():
+        if model_quantity(records, model) != quantity:
+            trained = model_quantity(records, model)
+            raise GreyboxError(f"{name} was trained on a {trained} [{EFFORT_UNITS[trained]}], the --test logs carry "
+                               f"a {quantity} [{EFFORT_UNITS[quantity]}]; evaluate it on logs of its quantity "
+                               "(greybox predict --axis-config converts a current and a motor torque)")
+    unit = EFFORT_UNITS[quantity]
     records, predictions = evaluate_models(models, runs, run_names)
     print(f"evaluated {len(models)} model(s) on {len(runs)} log(s), {sum(len(r) for r in runs)} samples, "
           f"effort in {unit}")

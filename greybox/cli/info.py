@@ -9,9 +9,11 @@ from pathlib import Path, PurePath
 
 import numpy as np
 
+from ..data.effort import EFFORT_UNITS, effort_quantity, effort_text
 from ..data.log import AxisLog
 from ..json_values import jsonable
 from ..persistence import load_model
+from ..provenance import model_quantity
 from ..registry import model_kind
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs
@@ -50,7 +52,8 @@ def summarise(log: AxisLog) -> dict:
         Samples, sample time [ms], duration [s], kind of axis (``motion``),
         position range [mm] and peak speed [mm/min] (keys ``position_min_mm``,
         ``speed_max_mm_min``; ``..._deg``, ``..._deg_min`` for a rotary axis),
-        effort RMS and range (in the log's unit) and, for synthetic logs, the
+        what the effort is (``effort_quantity``: a current, or a motor torque [Nm] of a servo
+        trace), its RMS and range (in the log's unit) and, for synthetic logs, the
         RMS of the known noise (the noise floor).
     """
     length = log.units.length
@@ -65,7 +68,8 @@ def summarise(log: AxisLog) -> dict:
         f"position_min_{length}": float(log.position.min()),
         f"position_max_{length}": float(log.position.max()),
         f"speed_max_{length}_min": float(60.0 * np.abs(log.velocity).max()) if log.velocity is not None else None,
-        "effort_unit": log.effort_unit,
+        "effort_quantity": effort_quantity(log),
+        "effort_unit": EFFORT_UNITS[effort_quantity(log)],
         "effort_rms": float(np.sqrt(np.mean(log.effort**2))),
         "effort_min": float(log.effort.min()),
         "effort_max": float(log.effort.max()),
@@ -146,10 +150,11 @@ def describe_model(path, model) -> dict:
             "selection": jsonable(getattr(model, "selection_", None))}
 
 
-def _print_model(name: str, summary: dict, model) -> None:
-    print(f"model {name}: {summary['kind']}, {summary['motion']} axis, effort in {summary['effort_unit']}, "
-          f"step {summary['sample_time_ms']:g} ms")
-    print("\n".join(model_lines(model)))
+def _print_model(name: str, summary: dict, model, records: dict) -> None:
+    quantity = model_quantity(records, model)
+    print(f"model {name}: {summary['kind']}, {summary['motion']} axis, effort in "
+          f"{effort_text(quantity)}, step {summary['sample_time_ms']:g} ms")
+    print("\n".join(model_lines(model, quantity=quantity)))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -158,11 +163,13 @@ def run(args: argparse.Namespace) -> int:
     models = [(path, *load_model(path, records=True)) for path in args.logs if kinds[path]]  # all checked first
     logs = [path for path in args.logs if not kinds[path]]
     for path, model, records in models:
-        summary = {**describe_model(path, model), **({"records": records} if records else {})}
+        quantity = model_quantity(records, model)
+        summary = {**describe_model(path, model), "effort": {"quantity": quantity, "unit": EFFORT_UNITS[quantity]},
+                   **({"records": records} if records else {})}
         if args.json:
             print(json.dumps(summary))
         else:
-            _print_model(shown[path], summary, model)
+            _print_model(shown[path], summary, model, records)
             for line in record_lines(records) or region_lines(model):
                 print(line)
     if logs:

@@ -117,18 +117,23 @@ def _progress():
 
 
 def _print_figures(figures) -> None:
-    """The console lines of one axis's figures (:class:`greybox.predict.AxisFigures`)."""
-    tally, unit, units = figures.tally, figures.effort_unit, figures.units
-    noun = "current" if unit == "A" else units.load
+    """The console lines of one axis's figures (:class:`greybox.predict.AxisFigures`); the load's figures leave
+    out the samples at standstill (:attr:`greybox.predict.process.ProcessResult.standstill`)."""
+    from ..data.effort import EFFORT_UNITS
+
+    tally, quantity, units = figures.tally, figures.quantity, figures.units
+    noun, unit = quantity, EFFORT_UNITS[quantity]
     print(f"  {noun:<8} rms measured {tally.rms('measured'):.4g} {unit}, model {tally.rms('model'):.4g} "
           f"{unit}, process {tally.rms('process'):.4g} {unit}, largest |process| {tally.largest['process']:.4g} {unit}")
-    if unit == "A" and figures.load_constants is not None:
+    if quantity in ("current", "motor torque") and figures.load_constants is not None:
         driving, backdriven = figures.load_constants
-        per_ampere = f"{units.load_unit}/A"
+        per_ampere = f"{units.load_unit}/{unit}"
         factors = (f"{driving:.6g} {per_ampere}" if driving == backdriven
                    else f"{driving:.6g} {per_ampere} driving, {backdriven:.6g} {per_ampere} back-driven")
-        print(f"  {units.load:<8} rms process {tally.rms('load'):.4g} {units.load_unit}, "
-              f"largest |process| {tally.largest['load']:.4g} {units.load_unit} "
+        standing = tally.n_samples - tally.n_moving
+        where = f" of the {tally.n_moving} samples in motion (standstill left out)" if standing else ""
+        print(f"  {units.load:<8} rms process {tally.rms('load_moving'):.4g} {units.load_unit}, "
+              f"largest |process| {tally.largest['load_moving']:.4g} {units.load_unit}{where} "
               f"({factors} from {figures.axis_file})")
     _report_extrapolation(figures.extrapolation, figures.log_name)
     interval = figures.interval
@@ -161,8 +166,8 @@ def _report_extrapolation(summary: dict, log_name: str) -> None:
     standstill = summary["by"].get("standstill", 0.0)
     if standstill > 0.0:
         print(f"note: {log_name}: {100 * standstill:.1f} % of the samples are at standstill, where a memoryless "
-              "model cannot know the friction the drive holds (flagged in the column outside_training, not "
-              "process force); gms, lugre and gmssvr carry it from the last motion", file=sys.stderr)
+              "model cannot know the friction the drive holds (flagged in the column standstill and left out of "
+              "the process force figures); gms, lugre and gmssvr carry it from the last motion", file=sys.stderr)
     beyond = max([share for name, share in summary["by"].items() if name != "standstill"] or [0.0])
     if summary["share"] > summary["warn_above"] and beyond > 0.0:
         print(f"note: {log_name}: {100 * summary['share']:.1f} % of the samples lie outside the positions, speeds "

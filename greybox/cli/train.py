@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import check_output_path
+from ..data.effort import EFFORT_UNITS, check_one_effort, effort_quantity, effort_text
 from ..errors import GreyboxError, ModelFileError
 from ..identify.intervals import METHODS as INTERVAL_METHODS
 from ..identify.intervals import attach_intervals
@@ -114,6 +115,7 @@ def _read_all(args: argparse.Namespace, axis=None) -> tuple[list, list, list]:
     """The names and runs of --train, and the runs of --stage2 (of one axis of a machine)."""
     names, runs = _read(args, args.train, axis)
     second_names, second = _read(args, args.stage2, axis) if args.stage2 else ([], [])
+    check_one_effort(runs + second)  # before any fit: a model of a current and a torque at once is neither
     return names + second_names, runs, second
 
 
@@ -171,9 +173,10 @@ def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
 
 def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
     """Print the training error per run and the parameters; return the predictions."""
-    unit = runs[0].effort_unit
+    quantity = effort_quantity(runs[0])
+    unit = EFFORT_UNITS[quantity]
     print(f"trained {label} on {len(runs)} run(s), {sum(len(r) for r in runs)} samples, "
-          f"effort in {unit}, in {elapsed:.1f} s")
+          f"effort in {effort_text(quantity)}, in {elapsed:.1f} s")
     print(f"  {'run':<32} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7}")
     predictions = [model.predict(run) for run in runs]
     for path, run, prediction in zip(names, runs, predictions):
@@ -183,7 +186,7 @@ def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
         table = metrics_table(np.concatenate([r.effort for r in runs]), np.concatenate(predictions))
         print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
     print("  (RE = RMSE / mean |effort|)")
-    print("\n".join(model_lines(model)))
+    print("\n".join(model_lines(model, quantity=quantity)))
     if takes_hyperparameter(model, "fit_offset"):
         offset_note([run.effort for run in runs], predictions, unit)
     return predictions
@@ -283,6 +286,7 @@ def _run_auto(args: argparse.Namespace) -> int:
         pieces, _ = read_named_runs(args, [path], [path])
         runs += pieces
         groups += [str(path)] * len(pieces)
+    check_one_effort(runs)
     started = time.perf_counter()
     report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
     model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.model_inertia,

@@ -39,6 +39,7 @@ import json
 import math
 import os
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from typing import Mapping
 
@@ -78,6 +79,13 @@ _SCREW = "screw_lead_mm"
 
 #: Values of an efficiency that read as a percentage of a real drive train (write x / 100 instead) [%].
 PERCENT_EFFICIENCY = (30.0, 100.0)
+
+#: Smallest efficiency taken without a note [-]: a ball screw drives at 0.85-0.95 (back-driven a little
+#: less), a planetary or belt stage at 0.9-0.98, so a drive train of a feed axis passes well over half the
+#: motor's power; only sliding lead screws and worm gears go down to 0.3. Below it the value is most likely
+#: a slip (0.009 for 0.9, a percentage divided twice) and the process force would come out that many times
+#: too large or small.
+MIN_PLAUSIBLE_EFFICIENCY = 0.3
 
 #: Keys with a default: a motor coupled directly (gear ratio 1).
 DEFAULTS = {"gear_ratio": 1.0}
@@ -250,6 +258,21 @@ def _check_values(values: Mapping[str, object], where: str, names: Mapping[str, 
                      f"was it written in metres? {lead:g} m is {lead * 1000:g} mm")
 
 
+def _note_low_efficiencies(values: Mapping[str, float], where: str, names: Mapping[str, str]) -> None:
+    """Warn once per key as written of an efficiency below :data:`MIN_PLAUSIBLE_EFFICIENCY` (taken as given)."""
+    noted = set()
+    for key in _EFFICIENCIES:
+        efficiency, written = values[key], names.get(key, key)
+        if efficiency >= MIN_PLAUSIBLE_EFFICIENCY or written in noted:
+            continue
+        noted.add(written)
+        slip = (f"; {efficiency:g} reads like {efficiency * 100:g} divided by 100 once too often"
+                if MIN_PLAUSIBLE_EFFICIENCY <= efficiency * 100 <= 1.0 else "")
+        warnings.warn(f"{where}: {written} = {efficiency:g} is implausibly low for a feed axis (a ball screw passes "
+                      f"0.85-0.95 of the motor's power, below {MIN_PLAUSIBLE_EFFICIENCY:g} only sliding screws and "
+                      f"worm gears){slip}; the process force scales with it", stacklevel=3)
+
+
 def check_channels(table, where: str) -> dict[str, str]:
     """A ``[channels]`` table checked: ``{canonical_name: name_in_log}``, each quantity mapped once.
 
@@ -353,7 +376,9 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
         hint = (f" (for a rotary axis write motion = \"rotary\" instead of a {_SCREW})"
                 if _SCREW in missing and motion == "linear" else "")
         _fail(where, f"missing {lines}{hint}")
-    _check_values(values, where, {key: SHARED_EFFICIENCY for key in _EFFICIENCIES} if shared is not None else None)
+    written = {key: SHARED_EFFICIENCY for key in _EFFICIENCIES} if shared is not None else {}
+    _check_values(values, where, written or None)
+    _note_low_efficiencies(values, where, written)
     channels = check_channels(document.get("channels", {}), where)
     constants = {_SCREW: None, **{key: float(values[key]) for key in required}}
     return AxisConfig(**constants, name=str(document.get("name", "")), motion=motion, channels=channels,

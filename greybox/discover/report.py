@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text_atomic
-from ..evaluate.plots import import_pyplot, save_figure
+from ..evaluate.plots import import_pyplot, legend_outside, save_figure
 from ..json_values import jsonable
 from .workflow import DiscoveryResult
 
@@ -156,11 +156,11 @@ def plot_evidence(result: DiscoveryResult, path) -> Path:
         ax.set_xlabel("explained fraction of the residual")
         ax.set_title(f"step {index + 1}: " + (f"adds {step.winner}" if step.winner else "nothing passes"),
                      fontsize=10)
-        marks, _ = ax.get_legend_handles_labels()
-        ax.legend(handles=[Patch(color="C2", label="added in this step"), Patch(color="C1", label="passes, not added"),
-                           Patch(color="C0", label="does not pass"), *marks],
-                  fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)  # below the bars
         ax.grid(True, axis="x", alpha=0.3)
+    marks, _ = axes[0, 0].get_legend_handles_labels()  # the same colours and marks in every step: one legend
+    figure.legend(handles=[Patch(color="C2", label="added in this step"), Patch(color="C1", label="passes, not added"),
+                           Patch(color="C0", label="does not pass"), *marks],
+                  fontsize=8, loc="outside lower center", ncol=4)  # below every axis label, in the layout
     ax = axes[0, -1]
     shown = next((i for i, step in enumerate(result.steps)
                   if step.winner and step.candidates[step.winner].shape_name == "period_mm"), 0)
@@ -173,7 +173,7 @@ def plot_evidence(result: DiscoveryResult, path) -> Path:
     ax.set_ylabel("explained fraction of the residual")
     ax.set_title(f"step {shown + 1}: period scans (dashed: pass level)", fontsize=10)
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)  # below the curves
+        legend_outside(ax, fontsize=7)  # right of the curves, clear of the axis labels
     ax.grid(True, alpha=0.3)
     return save_figure(figure, path)
 

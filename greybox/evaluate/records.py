@@ -16,6 +16,7 @@ model can do.
 from __future__ import annotations
 
 import os
+import textwrap
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -147,11 +148,23 @@ def _report_parts(records, predictions, runs, run_names, out_dir: Path | None):
     return figures, tables, "greybox: model evaluation", intro
 
 
+#: Text lines per page of the PDF report, and their spacing [share of the page height] (7 pt on A4 landscape).
+_PAGE_LINES = 62
+_LINE_HEIGHT = 0.0138
+#: Characters per line of the PDF report's text (7 pt monospace across A4 landscape).
+_TEXT_WIDTH = 170
+
+
+def _wrapped(text: str) -> list[tuple[str, bool]]:
+    """A paragraph as lines of at most :data:`_TEXT_WIDTH` characters, none of them bold."""
+    return [(line, False) for line in textwrap.wrap(text, _TEXT_WIDTH)] or [("", False)]
+
+
 def write_evaluation_pdf(path: str | os.PathLike, records: Sequence[Mapping], predictions: Mapping, runs,
                          run_names: Sequence[str]) -> Path:
     """The report of ``greybox evaluate`` as one PDF file a person can send: tables, then the figures.
 
-    Page 1 holds the title, the tables (as in ``tables.md``) and where the figures were measured
+    Page 1 holds the title, the tables as plain text (the rows of ``tables.md``) and where the figures were measured
     (:func:`greybox.provenance.provenance_line`); each figure follows on a page of its own, its caption
     above it. Written with matplotlib's PDF backend, atomically.
 
@@ -175,15 +188,27 @@ def write_evaluation_pdf(path: str | os.PathLike, records: Sequence[Mapping], pr
     path = Path(path)
     plt = import_pyplot(path)
     figures, tables, title, intro = _report_parts(records, predictions, runs, run_names, None)
-    text = "\n\n".join([intro, *(table.to_markdown() for table in tables), provenance_line()])
+    lines = _wrapped(intro) + [("", False)]
+    for table in tables:
+        text = table.to_text()
+        lines += [(text[0], True), *((row, False) for row in text[1:len(table.rows) + 3])]
+        lines += [wrapped for note in text[len(table.rows) + 3:] for wrapped in _wrapped(note)] + [("", False)]
+    lines += _wrapped(provenance_line())
     pages = []
     try:
-        first = plt.figure(figsize=(11.69, 8.27))  # A4 landscape [in]
-        first.text(0.04, 0.95, title, fontsize=14, weight="bold", va="top")
-        first.text(0.04, 0.90, text, family="monospace", fontsize=6.5, va="top", wrap=True)
-        pages.append(first)
+        for start in range(0, len(lines), _PAGE_LINES):
+            page = plt.figure(figsize=(11.69, 8.27))  # A4 landscape [in]
+            page.text(0.04, 0.95, title if start == 0 else f"{title} (continued)", fontsize=14, weight="bold",
+                      va="top")
+            for k, (text, bold) in enumerate(lines[start:start + _PAGE_LINES]):
+                page.text(0.04, 0.89 - k * _LINE_HEIGHT, text, family="monospace", fontsize=7, va="top",
+                          weight="bold" if bold else "normal")
+            pages.append(page)
         for caption, figure in figures:
-            figure.suptitle(caption, fontsize=9)
+            width_chars = int(figure.get_figwidth() * 72 / (0.55 * 9))  # 9 pt text, about 0.55 em a character
+            figure.suptitle(textwrap.fill(caption, width_chars), fontsize=9)
+            if not figure.get_layout_engine():
+                figure.set_layout_engine("constrained")  # room for the caption above the axes
             pages.append(figure)
         with atomic_output(path) as temporary:
             with PdfPages(temporary, metadata={"Title": title, "Creator": "greybox evaluate"}) as document:

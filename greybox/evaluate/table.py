@@ -39,3 +39,19 @@ class Table:
             lines.append("")
             lines += [f"{note}  " if i < len(self.notes) - 1 else note for i, note in enumerate(self.notes)]
         return "\n".join(lines) + "\n"
+
+    def to_text(self) -> list[str]:
+        """The table as plain text lines, for a page without Markdown: the title, the header and rows in
+        columns padded to their widest cell (numbers right-aligned), a rule under the header, then the notes."""
+        widths = [max([len(name), *(len(row[k]) for row in self.rows)]) for k, name in enumerate(self.header)]
+
+        def numeric(cell: str) -> bool:
+            return cell.replace(".", "", 1).replace("-", "", 1).replace("e", "", 1).replace("+", "").isdigit()
+
+        def line(cells) -> str:
+            return "  ".join(cell.rjust(width) if numeric(cell) else cell.ljust(width)
+                             for cell, width in zip(cells, widths)).rstrip()
+
+        return [self.title, line(self.header), "  ".join("-" * width for width in widths),
+                *(line(row) for row in self.rows), *self.notes]
+

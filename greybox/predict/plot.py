@@ -48,12 +48,12 @@ def moving_mean(values, window: int) -> np.ndarray:
     return (sums[stop] - sums[start]) / (stop - start)
 
 
-def _mark_outside(ax, time, outside, max_points: int, label: str) -> None:
+def _mark_outside(ax, time, outside, max_points: int, label: str, color: str = "tab:orange") -> None:
     """Shade the time spans (thinned to bins, :func:`envelope_indices`) where the log leaves the training region."""
     starts = envelope_indices(outside.size, max_points)
     flags = np.logical_or.reduceat(outside, starts) if starts.size < outside.size else outside
     ax.fill_between(time[starts], 0, 1, where=flags, step="post", transform=ax.get_xaxis_transform(),
-                    color="tab:orange", alpha=0.15, lw=0, label=label)
+                    color=color, alpha=0.15, lw=0, label=label)
     legend_outside(ax)
 
 
@@ -102,16 +102,16 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
             raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
         shown = slice(first, stop)
     plt = import_pyplot(path)
-    unit = result.effort_unit
+    unit = result.shown_unit
     units = result.units
-    noun = "current" if unit == "A" else units.load
+    noun = result.quantity
     load_label = f"process {units.load} [{units.load_unit}]"
 
     def line(ax, values, **style):
         ax.plot(*envelope(result.time[shown], values[shown], max_points), **style)
 
     factors = result.load_constants
-    force_panel = unit == "A" and factors is not None and factors[0] != factors[1]
+    force_panel = result.effort_unit == "A" and factors is not None and factors[0] != factors[1]
     figure, axes = plt.subplots(4 if force_panel else 3, 1, sharex=True, figsize=(11, 10 if force_panel else 8),
                                 layout="constrained", height_ratios=(1, 2, 2, 2) if force_panel else (1, 2, 2))
     ax_v, ax_i, ax_p = axes[:3]
@@ -139,7 +139,7 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     process_panel(ax_p, result.process, result.process_bounds, f"process {noun} = measured - model",
                   "tab:red", "darkred")
     ax_p.set_ylabel(f"process {noun} [{unit}]")
-    if unit == "A" and factors and not force_panel:
+    if result.effort_unit == "A" and factors and not force_panel:
         factor = factors[0]
         right = ax_p.secondary_yaxis("right", functions=(lambda i: i * factor, lambda f: f / factor))
         right.set_ylabel(load_label)
@@ -148,11 +148,15 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
                       f"process {units.load} (driving: eta_d K_0 I, back-driven: K_0 I / eta_b)", "tab:green",
                       "darkgreen")
         axes[3].set_ylabel(load_label)
-    if result.outside is not None and np.any(result.outside[shown]):
-        share = 100.0 * float(np.mean(result.outside))
-        for ax in axes[2:]:
-            _mark_outside(ax, result.time[shown], result.outside[shown], max_points,
-                          f"outside the training region ({share:.1f} % of the log)")
+    standing = np.zeros(result.time.size, bool) if result.standstill is None else result.standstill
+    beyond = None if result.outside is None else result.outside & ~standing
+    for flags, label, color in ((beyond, "outside the training region", "tab:orange"),
+                                (standing, "standstill: friction held unknown to the model, no process figure",
+                                 "tab:purple")):
+        if flags is not None and np.any(flags[shown]):
+            for ax in axes[2:]:
+                _mark_outside(ax, result.time[shown], flags[shown], max_points,
+                              f"{label} ({100.0 * float(np.mean(flags)):.1f} % of the log)", color)
     axes[-1].set_xlabel("time [s]")
     for ax in axes:
         ax.grid(True, alpha=0.3)
@@ -213,8 +217,8 @@ def plot_machine_process(result, path: str | os.PathLike | None = None, *,
         if axis_result.load is not None:
             column, what, unit = f"{axis}_{units.load}_process_{units.load_unit}", units.load, units.load_unit
         else:
-            column, what, unit = f"{axis}_current_process_{axis_result.effort_unit}", "current", \
-                axis_result.effort_unit
+            what, unit = axis_result.quantity, axis_result.shown_unit
+            column = f"{axis}_{what.replace(' ', '_')}_process_{unit}"
         panels.append((columns[column], f"axis {axis}: process {what} [{unit}]"))
     resultant = result.resultant()
     if resultant is not None:

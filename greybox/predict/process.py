@@ -61,6 +61,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..data.axis_config import AxisConfig
+from ..data.effort import EFFORT_UNITS, column_stem, effort_quantity
 from ..data.log import AxisLog, as_log_list
 from ..data.quantities import MOTIONS, Motion
 from ..data.units import MOTOR_TORQUE
@@ -118,6 +119,12 @@ class ProcessResult:
         True where the log leaves the region the model's training runs covered
         (:meth:`~greybox.estimator.CurrentModel.outside_training`); None for a model file that
         predates the record of that region.
+    effort_quantity : str, default ""
+        What the effort is (:func:`~greybox.data.effort.effort_quantity`): ``"motor torque"`` for a servo
+        trace's torque [Nm] read as a current; "" for the quantity ``effort_unit`` names.
+    standstill : ndarray of bool or None
+        True where a memoryless model sees the axis at standstill (part of ``outside``): the friction the
+        drive holds there is unknown to it, so ``process`` and ``load`` there are no process figures.
     """
 
     time: np.ndarray
@@ -136,6 +143,18 @@ class ProcessResult:
     half_width: np.ndarray | None = None
     load_bounds: tuple | None = None
     outside: np.ndarray | None = None
+    effort_quantity: str = ""
+    standstill: np.ndarray | None = None
+
+    @property
+    def quantity(self) -> str:
+        """What the effort is: ``"current"``, ``"motor torque"``, ``"force"`` or ``"torque"``."""
+        return self.effort_quantity or ("current" if self.effort_unit == "A" else self.units.load)
+
+    @property
+    def shown_unit(self) -> str:
+        """Unit of the effort as shown and written: A, Nm (a motor torque or a rotary load) or N."""
+        return EFFORT_UNITS[self.quantity]
 
     @property
     def process(self) -> np.ndarray:
@@ -167,16 +186,16 @@ class ProcessResult:
         that predates the record). For a force log the effort columns are
         ``force_measured_N``, ``force_model_N``, ``force_process_N`` (and its
         bounds). A rotary axis writes ``torque_..._Nm``, ``position_deg`` and
-        ``velocity_deg_s`` instead.
+        ``velocity_deg_s`` instead; a linear axis's motor torque ``motor_torque_..._Nm``. A memoryless
+        model adds ``standstill`` (1 where the axis stands, else 0).
         """
         units = self.units
-        quantity = "current" if self.effort_unit == "A" else units.load
-        unit = self.effort_unit
+        quantity, unit = column_stem(self.quantity), self.shown_unit
         out = {"time_s": self.time, f"{quantity}_measured_{unit}": self.measured,
                f"{quantity}_model_{unit}": self.model, f"{quantity}_process_{unit}": self.process}
         if self.half_width is not None:
             out[f"{quantity}_process_lower_{unit}"], out[f"{quantity}_process_upper_{unit}"] = self.process_bounds
-        if self.load is not None and unit == "A":
+        if self.load is not None and self.effort_unit == "A":
             load, load_unit = units.load, units.load_unit
             out[f"{load}_process_{load_unit}"] = self.load
             if self.load_bounds is not None:
@@ -185,6 +204,8 @@ class ProcessResult:
         out[units.velocity_column] = self.velocity
         if self.outside is not None:
             out["outside_training"] = self.outside.astype(np.float64)
+        if self.standstill is not None:
+            out["standstill"] = self.standstill.astype(np.float64)
         return out
 
     def to_frame(self):
@@ -235,9 +256,12 @@ class ProcessTally:
     n_samples : int
         Samples added.
     sum_squares : dict of str to float
-        Sums of squares of ``measured``, ``model``, ``process`` and ``load`` (A^2, N^2 or Nm^2).
+        Sums of squares of ``measured``, ``model``, ``process`` and ``load`` (A^2, N^2 or Nm^2), and of
+        ``load_moving``: the load outside standstill (:attr:`ProcessResult.standstill`).
     largest : dict of str to float
-        Largest ``|process|`` and ``|load|``.
+        Largest ``|process|``, ``|load|`` and ``|load|`` outside standstill (``load_moving``).
+    n_moving : int
+        Samples outside standstill (all samples of a model that carries the friction at rest).
     half_width_sum : float
         Sum of the interval half-widths (0 without an interval).
     outside_counts : dict of str to int
@@ -250,8 +274,10 @@ class ProcessTally:
     """
 
     n_samples: int = 0
-    sum_squares: dict = field(default_factory=lambda: dict.fromkeys(("measured", "model", "process", "load"), 0.0))
-    largest: dict = field(default_factory=lambda: dict.fromkeys(("process", "load"), 0.0))
+    sum_squares: dict = field(default_factory=lambda: dict.fromkeys(("measured", "model", "process", "load",
+                                                                     "load_moving"), 0.0))
+    largest: dict = field(default_factory=lambda: dict.fromkeys(("process", "load", "load_moving"), 0.0))
+    n_moving: int = 0
     half_width_sum: float = 0.0
     outside_counts: dict = field(default_factory=dict)
     n_outside: int = 0
@@ -277,6 +303,11 @@ class ProcessTally:
                 self.sum_squares[name] += float(np.einsum("i,i->", array, array))  # no BLAS: its threads spin
                 if name in self.largest:
                     self.largest[name] = max(self.largest[name], float(np.max(np.abs(array))))
+        moving = result.load if result.standstill is None or result.load is None else result.load[~result.standstill]
+        self.n_moving += len(result.time) if result.standstill is None else int(np.count_nonzero(~result.standstill))
+        if moving is not None and len(moving):
+            self.sum_squares["load_moving"] += float(np.einsum("i,i->", moving, moving))
+            self.largest["load_moving"] = max(self.largest["load_moving"], float(np.max(np.abs(moving))))
         if result.half_width is not None:
             self.half_width_sum += float(np.sum(result.half_width))
         if regions:
@@ -290,10 +321,12 @@ class ProcessTally:
 
         Parameters
         ----------
-        name : {"measured", "model", "process", "load"}
-            Which signal [A] (or [N], [Nm]).
+        name : {"measured", "model", "process", "load", "load_moving"}
+            Which signal [A] (or [N], [Nm]); ``load_moving`` over the samples outside standstill (NaN
+            when every sample stands).
         """
-        return float(np.sqrt(self.sum_squares[name] / self.n_samples))
+        count = self.n_moving if name == "load_moving" else self.n_samples
+        return float(np.sqrt(self.sum_squares[name] / count)) if count else float("nan")
 
     def extrapolation(self) -> dict:
         """:func:`extrapolation_summary` of the samples added."""
@@ -331,7 +364,8 @@ def check_process_inputs(runs: Sequence[AxisLog], axis_config: AxisConfig | None
 
 
 def process_attrs(model, *, axis_config: AxisConfig | None, interval: ProcessInterval | None, chunk_s: float,
-                  motion: str, effort_unit: str, tally: ProcessTally, runs: list | None = None) -> dict:
+                  motion: str, effort_unit: str, tally: ProcessTally, runs: list | None = None,
+                  effort: str = "") -> dict:
     """The JSON-able description of a process result (``ProcessResult.attrs``).
 
     Parameters
@@ -350,13 +384,20 @@ def process_attrs(model, *, axis_config: AxisConfig | None, interval: ProcessInt
         The figures of the whole result (for the extrapolation summary).
     runs : list of dict, optional
         ``{"start_s", "samples"}`` of each run of a log split at gaps.
+    effort : str, default ""
+        What the effort is (:func:`~greybox.data.effort.effort_quantity`); "" for the quantity
+        ``effort_unit`` names. A motor torque's load constants are per Nm (``k_t = 1``).
     """
-    attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s)}
+    quantity = effort or ("current" if effort_unit == "A" else MOTIONS[motion].load)
+    attrs: dict = {"model_kind": model_kind(model), "chunk_s": float(chunk_s),
+                   "effort": {"quantity": quantity, "unit": EFFORT_UNITS[quantity]}}
     if runs is not None and len(runs) > 1:
         attrs["runs"] = runs
     if effort_unit == "A" and axis_config is not None:
         units = MOTIONS[motion]
-        per_ampere = f"{units.load_unit}_per_A"
+        per_ampere = f"{units.load_unit}_per_{EFFORT_UNITS[quantity]}"
+        if quantity == "motor torque":  # the effort is k_t I already
+            axis_config = axis_config.without_torque_constant()
         factors = axis_config.load_constants
         constants = {key: value for key, value in axis_config.to_dict().items() if key not in ("name", "channels")}
         attrs["axis_config"] = {"source": axis_config.source, **constants,
@@ -443,7 +484,8 @@ def _block_result(block: AxisLog, predicted: np.ndarray, regions: dict, axis_con
                          load_constants=factors,
                          axis=block.axis or (axis_config.name if axis_config is not None else ""),
                          source=block.source, dataset=block.dataset or "", half_width=half_width,
-                         load_bounds=load_bounds, outside=outside)
+                         load_bounds=load_bounds, outside=outside, effort_quantity=effort_quantity(block),
+                         standstill=regions.get("standstill") if regions else None)
 
 
 def join_results(parts: Sequence[ProcessResult], attrs: dict) -> ProcessResult:
@@ -467,7 +509,8 @@ def join_results(parts: Sequence[ProcessResult], attrs: dict) -> ProcessResult:
         bounds = tuple(np.concatenate([part.load_bounds[k] for part in parts]) for k in (0, 1))
     return replace(first, time=joined("time"), position=joined("position"), velocity=joined("velocity"),
                    measured=joined("measured"), model=joined("model"), load=joined("load"),
-                   half_width=joined("half_width"), outside=joined("outside"), load_bounds=bounds, attrs=attrs)
+                   half_width=joined("half_width"), outside=joined("outside"), standstill=joined("standstill"),
+                   load_bounds=bounds, attrs=attrs)
 
 
 def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: AxisConfig | None = None,
@@ -522,5 +565,6 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
                                             progress=None if progress is None else step)]
     attrs = process_attrs(model, axis_config=axis_config, interval=interval, chunk_s=chunk_s,
                           motion=runs[0].motion, effort_unit=runs[0].effort_unit, tally=tally,
-                          runs=[{"start_s": float(run.time[0]), "samples": len(run)} for run in runs])
+                          runs=[{"start_s": float(run.time[0]), "samples": len(run)} for run in runs],
+                          effort=effort_quantity(runs[0]))
     return join_results(parts, attrs)

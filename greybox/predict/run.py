@@ -32,7 +32,8 @@ import numpy as np
 from ..errors import GreyboxError
 from ..fleet import check_out_dir, fleet_summary, read_prepared
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
-from ..provenance import preparation_warning
+from ..provenance import model_quantity, preparation_warning
+from .effort import align_effort
 from .interval import DEFAULT_COVERAGE, ProcessInterval, calibrate_interval
 from .output import check_output_path, output_paths, write_process
 from .process import ProcessTally
@@ -95,6 +96,9 @@ class AxisFigures:
         Name of the log.
     calibration_logs : int
         Calibration logs the interval was calibrated on.
+    quantity : str
+        What the effort is (:func:`~greybox.data.effort.effort_quantity`): "current", "motor torque",
+        "force" or "torque".
     """
 
     tally: ProcessTally
@@ -106,6 +110,7 @@ class AxisFigures:
     axis_file: str | None = None
     log_name: str = ""
     calibration_logs: int = 0
+    quantity: str = "current"
 
     @property
     def units(self):
@@ -290,8 +295,9 @@ class ModelFile:
 
         def interval() -> ProcessInterval | None:  # computed once, whether the log streams or not
             if not calibrated:
-                calibrated.append(request.interval(
-                    model, lambda path: read_prepared(path, read, columns=columns, notify=request.notify)))
+                calibrated.append(request.interval(model, lambda path: align_effort(
+                    records, model, read_prepared(path, read, columns=columns, notify=request.notify), config,
+                    Path(path).name, names[1], request.notify)))
             return calibrated[0]
 
         figures = {"axis_file": Path(request.axis_config).name if request.axis_config else None,
@@ -302,12 +308,15 @@ class ModelFile:
             streamed = open_stream(log, columns=columns,
                                    topic=read.get("topic"), axis=read.get("axis"), sample_time=read.get("sample_time"),
                                    resample=read.get("resample"))
+        if streamed is not None and _first_quantity(streamed) != model_quantity(records, model):
+            streamed = None  # read whole, to convert its effort (align_effort)
         if streamed is not None:
             request.warn(preparation_warning(records, read, None, *names))
             done = self._stream(model, streamed, config, request, inputs, attrs, interval, figures)
             if done is not None:
                 return done
-        runs = read_prepared(log, read, columns=columns, notify=request.notify)
+        runs = align_effort(records, model, read_prepared(log, read, columns=columns, notify=request.notify), config,
+                            *names, request.notify)
         if streamed is None:
             request.warn(preparation_warning(records, read, runs, *names))
         return self._whole(model, runs, log, config, request, inputs, attrs, interval, figures)
@@ -352,13 +361,16 @@ class ModelFile:
             return None
         elapsed = time.perf_counter() - started
         table_attrs, dataset, unit = done.metadata["attrs"], done.metadata["dataset"], done.metadata["effort_unit"]
+        quantity = table_attrs["effort"]["quantity"]
+        if config is not None and quantity == "motor torque":  # the effort is k_t I already
+            config = config.without_torque_constant()
         summary = (f"predicted {Path(attrs['log_file']).name} with the {table_attrs['model_kind']} model "
                    f"{Path(self.path).name}: {done.tally.n_samples} samples, {done.duration:.1f} s, {done.n_chunks} "
                    f"chunk(s) of {request.chunk_s:g} s" + (f", dataset {dataset}" if dataset else "")
                    + ", read and written block by block")
         load_constants = config.load_constants if config is not None and unit == "A" else None
         axis = AxisFigures(done.tally, unit, done.motion, load_constants, table_attrs["extrapolation"],
-                           interval=calibrated, **figures)
+                           interval=calibrated, quantity=quantity, **figures)
         return Prediction(summary=[summary], axes=[(None, axis)],
                           written=[str(target) for target in output_paths(request.out)], elapsed_s=elapsed)
 
@@ -368,7 +380,14 @@ def _figures_of(result, interval: ProcessInterval | None, figures: dict) -> Axis
     tally = ProcessTally()
     tally.add(result)
     return AxisFigures(tally, result.effort_unit, result.motion, result.load_constants,
-                       result.attrs["extrapolation"], interval=interval, **figures)
+                       result.attrs["extrapolation"], interval=interval, quantity=result.quantity, **figures)
+
+
+def _first_quantity(log) -> str:
+    """What the effort of a log opened block by block is (:func:`~greybox.data.effort.effort_quantity`)."""
+    from ..data.effort import effort_quantity
+
+    return effort_quantity(next(iter(log.blocks(1))))
 
 
 class ModelsDirectory(ModelFile):
@@ -438,6 +457,9 @@ class MachineDirectory:
         runs = {name: read_axis(log, name) for name in machine.axes}
         for name in machine.axes:  # each axis's model file, its training record against the log's preparation
             records = load_model(Path(self.path) / f"{name}.gbm", records=True)[1]
+            runs[name] = align_effort(records, machine.models[name], runs[name],
+                                      described[name].config if name in described else None,
+                                      f"{Path(log).name} (axis {name})", f"{name}.gbm", request.notify)
             request.warn(preparation_warning(records, read, runs[name], f"{Path(log).name} (axis {name})",
                                              f"{name}.gbm"))
         window = _window(request, runs[machine.axes[0]], log)

@@ -19,6 +19,7 @@ from typing import Callable
 from threadpoolctl import threadpool_limits
 
 from ..data.axis_config import AxisConfig
+from ..data.effort import effort_quantity
 from ..data.stream import median_step, prepared_blocks
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from .interval import ProcessInterval
@@ -126,7 +127,8 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
 
     def metadata() -> dict:
         table_attrs = process_attrs(model, axis_config=axis_config, interval=interval, chunk_s=chunk_s,
-                                    motion=first.motion, effort_unit=first.effort_unit, tally=tally)
+                                    motion=first.motion, effort_unit=first.effort_unit, tally=tally,
+                                    effort=effort_quantity(first))
         table_attrs.update(attrs or {})
         described.update({"axis": first.axis or (axis_config.name if axis_config is not None else ""),
                           "dataset": first.dataset or "", "effort_unit": first.effort_unit, "attrs": table_attrs})

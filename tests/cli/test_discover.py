@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
+import time
 
 import numpy as np
 import pytest
 
 from greybox import registry
+from greybox.cli import build_parser
 from greybox.cli import discover as discover_cli
 from greybox.data.io import write_log
 from greybox.discover.augment import AugmentedModel
@@ -144,3 +147,20 @@ def test_base_misfit_is_reported_and_its_curve_saved(tmp_path, capsys):
     document = json.loads(out.read_text())
     assert [entry["name"] for entry in document["effects"]] == ["stribeck"]
     assert document["base_misfit"] is None and document["settings"]["refine_base"] is False
+
+
+@pytest.mark.slow  # a discovery run takes about half a minute
+def test_the_printed_wall_time_counts_from_the_start_of_the_process(tmp_path, capsys):
+    train, test, _ = case_logs(StudyCase("position_periodic_friction", 1.5, 3, "coulomb", 15.0))
+    paths = []
+    for name, log in (("train.csv", train), ("test.csv", test)):
+        write_log(log.replace(acceleration=None, extras={}, attrs={}), tmp_path / name)
+        paths.append(str(tmp_path / name))
+    args = build_parser().parse_args(["discover", "--model", "coulomb", "--train", paths[0], "--test", paths[1],
+                                      "--json", str(tmp_path / "found.json"), "--quiet", "--max-effects", "1"])
+    args.started_s = time.perf_counter() - 100.0  # as main sets it: the process started 100 s ago
+    args.startup_counted = True
+    assert args.run(args) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    match = re.fullmatch(r"done in (\d+\.\d) s wall, start-up included", last)
+    assert match and float(match.group(1)) >= 100.0

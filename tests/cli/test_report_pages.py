@@ -117,8 +117,8 @@ def test_the_evidence_figure_explains_its_bar_colours(tmp_path, monkeypatch):
     shown = []
 
     def keep(figure, *args, **kwargs):
-        shown.append([text.get_text() for ax in figure.axes if ax.get_legend()
-                      for text in ax.get_legend().get_texts()])
+        legends = [*figure.legends, *(ax.get_legend() for ax in figure.axes if ax.get_legend())]
+        shown.append([text.get_text() for legend in legends for text in legend.get_texts()])
         return original(figure, *args, **kwargs)
 
     monkeypatch.setattr(plt.Figure, "savefig", keep)

@@ -67,7 +67,8 @@ def test_predict_writes_the_flag_and_notes_it_once(tmp_path, capsys, suffix):
     assert cli.main(["predict", str(tmp_path / "s.gbm"), str(cut), "--out", str(out), "--quiet"]) == 0
     err = capsys.readouterr().err
     notes = [line for line in err.splitlines() if "standstill" in line]
-    assert len(notes) == 1 and "not process force" in notes[0]
+    assert len(notes) == 1 and "left out of the process force" in notes[0]
     table = pd.read_csv(out)
     resting = np.abs(table["velocity_mm_s"].to_numpy()) < STANDSTILL_SHARE * np.abs(table["velocity_mm_s"]).max()
     np.testing.assert_array_equal(table["outside_training"].to_numpy() == 1, resting)
+    np.testing.assert_array_equal(table["standstill"].to_numpy() == 1, resting)
