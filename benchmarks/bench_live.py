@@ -17,7 +17,11 @@ All figures come from one run and are printed with the core count and the load o
 
 4. with ``--record-minutes M``: a synthetic cutting log of M minutes streamed through a session that
    records it (rolling Parquet files of 60 s), against ``greybox predict`` on the same log: the largest
-   difference of the model current, and the resident memory after 10 % and at the end of the stream.
+   difference of the model current, and the resident memory after 10 % and at the end of the stream
+   (its growth over the last 90 % of the stream: flat memory is a growth near 0).
+
+The broker runs with ``set_tcp_nodelay true`` and the benchmark's publisher sets ``TCP_NODELAY``, as
+``greybox live`` does on its own connections.
 
 Without ``--model`` a GMS+SVR model is fitted on data/X_A.mcap and data/X_B.mcap with fixed
 hyperparameters (as benchmarks/bench_gmssvr_predict.py does).
@@ -154,6 +158,7 @@ def recording(model_path, minutes: float, batch: int, folder: Path) -> dict:
     session.close()
     elapsed = time.perf_counter() - started
     memory["resident_mb_at_end"] = _resident_mb()
+    memory["resident_growth_mb_10_to_100_percent"] = memory["resident_mb_at_end"] - memory["resident_mb_at_10_percent"]
     expected = pd.read_parquet(table, columns=["current_model_A"])["current_model_A"].to_numpy()
     largest, offset = 0.0, 0
     for path in recorder.written:
@@ -178,7 +183,9 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) ->
         return {"skipped": "the mosquitto broker is not installed (Debian package 'mosquitto')"}
     port = _free_port()
     config = folder / "mosquitto.conf"
-    config.write_text(f"listener {port} 127.0.0.1\nallow_anonymous true\n")
+    # set_tcp_nodelay: the broker sends each message at once (Nagle's algorithm would hold a small message
+    # back until the previous one is acknowledged); greybox's own clients set TCP_NODELAY themselves
+    config.write_text(f"listener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\n")
     broker = subprocess.Popen([binary, "-c", str(config)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     live = None
     try:
@@ -201,6 +208,7 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) ->
             arrived[json.loads(message.payload)["seq"]] = time.perf_counter()
 
         client.on_message = on_message
+        client.on_socket_open = lambda c, u, sock: sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         client.connect("127.0.0.1", port)
         client.loop_start()
         ready.wait(10)

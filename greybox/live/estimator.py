@@ -95,25 +95,33 @@ class StepOutput:
 
 
 class _Run:
-    """One run: its look-ahead, and the process blocks fed one block at a time."""
+    """One run: its look-ahead, and the process blocks fed one block at a time.
+
+    The model and the stream are checked at the run's first block (:meth:`CurrentModel.stream_view`);
+    the blocks' samples were checked as they arrived, so each chunk is not checked again.
+    """
 
     def __init__(self, model, *, index: int, sample_time: float, axis_config, cutoff_hz, chunk_s, tally):
         self.index = index
         self.lookahead = Lookahead(sample_time=sample_time, cutoff_hz=cutoff_hz)
+        self.model = model
+        self.sample_time = sample_time
         self.axis_config = axis_config
+        self.chunk_s = chunk_s
+        self.tally = tally
         self._box: deque = deque()
-        self._results: Iterator[ProcessResult] = process_blocks(
-            model, self._mailbox(), sample_time=sample_time, axis_config=axis_config, chunk_s=chunk_s, tally=tally)
-        self._checked = False
+        self._results: Iterator[ProcessResult] | None = None
 
     def _mailbox(self) -> Iterator[AxisLog]:
         while True:
             yield self._box.popleft()
 
     def estimate(self, block: AxisLog) -> ProcessResult:
-        if not self._checked:
+        if self._results is None:
             check_process_inputs([block], self.axis_config)
-            self._checked = True
+            view = self.model.stream_view(block, sample_time=self.sample_time)
+            self._results = process_blocks(view, self._mailbox(), sample_time=self.sample_time,
+                                           axis_config=self.axis_config, chunk_s=self.chunk_s, tally=self.tally)
         self._box.append(block)
         return next(self._results)
 
