@@ -5,7 +5,8 @@ All figures come from one run and are printed with the core count and the load o
 1. compute: a GMS+SVR model's live session (decode the JSON message, estimate, encode the output)
    over ``--seconds`` of a shipped log in messages of ``--batch`` samples, on one core (affinity set,
    one BLAS and numba thread); the time of each message divided by its samples, percentiles over the
-   messages after the look-ahead has filled;
+   messages after the look-ahead has filled: wall-clock time (what a sample waits, including the time
+   the core spends on other processes) and the thread's CPU time (the work itself);
 2. CPU share of ``--axes`` axes at 500 Hz: as many sessions in one process, each fed the log; the
    process CPU time divided by the stream's duration (the share of one core they need to keep up);
 3. end to end: a Mosquitto broker on a free loopback port, ``greybox live`` reading and writing it, the
@@ -95,15 +96,21 @@ def compute(model_path, messages, batch: int, lookahead: int, step_s: float) -> 
     from greybox.live.sources import Received
 
     session = _session(model_path, step_s)
-    times = []
+    times, cpu = [], []
     for k, message in enumerate(messages):
         item = Received(message, f"message {k}", 0.0)
-        started = time.perf_counter()
+        started, started_cpu = time.perf_counter(), time.thread_time()
         session.handle(item)
         times.append(time.perf_counter() - started)
-    per_sample = np.array(times[lookahead // batch + 2:]) / batch * 1e6
+        cpu.append(time.thread_time() - started_cpu)
+    skip = lookahead // batch + 2
+    per_sample = np.array(times[skip:]) / batch * 1e6
+    cpu_per_sample = np.array(cpu[skip:]) / batch * 1e6
     return {"messages": len(per_sample), "batch": batch, "p50_us_per_sample": float(np.percentile(per_sample, 50)),
-            "p99_us_per_sample": float(np.percentile(per_sample, 99)), "max_us_per_sample": float(per_sample.max())}
+            "p99_us_per_sample": float(np.percentile(per_sample, 99)), "max_us_per_sample": float(per_sample.max()),
+            "cpu_p50_us_per_sample": float(np.percentile(cpu_per_sample, 50)),
+            "cpu_p99_us_per_sample": float(np.percentile(cpu_per_sample, 99)),
+            "cpu_max_us_per_sample": float(cpu_per_sample.max())}
 
 
 def cpu_share(model_path, messages, axes: int, duration_s: float, step_s: float) -> dict:
