@@ -5,7 +5,8 @@ All figures come from one run and are printed with the core count and the load o
 1. compute: a GMS+SVR model's live session (decode the JSON message, estimate, encode the output)
    over ``--seconds`` of a shipped log in messages of ``--batch`` samples, on one core (affinity set,
    one BLAS and numba thread); the time of each message divided by its samples, percentiles over the
-   messages after the look-ahead has filled;
+   messages after the look-ahead has filled: wall-clock time (what a sample waits, including the time
+   the core spends on other processes) and the thread's CPU time (the work itself);
 2. CPU share of ``--axes`` axes at 500 Hz: as many sessions in one process, each fed the log; the
    process CPU time divided by the stream's duration (the share of one core they need to keep up);
 3. end to end: a Mosquitto broker on a free loopback port, ``greybox live`` reading and writing it, the
@@ -17,7 +18,11 @@ All figures come from one run and are printed with the core count and the load o
 
 4. with ``--record-minutes M``: a synthetic cutting log of M minutes streamed through a session that
    records it (rolling Parquet files of 60 s), against ``greybox predict`` on the same log: the largest
-   difference of the model current, and the resident memory after 10 % and at the end of the stream.
+   difference of the model current, and the resident memory after 10 % and at the end of the stream
+   (its growth over the last 90 % of the stream: flat memory is a growth near 0).
+
+The broker runs with ``set_tcp_nodelay true`` and the benchmark's publisher sets ``TCP_NODELAY``, as
+``greybox live`` does on its own connections.
 
 Without ``--model`` a GMS+SVR model is fitted on data/X_A.mcap and data/X_B.mcap with fixed
 hyperparameters (as benchmarks/bench_gmssvr_predict.py does).
@@ -91,15 +96,21 @@ def compute(model_path, messages, batch: int, lookahead: int, step_s: float) -> 
     from greybox.live.sources import Received
 
     session = _session(model_path, step_s)
-    times = []
+    times, cpu = [], []
     for k, message in enumerate(messages):
         item = Received(message, f"message {k}", 0.0)
-        started = time.perf_counter()
+        started, started_cpu = time.perf_counter(), time.thread_time()
         session.handle(item)
         times.append(time.perf_counter() - started)
-    per_sample = np.array(times[lookahead // batch + 2:]) / batch * 1e6
+        cpu.append(time.thread_time() - started_cpu)
+    skip = lookahead // batch + 2
+    per_sample = np.array(times[skip:]) / batch * 1e6
+    cpu_per_sample = np.array(cpu[skip:]) / batch * 1e6
     return {"messages": len(per_sample), "batch": batch, "p50_us_per_sample": float(np.percentile(per_sample, 50)),
-            "p99_us_per_sample": float(np.percentile(per_sample, 99)), "max_us_per_sample": float(per_sample.max())}
+            "p99_us_per_sample": float(np.percentile(per_sample, 99)), "max_us_per_sample": float(per_sample.max()),
+            "cpu_p50_us_per_sample": float(np.percentile(cpu_per_sample, 50)),
+            "cpu_p99_us_per_sample": float(np.percentile(cpu_per_sample, 99)),
+            "cpu_max_us_per_sample": float(cpu_per_sample.max())}
 
 
 def cpu_share(model_path, messages, axes: int, duration_s: float, step_s: float) -> dict:
@@ -154,6 +165,7 @@ def recording(model_path, minutes: float, batch: int, folder: Path) -> dict:
     session.close()
     elapsed = time.perf_counter() - started
     memory["resident_mb_at_end"] = _resident_mb()
+    memory["resident_growth_mb_10_to_100_percent"] = memory["resident_mb_at_end"] - memory["resident_mb_at_10_percent"]
     expected = pd.read_parquet(table, columns=["current_model_A"])["current_model_A"].to_numpy()
     largest, offset = 0.0, 0
     for path in recorder.written:
@@ -178,7 +190,9 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) ->
         return {"skipped": "the mosquitto broker is not installed (Debian package 'mosquitto')"}
     port = _free_port()
     config = folder / "mosquitto.conf"
-    config.write_text(f"listener {port} 127.0.0.1\nallow_anonymous true\n")
+    # set_tcp_nodelay: the broker sends each message at once (Nagle's algorithm would hold a small message
+    # back until the previous one is acknowledged); greybox's own clients set TCP_NODELAY themselves
+    config.write_text(f"listener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\n")
     broker = subprocess.Popen([binary, "-c", str(config)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     live = None
     try:
@@ -201,6 +215,7 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) ->
             arrived[json.loads(message.payload)["seq"]] = time.perf_counter()
 
         client.on_message = on_message
+        client.on_socket_open = lambda c, u, sock: sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         client.connect("127.0.0.1", port)
         client.loop_start()
         ready.wait(10)

@@ -29,7 +29,7 @@ from .identify.progress import make_progress
 from .identify.selection import check_selection_record
 from .metrics import rmse
 
-__all__ = ["CurrentModel", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
+__all__ = ["CurrentModel", "StreamView", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
 
 #: Largest magnitude of an identified parameter a model file may carry: currents of a feed axis are
 #: amperes, stiffnesses thousands of A/mm; 1e12 in any unit is a corrupt or hostile file.
@@ -276,9 +276,53 @@ class CurrentModel(ModelProtocol):
         region : object
             The region check's state after the chunk.
         """
-        current, state = self.predict_chunk(log, state, sample_time=sample_time)
-        flags, region = self.outside_training_chunk(log, region, sample_time=sample_time)
-        return current, state, flags, region
+        run, start, step = self._chunk_arguments(log, state, sample_time)
+        return self._stream_step(step)(run, start, region)
+
+    def stream_view(self, first: AxisLog, *, sample_time: float) -> "StreamView":
+        """The model for the chunks of one stream: the checks of the model and of the stream done once here.
+
+        :meth:`predict_flag_chunk` checks the model, its chunk and its step on every call; a live stream
+        gives chunks of a few samples many times a second, whose columns were checked as they arrived.
+        The view's :meth:`~StreamView.predict_flag_chunk` gives what this model's gives, without them.
+
+        Parameters
+        ----------
+        first : AxisLog
+            The stream's first prepared chunk: the effort unit and kind of axis of all that follow.
+        sample_time : float
+            Step [s] of the stream's run.
+
+        Returns
+        -------
+        StreamView
+
+        Raises
+        ------
+        LogError
+            For a chunk the model does not take (see :func:`check_runs`), or a step that is not positive.
+        ParameterError
+            For learned parameters that do not give a stable simulation at ``sample_time``.
+        """
+        self._check_predict_runs(first)
+        if not (np.isfinite(sample_time) and sample_time > 0.0):
+            raise LogError(first.source or None, f"the step must be a positive number of seconds, got {sample_time!r}")
+        return StreamView(self, self._stream_step(float(sample_time)))
+
+    def _stream_step(self, sample_time: float):
+        """``step(run, state, region) -> (current, state, flags, region)`` of checked chunks at ``sample_time``.
+
+        The model and the step are checked here, once; ``step`` does not check its chunk. Models that
+        check their parameters per simulation override it to check them once.
+        """
+        check_is_fitted(self)
+
+        def step(run, state, region):
+            current, end = self._effort(run, state, sample_time)
+            flags, region = self._region_flags(run, region, sample_time)
+            return current, end, flags, region
+
+        return step
 
     def friction_chunk(self, log: AxisLog, state=None, *, sample_time: float | None = None):
         """Friction of one chunk of a run from a given state (no inertia, no offset) [A, or N].
@@ -507,6 +551,10 @@ class CurrentModel(ModelProtocol):
             The state after the chunk: the ``state`` of the next chunk.
         """
         check_is_fitted(self)
+        return self._region_flags(log, state, sample_time)
+
+    def _region_flags(self, log: AxisLog, state, sample_time: float):
+        """:meth:`outside_training_chunk` of a fitted model (not checked again)."""
         out = {}
         for name, channel in _REGION_CHANNELS.items():
             bounds = getattr(self, name, None)
@@ -570,3 +618,44 @@ def _probe_run(sample_time: float, effort_unit: str, motion: str) -> AxisLog:
     acceleration = np.gradient(velocity, sample_time)
     return AxisLog(time=time, position=position, effort=np.zeros(n), velocity=velocity,
                    acceleration=acceleration, effort_unit=effort_unit, motion=motion)
+
+
+class StreamView:
+    """A fitted model for the chunks of one stream, checked once (:meth:`CurrentModel.stream_view`).
+
+    It answers :meth:`initial_state`, :meth:`region_state` and :meth:`predict_flag_chunk` as the model does,
+    so that :func:`greybox.predict.process.process_blocks` runs it as the model itself.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        The model.
+    step : callable
+        Its ``step(run, state, region)`` at the stream's step (:meth:`CurrentModel._stream_step`).
+    """
+
+    def __init__(self, model: CurrentModel, step):
+        self.model = model
+        self._step = step
+
+    def initial_state(self):
+        """The model's state at the start of a run."""
+        return self.model.initial_state()
+
+    def region_state(self):
+        """The state of the model's region check at the start of a run."""
+        return self.model.region_state()
+
+    def predict_flag_chunk(self, log: AxisLog, state, region, *, sample_time: float):
+        """:meth:`CurrentModel.predict_flag_chunk` of a chunk of the stream, not checked again.
+
+        Parameters
+        ----------
+        log : AxisLog
+            Prepared chunk of at least two samples with finite values (checked as they arrived).
+        state, region : object
+            As in :meth:`CurrentModel.predict_flag_chunk`.
+        sample_time : float
+            Step [s]; that of the view (the argument is there for the model's signature).
+        """
+        return self._step(log, state, region)

@@ -14,6 +14,7 @@ This module imports nothing of greybox but the errors.
 
 from __future__ import annotations
 
+import functools
 import re
 from typing import Mapping
 
@@ -88,6 +89,7 @@ def split_unit(header: str) -> tuple[str, str | None]:
     return match.group("words").strip(), unit.strip()
 
 
+@functools.lru_cache(maxsize=4096)  # a live stream asks for the same few headers in every message
 def canonical_header(header: str) -> str | None:
     """greybox's column name for an export's header, or None when its words or unit are not in the vocabulary.
 

@@ -23,6 +23,7 @@ ordinary extra.
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from typing import Mapping
@@ -92,6 +93,7 @@ _UNIT_WORDS = frozenset(
 )
 
 
+@functools.lru_cache(maxsize=4096)  # a live stream asks for the same few names in every message
 def parse_column_name(name: str) -> tuple[str, str | None] | None:
     """Split a column name into quantity and unit suffix.
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from sklearn.utils.validation import check_is_fitted
 
 from ..base import EFFORT, LENGTH, LinearPart, Parameter
 from ..errors import ParameterError, Setting
@@ -40,7 +41,7 @@ from .directions import direction_pair, viscous_columns
 from .kernels import direction_curves, gms_friction_kernel, gms_trajectory_kernel
 from .plant_laws import gms_plant_law
 
-__all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_trajectory"]
+__all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_trajectory", "gms_trajectory_runner"]
 
 #: Largest ``T C / min(s_0, s_inf)`` the identification allows: the slip step
 #: then relaxes monotonically (no overshoot), well inside the stability limit 2.
@@ -245,18 +246,48 @@ def gms_trajectory(velocity, sample_time, *, alpha, C, s_0, s_inf, v_s, k=None, 
     state : GMSState
         State after the last sample.
     """
+    runner = gms_trajectory_runner(sample_time, alpha=alpha, C=C, s_0=s_0, s_inf=s_inf, v_s=v_s, k=k, sigma=sigma,
+                                   mu=mu)
+    return runner(velocity, state)
+
+
+def gms_trajectory_runner(sample_time, *, alpha, C, s_0, s_inf, v_s, k=None, sigma=0.0, mu=0.0):
+    """:func:`gms_trajectory` with its parameters checked and converted once, for the chunks of a stream.
+
+    Parameters
+    ----------
+    sample_time : float
+        Step T [s].
+    alpha, C, s_0, s_inf, v_s, k, sigma, mu
+        As in :func:`gms_trajectory`.
+
+    Returns
+    -------
+    callable
+        ``runner(velocity, state)`` [mm/s, GMSState or None] returning what :func:`gms_trajectory` returns.
+
+    Raises
+    ------
+    ParameterError
+        As :func:`check_gms_parameters`.
+    """
     alpha = np.ascontiguousarray(alpha, dtype=float)
     k = np.zeros_like(alpha) if k is None else np.ascontiguousarray(k, dtype=float)
     check_gms_parameters(alpha, k, C, sigma, s_0, s_inf, v_s, mu, sample_time)
-    start = _as_state(state, alpha.size)
-    velocity = np.ascontiguousarray(velocity, dtype=float)
-    z = np.empty((velocity.size, alpha.size))
-    mode = np.empty((velocity.size, alpha.size), dtype=np.int8)
-    w, friction = np.empty(velocity.size), np.empty(velocity.size)
-    z_end, mode_end = gms_trajectory_kernel(velocity, float(sample_time), alpha, k, float(sigma),
-                                            _curves(s_0, s_inf, v_s), float(C), direction_pair(mu, "GMS mu"),
-                                            start.z, start.mode, z, mode, w, friction)
-    return z, mode == 0, w, friction, GMSState(z_end, mode_end)
+    step, sigma, C = float(sample_time), float(sigma), float(C)
+    curves, mu = _curves(s_0, s_inf, v_s), direction_pair(mu, "GMS mu")
+
+    def runner(velocity, state=None):
+        start = _as_state(state, alpha.size)
+        velocity = np.ascontiguousarray(velocity, dtype=float)
+        z = np.empty((velocity.size, alpha.size))
+        mode = np.empty((velocity.size, alpha.size), dtype=np.int8)
+        w, friction = np.empty(velocity.size), np.empty(velocity.size)
+        z_end, mode_end = gms_trajectory_kernel(velocity, step, alpha, k, sigma, curves, C, mu, start.z, start.mode,
+                                                z, mode, w, friction)
+        return z, mode == 0, w, friction, GMSState(z_end, mode_end)
+
+    return runner
 
 
 class _Regression:
@@ -653,8 +684,31 @@ class GMSModel(CurrentModel):
         """
         (run,) = self._check_predict_runs(log)
         step = run.sample_time if sample_time is None else float(sample_time)
-        z, stick, _, friction, end = gms_trajectory(run.velocity, step, state=state, **self._parameters())
-        return self.J_ * run.acceleration + friction + self.offset_, z, stick, end
+        return self.trajectory_runner(step)(run, state)
+
+    def trajectory_runner(self, sample_time: float):
+        """:meth:`trajectory` of the chunks of a stream, the parameters checked once here and not per chunk.
+
+        Parameters
+        ----------
+        sample_time : float
+            Integration step [s].
+
+        Returns
+        -------
+        callable
+            ``runner(run, state)``: for a prepared chunk (checked by the caller) and the state before it,
+            what :meth:`trajectory` returns.
+        """
+        check_is_fitted(self)
+        elements = gms_trajectory_runner(sample_time, **self._parameters())
+        J, offset = self.J_, self.offset_
+
+        def runner(run, state=None):
+            z, stick, _, friction, end = elements(run.velocity, state)
+            return J * run.acceleration + friction + offset, z, stick, end
+
+        return runner
 
     def states(self, logs):
         """Element deflections and stick flags over one or several runs (each from rest).

@@ -2,13 +2,16 @@
 
 An address is ``mqtt://HOST[:PORT]/TOPIC`` (port 1883 by default; the topic may hold ``/`` and, for a
 source, the wildcards ``+`` and ``#``). A connection reconnects by itself after the broker goes away
-(paho's network loop, retrying within a second) and reports each loss and return.
+(paho's network loop, retrying within a second) and reports each loss and return. Its socket sends each
+message at once (``TCP_NODELAY``); a broker does the same for its clients with ``set_tcp_nodelay true``
+in its configuration (Mosquitto).
 """
 
 from __future__ import annotations
 
 import itertools
 import os
+import socket
 import threading
 import time
 from dataclasses import dataclass
@@ -86,6 +89,15 @@ def parse_address(text: str, option: str) -> BrokerAddress:
     return BrokerAddress(parts.hostname, port, topic)
 
 
+def _no_delay(client, userdata, sock) -> None:
+    """Send each message at once: Nagle's algorithm holds a small write back until the previous one is
+    acknowledged, which with delayed acknowledgements costs up to 40 ms a message."""
+    try:
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    except (OSError, AttributeError):  # not a TCP socket (e.g. a websocket wrapper): leave it as it is
+        pass
+
+
 class Connection:
     """A paho-mqtt client connected to a broker, reconnecting by itself.
 
@@ -126,6 +138,7 @@ class Connection:
         self.client.on_connect = self._connected_cb
         self.client.on_disconnect = self._disconnected_cb
         self.client.on_subscribe = lambda *args: self._subscribed.set()
+        self.client.on_socket_open = _no_delay
         if on_message is not None:
             self.client.on_message = lambda client, userdata, message: on_message(
                 message.topic, message.payload, time.time())

@@ -95,25 +95,33 @@ class StepOutput:
 
 
 class _Run:
-    """One run: its look-ahead, and the process blocks fed one block at a time."""
+    """One run: its look-ahead, and the process blocks fed one block at a time.
+
+    The model and the stream are checked at the run's first block (:meth:`CurrentModel.stream_view`);
+    the blocks' samples were checked as they arrived, so each chunk is not checked again.
+    """
 
     def __init__(self, model, *, index: int, sample_time: float, axis_config, cutoff_hz, chunk_s, tally):
         self.index = index
         self.lookahead = Lookahead(sample_time=sample_time, cutoff_hz=cutoff_hz)
+        self.model = model
+        self.sample_time = sample_time
         self.axis_config = axis_config
+        self.chunk_s = chunk_s
+        self.tally = tally
         self._box: deque = deque()
-        self._results: Iterator[ProcessResult] = process_blocks(
-            model, self._mailbox(), sample_time=sample_time, axis_config=axis_config, chunk_s=chunk_s, tally=tally)
-        self._checked = False
+        self._results: Iterator[ProcessResult] | None = None
 
     def _mailbox(self) -> Iterator[AxisLog]:
         while True:
             yield self._box.popleft()
 
     def estimate(self, block: AxisLog) -> ProcessResult:
-        if not self._checked:
+        if self._results is None:
             check_process_inputs([block], self.axis_config)
-            self._checked = True
+            view = self.model.stream_view(block, sample_time=self.sample_time)
+            self._results = process_blocks(view, self._mailbox(), sample_time=self.sample_time,
+                                           axis_config=self.axis_config, chunk_s=self.chunk_s, tally=self.tally)
         self._box.append(block)
         return next(self._results)
 
@@ -137,23 +145,27 @@ class LiveEstimator:
         Derivative-filter cut-off [Hz] (default as ``greybox predict``).
     chunk_s : float, default 60.0
         Chunk length [s] of the model within a message (as ``greybox predict --chunk-s``).
+    keep_tally : bool, default False
+        Keep the running figures of every sample estimated (:attr:`tally`); their sums of squares cost
+        about a tenth of a message's time, and the session needs none of them.
 
     Attributes
     ----------
-    tally : ProcessTally
-        Running figures of every sample estimated.
+    tally : ProcessTally or None
+        Running figures of every sample estimated (with ``keep_tally``).
     runs : int
         Runs started (1 + gaps).
     """
 
     def __init__(self, model, *, axis_config: AxisConfig | None = None, sample_time: float | None = None,
-                 tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S):
+                 tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
+                 keep_tally: bool = False):
         self.model = model
         self.axis_config = axis_config
         self.cutoff_hz = cutoff_hz
         self.chunk_s = float(chunk_s)
         self.timeline = Timeline(sample_time=sample_time, tolerance=tolerance)
-        self.tally = ProcessTally()
+        self.tally = ProcessTally() if keep_tally else None
         self.runs = 0
         self._run: _Run | None = None
 

@@ -3,24 +3,30 @@
 Offline, a log lacking velocity or acceleration gets them from a zero-phase (forward-backward) low-pass
 and central differences (:func:`greybox.data.prepare.derive`): the value at a sample depends on the
 samples after it. The filter's memory decays geometrically; with
-:func:`~greybox.data.prepare.derivative_margin` samples on each side of a stretch, the stretch comes out as
-it does in the whole log (:func:`greybox.data.stream.prepared_blocks` rests on the same fact). A live
-stream therefore gives a sample's estimate once that many samples after it have arrived: a delay of
+:func:`~greybox.data.prepare.derivative_margin` samples after a sample, its value comes out as it does in
+the whole log (:func:`greybox.data.stream.prepared_blocks` rests on the same fact). A live stream
+therefore gives a sample's estimate once that many samples after it have arrived: a delay of
 ``margin * sample_time`` (184 samples, 0.368 s at 2 ms with the default 50 Hz cut-off), the price of
 the offline result. Messages that carry velocity and acceleration need no derivative and no delay.
 
-At the end of a run (a gap, or the end of the stream) the samples still waiting are derived as the
-end of a log is.
+The forward pass of the filter runs once over each sample as it arrives, its state carried from
+message to message; per message only the backward pass over the look-ahead runs
+(:class:`~greybox.live.zerophase.ZeroPhaseStream`). At the end of a run (a gap, or the end of the
+stream) the samples still waiting are derived as the end of a log is.
 """
 
 from __future__ import annotations
 
-from ..data.blocks import concatenate
+import numpy as np
+
 from ..data.log import AxisLog
-from ..data.prepare import derivative_margin, derive
+from ..data.prepare import derivative_filter, derivative_margin
 from ..errors import LogError
+from .zerophase import ZeroPhaseStream
 
 __all__ = ["Lookahead"]
+
+_CHANNELS = ("time", "position", "effort", "velocity", "acceleration")
 
 
 class Lookahead:
@@ -45,9 +51,12 @@ class Lookahead:
         self.cutoff_hz = cutoff_hz
         self.margin = 0
         self._needs: bool | None = None
-        self._before: AxisLog | None = None  # the last `margin` raw samples already given out
-        self._pending: list[AxisLog] = []
+        self._first: AxisLog | None = None  # the run's first samples: names, units, attrs
+        self._filter: ZeroPhaseStream | None = None
+        self._attrs: dict = {}
+        self._pending: dict[str, list] = {}
         self._n_pending = 0
+        self._given = 0  # samples of the run given out
 
     @property
     def waiting(self) -> int:
@@ -63,12 +72,16 @@ class Lookahead:
             Consecutive samples of the run, not prepared (or carrying velocity and acceleration).
         """
         if self._needs is None:
-            self._needs = not log.is_prepared
-            self.margin = derivative_margin(self.sample_time, cutoff_hz=self.cutoff_hz) if self._needs else 0
-        self._pending.append(log)
+            self._start(log)
+        for name in self._pending:
+            self._pending[name].append(getattr(log, name) if name in _CHANNELS else log.extras[name])
         self._n_pending += len(log)
+        if self._filter is not None:
+            self._filter.push(log.position if log.velocity is None else log.velocity)
+            if not self._filter.started:
+                return None
         ready = self._n_pending - self.margin
-        return self._give(ready) if ready >= 2 else None
+        return self._give(ready, final=False) if ready >= 2 else None
 
     def finish(self) -> AxisLog | None:
         """The samples still waiting, prepared as the end of a log; None when none are waiting.
@@ -80,22 +93,47 @@ class Lookahead:
         """
         if not self._n_pending:
             return None
-        return self._give(self._n_pending)
+        if self._filter is not None and not self._filter.started:
+            n = self._filter.received
+            self._pending = {name: [] for name in self._pending}
+            self._n_pending = 0
+            raise LogError(self._first.source or None, f"the log has {n} samples; the 4th-order filter needs at "
+                                                       f"least {self._filter.needed}")
+        return self._give(self._n_pending, final=True)
 
-    def _give(self, ready: int) -> AxisLog:
-        raw = concatenate(self._pending)
-        window = raw if self._before is None else concatenate([self._before, raw])
-        first = 0 if self._before is None else len(self._before)
-        if self._needs:
-            try:
-                window = derive(window, cutoff_hz=self.cutoff_hz, sample_time=self.sample_time)
-            except LogError:
-                self._pending, self._n_pending = [], 0
-                raise
-        out = window.select(slice(first, first + ready))
-        given = concatenate([self._before, raw.select(slice(0, ready))]) if self._before is not None else \
-            raw.select(slice(0, ready))
-        self._before = given.select(slice(max(0, len(given) - self.margin), None)) if self.margin else None
-        rest = raw.select(slice(ready, None))
-        self._pending, self._n_pending = ([rest], len(rest)) if len(rest) else ([], 0)
-        return out
+    def _start(self, log: AxisLog) -> None:
+        self._needs = not log.is_prepared
+        self._first = log
+        present = [name for name in _CHANNELS if getattr(log, name) is not None]
+        self._pending = {name: [] for name in [*present, *log.extras]}
+        self._attrs = dict(log.attrs)
+        if not self._needs:
+            return
+        self.margin = derivative_margin(self.sample_time, cutoff_hz=self.cutoff_hz)
+        sos, cutoff = derivative_filter(self.sample_time, cutoff_hz=self.cutoff_hz, source=log.source or None)
+        self._filter = ZeroPhaseStream(sos, sample_time=self.sample_time, differences=1 + (log.velocity is None))
+        derived = ["acceleration"] if log.velocity is not None else \
+            ["velocity"] + (["acceleration"] if log.acceleration is None else [])
+        self._attrs["derivative_filter"] = {"cutoff_hz": cutoff, "order": 4, "derived": derived}
+
+    def _give(self, ready: int, *, final: bool) -> AxisLog:
+        columns = {}
+        for name, parts in self._pending.items():
+            joined = parts[0] if len(parts) == 1 else np.concatenate(parts)
+            columns[name] = joined[:ready]
+            rest = joined[ready:]
+            self._pending[name] = [rest] if len(rest) else []
+        self._n_pending -= ready
+        if self._filter is not None:
+            derivatives = self._filter.derivatives(self._given, self._given + ready, final=final)
+            if self._first.velocity is None:
+                columns["velocity"] = derivatives[0]
+                if self._first.acceleration is None:
+                    columns["acceleration"] = derivatives[1]
+            else:
+                columns["acceleration"] = derivatives[0]
+        self._given += ready
+        first = self._first
+        extras = {name: columns.pop(name) for name in first.extras}
+        return AxisLog(**columns, effort_unit=first.effort_unit, axis=first.axis, dataset=first.dataset,
+                       source=first.source, motion=first.motion, extras=extras, attrs=self._attrs)

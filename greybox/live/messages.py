@@ -241,7 +241,7 @@ def message_log(columns: Mapping[str, np.ndarray], *, name: str, mapping: Mappin
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise MessageError(f"channel '{channel}' holds {values[bad[0]]} at sample {bad[0]} of the message")
-    return log.replace(extras={})
+    return log.replace(extras={}) if log.extras else log
 
 
 def _number(value: float):

@@ -143,8 +143,11 @@ class Timeline:
         last = self._last
 
         def close(stop: int) -> None:
-            if keep[start:stop].any():
-                events.append(log.select(np.flatnonzero(keep[start:stop]) + start))
+            kept = np.flatnonzero(keep[start:stop])
+            if kept.size == len(log):  # every sample of the message kept: the message itself
+                events.append(log)
+            elif kept.size:
+                events.append(log.select(kept + start))
 
         for k, t in enumerate(log.time.tolist()):
             if last is None:

@@ -294,12 +294,16 @@ class GMSSVRModel(KernelRegressionModel):
             raise ParameterError(f"gms must be a GMSModel or None, got {type(self.gms).__name__}")
 
     # ---------------------------------------------------------------- prediction
-    def _inputs(self, run: AxisLog, state, sample_time: float):
+    def _inputs(self, run: AxisLog, state, sample_time: float, trajectory=None):
         """SVR inputs of one run or chunk: position [mm], GMS current [A], deflections [mm]; and the end state.
 
-        One simulation of the GMS stage gives both its current and its element states.
+        One simulation of the GMS stage gives both its current and its element states (``trajectory``: the
+        stage's :meth:`~greybox.friction.GMSModel.trajectory_runner` of a stream, checked once).
         """
-        gms_current, z, _, end = self.gms_.trajectory(run, state, sample_time=sample_time)
+        if trajectory is None:
+            gms_current, z, _, end = self.gms_.trajectory(run, state, sample_time=sample_time)
+        else:
+            gms_current, z, _, end = trajectory(run, state)
         return np.column_stack((run.position, gms_current, z)), end
 
     def _inputs_chunk(self, run: AxisLog, state, sample_time: float):
@@ -317,38 +321,33 @@ class GMSSVRModel(KernelRegressionModel):
         inputs, end = self._inputs(run, state, sample_time)
         return self._friction_of(run, inputs), end
 
-    def _friction_of(self, run: AxisLog, inputs) -> np.ndarray:
+    def _friction_of(self, run: AxisLog, inputs, frame=None) -> np.ndarray:
         """Friction [A] of a chunk whose SVR inputs are ``inputs``: the prediction less inertia and offset.
 
         Outside the box of the training inputs the prediction is handed over to the GMS stage's
-        (:mod:`greybox.models.handover`).
+        (:mod:`greybox.models.handover`). ``frame``: the :meth:`kernel_frame` of a stream, built once.
         """
-        current = self._kernel_predict(inputs)
+        frame = self.kernel_frame() if frame is None else frame
+        scaled = frame.coordinates(inputs)
+        current = frame.expansion(inputs, scaled)
         if self.target == "residual":
             current = current + inputs[:, 1]
-        current = hand_over(inputs[:, 1], current, self._handover(inputs))
+        current = hand_over(inputs[:, 1], current, frame.weight(inputs, scaled))
         return current - self.J_ * run.acceleration - self.offset_
 
-    def predict_flag_chunk(self, log: AxisLog, state, region, *, sample_time: float):
-        """As :meth:`CurrentModel.predict_flag_chunk <greybox.estimator.CurrentModel.predict_flag_chunk>`, the
-        GMS stage simulated once for both: the region check carries the same GMS state as the prediction.
+    def _stream_step(self, sample_time: float):
+        """The prediction and region check of checked chunks, the GMS stage simulated once for both, its
+        parameters and the kernel's frame checked once."""
+        check_is_fitted(self, "gms_")
+        trajectory = self.gms_.trajectory_runner(sample_time)
+        frame = self.kernel_frame()
 
-        Parameters
-        ----------
-        log : AxisLog
-            Prepared chunk: consecutive samples of one run.
-        state : object
-            GMS state before the chunk (:meth:`initial_state` at the start of a run); used for both the
-            prediction and the region check.
-        region : object
-            State of the region check before the chunk; not used, since it equals ``state`` here.
-        sample_time : float
-            Step [s] of the whole run.
-        """
-        run, start, step = self._chunk_arguments(log, state, sample_time)
-        inputs, end = self._inputs(run, start, step)
-        current = self.J_ * run.acceleration + self._friction_of(run, inputs) + self.offset_
-        return current, end, self._flags(run, inputs, step), end
+        def step(run, state, region):
+            inputs, end = self._inputs(run, state, sample_time, trajectory)
+            current = self.J_ * run.acceleration + self._friction_of(run, inputs, frame) + self.offset_
+            return current, end, self._flags(run, inputs, sample_time), end
+
+        return step
 
     def _n_params(self) -> int:
         return int(self.dual_coef_.size) + 1 + self.gms_.n_params

@@ -49,7 +49,7 @@ from .handover import hand_over, handover_weight, handover_width
 from .rbf import rbf_expansion
 from .subset import coverage_subset
 
-__all__ = [
+__all__ = ["KernelFrame",
     "KernelRegressionModel",
     "SVRCurrentModel",
     "SVRExpansion",
@@ -487,52 +487,37 @@ class KernelRegressionModel(CurrentModel):
             parts.append(flags)
         return {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
 
-    def outside_training_chunk(self, log: AxisLog, state, *, sample_time: float):
-        """As in the base class, with ``"inputs"`` flagged where an SVR input lies outside its training range.
-
-        Parameters
-        ----------
-        log : AxisLog
-            Prepared chunk: consecutive samples of one run.
-        state : object
-            :meth:`region_state` at the start of the run, else what the previous chunk returned.
-        sample_time : float
-            Step [s] of the whole run.
-
-        Returns
-        -------
-        flags : dict of str to ndarray of bool
-            As :meth:`outside_training` for the chunk's samples.
-        state : object
-            The state after the chunk: the ``state`` of the next chunk.
-        """
+    def _region_flags(self, log: AxisLog, state, sample_time: float):
+        """The base class's flags, with ``"inputs"`` where an SVR input lies outside its training range."""
         if getattr(self, "input_range_", None) is None:  # a file that predates the record
-            return super().outside_training_chunk(log, state, sample_time=sample_time)
+            return super()._region_flags(log, state, sample_time)
         X, state = self._inputs_chunk(log, state, sample_time)
         return self._flags(log, X, sample_time), state
 
     def _flags(self, log: AxisLog, X, sample_time: float) -> dict[str, np.ndarray]:
         """The training-region flags of a chunk whose SVR inputs are ``X``."""
-        out, _ = super().outside_training_chunk(log, None, sample_time=sample_time)
+        out, _ = super()._region_flags(log, None, sample_time)
         if getattr(self, "input_range_", None) is not None:
             out["inputs"] = np.any((X < self.input_range_[0]) | (X > self.input_range_[1]), axis=1)
         return out
 
-    def _kernel_coordinates(self, X) -> np.ndarray:
-        """Raw inputs ``X``, shape (n, n_features), in the kernel's coordinates: standardised, times sqrt(weight)."""
-        scaled = (np.asarray(X, dtype=np.float64) - self.input_mean_) / self.input_scale_
-        weights = getattr(self, "input_weights_", None)  # None: a file that predates the weights (all 1)
-        if weights is not None:
-            if np.shape(weights) != np.shape(self.input_scale_) or not np.all(np.asarray(weights) > 0):
-                raise ParameterError(f"input_weights_ must hold one positive weight per input "
-                                     f"({np.size(self.input_scale_)}), got {weights!r}")
-            scaled = scaled * np.sqrt(weights)
-        return scaled
+    def kernel_frame(self) -> "KernelFrame":
+        """The kernel's coordinates and hand-over box, checked once (:class:`KernelFrame`).
+
+        Returns
+        -------
+        KernelFrame
+
+        Raises
+        ------
+        ParameterError
+            For kernel weights that are not one positive number per input.
+        """
+        return KernelFrame(self)
 
     def _kernel_predict(self, X) -> np.ndarray:
         """The fitted expansion at raw (unscaled) inputs ``X``, shape (n, n_features) [A]."""
-        return rbf_expansion(self._kernel_coordinates(X), self.support_vectors_, self.dual_coef_, self.intercept_,
-                             self.gamma_)
+        return self.kernel_frame().expansion(X)
 
     def _handover(self, X) -> np.ndarray | None:
         """Weight of the correction at raw inputs ``X`` (:func:`greybox.models.handover.handover_weight`).
@@ -540,11 +525,7 @@ class KernelRegressionModel(CurrentModel):
         None for a model without the hand-over (fitted with ``handover=False``, or read from a file that
         predates it): its correction applies everywhere, as it was fitted.
         """
-        width = getattr(self, "handover_width_", None)
-        if width is None:
-            return None
-        box = self._kernel_coordinates(self.input_range_)
-        return handover_weight(self._kernel_coordinates(X), box[0], box[1], width)
+        return self.kernel_frame().weight(X)
 
     def _kernel_parameters(self) -> list[Parameter]:
         """Rows of the SVR stage for the parameter table."""
@@ -765,3 +746,74 @@ class SVRCurrentModel(KernelRegressionModel):
 #: Every name a search interval can be given for (``bounds=``) in the kernel models: the SVR
 #: hyperparameters and the sole SVR's kernel weights.
 BOUNDED = HYPERPARAMETERS + tuple(SVRCurrentModel._weighted)
+
+
+class KernelFrame:
+    """The coordinates of a fitted kernel model's expansion and its hand-over box, checked once.
+
+    Raw SVR inputs are standardised and multiplied by the square root of their kernel weight; the
+    hand-over (:mod:`greybox.models.handover`) tapers the correction beyond the box of the training
+    inputs in those coordinates. A stream of chunks builds the frame once instead of per chunk.
+
+    Parameters
+    ----------
+    model : KernelRegressionModel
+        A fitted kernel model.
+
+    Raises
+    ------
+    ParameterError
+        For kernel weights that are not one positive number per input.
+    """
+
+    def __init__(self, model: KernelRegressionModel):
+        self.model = model
+        self.mean = model.input_mean_
+        self.scale = model.input_scale_
+        weights = getattr(model, "input_weights_", None)  # None: a file that predates the weights (all 1)
+        if weights is not None and (np.shape(weights) != np.shape(self.scale) or not np.all(np.asarray(weights) > 0)):
+            raise ParameterError(f"input_weights_ must hold one positive weight per input "
+                                 f"({np.size(self.scale)}), got {weights!r}")
+        self.root_weights = None if weights is None else np.sqrt(weights)
+        self.width = getattr(model, "handover_width_", None)
+        self.box = None if self.width is None else self.coordinates(model.input_range_)
+
+    def coordinates(self, X) -> np.ndarray:
+        """Raw inputs ``X``, shape (n, n_features), in the kernel's coordinates: standardised, times sqrt(weight).
+
+        Parameters
+        ----------
+        X : array_like, shape (n, n_features)
+            Raw SVR inputs (their units: mm, A, mm/s, ...).
+        """
+        scaled = (np.asarray(X, dtype=np.float64) - self.mean) / self.scale
+        return scaled if self.root_weights is None else scaled * self.root_weights
+
+    def expansion(self, X, scaled=None) -> np.ndarray:
+        """The fitted expansion at raw inputs ``X`` [A].
+
+        Parameters
+        ----------
+        X : array_like, shape (n, n_features)
+            Raw SVR inputs.
+        scaled : ndarray, optional
+            ``coordinates(X)`` when already at hand.
+        """
+        m = self.model
+        return rbf_expansion(self.coordinates(X) if scaled is None else scaled, m.support_vectors_, m.dual_coef_,
+                             m.intercept_, m.gamma_)
+
+    def weight(self, X, scaled=None) -> np.ndarray | None:
+        """Weight of the correction at raw inputs ``X``; None for a model without the hand-over.
+
+        Parameters
+        ----------
+        X : array_like, shape (n, n_features)
+            Raw SVR inputs.
+        scaled : ndarray, optional
+            ``coordinates(X)`` when already at hand.
+        """
+        if self.width is None:
+            return None
+        return handover_weight(self.coordinates(X) if scaled is None else scaled, self.box[0], self.box[1],
+                               self.width)
