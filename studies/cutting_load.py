@@ -51,16 +51,16 @@ from typing import Mapping
 
 import numpy as np
 
-from ..atomic import write_text_atomic
-from ..data.prepare import prepare
-from ..evaluate.interval import calibrate_interval
-from ..evaluate.process import predict_process
-from ..evaluate.report import MODEL_LABELS
-from ..metrics import rmse
-from ..twin.cutting import CuttingSpec
-from ..twin.family import draw_member, member_dataset
-from .experiments import EXPERIMENTS, MODEL_SETTINGS, Experiment, run_experiments
-from .members import run_members
+from greybox.atomic import write_text_atomic
+from greybox.data.prepare import prepare
+from greybox.evaluate.interval import calibrate_interval
+from greybox.evaluate.process import predict_process
+from greybox.evaluate.report import MODEL_LABELS
+from greybox.metrics import rmse
+from greybox.reproduce.experiments import EXPERIMENTS, MODEL_SETTINGS, Experiment, run_experiments
+from greybox.twin.cutting import CuttingSpec
+from greybox.twin.family import draw_member, member_dataset
+from studies.members import run_members
 
 __all__ = ["CUT", "TARGET_PCT", "COVERAGE", "COVERAGE_TARGET", "CALIBRATIONS", "PASSES", "run_member", "summarise",
            "cutting_load_markdown", "run_cutting_load_study"]

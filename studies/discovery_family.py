@@ -1,6 +1,6 @@
 """Validation of the discovery workflow on axes it was not developed on: the hysteresis family.
 
-The axes come from :mod:`greybox.studies.hysteresis_axis`, a simulator written
+The axes come from :mod:`studies.hysteresis_axis`, a simulator written
 apart from greybox's friction models and its synthetic twin: a Bouc-Wen
 hysteresis with Stribeck weakening, its own trajectories and noise, and its
 own implementation of every hidden effect. No library column is the hidden
@@ -35,16 +35,16 @@ from dataclasses import asdict
 import numpy as np
 from sklearn.base import clone
 
-from ..atomic import write_text_atomic
-from ..data.prepare import prepare
-from ..discover.augment import AugmentedModel
-from ..discover.effects import REFINEMENTS
-from ..discover.report import write_json
-from ..discover.workflow import discover
-from ..friction import GMSModel
-from ..metrics import rmse
-from .discovery import wilson_interval
-from .hysteresis_axis import HIDDEN_EFFECTS, FamilyCase, family_logs
+from greybox.atomic import write_text_atomic
+from greybox.data.prepare import prepare
+from greybox.discover.augment import AugmentedModel
+from greybox.discover.effects import REFINEMENTS
+from greybox.discover.report import write_json
+from greybox.discover.workflow import discover
+from greybox.friction import GMSModel
+from greybox.metrics import rmse
+from studies.discovery import wilson_interval
+from studies.hysteresis_axis import HIDDEN_EFFECTS, FamilyCase, family_logs
 
 __all__ = ["ACCEPTED_NULL_VERDICTS", "PERIOD_TOLERANCE", "run_family_case", "summarise_family", "family_markdown",
            "run_family_study"]

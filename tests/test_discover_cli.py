@@ -14,7 +14,7 @@ from greybox.data.io import write_log
 from greybox.discover.augment import AugmentedModel
 from greybox.errors import GreyboxError
 from greybox.persistence import load_model
-from greybox.studies.discovery import StudyCase, case_logs
+from studies.discovery import StudyCase, case_logs
 
 
 def run_cli(argv):

@@ -11,7 +11,7 @@ from pathlib import Path
 from ..errors import GreyboxError
 from ..evaluate.pattern import paper_pattern
 from ..evaluate.report import check_output_dir
-from ..studies.experiments import EXPERIMENTS, find_log, reproduce
+from ..reproduce.experiments import EXPERIMENTS, find_log, reproduce
 from ._types import POSITIVE_INT
 
 

@@ -22,10 +22,10 @@ import pytest
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel
 from greybox.model_choice import choose_model
-from greybox.studies import auto
-from greybox.studies import emps as bench
+from studies import auto
+from studies import emps as bench
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "emps_benchmark.py"
 
 SYMMETRIC = {"M_kg": 95.1089, "Fv_N_s_per_m": 203.5034, "Fc_N": 20.3935, "offset_N": -3.1648}
