@@ -14,7 +14,7 @@ others (four independent trajectories). It is scored against an *oracle*: the
 base model fitted to the training effort minus the true hidden current, and
 predicting the test effort with the true hidden current added. Gap closure =
 (test RMSE before - after) / (before - oracle). The base refinements of the
-workflow (:data:`greybox.discover.effects.REFINEMENTS`) fix part of the base's
+workflow (:data:`greybox.models.effects.REFINEMENTS`) fix part of the base's
 own misfit, which the oracle does not, so this closure can exceed 1 without the
 effect being found well; the *effect closure* compares like with like: before
 = the base with the refinements the workflow kept, oracle = the same fitted to
@@ -37,12 +37,12 @@ from sklearn.base import clone
 
 from greybox.atomic import write_text_atomic
 from greybox.data.prepare import prepare
-from greybox.discover.augment import AugmentedModel
-from greybox.discover.effects import REFINEMENTS
 from greybox.discover.report import write_json
 from greybox.discover.workflow import discover
 from greybox.friction import GMSModel
 from greybox.metrics import rmse
+from greybox.models.augmented import AugmentedModel
+from greybox.models.effects import REFINEMENTS
 from studies.discovery import wilson_interval
 from studies.hysteresis_axis import HIDDEN_EFFECTS, FamilyCase, family_logs
 

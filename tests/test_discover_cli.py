@@ -11,8 +11,8 @@ import pytest
 from greybox import registry
 from greybox.cli import discover as discover_cli
 from greybox.data.io import write_log
-from greybox.discover.augment import AugmentedModel
 from greybox.errors import GreyboxError
+from greybox.models.augmented import AugmentedModel
 from greybox.persistence import load_model
 from studies.discovery import StudyCase, case_logs
 

@@ -17,7 +17,12 @@ rules (DESIGN.md, "Layout"):
   the models it tests would flatter them;
 - the physical and current models (``greybox.friction``, ``greybox.models``)
   import nothing of the layers above them: ``evaluate``, ``discover``,
-  ``reproduce``, ``control``, ``cli``.
+  ``reproduce``, ``control``, ``cli``;
+- the model layer as a whole (:data:`MODEL_LAYER`: the model kinds in
+  ``friction`` and ``models``, their registry and file format, the
+  identification and data layers they stand on) imports nothing outside it:
+  no import runs back up the layers (the registry of model kinds imports no
+  workflow: the augmented kind of ``greybox discover`` lives in ``models``).
 
 An import names a module (``import greybox.twin.plant``, ``from ..twin import
 plant``) or a package's ``__init__`` (``from ..twin import make_dataset``).
@@ -42,6 +47,10 @@ PACKAGE_DIR = Path(__file__).resolve().parents[1] / "greybox"
 #: Packages that may import the synthetic twin (besides the twin itself).
 TWIN_USERS = ("greybox.control", "greybox.reproduce", "greybox.cli")
 #: Layers the models must not depend on.
+#: The model kinds and everything they stand on: importing nothing outside this set.
+MODEL_LAYER = ("greybox.base", "greybox.errors", "greybox.threads", "greybox.atomic", "greybox.json_values",
+               "greybox.provenance", "greybox.metrics", "greybox.data", "greybox.identify", "greybox.estimator",
+               "greybox.friction", "greybox.models", "greybox.registry", "greybox.persistence")
 ABOVE_MODELS = ("greybox.evaluate", "greybox.discover", "greybox.reproduce", "greybox.control", "greybox.cli")
 
 
@@ -252,6 +261,14 @@ def test_the_models_import_nothing_of_the_layers_above_them(graph):
                       lambda m: _within(m, "greybox.friction") or _within(m, "greybox.models"),
                       lambda t: any(_within(t, p) for p in ABOVE_MODELS))
     assert not found, "friction/ and models/ depend on a layer above them:\n" + "\n".join(found)
+
+
+def test_the_model_layer_imports_nothing_above_it(graph):
+    assert "greybox.registry" in graph and "greybox.models.augmented" in graph
+    found = forbidden(graph,
+                      lambda m: any(_within(m, p) for p in MODEL_LAYER),
+                      lambda t: t != "greybox" and not any(_within(t, p) for p in MODEL_LAYER))
+    assert not found, "an import runs back up the layers (the model layer imports a workflow):\n" + "\n".join(found)
 
 
 # ---------------------------------------------------------------- the checker itself

@@ -10,12 +10,12 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import check_output_path
-from ..discover.effects import EFFECT_NAMES, effect
 from ..discover.heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN
 from ..discover.report import REPORT_FILES, write_json, write_report
 from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
+from ..models.effects import EFFECT_NAMES, effect
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import CommandLineError, add_model_arguments, build_model
