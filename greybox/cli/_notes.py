@@ -22,12 +22,12 @@ import warnings
 from typing import Iterator
 
 from ..errors import LogError, ParameterError
-from ._build import _MODEL_OPTIONS, CommandLineError
+from ._model_options import MODEL_OPTIONS, CommandLineError
 
 __all__ = ["OPTION_OF", "command_notes", "error_message", "option_words"]
 
 #: Hyperparameter -> the option that sets it in train, discover and compensate (see ``_build``).
-OPTION_OF = {hyperparameter: option for option, _, hyperparameter in _MODEL_OPTIONS}
+OPTION_OF = {hyperparameter: option for option, _, hyperparameter in MODEL_OPTIONS}
 
 #: Options that are flags (no value): ``name=True`` is the flag itself.
 _FLAGS = {"fit_offset", "asymmetric"}

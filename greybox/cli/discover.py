@@ -26,7 +26,6 @@ from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "discover",
-        help="find, name and add the effects a friction model misses",
         description="Fit the base model on the training logs, locate where its residual lies (by regime), "
         "score a library of named effects against a null calibrated on simulated data with nothing missing, "
         "add the winning effect and refit jointly (at most --max-effects times), and report the error on the "
