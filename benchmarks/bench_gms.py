@@ -31,11 +31,14 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the plain-Python references
+
+from friction_reference import gms_reference
+from friction_signals import STEP, motion_log, velocity_profile
+
 from greybox.friction import GMSModel
 from greybox.friction.gms import GMSState, simulate_gms
 from greybox.friction.kernels import direction_curves, gms_friction_kernel
-from greybox.friction.reference import gms_reference
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -2,7 +2,7 @@
 
 Runs the paper's two experiments on the shipped data exactly as
 ``greybox reproduce`` does (the command is a thin wrapper of
-:func:`greybox.studies.experiments.reproduce`), showing its progress on
+:func:`greybox.reproduce.experiments.reproduce`), showing its progress on
 stderr, then prints one JSON object:
 
 - ``seconds``: wall time of the whole run (reading, fitting, testing, figures, report);
@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 from greybox.evaluate.report import noise_floor_ratios
-from greybox.studies.experiments import reproduce
+from greybox.reproduce.experiments import reproduce
 
 #: Targets of GitHub issue 4.
 MAX_SECONDS = 600.0

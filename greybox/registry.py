@@ -7,9 +7,9 @@ a file cannot make greybox run code other than these classes' constructors.
 
 from __future__ import annotations
 
-from .discover.augment import AugmentedModel
 from .friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from .friction.backlash import BacklashModel
+from .models.augmented import AugmentedModel
 from .models.gmssvr import GMSSVRModel
 from .models.svr import SVRCurrentModel
 

@@ -1,6 +1,6 @@
 """The ARTS friction benchmark: greybox's friction models on a real dry-friction device with backlash.
 
-Runs the protocol of :mod:`greybox.studies.arts` (train on the 0.25 Hz test of
+Runs the protocol of :mod:`studies.arts` (train on the 0.25 Hz test of
 each amplitude, test on the other excitations; RE and relerr of the modelled
 force) and prints the Markdown tables.
 
@@ -16,8 +16,10 @@ import os
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
 from greybox.errors import GreyboxError
-from greybox.studies.arts import MODEL_NAMES, arts_benchmark
+from studies.arts import MODEL_NAMES, arts_benchmark
 
 #: Default data folder: ``$GREYBOX_REAL_DATA/ARTS_friction_damper``, else ``../shared/data/real/ARTS_friction_damper``
 #: beside the repository (as the tests look for it).

@@ -4,7 +4,7 @@ Fits Stribeck, GMS and GMS+SVR (the paper's experiment 2 on each member's air
 cuts A and B), cuts dataset D with a force that opposes the motion on one
 stroke and pushes the table along on the other, and compares the process
 force ``greybox predict`` gives with the member's axis file against the true
-one (:mod:`greybox.studies.cutting_load`). Example (the figures of the README)::
+one (:mod:`studies.cutting_load`). Example (the figures of the README)::
 
     python scripts/cutting_load_validation.py --members 24 --seed 2026 --workers 2 --json load.json --markdown load.md
 """
@@ -13,8 +13,11 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from greybox.studies.cutting_load import run_cutting_load_study
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
+from studies.cutting_load import run_cutting_load_study
 
 
 def parse_args(argv=None) -> argparse.Namespace:

@@ -1,6 +1,6 @@
 """Validation of ``greybox predict`` on the synthetic axis: recovery of a known cutting-force current.
 
-Runs the protocol of :mod:`greybox.studies.cutting` (models fitted on the
+Runs the protocol of :mod:`studies.cutting` (models fitted on the
 shipped air cuts, cutting logs of the twin at several cut strengths, the
 process current recovered and compared with the truth) and prints its tables.
 
@@ -15,9 +15,11 @@ import argparse
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
 from greybox.errors import GreyboxError
-from greybox.studies.cutting import DEFAULT_STRENGTHS, KINDS, cutting_validation
 from greybox.twin.cutting import CuttingSpec
+from studies.cutting import DEFAULT_STRENGTHS, KINDS, cutting_validation
 
 ROOT = Path(__file__).resolve().parents[1]
 

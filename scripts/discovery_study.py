@@ -3,14 +3,14 @@
 Hides every library effect at several strengths in synthetic logs, runs
 ``greybox.discover.workflow.discover`` on each, and reports the false-positive
 rate on null data, the naming accuracy and the test-gap closure against the
-true term (:mod:`greybox.studies.discovery`). Four sections:
+true term (:mod:`studies.discovery`). Four sections:
 
 ``coulomb``  Coulomb plant (the base model class is exactly right), Coulomb base model.
 ``twin``     the twin's truth plant, GMS base model (the plant's own structure
              may be found too: counted as background, not as false).
-``family``   axes of the independent hysteresis family (:mod:`greybox.studies.hysteresis_axis`,
+``family``   axes of the independent hysteresis family (:mod:`studies.hysteresis_axis`,
              a Bouc-Wen friction law the workflow was not developed on), GMS base model,
-             a null axis and one hidden effect per seed (:mod:`greybox.studies.discovery_family`).
+             a null axis and one hidden effect per seed (:mod:`studies.discovery_family`).
 ``emps``     the real EMPS benchmark (``--data`` directory): base fitted on
              DATA_EMPS, tested on DATA_EMPS_PULSES, Coulomb and GMS bases (both
              with an offset); errors also on the benchmark's decimated samples.
@@ -31,9 +31,12 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from greybox.studies.discovery import SECTIONS, run_section
-from greybox.studies.discovery_family import run_family_study
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
+from studies.discovery import SECTIONS, run_section
+from studies.discovery_family import run_family_study
 
 
 def parse_args(argv=None) -> argparse.Namespace:

@@ -1,6 +1,6 @@
 """The EMPS benchmark: greybox's friction models on a real ball-screw drive.
 
-Runs the benchmark's protocol (:mod:`greybox.studies.emps`: data, filtering,
+Runs the benchmark's protocol (:mod:`studies.emps`: data, filtering,
 decimated relerr, the published IDIM-LS estimators beside the greybox fits)
 and prints the Markdown table.
 
@@ -16,8 +16,10 @@ import os
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
 from greybox.errors import GreyboxError
-from greybox.studies.emps import MODEL_NAMES, TEST_FILE, TRAIN_FILE, emps_benchmark
+from studies.emps import MODEL_NAMES, TEST_FILE, TRAIN_FILE, emps_benchmark
 
 #: Default data folder: ``$GREYBOX_REAL_DATA/EMPS``, else ``../shared/data/real/EMPS`` beside the repository
 #: (as the tests look for it).

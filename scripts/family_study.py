@@ -4,7 +4,7 @@ Draws ``--members`` axes of the family (four friction laws in turn, random
 parameters in documented ranges), fits every model of the paper's experiment
 1 on each axis' dataset A, tests on C and on C with a cut, and reports each
 model's median and 90th percentile of test RE over the noise floor's RE and
-of the process-force error (:mod:`greybox.studies.robustness`). Example (the
+of the process-force error (:mod:`studies.robustness`). Example (the
 figures of the README)::
 
     python scripts/family_study.py --members 50 --seed 2026 --workers 2 --json family.json --markdown family.md
@@ -12,7 +12,7 @@ figures of the README)::
 The JSON is rewritten after every member, so a long run can be followed.
 ``--choose-priors`` instead scores the GMS+SVR prior candidates on the training
 runs (fit on three quarters of A, score on the rest of A and on B) of a
-development family (:mod:`greybox.studies.priors`); with ``--model svr`` the
+development family (:mod:`studies.priors`); with ``--model svr`` the
 sole SVR's kernel candidates::
 
     python scripts/family_study.py --choose-priors --members 12 --seed 1 --workers 2 --json priors.json
@@ -23,9 +23,12 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from greybox.studies.priors import run_prior_study
-from greybox.studies.robustness import run_robustness_study
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
+from studies.priors import run_prior_study
+from studies.robustness import run_robustness_study
 
 
 def parse_args(argv=None) -> argparse.Namespace:

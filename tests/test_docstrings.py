@@ -5,7 +5,8 @@ constructor and the methods it defines whose names do not start with an undersco
 documented when its name heads an entry of the docstring's ``Parameters`` or ``Other Parameters``
 section (a class's constructor in the class docstring; a dataclass may list its fields under
 ``Attributes`` instead). ``*args`` and ``**kwargs`` are exempt. The command-line entry point
-(``greybox.__main__``) is wired by argparse and has none.
+(``greybox.__main__``) is wired by argparse and has none. The validation studies of the repository
+(``studies/``, not installed) are held to the same rule.
 """
 
 from __future__ import annotations
@@ -19,16 +20,18 @@ import re
 import pytest
 
 import greybox
+import studies
 
 SECTIONS = ("Parameters", "Other Parameters")
 ENTRY = re.compile(r"^([*A-Za-z_][\w*]*(?:\s*,\s*[*A-Za-z_][\w*]*)*)\s*(?::|$)")
 
 
 def module_names() -> list[str]:
-    names = ["greybox"]
-    for info in pkgutil.walk_packages(greybox.__path__, "greybox."):
-        if not info.name.endswith("__main__"):
-            names.append(info.name)
+    names = ["greybox", "studies"]
+    for package in (greybox, studies):
+        for info in pkgutil.walk_packages(package.__path__, package.__name__ + "."):
+            if not info.name.endswith("__main__"):
+                names.append(info.name)
     return sorted(names)
 
 

@@ -6,8 +6,9 @@ still a dependency, and hiding a cycle in a function does not remove it. The
 rules (DESIGN.md, "Layout"):
 
 - no import cycle between modules;
-- only ``greybox.twin`` itself, ``greybox.control``, ``greybox.studies`` and
-  ``greybox.cli`` import the synthetic twin;
+- only ``greybox.twin`` itself, ``greybox.control``, ``greybox.reproduce`` and
+  ``greybox.cli`` import the synthetic twin (the validation studies, ``studies/``
+  beside the package, may too: they are not part of it);
 - ``greybox.threads`` (thread pools shared by the data readers and the models)
   imports nothing of greybox;
 - ``greybox.base`` (the model protocol) and ``greybox.twin.laws.base`` (the
@@ -16,11 +17,16 @@ rules (DESIGN.md, "Layout"):
   the models it tests would flatter them;
 - the physical and current models (``greybox.friction``, ``greybox.models``)
   import nothing of the layers above them: ``evaluate``, ``predict``,
-  ``discover``, ``studies``, ``control``, ``cli``;
+  ``discover``, ``reproduce``, ``control``, ``cli``;
 - prediction (``greybox.predict``) sits above the models, the data and
   ``evaluate`` (metrics, regimes, figures), which import nothing of it, and
   below its users, which it imports nothing of: ``live``, ``monitor``,
-  ``discover``, ``control``, ``studies``, ``cli``.
+  ``discover``, ``control``, ``reproduce``, ``cli``;
+- the model layer as a whole (:data:`MODEL_LAYER`: the model kinds in
+  ``friction`` and ``models``, their registry and file format, the
+  identification and data layers they stand on) imports nothing outside it:
+  no import runs back up the layers (the registry of model kinds imports no
+  workflow: the augmented kind of ``greybox discover`` lives in ``models``).
 
 An import names a module (``import greybox.twin.plant``, ``from ..twin import
 plant``) or a package's ``__init__`` (``from ..twin import make_dataset``).
@@ -43,12 +49,16 @@ import pytest
 PACKAGE_DIR = Path(__file__).resolve().parents[1] / "greybox"
 
 #: Packages that may import the synthetic twin (besides the twin itself).
-TWIN_USERS = ("greybox.control", "greybox.studies", "greybox.cli")
+TWIN_USERS = ("greybox.control", "greybox.reproduce", "greybox.cli")
 #: Layers the models must not depend on.
-ABOVE_MODELS = ("greybox.evaluate", "greybox.predict", "greybox.discover", "greybox.studies", "greybox.control",
+#: The model kinds and everything they stand on: importing nothing outside this set.
+MODEL_LAYER = ("greybox.base", "greybox.errors", "greybox.threads", "greybox.atomic", "greybox.json_values",
+               "greybox.provenance", "greybox.metrics", "greybox.data", "greybox.identify", "greybox.estimator",
+               "greybox.friction", "greybox.models", "greybox.registry", "greybox.persistence")
+ABOVE_MODELS = ("greybox.evaluate", "greybox.predict", "greybox.discover", "greybox.reproduce", "greybox.control",
                 "greybox.cli")
 #: Layers prediction must not depend on (they use it, or stand beside it).
-ABOVE_PREDICT = ("greybox.live", "greybox.monitor", "greybox.discover", "greybox.control", "greybox.studies",
+ABOVE_PREDICT = ("greybox.live", "greybox.monitor", "greybox.discover", "greybox.control", "greybox.reproduce",
                  "greybox.cli")
 
 
@@ -226,11 +236,11 @@ def test_no_import_cycle(graph):
     assert not found, "import cycles (imports inside functions count):\n" + "\n".join(found)
 
 
-def test_only_the_twin_the_control_loop_the_studies_and_the_cli_import_the_twin(graph):
+def test_only_the_twin_the_control_loop_reproduce_and_the_cli_import_the_twin(graph):
     found = forbidden(graph,
                       lambda m: not any(_within(m, p) for p in ("greybox.twin", *TWIN_USERS)),
                       lambda t: _within(t, "greybox.twin"))
-    assert not found, "the synthetic twin imported outside twin/, control/, studies/, cli/:\n" + "\n".join(found)
+    assert not found, "the synthetic twin imported outside twin/, control/, reproduce/, cli/:\n" + "\n".join(found)
 
 
 def test_the_model_protocol_imports_nothing_of_greybox(graph):
@@ -268,6 +278,14 @@ def test_prediction_imports_nothing_of_its_users_and_evaluate_nothing_of_predict
     assert not found, "greybox/predict/ depends on a layer above it:\n" + "\n".join(found)
     found = forbidden(graph, lambda m: _within(m, "greybox.evaluate"), lambda t: _within(t, "greybox.predict"))
     assert not found, "greybox/evaluate/ (metrics, reports, figures) depends on prediction:\n" + "\n".join(found)
+
+
+def test_the_model_layer_imports_nothing_above_it(graph):
+    assert "greybox.registry" in graph and "greybox.models.augmented" in graph
+    found = forbidden(graph,
+                      lambda m: any(_within(m, p) for p in MODEL_LAYER),
+                      lambda t: t != "greybox" and not any(_within(t, p) for p in MODEL_LAYER))
+    assert not found, "an import runs back up the layers (the model layer imports a workflow):\n" + "\n".join(found)
 
 
 # ---------------------------------------------------------------- the checker itself
@@ -322,3 +340,16 @@ def test_a_submodule_import_from_outside_runs_its_package_init(tmp_path):
     (root / "a" / "leaf.py").write_text("")
     (root / "b" / "x.py").write_text("from ..a.leaf import *\n")
     assert any("pkg.a" in line and "pkg.b.x" in line for line in cycles(import_graph(root)))
+
+
+def test_the_package_imports_nothing_of_the_repository_folders():
+    """``studies/``, ``tests/``, ``scripts/`` and ``benchmarks/`` sit beside the package and are not installed."""
+    outside = ("studies", "tests", "scripts", "benchmarks", "conftest", "friction_reference", "friction_signals")
+    found = []
+    for module, path in module_files(PACKAGE_DIR).items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = ([alias.name for alias in node.names] if isinstance(node, ast.Import)
+                     else [node.module] if isinstance(node, ast.ImportFrom) and not node.level else [])
+            found += [f"{module} (line {node.lineno}) imports {name}" for name in names
+                      if name and name.split(".")[0] in outside]
+    assert not found, "the installed package imports a folder that is not installed:\n" + "\n".join(found)

@@ -306,7 +306,7 @@ def test_registry_names_every_current_model():
 
 
 def test_discovered_models_are_files_but_not_trainable_kinds():
-    from greybox.discover.augment import AugmentedModel
+    from greybox.models.augmented import AugmentedModel
 
     assert registry.model_class("augmented") is AugmentedModel
     assert registry.model_kind(AugmentedModel()) == "augmented"

@@ -1,12 +1,16 @@
 """The ``greybox`` command line.
 
 Each sub-command lives in its own module of this package and provides
-``add_parser(subparsers)``, which registers the sub-command and sets
-``run=<callable(args) -> int>`` as its default. Errors caused by the user's
-input (:class:`greybox.errors.GreyboxError`) are printed as one line naming the
-file and the problem, with exit status 2 and no traceback. Warnings issued while
-a command runs are printed as one ``note:`` line each; in both, a model
-hyperparameter is named by the option that sets it (:mod:`greybox.cli._notes`).
+``add_parser(subparsers)``, which registers the sub-command (its options) and
+sets ``run=<callable(args) -> int>`` as its default. :data:`SUMMARIES` lists
+the sub-commands with their one-line summaries; a sub-command's module is
+imported only when that sub-command runs (or shows its ``--help``), so that
+``greybox --help`` loads no model, reader or plotting library. Errors caused by
+the user's input (:class:`greybox.errors.GreyboxError`) are printed as one line
+naming the file and the problem, with exit status 2 and no traceback. Warnings
+issued while a command runs are printed as one ``note:`` line each; in both, a
+model hyperparameter is named by the option that sets it
+(:mod:`greybox.cli._spelling`).
 """
 
 from __future__ import annotations
@@ -22,9 +26,25 @@ import time
 from ..errors import GreyboxError
 from ._spelling import command_notes, error_message
 
+#: Sub-commands, in the order ``greybox --help`` lists them: name (of the command and of its module in this
+#: package) -> one-line summary.
+SUMMARIES = {
+    "synth": "write synthetic axis logs (datasets A-D, P) of the twin machine",
+    "info": "summarise logs and model files",
+    "plot": "draw a log as a PNG",
+    "train": "fit a current model to logs and save it",
+    "evaluate": "test saved models on logs and report their errors",
+    "predict": "process current (and force) of a cutting log from a model trained on air cuts",
+    "reproduce": "run the paper's experiments on the shipped data and write the report",
+    "discover": "find, name and add the effects a friction model misses",
+    "compensate": "compare friction models by the tracking error of a position loop with their feed-forward",
+    "plan": "write the air-cut NC program (datasets A and B of the paper) to run on the machine",
+    "live": "process current (and force) of a live stream from the controller (MQTT or stdin), with limits",
+    "examples": "write the example axis and machine files into a folder",
+    "monitor": "fingerprint axis logs into a history, detect friction changes, write a dashboard",
+}
 #: Sub-command modules, in the order ``greybox --help`` lists them.
-COMMANDS = ("synth", "info", "plot", "train", "evaluate", "predict", "reproduce", "discover", "compensate",
-            "plan", "live", "examples", "monitor")
+COMMANDS = tuple(SUMMARIES)
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -35,8 +55,59 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """Return the argument parser of the ``greybox`` command."""
+class _Registrar:
+    """The sub-parsers as a sub-command's module sees them: its one-line summary comes from :data:`SUMMARIES`."""
+
+    def __init__(self, subparsers):
+        self._subparsers = subparsers
+
+    def add_parser(self, name: str, **kwargs) -> argparse.ArgumentParser:
+        """Register the sub-command ``name`` (keyword arguments of :class:`argparse.ArgumentParser`) and return its
+        parser.
+
+        Parameters
+        ----------
+        name : str
+            The sub-command, a key of :data:`SUMMARIES`.
+        **kwargs
+            Passed on to the sub-parsers' ``add_parser`` (description, ...); ``help`` is the summary.
+        """
+        kwargs["help"] = SUMMARIES[name]
+        return self._subparsers.add_parser(name, **kwargs)
+
+
+def command_of(argv: list[str]) -> str | None:
+    """The sub-command that ``argv`` names, if any: its first argument that is not an option.
+
+    Parameters
+    ----------
+    argv : list of str
+        The arguments after the program name. The options of ``greybox`` itself (``--help``,
+        ``--version``) take no value, so the first other argument is the sub-command.
+
+    Returns
+    -------
+    str or None
+        That argument if it names a sub-command, else None.
+    """
+    for argument in argv:
+        if argument == "--":
+            return None
+        if not argument.startswith("-"):
+            return argument if argument in COMMANDS else None
+    return None
+
+
+def build_parser(commands=None) -> argparse.ArgumentParser:
+    """Return the argument parser of the ``greybox`` command.
+
+    Parameters
+    ----------
+    commands : iterable of str, optional
+        The sub-commands whose modules are imported and whose options are registered; the others are listed
+        by their summary only (enough for ``greybox --help`` and for naming an unknown sub-command). Default:
+        all of them.
+    """
     from .. import __version__
 
     parser = OneLineParser(
@@ -46,8 +117,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"greybox {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                        parser_class=OneLineParser)
+    loaded = set(COMMANDS if commands is None else commands)
     for name in COMMANDS:
-        importlib.import_module(f"{__name__}.{name}").add_parser(subparsers)
+        if name in loaded:
+            importlib.import_module(f"{__name__}.{name}").add_parser(_Registrar(subparsers))
+        else:
+            subparsers.add_parser(name, help=SUMMARIES[name])
     return parser
 
 
@@ -105,8 +180,9 @@ def main(argv: list[str] | None = None) -> int:
     SIGTERM ends the command like Ctrl-C: no output is left half-written, an earlier file of the same
     name is kept, and the status is 143 (130 for Ctrl-C).
     """
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    arguments = sys.argv[1:] if argv is None else argv
+    parser = build_parser([command] if (command := command_of(arguments)) else [])
+    args = parser.parse_args(arguments)
     age = process_age_s() if argv is None else None  # a command of its own: its start-up counts too
     args.started_s = time.perf_counter() - (age or 0.0)
     args.startup_counted = age is not None

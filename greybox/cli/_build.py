@@ -8,22 +8,10 @@ import json
 from ..errors import GreyboxError
 from ..friction.backlash import BacklashModel
 from ..registry import model_class
+from ._model_options import MODEL_OPTIONS, CommandLineError
 from ._types import NON_NEGATIVE, POSITIVE_INT, SEED
 
 __all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting", "takes_hyperparameter"]
-
-
-class CommandLineError(GreyboxError):
-    """An error the command line words itself (its message names options already and is printed as is)."""
-
-#: Options that set a model hyperparameter: (option, attribute of the parsed arguments, hyperparameter).
-_MODEL_OPTIONS = (
-    ("--offset", "offset", "fit_offset"),
-    ("--asymmetric", "asymmetric", "asymmetric"),
-    ("--elements", "elements", "n_elements"),
-    ("--model-seed", "model_seed", "random_state"),
-    ("--inertia", "model_inertia", "inertia"),
-)
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model options",
@@ -123,7 +111,7 @@ def build_model(kind: str, args: argparse.Namespace):
     accepted = model.get_params(deep=False)
     stage = model.first_stage()
     params, stage_params = {}, {}
-    for option, attribute, name in _MODEL_OPTIONS:
+    for option, attribute, name in MODEL_OPTIONS:
         value = getattr(args, attribute, None)
         if value is None and name == "fit_offset" and getattr(args, "offset_default", False) \
                 and not getattr(args, "asymmetric", False) \
@@ -147,7 +135,7 @@ def build_model(kind: str, args: argparse.Namespace):
         if not sep or not name:
             raise CommandLineError(f"--set expects NAME=VALUE, got {setting!r}")
         if name not in accepted:
-            offered = {hyperparameter: option for option, _, hyperparameter in _MODEL_OPTIONS}
+            offered = {hyperparameter: option for option, _, hyperparameter in MODEL_OPTIONS}
             takes = ", ".join(offered.get(other, f"--set {other}=...") for other in sorted(accepted))
             raise CommandLineError(f"--set {name}=...: the {kind} model has no such hyperparameter; it takes {takes}")
         params[name] = parse_setting(text)

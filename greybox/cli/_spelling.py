@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Iterator
 
 from ..errors import Setting
-from ._build import _MODEL_OPTIONS
+from ._model_options import MODEL_OPTIONS
 
 __all__ = ["OPTIONS", "Option", "command_notes", "error_message", "spelt"]
 
@@ -46,14 +46,14 @@ class Option:
 #: none (``--asymmetric``, ``--offset``).
 _FLAGS = {"fit_offset", "asymmetric"}
 
-#: Metavariables of the model options (as ``greybox.cli._build`` declares them).
+#: Metavariables of the model options (as ``greybox.cli._build`` declares their options).
 _MODEL_METAVARS = {"n_elements": "N", "random_state": "N", "inertia": "J"}
 
 #: Setting -> the option that sets it: the model options of train, discover and compensate
-#: (``greybox.cli._build``) and the log readers' options (``greybox.cli._options.add_log_arguments``).
+#: (``greybox.cli._model_options``) and the log readers' options (``greybox.cli._options.add_log_arguments``).
 OPTIONS: dict[str, Option] = {
     **{name: Option(flag, None if name in _FLAGS else _MODEL_METAVARS.get(name, "VALUE"))
-       for flag, _, name in _MODEL_OPTIONS},
+       for flag, _, name in MODEL_OPTIONS},
     "columns": Option("--columns", "NAME=COLUMN"),
     "sample_time": Option("--sample-time", "S"),
     "topic": Option("--topic", "TOPIC"),

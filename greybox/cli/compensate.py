@@ -32,7 +32,6 @@ def add_parser(subparsers) -> None:
 
     parser = subparsers.add_parser(
         "compensate",
-        help="compare friction models by the tracking error of a position loop with their feed-forward",
         description="Simulate a PID position loop around a plant (the synthetic axis, or an identified GMS/LuGre "
         "model) with feed-forward of the inertia plus each friction model, one set of PID gains for all, on a "
         "low-stroke and a high-stroke filtered random reference (or references given as logs), and write a table "

@@ -10,12 +10,12 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import check_output_path
-from ..discover.effects import EFFECT_NAMES, effect
 from ..discover.heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN
 from ..discover.report import REPORT_FILES, write_json, write_report
 from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
+from ..models.effects import EFFECT_NAMES, effect
 from ..persistence import load_model, save_model
 from ..registry import MODEL_CLASSES
 from ._build import CommandLineError, add_model_arguments, build_model
@@ -26,7 +26,6 @@ from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "discover",
-        help="find, name and add the effects a friction model misses",
         description="Fit the base model on the training logs, locate where its residual lies (by regime), "
         "score a library of named effects against a null calibrated on simulated data with nothing missing, "
         "add the winning effect and refit jointly (at most --max-effects times), and report the error on the "

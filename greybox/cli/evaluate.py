@@ -20,7 +20,6 @@ from ._provenance import warn_preparation
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "evaluate",
-        help="test saved models on logs and report their errors",
         description="Load model files, predict the current of every test log, and print RMSE, RE and NMSE per "
         "model, overall and per operating regime (low/high velocity, reversals, constant feed, acceleration). "
         "With --out, also write a report: metrics.json/csv, tables.md, figures and index.html (or one PDF file).",

@@ -19,7 +19,6 @@ DATA_COMMAND = "greybox synth --axis X Y --out data --seed 2024 --truth essentia
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "examples",
-        help="write the example axis and machine files into a folder",
         description="Write the example axis files (axis_x.toml: a linear ball-screw axis; axis_c.toml: a rotary "
         "axis) and machine file (machine.toml) that --axis-config and --machine take, installed with greybox, "
         f"into DIR, and print the command that makes the synthetic logs of the walk-throughs ({DATA_COMMAND}).",

@@ -26,7 +26,6 @@ MODEL_SUFFIX = ".gbm"
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "info",
-        help="summarise logs and model files",
         description="Print one line per log: samples, step, duration, position, velocity and effort ranges; "
                     "for a model file (.gbm) its kind, parameters and fit.",
     )

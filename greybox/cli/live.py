@@ -13,7 +13,6 @@ def add_parser(subparsers) -> None:
 
     parser = subparsers.add_parser(
         "live",
-        help="process current (and force) of a live stream from the controller (MQTT or stdin), with limits",
         description="Run a model trained on air cuts over the samples of a live stream, message by message, "
         "carrying its state: per message the estimates it completes (the columns of 'greybox predict') go to the "
         "sink. Fed the samples of a log, the estimates equal 'greybox predict' on it. Messages: JSON (one sample "

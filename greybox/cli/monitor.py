@@ -10,7 +10,6 @@ from ._types import NumberRange
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "monitor",
-        help="fingerprint axis logs into a history, detect friction changes, write a dashboard",
         description=(
             "Fit each log's friction fingerprint (sliding and break-away level per direction, viscous "
             "coefficient, residual noise, with 95 %% intervals) on its stretches without process load, add it to "

@@ -18,7 +18,6 @@ def add_parser(subparsers) -> None:
     defaults = AirCutPlan("X", (0.0, 1.0), (0.0, 1.0), (1.0, 2.0))
     parser = subparsers.add_parser(
         "plan",
-        help="write the air-cut NC program (datasets A and B of the paper) to run on the machine",
         description="Write an NC program (ISO G-code: G90, G1 with F per minute, G4 dwells) for one axis: a "
         "warm-up, dataset A (random feed steps with reversals and sinusoidal motion as short linear moves "
         "inside the window) and dataset B (constant-feed sweeps over the travel). Record the axis while it "

@@ -15,7 +15,6 @@ from ._window import add_window_argument, check_window
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "plot",
-        help="draw a log as a PNG",
         description="Draw position, velocity and current over time, and current over velocity. A long log is "
         "drawn as its envelope (minimum and maximum of each pixel column); --window draws a stretch of it.",
     )

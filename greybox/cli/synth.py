@@ -21,7 +21,6 @@ from ._types import FINITE, MAX_SEED, NON_NEGATIVE, POSITIVE, POSITIVE_INT, SEED
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "synth",
-        help="write synthetic axis logs (datasets A-D, P) of the twin machine",
         description=(
             "Simulate the synthetic feed axis (24-element Maxwell-slip friction, position-dependent, "
             "motor cogging, inertia, AR(1) current noise) along the trajectories of Rüppel et al. (2024, Table 1) and "

@@ -30,7 +30,6 @@ from ._types import POSITIVE_INT
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "train",
-        help="fit a current model to logs and save it",
         description="Read and prepare every training log as a separate run, fit the model to all runs, "
         "print the training error and the identified parameters, and save the model file. With --axes (or "
         "--machine), fit one model per axis of logs that hold several axes and write a machine model: a "

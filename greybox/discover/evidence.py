@@ -4,7 +4,7 @@ One step of the discovery workflow asks: does any library effect explain
 part of the present model's residual better than chance? For every candidate
 the statistic is the fraction of the residual's sum of squares it explains
 when fitted together with the model's own linear parameters (the nuisance,
-:mod:`greybox.discover.projection`), maximised over its shape parameter
+:mod:`greybox.identify.projection`), maximised over its shape parameter
 (periods from a least-squares scan in position, time constants and Stribeck
 velocities over logarithmic grids). A generic *structure* candidate, the
 indicator columns of :func:`greybox.discover.locate.structure_basis`, asks
@@ -55,10 +55,10 @@ from threadpoolctl import threadpool_limits
 
 from ..base import LinearPart
 from ..data.log import AxisLog
-from .effects import Effect, EffectContext, effect, scan_periods
+from ..identify.projection import Nuisance, PositionScan, added_squares
+from ..models.effects import Effect, EffectContext, effect, scan_periods
 from .locate import structure_basis
 from .noise import ResidualNoise
-from .projection import Nuisance, PositionScan, added_squares
 
 __all__ = ["CandidateScore", "StepEvidence", "score_step", "STRUCTURE"]
 

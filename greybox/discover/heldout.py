@@ -47,9 +47,9 @@ import scipy.linalg
 
 from ..data.log import AxisLog
 from ..errors import GreyboxError
-from .effects import Effect, EffectContext, scan_periods
+from ..identify.projection import Nuisance, PositionScan, added_squares
+from ..models.effects import Effect, EffectContext, scan_periods
 from .noise import ResidualNoise
-from .projection import Nuisance, PositionScan, added_squares
 
 __all__ = ["HeldOutGain", "HeldOutTest", "block_labels", "DEFAULT_BLOCKS", "DEFAULT_MIN_GAIN"]
 

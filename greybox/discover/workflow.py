@@ -6,7 +6,7 @@
 2. up to ``max_effects`` steps: score the library effects against the
    present model's residual with a null-calibrated test
    (:func:`greybox.discover.evidence.score_step`); add the winning effect to
-   an :class:`~greybox.discover.augment.AugmentedModel` and refit it jointly;
+   an :class:`~greybox.models.augmented.AugmentedModel` and refit it jointly;
    stop when nothing passes. A term whose joint refit explains no more than
    chance (the base's own refit absorbed it) is dropped and not tried again;
 3. the gap on the test runs: the base model alone against the augmented
@@ -14,7 +14,7 @@
 
 Before any effect is named, the base model is *refined* (``refine_base``): a
 flexible friction curve along the speed, and the friction held at rest with
-pre-sliding transients (:data:`greybox.discover.effects.REFINEMENTS`), join its
+pre-sliding transients (:data:`greybox.models.effects.REFINEMENTS`), join its
 linear columns in every test, so that a base whose friction law is only
 approximately right (another Stribeck curve, another pre-sliding shape) does
 not make effects look missing; velocity-only effects (``stribeck``,
@@ -51,9 +51,9 @@ from ..errors import GreyboxError
 from ..estimator import check_runs
 from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
 from ..metrics import metrics_table
+from ..models.augmented import AugmentedModel
+from ..models.effects import EFFECT_NAMES, REFINEMENTS, VELOCITY_ONLY, effect
 from ..provenance import provenance
-from .augment import AugmentedModel
-from .effects import EFFECT_NAMES, REFINEMENTS, VELOCITY_ONLY, effect
 from .evidence import StepEvidence, score_step
 from .heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN, HeldOutTest
 from .locate import residual_by_regime, residual_profiles, structure_basis

@@ -4,7 +4,7 @@ A *metric record* (:func:`metric_record`) holds the errors of one model on
 one side (``train`` or ``test``) of an experiment or evaluation: RMSE [A], RE
 [%], NMSE [%], largest error [A], and the errors per run. The tables and files
 of :mod:`greybox.evaluate.report` are built from such records, those of the
-paper's experiments (:mod:`greybox.studies.experiments`) as those of
+paper's experiments (:mod:`greybox.reproduce.experiments`) as those of
 :func:`evaluate_models`.
 
 When the logs carry the noise-free current (the extra channel

@@ -21,8 +21,8 @@ Files written by :func:`write_report`:
 ``tables.md``
     Markdown tables (:class:`~greybox.evaluate.table.Table`): one per experiment in the layout of
     the paper's Tables 3 and 4 with the published figures beside ours, the
-    checks of the paper's pattern (:mod:`greybox.evaluate.pattern`), the
-    SVR hyperparameters like the paper's Table 2, the noise-floor ratio of the
+    checks of the paper's pattern and the sole SVR beside the paper's figures
+    (:mod:`greybox.evaluate.pattern`), the SVR hyperparameters like the paper's Table 2, the noise-floor ratio of the
     grey-box model, the sole SVR's change from training to each test log, and
     the fit times.
 ``index.html``
@@ -43,7 +43,7 @@ from ..atomic import write_text_atomic
 from ..provenance import provenance, provenance_line
 from .html import write_html
 from .paper import PAPER_RE, PAPER_SOURCE
-from .pattern import paper_pattern, paper_pattern_table
+from .pattern import paper_pattern, paper_pattern_table, sole_svr_beside_paper, sole_svr_table
 from .table import Table
 
 __all__ = [
@@ -542,6 +542,8 @@ def report_tables(records: Sequence[Mapping], hyperparameters: Sequence[Mapping]
         tables.append(hyperparameter_table(hyperparameters))
     if paper_pattern(records):
         tables.append(paper_pattern_table(records))
+    if sole_svr_beside_paper(records):
+        tables.append(sole_svr_table(records))
     if noise_floor_ratios(records):
         tables.append(noise_floor_table(records))
     if svr_generalisation(records):

@@ -5,11 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..base import EFFORT, LENGTH, LinearPart, Parameter
-from ..curves import stribeck_curve
 from ..errors import ParameterError, Setting
 from ..estimator import CurrentModel
 from ..identify.initial import check_motion, samples_at_speed
-from ..identify.static import check_direction_settings, fit_stribeck, stribeck_regressors
+from ..identify.static import check_direction_settings, fit_stribeck, stribeck_curve, stribeck_regressors
 
 __all__ = ["StribeckModel", "stribeck_curve"]
 

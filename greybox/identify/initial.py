@@ -16,10 +16,9 @@ from typing import Sequence
 
 import numpy as np
 
-from ..curves import stribeck_curve
 from ..data.log import AxisLog
 from ..errors import LogError
-from .static import fit_coulomb, fit_stribeck
+from .static import fit_coulomb, fit_stribeck, stribeck_curve
 
 __all__ = ["SLIDING_DISTANCE_MM", "DEFAULT_DEFLECTION_MM", "motion_direction", "distance_since_reversal",
            "sliding_mask", "samples_at_speed", "static_initial_guess", "direction_level_ratio", "presliding_deflection",

@@ -16,6 +16,10 @@ inertia ``J`` estimated jointly:
   a time (coordinate search) from the best common value: the friction
   columns of the two directions touch disjoint samples, only ``J`` couples
   them.
+
+:func:`stribeck_curve` is the one NumPy copy of the Stribeck curve that the
+models, these fits and the initial guesses evaluate (the compiled kernels
+evaluate the same curve per sample: :func:`greybox.friction.kernels.stribeck_at`).
 """
 
 from __future__ import annotations
@@ -29,7 +33,8 @@ from threadpoolctl import threadpool_limits
 from ..errors import ParameterError, Setting
 from .linear import bounded_lstsq
 
-__all__ = ["check_direction_settings", "fit_coulomb", "fit_stribeck", "stribeck_regressors", "velocity_range"]
+__all__ = ["check_direction_settings", "fit_coulomb", "fit_stribeck", "stribeck_curve", "stribeck_regressors",
+           "velocity_range"]
 
 #: Number of log-spaced Stribeck velocities tried before the local refinement.
 _N_GRID = 40
@@ -37,6 +42,28 @@ _N_GRID = 40
 _XATOL = 1e-6
 #: Most rounds of the coordinate search of the two Stribeck velocities of the asymmetric model.
 _MAX_ROUNDS = 20
+
+
+def stribeck_curve(velocity, s_0: float, s_inf: float, v_s: float) -> np.ndarray:
+    """Decaying Stribeck curve ``s(v) = s_inf + (s_0 - s_inf) exp(-|v| / v_s)``.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Velocity [mm/s].
+    s_0 : float
+        Value at rest (static friction level, or GMS break-away deflection).
+    s_inf : float
+        Value at high speed (Coulomb level), same unit as ``s_0``.
+    v_s : float
+        Stribeck velocity [mm/s], positive.
+
+    Returns
+    -------
+    ndarray
+        ``s(v)`` in the unit of ``s_0``; even in ``v``.
+    """
+    return s_inf + (s_0 - s_inf) * np.exp(-np.abs(np.asarray(velocity, dtype=float)) / v_s)
 
 
 def check_direction_settings(asymmetric: bool, fit_offset: bool) -> None:

@@ -27,7 +27,7 @@ scale of the box of the training inputs (:mod:`greybox.models.handover`),
 and is unchanged inside it. Both targets search the same
 intervals (:func:`greybox.models.svr.default_bounds`). The residual target
 was chosen on the training runs of a development family of truth axes
-(:mod:`greybox.studies.priors`): fitted on three quarters of dataset A and
+(``studies/priors.py`` in the repository): fitted on three quarters of dataset A and
 scored on the rest of A and on B, it is far better than the current target
 on B (the whole travel, beyond A's window), and a floor on the kernel
 parameter gamma, meant to keep the correction local, made no difference

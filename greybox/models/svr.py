@@ -610,7 +610,7 @@ class SVRCurrentModel(KernelRegressionModel):
         :data:`WEIGHT_BOUNDS` with the others when None (1 when not
         optimised). 1 is the isotropic kernel, the only one before the
         weight existed; searching it was chosen on the training runs of a
-        development family of truth axes (:mod:`greybox.studies.priors`).
+        development family of truth axes (``studies/priors.py`` in the repository).
     n_subset : int, default 2000
         Training samples, chosen to cover the (p, v) plane evenly
         (SVR training time grows roughly with its square).

@@ -14,10 +14,10 @@ from greybox import registry
 from greybox.cli import build_parser
 from greybox.cli import discover as discover_cli
 from greybox.data.io import write_log
-from greybox.discover.augment import AugmentedModel
 from greybox.errors import GreyboxError
+from greybox.models.augmented import AugmentedModel
 from greybox.persistence import load_model
-from greybox.studies.discovery import StudyCase, case_logs
+from studies.discovery import StudyCase, case_logs
 
 
 def run_cli(argv):

@@ -118,9 +118,12 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
                      "--jobs", "1", "--no-models"]) == 0
     captured = capsys.readouterr()
     assert "axis Y, experiment 2: gmssvr (GMS on A, SVR on B)" in captured.err  # progress display
-    # one axis: the four per-axis checks of the paper's pattern, flagged as a quick run
+    # one axis: the one per-axis check of the paper's pattern, flagged as a quick run; the sole SVR's three
+    # figures beside the paper's without a pass/fail
     pattern = [line for line in captured.out.splitlines() if line.startswith("  met ") or "not met" in line]
-    assert len(pattern) == 4 and "checks met (--quick: small search budgets" in captured.out
+    assert len(pattern) == 1 and "checks met (--quick: small search budgets" in captured.out
+    assert "the sole SVR beside the paper (shown, not checked" in captured.out
+    assert sum("sole SVR" in line and "(paper " in line for line in captured.out.splitlines()) == 3
     assert "The paper's pattern on the synthetic axes" in (out / "tables.md").read_text()
     records = json.loads((out / "metrics.json").read_text())
     assert {(r["experiment"], r["model"]) for r in records} == {

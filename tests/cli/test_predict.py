@@ -213,7 +213,7 @@ def test_negative_moving_mean_window_is_an_argparse_error(files, tmp_path, capsy
 
 def test_model_file_of_discover_predicts_in_chunks(files, tmp_path, capsys):
     """The augmented model files 'greybox discover --save-model' writes work in predict, across chunks."""
-    from greybox.discover.augment import AugmentedModel
+    from greybox.models.augmented import AugmentedModel
 
     train = prepare([make_dataset("X", "A", seed=11, duration_s=10)])[0]
     model = AugmentedModel(base=GMSModel(n_starts=1, max_iter=80), effects=[("thermal_drift", 2.0)],

@@ -109,7 +109,7 @@ def test_the_evidence_figure_explains_its_bar_colours(tmp_path, monkeypatch):
 
     from greybox.discover.report import plot_evidence
     from greybox.discover.workflow import discover
-    from greybox.studies.discovery import StudyCase, case_logs
+    from studies.discovery import StudyCase, case_logs
 
     train, test, _ = case_logs(StudyCase("position_periodic_force", 1.5, 2, "coulomb", 10.0))
     result = discover(CoulombModel(), train, test, seed=2, max_effects=1)

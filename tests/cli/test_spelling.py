@@ -119,9 +119,9 @@ def test_text_around_the_settings_is_kept_as_it_is():
 
 
 def test_every_model_option_of_the_commands_is_in_the_one_table():
-    from greybox.cli._build import _MODEL_OPTIONS
+    from greybox.cli._model_options import MODEL_OPTIONS
 
-    assert {name: OPTIONS[name].flag for _, _, name in _MODEL_OPTIONS} == {
+    assert {name: OPTIONS[name].flag for _, _, name in MODEL_OPTIONS} == {
         "fit_offset": "--offset", "asymmetric": "--asymmetric", "n_elements": "--elements",
         "random_state": "--model-seed", "inertia": "--inertia"}
 

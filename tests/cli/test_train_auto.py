@@ -6,11 +6,11 @@ import json
 
 import numpy as np
 import pytest
+from friction_signals import motion_log, velocity_profile
 from scipy.io import savemat
 
 import greybox.cli as cli
 from greybox.data.io import write_log
-from greybox.friction.signals import motion_log, velocity_profile
 from greybox.persistence import load_model
 
 

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from greybox.data.prepare import prepare
-from greybox.discover.augment import AugmentedModel
-from greybox.discover.effects import effect
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel, StribeckModel
+from greybox.models.augmented import AugmentedModel
+from greybox.models.effects import effect
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
@@ -126,7 +126,7 @@ def test_two_terms_of_one_periodic_effect_stay_apart(stroke):
 
 
 def test_refinement_never_brings_a_period_next_to_another_of_the_same_effect():
-    from greybox.discover.augment import _apart
+    from greybox.models.augmented import _apart
 
     step = 0.01
     # bracket [4, 6] mm (0.167 ... 0.25 1/mm) around 5 mm; other terms 3 steps above and below in frequency

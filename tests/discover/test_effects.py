@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from greybox.data.log import AxisLog
-from greybox.discover.effects import EFFECT_NAMES, EFFECTS, EffectContext, effect, period_scan
 from greybox.errors import GreyboxError
+from greybox.models.effects import EFFECT_NAMES, EFFECTS, EffectContext, effect, period_scan
 from greybox.twin import EFFECTS as TWIN_EFFECTS
 from greybox.twin import EffectInputs, effect_current
 

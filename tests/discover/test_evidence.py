@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from greybox.data.log import AxisLog
-from greybox.discover.augment import AugmentedModel
-from greybox.discover.effects import EffectContext
 from greybox.discover.evidence import score_step
 from greybox.friction import CoulombModel
+from greybox.models.augmented import AugmentedModel
+from greybox.models.effects import EffectContext
 
 
 def sine_stroke(n=6000, step=0.002, seed=0):

@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 
 from greybox.data.prepare import prepare
-from greybox.discover.augment import AugmentedModel
-from greybox.discover.effects import effect
 from greybox.discover.heldout import HeldOutTest, _solve, block_labels
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel, GMSModel
-from greybox.studies.discovery import StudyCase, case_logs
-from greybox.studies.hysteresis_axis import FamilyCase, family_logs
+from greybox.models.augmented import AugmentedModel
+from greybox.models.effects import effect
+from studies.discovery import StudyCase, case_logs
+from studies.hysteresis_axis import FamilyCase, family_logs
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.sparse
 
-from greybox.discover.projection import Nuisance, PositionScan, _reduction, _reduction_pairs, added_squares
+from greybox.identify.projection import Nuisance, PositionScan, _reduction, _reduction_pairs, added_squares
 
 
 def rss(matrix, target):

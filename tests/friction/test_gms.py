@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from friction_reference import gms_reference
+from friction_signals import STEP, motion_log, velocity_profile
 
 from greybox.errors import ParameterError
 from greybox.friction import GMSModel, stribeck_curve
@@ -15,8 +17,6 @@ from greybox.friction.gms import (
     check_gms_parameters,
     simulate_gms,
 )
-from greybox.friction.reference import gms_reference
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 
 TRUTH = {"alpha": np.array([0.1, 0.2, 0.3, 0.4]), "k": np.array([40.0, 60.0, 30.0, 45.0]), "sigma": 0.002,
          "s_0": 0.02, "s_inf": 0.015, "v_s": 5.0, "C": 2.25, "mu": 0.005}

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from friction_reference import gms_reference, lugre_reference, play_operator_reference
+from friction_signals import STEP, velocity_profile
 
 from greybox.friction.directions import direction_pair
 from greybox.friction.gms import GMSState, gms_trajectory, simulate_gms
@@ -15,8 +17,6 @@ from greybox.friction.kernels import (
     play_operator_kernel,
 )
 from greybox.friction.lugre import simulate_lugre
-from greybox.friction.reference import gms_reference, lugre_reference, play_operator_reference
-from greybox.friction.signals import STEP, velocity_profile
 
 
 def gms_parameters(n_elements, seed=0):

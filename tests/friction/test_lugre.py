@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import plant_reference as ref
 import pytest
+from friction_reference import lugre_reference
+from friction_signals import STEP, motion_log, velocity_profile
 from scipy.integrate import solve_ivp
 
 from greybox.control.loop import controller_periods
@@ -15,8 +17,6 @@ from greybox.control.tuning import default_bandwidth_hz, pole_placement_gains
 from greybox.errors import LogError, ParameterError
 from greybox.friction import LuGreModel, stribeck_curve
 from greybox.friction.lugre import check_lugre_parameters, simulate_lugre
-from greybox.friction.reference import lugre_reference
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.persistence import load_model, save_model
 
 PARAMS = {"sigma1": 0.02, "sigma2": 0.004, "coulomb": 0.6, "static": 0.9, "v_s": 3.0}

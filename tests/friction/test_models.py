@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from friction_signals import STEP, motion_log, velocity_profile
 from sklearn.base import clone
 
 from greybox.errors import LogError, ParameterError
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.friction.gms import simulate_gms
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 
 QUICK = {
     "coulomb": lambda: CoulombModel(),

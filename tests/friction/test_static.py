@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 import scipy.io
 import scipy.signal
+from friction_signals import motion_log, velocity_profile
 
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
 from greybox.friction import CoulombModel, StribeckModel, stribeck_curve
 from greybox.friction.coulomb import coulomb_friction
-from greybox.friction.signals import motion_log, velocity_profile
 from greybox.identify.static import fit_stribeck
 from greybox.persistence import load_model, save_model
 

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from friction_signals import STEP, motion_log, velocity_profile
 from scipy.optimize import lsq_linear
 
 from greybox.friction import stribeck_curve
 from greybox.friction.gms import simulate_gms
-from greybox.friction.signals import STEP, motion_log, velocity_profile
 from greybox.identify.initial import (
     distance_since_reversal,
     motion_direction,

@@ -17,12 +17,12 @@ from greybox.base import Parameter
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
-from greybox.discover.augment import AugmentedModel
 from greybox.errors import ModelFileError
 from greybox.estimator import CurrentModel
 from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.friction.backlash import BacklashModel
 from greybox.identify.intervals import attach_intervals, cluster_covariance, cluster_labels, parameter_intervals
+from greybox.models.augmented import AugmentedModel
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 

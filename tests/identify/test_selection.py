@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 import pytest
+from friction_signals import motion_log, velocity_profile
 from sklearn.base import BaseEstimator
 
 from greybox.errors import GreyboxError, ParameterError
 from greybox.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.friction.backlash import BacklashModel
-from greybox.friction.signals import motion_log, velocity_profile
 from greybox.identify.selection import (
     CandidateScore,
     check_selection_record,

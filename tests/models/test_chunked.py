@@ -133,7 +133,7 @@ def test_bad_chunk_lengths_and_units(models, cut_log):
 def augmented(train_log):
     """A model of 'greybox discover': GMS base plus a drift with the time since the run start, a ripple and the
     pre-sliding refinement (its play-operator states carry over from chunk to chunk)."""
-    from greybox.discover.augment import AugmentedModel
+    from greybox.models.augmented import AugmentedModel
 
     return AugmentedModel(base=GMSModel(n_starts=1, max_iter=80),
                           effects=[("thermal_drift", 3.0), ("position_periodic_force", 10.0),

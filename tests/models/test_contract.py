@@ -22,11 +22,11 @@ from greybox import registry
 from greybox.base import EFFORT, Parameter
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
-from greybox.discover.augment import AugmentedModel
 from greybox.errors import GreyboxError
 from greybox.estimator import CurrentModel
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
 from greybox.friction.backlash import BacklashModel
+from greybox.models.augmented import AugmentedModel
 from greybox.models.chunked import predict_chunked
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset

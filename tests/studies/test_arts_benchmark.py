@@ -18,13 +18,13 @@ import numpy as np
 import pytest
 from scipy.signal import butter, sosfiltfilt
 
-from greybox.data.arts import read_arts
 from greybox.errors import GreyboxError, LogError
 from greybox.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.friction.backlash import BacklashModel
 from greybox.model_choice import choose_model
-from greybox.studies import arts as bench
-from greybox.studies import auto
+from studies import arts as bench
+from studies import auto
+from studies.arts_data import read_arts
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.

@@ -8,9 +8,9 @@ import pytest
 from greybox.data.prepare import prepare
 from greybox.friction.coulomb import CoulombModel
 from greybox.predict.process import predict_process
-from greybox.studies.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
+from studies.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
 
 
 def square_cut(n=4000, seed=0):

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from greybox.errors import GreyboxError
-from greybox.studies.cutting import cutting_validation
+from studies.cutting import cutting_validation
 
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "cutting_validation.py"
@@ -100,7 +100,7 @@ def test_existing_outputs_are_kept_without_force(tmp_path):
 def test_a_detail_strength_outside_the_case_is_refused_before_any_prediction():
     from types import SimpleNamespace
 
-    from greybox.studies.cutting import evaluate_model
+    from studies.cutting import evaluate_model
 
     case = SimpleNamespace(strengths=(0.25, 0.5, 1.0))  # nothing else is read before the check
     with pytest.raises(ValueError, match=r"detail_strength 0.75 A is not one of the case's cut strengths \(0.25"):

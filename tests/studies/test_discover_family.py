@@ -1,4 +1,4 @@
-"""A seeded small version of the discovery study on the hysteresis family (:mod:`greybox.studies.discovery_family`).
+"""A seeded small version of the discovery study on the hysteresis family (:mod:`studies.discovery_family`).
 
 The axes' friction law (Bouc-Wen with Stribeck weakening) is not the GMS base
 model's, so every residual holds deterministic misfit: nothing may be named on
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import pytest
 
-from greybox.studies.discovery_family import ACCEPTED_NULL_VERDICTS, run_family_case, summarise_family
-from greybox.studies.hysteresis_axis import FamilyCase
+from studies.discovery_family import ACCEPTED_NULL_VERDICTS, run_family_case, summarise_family
+from studies.hysteresis_axis import FamilyCase
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.

@@ -1,4 +1,4 @@
-"""The discovery workflow: a seeded small version of the validation study (:mod:`greybox.studies.discovery`).
+"""The discovery workflow: a seeded small version of the validation study (:mod:`studies.discovery`).
 
 Coulomb plant (the base model class is exactly right), 20 s logs: null data
 must give "nothing_missing", each hidden library effect must be named and
@@ -13,13 +13,13 @@ import json
 import numpy as np
 import pytest
 
-from greybox.discover.effects import EFFECT_NAMES, VELOCITY_ONLY
 from greybox.discover.report import write_json
 from greybox.discover.workflow import VERDICTS, discover
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel
-from greybox.studies.discovery import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
+from greybox.models.effects import EFFECT_NAMES, VELOCITY_ONLY
 from greybox.twin import CurrentNoise
+from studies.discovery import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.
@@ -130,7 +130,7 @@ def test_several_training_runs_each_drift_from_their_own_start():
 
 
 def test_the_study_tables_print_without_null_runs_or_eligible_cases():
-    from greybox.studies.discovery import markdown
+    from studies.discovery import markdown
 
     settings = {"description": "d", "base": "CoulombModel", "duration": 30.0, "seeds": 1, "null_seeds": 0,
                 "ratios": [1.0]}

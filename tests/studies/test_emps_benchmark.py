@@ -22,8 +22,8 @@ import pytest
 from greybox.errors import GreyboxError
 from greybox.friction import CoulombModel
 from greybox.model_choice import choose_model
-from greybox.studies import auto
-from greybox.studies import emps as bench
+from studies import auto
+from studies import emps as bench
 
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "emps_benchmark.py"

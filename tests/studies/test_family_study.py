@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from greybox.studies import priors
-from greybox.studies.experiments import QUICK_SETTINGS
-from greybox.studies.robustness import TARGETS, robustness_markdown, run_member, summarise
+from greybox.reproduce.experiments import QUICK_SETTINGS
+from studies import priors
+from studies.robustness import TARGETS, robustness_markdown, run_member, summarise
 
 
 def _row(index, law, ratios, process=30.0, mean=-2.0):
@@ -64,7 +64,7 @@ def _square(job):
 def test_members_run_in_order_and_the_json_holds_every_row(tmp_path):
     import json
 
-    from greybox.studies.members import run_members
+    from studies.members import run_members
 
     lines = []
     path = tmp_path / "study.json"

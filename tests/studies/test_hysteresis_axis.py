@@ -1,4 +1,4 @@
-"""The independent Bouc-Wen axis family (greybox.studies.hysteresis_axis): physics, logs, hidden effects."""
+"""The independent Bouc-Wen axis family (studies.hysteresis_axis): physics, logs, hidden effects."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from greybox.data.prepare import prepare
-from greybox.studies import hysteresis_axis as ha
+from studies import hysteresis_axis as ha
 
 SHORT_S = 10.0
 

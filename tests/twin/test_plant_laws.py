@@ -8,6 +8,8 @@ import math
 import numpy as np
 import plant_reference as ref
 import pytest
+from friction_reference import lugre_step_reference, stribeck_reference
+from friction_signals import STEP, velocity_profile
 
 from greybox.base import PlantLaw
 from greybox.friction import CoulombModel, GMSModel, LuGreModel
@@ -20,8 +22,6 @@ from greybox.friction.kernels import (
     stribeck_at,
 )
 from greybox.friction.plant_laws import MAX_STEP_RATIO, gms_plant_law, lugre_plant_law, stable_step
-from greybox.friction.reference import lugre_step_reference, stribeck_reference
-from greybox.friction.signals import STEP, velocity_profile
 from greybox.twin.plant import (
     default_plant_parameters,
     lag_decay,

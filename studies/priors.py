@@ -30,15 +30,15 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from ..atomic import write_text_atomic
-from ..data.prepare import prepare, trim
-from ..evaluate.records import TRUTH_CHANNEL
-from ..friction.gms import GMSModel
-from ..metrics import relative_error
-from ..models.gmssvr import GMSSVRModel
-from ..models.svr import SVRCurrentModel
-from ..twin.family import draw_member, member_dataset
-from .experiments import MODEL_SETTINGS
+from greybox.atomic import write_text_atomic
+from greybox.data.prepare import prepare, trim
+from greybox.evaluate.records import TRUTH_CHANNEL
+from greybox.friction.gms import GMSModel
+from greybox.metrics import relative_error
+from greybox.models.gmssvr import GMSSVRModel
+from greybox.models.svr import SVRCurrentModel
+from greybox.reproduce.experiments import MODEL_SETTINGS
+from greybox.twin.family import draw_member, member_dataset
 
 __all__ = ["CANDIDATES", "DEFAULT", "SVR_CANDIDATES", "SVR_DEFAULT", "STUDIES", "EQUIVALENT", "TRAIN_SHARE",
            "score_member", "run_prior_study"]

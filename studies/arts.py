@@ -5,7 +5,7 @@ Data: the harmonic tests of the ARTS-Lab friction device (D. Coble,
 Structural Control Systems", ARTS-Lab, 2024; CC BY-SA 4.0; cite it when using
 the data): ``test0.npy`` ... ``test12.npy``, 1024 Hz, displacement [mm],
 velocity [mm/s] and measured friction force [N] as read by
-:func:`greybox.data.arts.read_arts`. Amplitudes about 19 mm (test0-4), 39 mm
+:func:`studies.arts_data.read_arts`. Amplitudes about 19 mm (test0-4), 39 mm
 (test5-8) and 59 mm (test9-12); at each amplitude the tests run at 0.1, 0.25,
 0.5, 1 and 2 Hz (the 39 and 59 mm series without 2 Hz), seven periods each
 under a tapered envelope (two periods rising, three at full amplitude, two
@@ -45,17 +45,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import check_output_path, write_text_atomic
-from ..data.arts import read_arts
-from ..data.log import AxisLog
-from ..errors import GreyboxError
-from ..evaluate.plots import import_pyplot, save_figure
-from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from ..friction.backlash import BacklashModel
-from ..metrics import metrics_table
-from ..provenance import provenance, provenance_line
-from .auto import HeldOutChoice
-from .emps import learned_parameters
+from greybox.atomic import check_output_path, write_text_atomic
+from greybox.data.log import AxisLog
+from greybox.errors import GreyboxError
+from greybox.evaluate.plots import import_pyplot, save_figure
+from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.friction.backlash import BacklashModel
+from greybox.metrics import metrics_table
+from greybox.provenance import provenance, provenance_line
+from studies.arts_data import read_arts
+from studies.auto import HeldOutChoice
+from studies.emps import learned_parameters
 
 __all__ = ["TRAIN_FILES", "TEST_FILES", "FAST_FILES", "PLOT_FILES", "MODELS", "MODEL_NAMES", "benchmark_log",
            "run_benchmark", "markdown_table", "plot_loops", "arts_benchmark"]

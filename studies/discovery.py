@@ -45,22 +45,22 @@ from pathlib import Path
 import numpy as np
 from sklearn.base import clone
 
-from ..atomic import write_text_atomic
-from ..data.io import read_log
-from ..data.log import AxisLog
-from ..data.prepare import prepare
-from ..discover.augment import AugmentedModel
-from ..discover.effects import EFFECT_NAMES, VELOCITY_ONLY, EffectContext, effect
-from ..discover.noise import ResidualNoise
-from ..discover.report import write_json
-from ..discover.workflow import discover
-from ..friction import CoulombModel, GMSModel
-from ..metrics import relerr, rmse
-from ..twin import EFFECTS as TWIN_EFFECTS
-from ..twin import CurrentNoise, EffectInputs, axis_geometry, default_plant_parameters, make_dataset
-from ..twin import effect_current as twin_effect_current
-from .emps import BORDER as EMPS_BORDER
-from .emps import decimate_benchmark
+from greybox.atomic import write_text_atomic
+from greybox.data.io import read_log
+from greybox.data.log import AxisLog
+from greybox.data.prepare import prepare
+from greybox.discover.noise import ResidualNoise
+from greybox.discover.report import write_json
+from greybox.discover.workflow import discover
+from greybox.friction import CoulombModel, GMSModel
+from greybox.metrics import relerr, rmse
+from greybox.models.augmented import AugmentedModel
+from greybox.models.effects import EFFECT_NAMES, VELOCITY_ONLY, EffectContext, effect
+from greybox.twin import EFFECTS as TWIN_EFFECTS
+from greybox.twin import CurrentNoise, EffectInputs, axis_geometry, default_plant_parameters, make_dataset
+from greybox.twin import effect_current as twin_effect_current
+from studies.emps import BORDER as EMPS_BORDER
+from studies.emps import decimate_benchmark
 
 __all__ = ["PLANTS", "TRUE_SHAPES", "wilson_interval", "HIDDEN_LIBRARY_TERMS", "ABSORBED", "SECTIONS", "StudyCase",
            "case_logs", "null_logs", "run_case", "run_null", "summarise", "benchmark_relerr", "emps_section",
@@ -376,7 +376,7 @@ SECTIONS = {
 
 
 def benchmark_relerr(runs, prediction) -> float:
-    """relerr [%] on the EMPS benchmark's decimated samples of one run (:mod:`greybox.studies.emps`).
+    """relerr [%] on the EMPS benchmark's decimated samples of one run (:mod:`studies.emps`).
 
     Parameters
     ----------

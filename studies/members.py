@@ -8,7 +8,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from typing import Callable, Iterable
 
-from ..atomic import write_text_atomic
+from greybox.atomic import write_text_atomic
 
 __all__ = ["run_members"]
 

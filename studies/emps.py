@@ -49,17 +49,17 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import decimate
 
-from ..atomic import check_output_path, write_text_atomic
-from ..data.io import read_log
-from ..data.log import AxisLog
-from ..data.prepare import derive, trim
-from ..errors import GreyboxError
-from ..evaluate.plots import import_pyplot, save_figure
-from ..friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from ..friction.backlash import BacklashModel
-from ..metrics import relerr
-from ..provenance import provenance, provenance_line
-from .auto import HeldOutChoice
+from greybox.atomic import check_output_path, write_text_atomic
+from greybox.data.io import read_log
+from greybox.data.log import AxisLog
+from greybox.data.prepare import derive, trim
+from greybox.errors import GreyboxError
+from greybox.evaluate.plots import import_pyplot, save_figure
+from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.friction.backlash import BacklashModel
+from greybox.metrics import relerr
+from greybox.provenance import provenance, provenance_line
+from studies.auto import HeldOutChoice
 
 __all__ = ["TRAIN_FILE", "TEST_FILE", "PUBLISHED", "GREYBOX_MODELS", "IDIM_LS_MODELS", "MODEL_NAMES",
            "benchmark_log", "decimate_benchmark", "benchmark_relerr", "idim_ls", "learned_parameters",

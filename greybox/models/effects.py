@@ -1,5 +1,8 @@
 """The library of candidate effects: named parametric terms with physical regressors.
 
+The terms of the augmented model kind (:mod:`greybox.models.augmented`), the
+candidates that ``greybox discover`` (:mod:`greybox.discover`) searches.
+
 Each :class:`Effect` turns a prepared run into regressor columns, so that the
 effect's current is ``columns @ coefficients`` [A, or N for force logs]. Some
 effects also have one *shape* parameter that enters nonlinearly (a period in

@@ -12,7 +12,7 @@ from greybox.evaluate.records import NOISE_FLOOR
 from greybox.evaluate.report import svr_generalisation
 from greybox.metrics import rmse
 from greybox.persistence import load_model
-from greybox.studies.experiments import (
+from greybox.reproduce.experiments import (
     EXPERIMENTS,
     MODEL_SETTINGS,
     Experiment,

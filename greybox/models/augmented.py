@@ -1,7 +1,7 @@
 """A base current model plus named effect terms, fitted jointly.
 
 :class:`AugmentedModel` adds terms of the effect library
-(:mod:`greybox.discover.effects`) to a friction model and fits them together:
+(:mod:`greybox.models.effects`) to a friction model and fits them together:
 
 1. the base model is identified by its own ``fit`` (its nonlinear shape:
    Stribeck velocity, GMS element fractions, ...);
@@ -18,7 +18,7 @@
 
 Friction terms scale the friction of the base as identified in step 1 (or
 3) less its viscous part, over its level
-(:meth:`~greybox.discover.effects.EffectContext.friction_shape`): a friction
+(:meth:`~greybox.models.effects.EffectContext.friction_shape`): a friction
 that changes along the travel or with time is the base's sliding friction law
 scaled, its Stribeck curve and pre-sliding included, not the lubricant's
 viscous drag. That base is held
@@ -52,6 +52,7 @@ from ..friction.directions import viscous_columns
 from ..friction.gms import GMSModel
 from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
+from ..identify.projection import Nuisance, PositionScan, added_squares
 from .effects import (
     BASE_FRICTION,
     PERIOD_SEPARATION_STEPS,
@@ -61,7 +62,6 @@ from .effects import (
     period_scan,
     presliding_states,
 )
-from .projection import Nuisance, PositionScan, added_squares
 
 __all__ = ["AugmentedModel", "normalise_effects"]
 

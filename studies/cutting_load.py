@@ -51,16 +51,16 @@ from typing import Mapping
 
 import numpy as np
 
-from ..atomic import write_text_atomic
-from ..data.prepare import prepare
-from ..evaluate.report import MODEL_LABELS
-from ..metrics import rmse
-from ..predict.interval import calibrate_interval
-from ..predict.process import predict_process
-from ..twin.cutting import CuttingSpec
-from ..twin.family import draw_member, member_dataset
-from .experiments import EXPERIMENTS, MODEL_SETTINGS, Experiment, run_experiments
-from .members import run_members
+from greybox.atomic import write_text_atomic
+from greybox.data.prepare import prepare
+from greybox.evaluate.report import MODEL_LABELS
+from greybox.metrics import rmse
+from greybox.predict.interval import calibrate_interval
+from greybox.predict.process import predict_process
+from greybox.reproduce.experiments import EXPERIMENTS, MODEL_SETTINGS, Experiment, run_experiments
+from greybox.twin.cutting import CuttingSpec
+from greybox.twin.family import draw_member, member_dataset
+from studies.members import run_members
 
 __all__ = ["CUT", "TARGET_PCT", "COVERAGE", "COVERAGE_TARGET", "CALIBRATIONS", "PASSES", "run_member", "summarise",
            "cutting_load_markdown", "run_cutting_load_study"]
@@ -176,9 +176,9 @@ def _spread(values) -> dict:
 
 
 def summarise(rows: list[dict]) -> dict:
-    """Per model and conversion: median, 90th percentile and largest absolute mean force error per pass; RMS error.
+    """Per model and conversion: median, 90th percentile and largest |mean force error| per pass, and the RMS error.
 
-    ``met`` judges GMS+SVR with the axis file: the median absolute mean force error of each pass within
+    ``met`` judges GMS+SVR with the axis file: the median |mean force error| of each pass within
     :data:`TARGET_PCT`, with the share of members within it.
 
     Parameters

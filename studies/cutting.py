@@ -24,7 +24,7 @@ Protocol:
    perfect model would reach;
 6. the cut strength (and mean cut force) from which each model reaches the
    correlation target ``--target`` follows from the recovery error, which
-   does not depend on the strength (:mod:`greybox.studies.cut_recovery`);
+   does not depend on the strength (:mod:`studies.cut_recovery`);
    the swept logs check this.
 
 In the twin the cut changes neither the motion nor the noise, so the error of
@@ -50,21 +50,21 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import check_output_path, write_text_atomic
-from ..data.axis_config import read_axis_config
-from ..data.io import read_log
-from ..data.prepare import prepare
-from ..errors import GreyboxError
-from ..evaluate.plots import finish_figure, import_pyplot
-from ..evaluate.report import MODEL_LABELS as LABELS
-from ..metrics import rmse
-from ..models.chunked import predict_chunked
-from ..predict.process import predict_process
-from ..provenance import provenance, provenance_line
-from ..registry import MODEL_CLASSES
-from ..twin import make_dataset
-from ..twin.cutting import CuttingSpec
-from .cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
+from greybox.atomic import check_output_path, write_text_atomic
+from greybox.data.axis_config import read_axis_config
+from greybox.data.io import read_log
+from greybox.data.prepare import prepare
+from greybox.errors import GreyboxError
+from greybox.evaluate.plots import finish_figure, import_pyplot
+from greybox.evaluate.report import MODEL_LABELS as LABELS
+from greybox.metrics import rmse
+from greybox.models.chunked import predict_chunked
+from greybox.predict.process import predict_process
+from greybox.provenance import provenance, provenance_line
+from greybox.registry import MODEL_CLASSES
+from greybox.twin import make_dataset
+from greybox.twin.cutting import CuttingSpec
+from studies.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
 
 __all__ = ["TRAIN_FILES", "TEST_DATASETS", "KINDS", "DEFAULT_STRENGTHS", "CuttingCase", "evaluate_model",
            "detail_table", "sweep_table", "plot_correlation_vs_force", "CuttingValidation", "cutting_validation"]
@@ -395,7 +395,7 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
                 f"process RMSE {row['process_rmse_A']:.4f} A  r {swept}  "
                 f"|process error - air residual| <= {row['air_identity_A'] * 1e3:.2f} mA")
             if plot_dir:
-                from ..predict.plot import plot_process
+                from greybox.predict.plot import plot_process
 
                 plot_process(result, plot_dir / f"predict_{kind}_X_{case.dataset}.png")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..data.log import AxisLog
+from greybox.data.log import AxisLog
 
 #: Sample time of the synthetic logs [s] (500 Hz, as SINUMERIK traces).
 STEP = 0.002

@@ -17,7 +17,7 @@ These files are not read by :func:`greybox.data.io.read_log`: a ``.npy`` file
 carries neither column names nor units, and its extension is shared by every
 NumPy array, so reading any 4-column array as ``t, F, x, v`` in SI units would
 silently misread arrays of other origins. :func:`read_arts` is called by name
-(:mod:`greybox.studies.arts`).
+(:mod:`studies.arts`).
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import LogError
-from .log import AxisLog
-from .validate import check_finite, check_time
+from greybox.data.log import AxisLog
+from greybox.data.validate import check_finite, check_time
+from greybox.errors import LogError
 
 __all__ = ["ARTS_COLUMNS", "read_arts"]
 

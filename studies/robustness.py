@@ -6,7 +6,7 @@ cogging, noise and quantisation drawn from documented ranges):
 
 1. datasets A (training) and C (test) of the member, prepared like a real log;
 2. the models of experiment 1 of ``greybox reproduce`` (Coulomb, Stribeck,
-   LuGre, GMS, SVR, GMS+SVR; :data:`greybox.studies.experiments.EXPERIMENTS`)
+   LuGre, GMS, SVR, GMS+SVR; :data:`greybox.reproduce.experiments.EXPERIMENTS`)
    fitted on A with the reproduce settings, tested on C: test RE, and its
    ratio to the noise floor's RE (the RE of the noise-free current, what a
    perfect model reaches), and its ratio to the RE of noise and cogging
@@ -20,7 +20,7 @@ cogging, noise and quantisation drawn from documented ranges):
    of the RMS of the true process there. The true process current is the
    lossless one (``truth_process_A``, the force over ``K_0``), so the figure
    includes the friction the cut's load adds, which the efficiencies of the
-   member's axis file convert away (:mod:`greybox.studies.cutting_load`
+   member's axis file convert away (:mod:`studies.cutting_load`
    measures the force with them).
 
 Each model kind's median and 90th percentile over the members are the
@@ -37,16 +37,16 @@ from typing import Mapping
 
 import numpy as np
 
-from ..atomic import write_text_atomic
-from ..data.prepare import prepare
-from ..evaluate.records import TRUTH_CHANNEL
-from ..evaluate.report import MODEL_LABELS
-from ..metrics import relative_error
-from ..twin.cutting import CuttingSpec
-from ..twin.family import FAMILY_RANGES, draw_member, member_dataset
-from ..twin.laws import TRUTH_LAWS
-from .experiments import EXPERIMENTS, MODEL_SETTINGS, NOISE_FLOOR, run_experiments
-from .members import run_members
+from greybox.atomic import write_text_atomic
+from greybox.data.prepare import prepare
+from greybox.evaluate.records import TRUTH_CHANNEL
+from greybox.evaluate.report import MODEL_LABELS
+from greybox.metrics import relative_error
+from greybox.reproduce.experiments import EXPERIMENTS, MODEL_SETTINGS, NOISE_FLOOR, run_experiments
+from greybox.twin.cutting import CuttingSpec
+from greybox.twin.family import FAMILY_RANGES, draw_member, member_dataset
+from greybox.twin.laws import TRUTH_LAWS
+from studies.members import run_members
 
 __all__ = ["TARGETS", "run_member", "summarise", "robustness_markdown", "run_robustness_study"]
 

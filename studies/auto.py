@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import os
 
-from ..data.log import as_log_list
-from ..model_choice import choose_model
+from greybox.data.log import as_log_list
+from greybox.model_choice import choose_model
 
 __all__ = ["HeldOutChoice"]
 

@@ -95,7 +95,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 from scipy.signal import lfilter
 
-from ..data.log import AxisLog
+from greybox.data.log import AxisLog
 
 __all__ = ["HIDDEN_EFFECTS", "ROLES", "AXIS_RANGES", "EFFECT_RANGES", "SAMPLE_TIME_S", "SUBSTEPS", "TRAVEL_MM",
            "FEED_RANGE_MM_S", "ENCODER_RESOLUTION_MM", "FamilyCase", "AxisParameters", "Motion", "Modifiers",

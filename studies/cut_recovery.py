@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from ..metrics import rmse
+from greybox.metrics import rmse
 
 __all__ = ["recovery_metrics", "correlation_at_strength", "strength_for_correlation"]
 

@@ -11,12 +11,12 @@ from greybox.cli import main
 from greybox.data.axis_config import read_axis_config
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.studies.cutting_load import PASSES, TARGET_PCT, cutting_load_markdown, run_member, summarise
-from greybox.studies.experiments import QUICK_SETTINGS
+from greybox.reproduce.experiments import QUICK_SETTINGS
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
 from greybox.twin.drive import AXIS_EFFICIENCIES
 from greybox.twin.family import AXIS_FILE, draw_member, member_dataset
+from studies.cutting_load import PASSES, TARGET_PCT, cutting_load_markdown, run_member, summarise
 
 CUT_BOTH_WAYS = CuttingSpec(strength_A=1.0, return_pass=-0.6)
 

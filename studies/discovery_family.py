@@ -1,6 +1,6 @@
 """Validation of the discovery workflow on axes it was not developed on: the hysteresis family.
 
-The axes come from :mod:`greybox.studies.hysteresis_axis`, a simulator written
+The axes come from :mod:`studies.hysteresis_axis`, a simulator written
 apart from greybox's friction models and its synthetic twin: a Bouc-Wen
 hysteresis with Stribeck weakening, its own trajectories and noise, and its
 own implementation of every hidden effect. No library column is the hidden
@@ -14,7 +14,7 @@ others (four independent trajectories). It is scored against an *oracle*: the
 base model fitted to the training effort minus the true hidden current, and
 predicting the test effort with the true hidden current added. Gap closure =
 (test RMSE before - after) / (before - oracle). The base refinements of the
-workflow (:data:`greybox.discover.effects.REFINEMENTS`) fix part of the base's
+workflow (:data:`greybox.models.effects.REFINEMENTS`) fix part of the base's
 own misfit, which the oracle does not, so this closure can exceed 1 without the
 effect being found well; the *effect closure* compares like with like: before
 = the base with the refinements the workflow kept, oracle = the same fitted to
@@ -35,16 +35,16 @@ from dataclasses import asdict
 import numpy as np
 from sklearn.base import clone
 
-from ..atomic import write_text_atomic
-from ..data.prepare import prepare
-from ..discover.augment import AugmentedModel
-from ..discover.effects import REFINEMENTS
-from ..discover.report import write_json
-from ..discover.workflow import discover
-from ..friction import GMSModel
-from ..metrics import rmse
-from .discovery import wilson_interval
-from .hysteresis_axis import HIDDEN_EFFECTS, FamilyCase, family_logs
+from greybox.atomic import write_text_atomic
+from greybox.data.prepare import prepare
+from greybox.discover.report import write_json
+from greybox.discover.workflow import discover
+from greybox.friction import GMSModel
+from greybox.metrics import rmse
+from greybox.models.augmented import AugmentedModel
+from greybox.models.effects import REFINEMENTS
+from studies.discovery import wilson_interval
+from studies.hysteresis_axis import HIDDEN_EFFECTS, FamilyCase, family_logs
 
 __all__ = ["ACCEPTED_NULL_VERDICTS", "PERIOD_TOLERANCE", "run_family_case", "summarise_family", "family_markdown",
            "run_family_study"]
