@@ -2,10 +2,13 @@
 
 Usage::
 
-    python benchmarks/bench_monitor_detection.py [--seeds 5] [--days 56] [--start 35] [--rate 0.01] [--json]
+    python benchmarks/bench_monitor_detection.py [--seeds 5] [--first-seed 2000] [--days 56] [--start 35]
+        [--kinds lubrication,preload,backlash,defect,none] [--json]
 
-For each seed (1000, 1001, ...: apart from the tests' seeds) and each drift kind (lubrication, preload at
-``--rate`` per day from day ``--start``; none) the twin's X axis writes ``--days`` daily air-move logs
+For each seed (``--first-seed`` on: 2000 on are held out, used neither by the tests nor while the features
+and the detector were developed, which used seeds below 1000 and 1000-1014 for the first two kinds) and each
+drift kind at its documented rate (:data:`RATES`) from day ``--start`` (and none) the twin's X axis writes
+``--days`` daily air-move logs
 (in memory, :func:`greybox.twin.ageing.aged_log`), each is fingerprinted
 (:class:`greybox.monitor.fingerprint.FrictionFingerprint`, defaults) and the history is run through
 :class:`greybox.monitor.detect.ChangeDetector` (defaults: 28 baseline days, threshold calibrated for one
@@ -30,6 +33,15 @@ from greybox.monitor.history import SCHEMA, SCHEMA_VERSION
 from greybox.twin.ageing import Drift, aged_log
 
 DAY0 = dt.date(2026, 1, 1)
+#: The documented rate of each drift kind (per day: a fraction of the level, or mm of play).
+RATES = {"lubrication": 0.01, "preload": 0.01, "backlash": 0.0005, "defect": 0.02, "none": 0.0}
+#: The first alarm that names the right change: a level in the right direction, the backlash, the local excess.
+RIGHT = {
+    "lubrication": lambda a: a.direction == "rises" and a.feature.split("_")[0] in ("sliding", "breakaway"),
+    "preload": lambda a: a.direction == "falls" and a.feature.split("_")[0] in ("sliding", "breakaway"),
+    "backlash": lambda a: a.direction == "rises" and a.feature == "backlash",
+    "defect": lambda a: a.direction == "rises" and a.feature == "local_excess",
+}
 
 
 def history_table(seed: int, days: int, drifts) -> pa.Table:
@@ -45,22 +57,26 @@ def history_table(seed: int, days: int, drifts) -> pa.Table:
             rows[name].append(fitted.values_[name])
             rows[f"{name}_lo"].append(fitted.lower_[name])
             rows[f"{name}_hi"].append(fitted.upper_[name])
+        rows["map_position_mm"].append(fitted.map_position_mm_.tolist())
+        rows["map_excess_A"].append(fitted.map_excess_A_.tolist())
     return pa.Table.from_pydict(rows, schema=SCHEMA)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--first-seed", type=int, default=2000)
     parser.add_argument("--days", type=int, default=56)
     parser.add_argument("--start", type=int, default=35)
-    parser.add_argument("--rate", type=float, default=0.01)
+    parser.add_argument("--kinds", default=",".join(RATES))
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     results = {}
-    for kind in ("lubrication", "preload", "none"):
-        delays, named, false_alarms = [], [], 0
-        for seed in range(1000, 1000 + args.seeds):
-            drifts = [] if kind == "none" else [Drift(kind, args.start, args.rate)]
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    for kind in args.kinds.split(","):
+        delays, named, right, false_alarms = [], [], 0, 0
+        for seed in seeds:
+            drifts = [] if kind == "none" else [Drift(kind, args.start, RATES[kind])]
             detector = ChangeDetector().fit(history_table(seed, args.days, drifts))
             alarms = detector.alarms_
             if kind == "none":
@@ -73,20 +89,24 @@ def main() -> None:
                 first = min(after, key=lambda a: a.detected)
                 delays.append((first.detected - DAY0).days - args.start)
                 named.append(f"{first.feature} {first.direction}")
+                right += bool(RIGHT[kind](first))
             else:
                 delays.append(None)
                 named.append("not detected")
         watched = args.seeds * (args.days - 28) if kind == "none" else args.seeds * (args.start - 28)
-        results[kind] = {"delays_days": delays, "first_named": named, "false_alarms": false_alarms,
+        within = sum(d is not None and d <= 7 for d in delays)
+        results[kind] = {"rate_per_day": RATES[kind], "delays_days": delays, "within_7_days": within,
+                         "first_named": named, "right_first": right, "false_alarms": false_alarms,
                          "axis_days_watched_stable": watched}
     if args.json:
         print(json.dumps(results, indent=2))
         return
     for kind, r in results.items():
-        print(f"{kind}: delays {r['delays_days']} days, first alarm {r['first_named']}, false alarms "
+        print(f"{kind} (rate {r['rate_per_day']}/day): delays {r['delays_days']} days ({r['within_7_days']} within 7), "
+              f"first alarm {r['first_named']} ({r['right_first']} right), false alarms "
               f"{r['false_alarms']} in {r['axis_days_watched_stable']} stable axis-days after the baseline")
-    print(f"(seeds 1000-{999 + args.seeds}, {args.days} days, drift from day {args.start} at {args.rate} per day; "
-          f"the feature arrays: {', '.join(FEATURES)})")
+    print(f"(seeds {seeds.start}-{seeds.stop - 1}, {args.days} days, drifts from day {args.start}; "
+          f"features: {', '.join(FEATURES)})")
 
 
 if __name__ == "__main__":

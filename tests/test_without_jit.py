@@ -21,9 +21,9 @@ pytestmark = pytest.mark.slow
 ROOT = Path(__file__).resolve().parents[1]
 
 #: Test files of the compiled kernels: GMS and LuGre, SVR kernel sums, plant laws, JSON numbers and MCAP
-#: records, the controller, the truth laws of the family of axes.
+#: records, the controller, the truth laws of the family of axes, the ageing twin's play.
 KERNEL_TESTS = ("test_friction_kernels.py", "test_rbf.py", "test_plant_laws.py", "test_json_numbers.py",
-                "test_data_mcap.py", "test_control_pid.py", "test_twin_family.py")
+                "test_data_mcap.py", "test_control_pid.py", "test_twin_family.py", "test_twin_ageing.py")
 
 
 @pytest.mark.slow

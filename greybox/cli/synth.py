@@ -86,8 +86,8 @@ def add_parser(subparsers) -> None:
                              "DIR/<axis>_<YYYY-MM-DD>.mcap, with a day-to-day spread and the --drift given "
                              "(for greybox monitor)")
     parser.add_argument("--drift", action="append", default=[], metavar="KIND:START:RATE",
-                        help="with --history: a drift of every axis from day START (counted from 0) at RATE (a "
-                             "fraction of the friction level per day); KIND: " + "; ".join(DRIFT_KINDS.values())
+                        help="with --history: a drift of every axis from day START (counted from 0) at RATE per "
+                             "day; KIND: " + "; ".join(DRIFT_KINDS.values())
                              + " (repeatable)")
     parser.add_argument("--start-date", metavar="YYYY-MM-DD", default="2026-01-01",
                         help="with --history: the date of day 0 (default %(default)s)")

@@ -29,7 +29,7 @@ __all__ = ["HistoryError", "SCHEMA", "SCHEMA_VERSION", "append_fingerprint", "fi
            "read_history", "row_path"]
 
 #: Version of the row schema; a history written with another version is refused.
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 _KEY_FIELDS = [
     pa.field("schema_version", pa.int32(), nullable=False),
@@ -40,10 +40,14 @@ _KEY_FIELDS = [
     pa.field("source", pa.string()),
     pa.field("n_samples", pa.int64()),
 ]
-#: The row schema: keys, then each feature with the ends of its interval (``<feature>_lo``, ``<feature>_hi``).
+#: The row schema: keys, then each feature with the ends of its interval (``<feature>_lo``, ``<feature>_hi``),
+#: then the friction-along-travel map (bin centres and mean excess over the sliding level).
 SCHEMA = pa.schema(_KEY_FIELDS + [
     pa.field(f"{name}{suffix}", pa.float64(), metadata={"unit": FEATURE_UNITS[name]})
     for name in FEATURES for suffix in ("", "_lo", "_hi")
+] + [
+    pa.field("map_position_mm", pa.list_(pa.float64()), metadata={"unit": "mm"}),
+    pa.field("map_excess_A", pa.list_(pa.float64()), metadata={"unit": "A"}),
 ], metadata={"greybox.monitor.schema_version": str(SCHEMA_VERSION)})
 
 _NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
@@ -113,7 +117,7 @@ def has_log(history, sha256: str) -> Path | None:
 
 def append_fingerprint(history, *, machine: str, axis: str, date: dt.date, sha256: str, source: str,
                        n_samples: int, values: Mapping[str, float], lower: Mapping[str, float],
-                       upper: Mapping[str, float]) -> Path:
+                       upper: Mapping[str, float], map_position_mm=(), map_excess_A=()) -> Path:
     """Write the fingerprint of one log to the history (replacing the row of the same log).
 
     Parameters
@@ -132,6 +136,8 @@ def append_fingerprint(history, *, machine: str, axis: str, date: dt.date, sha25
         Number of samples fitted.
     values, lower, upper : mapping of str to float
         Point estimate and interval ends of each feature of :data:`~greybox.monitor.fingerprint.FEATURES`.
+    map_position_mm, map_excess_A : sequence of float, optional
+        The friction-along-travel map: bin centres [mm] and mean friction excess [A] (empty by default).
 
     Returns
     -------
@@ -144,6 +150,10 @@ def append_fingerprint(history, *, machine: str, axis: str, date: dt.date, sha25
            "log_sha256": [sha256], "source": [str(source)], "n_samples": [int(n_samples)]}
     for name in FEATURES:
         row[name], row[f"{name}_lo"], row[f"{name}_hi"] = [values[name]], [lower[name]], [upper[name]]
+    positions, excess = [float(p) for p in map_position_mm], [float(e) for e in map_excess_A]
+    if len(positions) != len(excess):
+        raise HistoryError(f"map of {len(positions)} positions and {len(excess)} values")
+    row["map_position_mm"], row["map_excess_A"] = [positions], [excess]
     table = pa.Table.from_pydict(row, schema=SCHEMA)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_output(path) as temporary:

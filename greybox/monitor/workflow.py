@@ -101,7 +101,8 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     fitted = (fingerprint or FrictionFingerprint()).fit(runs, unloaded=unloaded)
     written = append_fingerprint(history, machine=str(machine), axis=str(name), date=date, sha256=sha,
                                  source=Path(path).name, n_samples=fitted.n_samples_, values=fitted.values_,
-                                 lower=fitted.lower_, upper=fitted.upper_)
+                                 lower=fitted.lower_, upper=fitted.upper_,
+                                 map_position_mm=fitted.map_position_mm_, map_excess_A=fitted.map_excess_A_)
     return written, True
 
 
