@@ -3,12 +3,14 @@
 The page (``index.html``, readable in a browser without a server; figures embedded) has a table of the
 axes sorted by severity, a table of the alarms, and per axis a figure of every feature over the days:
 the daily value with its bootstrap interval, the baseline band (mean +- 2 standard deviations) over the
-baseline days, and the start and detection day of each alarm.
+baseline days, and the start and detection day of each alarm; and the friction-along-travel map: per day
+and position bin the friction's departure from its mean over the baseline days.
 """
 
 from __future__ import annotations
 
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +21,7 @@ from ..evaluate.table import Table
 from .detect import ChangeDetector
 from .fingerprint import FEATURE_UNITS
 
-__all__ = ["axis_figure", "write_report"]
+__all__ = ["axis_figure", "travel_map_figure", "write_report"]
 
 
 def axis_figure(trend, detector: ChangeDetector, path) -> Path:
@@ -71,6 +73,53 @@ def axis_figure(trend, detector: ChangeDetector, path) -> Path:
     return saved
 
 
+def travel_map_figure(trend, detector: ChangeDetector, path) -> Path | None:
+    """Write the friction-along-travel map of one axis: the departure from the baseline per day and position.
+
+    Parameters
+    ----------
+    trend : AxisTrend
+        The axis (:attr:`ChangeDetector.trends_`), with its daily map.
+    detector : ChangeDetector
+        The fitted detector (its baseline length).
+    path : path-like
+        PNG file to write.
+
+    Returns
+    -------
+    Path or None
+        ``path``, or None when the axis has no map.
+    """
+    centres, daily = trend.travel_map
+    if len(centres) == 0 or not np.any(np.isfinite(daily)):
+        return None
+    n_base = min(detector.baseline_days, len(trend.dates))
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        departure = daily - np.nanmean(daily[:n_base], axis=0)
+    plt = import_pyplot(path)
+    figure, ax = plt.subplots(figsize=(9, 2.8))
+    limit = float(np.nanmax(np.abs(departure))) or 1e-3
+    dates = np.array(trend.dates, dtype="datetime64[D]")
+    step = np.median(np.diff(centres)) if len(centres) > 1 else 1.0
+    image = ax.pcolormesh(np.append(dates, dates[-1] + np.timedelta64(1, "D")),
+                          np.append(centres - step / 2, centres[-1] + step / 2), np.ma.masked_invalid(departure.T),
+                          cmap="RdBu_r", vmin=-limit, vmax=limit, shading="flat")
+    figure.colorbar(image, ax=ax, label="friction vs baseline [A]")
+    for alarm in trend.alarms:
+        if np.isfinite(alarm.position_mm):
+            ax.plot(np.datetime64(alarm.detected, "D"), alarm.position_mm, "k*", ms=9)
+    ax.set_ylabel("position [mm]", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.set_title(f"{trend.machine} / {trend.axis}: friction along the travel, departure from the first {n_base} days "
+                 "(star: where an alarm found the largest departure)", fontsize=8)
+    figure.autofmt_xdate()
+    figure.tight_layout()
+    saved = save_figure(figure, path, dpi=90)
+    plt.close(figure)
+    return saved
+
+
 def write_report(detector: ChangeDetector, out_dir) -> Path:
     """Write the dashboard ``out_dir/index.html`` of a fitted detector.
 
@@ -112,8 +161,13 @@ def write_report(detector: ChangeDetector, out_dir) -> Path:
         for i, trend in enumerate(detector.trends_):
             png = axis_figure(trend, detector, Path(scratch) / f"axis_{i}.png")
             figures.append((f"{trend.machine} / {trend.axis} (severity {trend.severity:.2f})", png))
+            travel = travel_map_figure(trend, detector, Path(scratch) / f"travel_{i}.png")
+            if travel is not None:
+                figures.append((f"{trend.machine} / {trend.axis}: friction along the travel", travel))
         return write_html(out / "index.html", title="Friction fingerprints", tables=[axes_table, alarm_table],
                           figures=figures, embed=True,
                           intro="Per axis and day: sliding and break-away friction levels per direction, viscous "
-                                "coefficients and residual noise, fitted on the logs' stretches without process "
-                                "load, with 95 % block-bootstrap intervals.")
+                                "coefficients, residual noise, backlash width, amplitude of the lead-periodic "
+                                "friction and the largest local friction excess along the travel, fitted on the "
+                                "logs' stretches without process load, with 95 % bootstrap intervals; and the "
+                                "friction along the travel against its baseline.")
