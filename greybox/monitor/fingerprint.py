@@ -5,7 +5,8 @@ The fingerprint is fitted on the stretches of a log without process load:
 - an air cut (a dedicated run, e.g. of ``greybox plan``, or the twin's daily air moves) is unloaded
   throughout;
 - in a production log, the samples where a reference model's residual stays within its noise
-  (:func:`unloaded_samples`).
+  (:func:`unloaded_samples`), or where a spindle-load column says the spindle idles
+  (:func:`spindle_idle_samples`).
 
 On those samples, per direction of motion:
 
@@ -44,7 +45,8 @@ from ..data.log import AxisLog, as_log_list
 from ..errors import LogError, ParameterError
 from ..identify.static import fit_coulomb
 
-__all__ = ["FEATURES", "FEATURE_UNITS", "FrictionFingerprint", "reversal_widths", "unloaded_samples"]
+__all__ = ["FEATURES", "FEATURE_UNITS", "FrictionFingerprint", "reversal_widths", "spindle_idle_samples",
+           "unloaded_samples"]
 
 #: The fingerprint's features, in the order of every table, with their unit.
 FEATURE_UNITS = {
@@ -113,6 +115,40 @@ def unloaded_samples(residual, *, noise_A: float | None = None, factor: float = 
     return _moving_rms(r - np.median(r), int(window)) <= factor * noise_A
 
 
+def spindle_idle_samples(load, *, threshold: float | None = None, pad: int = 100) -> np.ndarray:
+    """Samples without process load by a spindle-load column: the spindle idles, and did so for a while.
+
+    Parameters
+    ----------
+    load : array_like, shape (n,)
+        Spindle load (any unit: %, A, kW); larger under cut.
+    threshold : float, optional
+        Load above which the spindle cuts, in the column's unit. By default the log's 5th percentile plus
+        a fifth of the span from its 5th to its 99th percentile (a log without a cut then has a span of
+        noise only: use ``threshold`` when whole logs may be without a cut).
+    pad : int, default 100
+        Samples (200 ms at 2 ms) on either side of a cut that count as loaded too (the axis load ramps in
+        and out with the engagement).
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        True where the sample is without process load.
+    """
+    values = np.asarray(load, dtype=float)
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise ParameterError("spindle load: the column is empty or has NaN or infinite values")
+    if threshold is None:
+        low, high = np.percentile(values, [5.0, 99.0])
+        threshold = low + 0.2 * (high - low)
+    if not np.isfinite(threshold) or isinstance(pad, bool) or not isinstance(pad, (int, np.integer)) or pad < 0:
+        raise ParameterError(f"spindle load: need a finite threshold and a non-negative pad, got {threshold}, {pad}")
+    cutting = (values > threshold).astype(float)
+    if pad:
+        cutting = np.convolve(cutting, np.ones(2 * int(pad) + 1), mode="same")
+    return cutting == 0.0
+
+
 def _block_indices(n: int, block: int, rng: np.random.Generator) -> np.ndarray:
     """Row indices of one moving-block bootstrap replicate of ``n`` rows in blocks of ``block`` rows."""
     block = min(block, n)
@@ -146,8 +182,10 @@ def _travel_features(x: np.ndarray, excess: np.ndarray, period_mm: float, bin_mm
     n_bins = int(index.max()) + 1
     counts = np.bincount(index, minlength=n_bins)
     width = design.shape[1]
-    gram = np.zeros((n_bins, width, width))
-    np.add.at(gram, index, design[:, :, None] * design[:, None, :])
+    gram = np.empty((n_bins, width, width))
+    for r in range(width):
+        for c in range(r, width):
+            gram[:, r, c] = gram[:, c, r] = np.bincount(index, weights=design[:, r] * design[:, c], minlength=n_bins)
     moment = np.stack([np.bincount(index, weights=design[:, c] * excess, minlength=n_bins) for c in range(width)],
                       axis=1)
     rows = np.stack([np.bincount(index, weights=design[:, c], minlength=n_bins) for c in range(width)], axis=1)
@@ -155,13 +193,17 @@ def _travel_features(x: np.ndarray, excess: np.ndarray, period_mm: float, bin_mm
     full = np.flatnonzero(counts >= min_count)
     local = np.full(n_bins, np.nan)
     fits = {}
+    gram_total, moment_total = gram.sum(axis=0), moment.sum(axis=0)
     interior = full[(full - 2 >= full.min()) & (full + 2 <= full.max())]  # the fit is not extrapolated there
     for j in interior:
         near = slice(max(0, j - 1), j + 2)
-        kept_gram = gram.sum(axis=0) - gram[near].sum(axis=0)
-        if np.sum(counts) - np.sum(counts[near]) < 2 * width or np.linalg.cond(kept_gram) > 1e10:
+        kept_gram = gram_total - gram[near].sum(axis=0)
+        if np.sum(counts) - np.sum(counts[near]) < 2 * width:
             continue
-        coef = np.linalg.solve(kept_gram, moment.sum(axis=0) - moment[near].sum(axis=0))
+        try:
+            coef = np.linalg.solve(kept_gram, moment_total - moment[near].sum(axis=0))
+        except np.linalg.LinAlgError:
+            continue
         local[j] = (total[j] - rows[j] @ coef) / counts[j]
         fits[j] = coef
     if not fits:

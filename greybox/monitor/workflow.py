@@ -8,11 +8,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
+import numpy as np
+
 from ..data.io import read_log
 from ..data.prepare import prepare
 from ..errors import GreyboxError, LogError
 from .detect import ChangeDetector
-from .fingerprint import FrictionFingerprint, unloaded_samples
+from .fingerprint import FrictionFingerprint, spindle_idle_samples, unloaded_samples
 from .history import append_fingerprint, file_sha256, has_log, read_history, row_path
 from .report import write_report
 
@@ -48,6 +50,7 @@ def log_date(log, path) -> dt.date:
 
 
 def fingerprint_file(path, history, *, machine: str | None = None, axis: str | None = None, model=None,
+                     spindle_column: str | None = None,
                      fingerprint: FrictionFingerprint | None = None) -> tuple[Path, bool]:
     """Fingerprint one log file into the history, unless the same file is there already.
 
@@ -63,7 +66,11 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
         Axis to read from a file of several axes (and its name); default the log's own axis.
     model : estimator, optional
         Reference model of the axis: only the samples where its residual stays within its noise are fitted
-        (:func:`~greybox.monitor.fingerprint.unloaded_samples`); without it the whole log is taken as an air cut.
+        (:func:`~greybox.monitor.fingerprint.unloaded_samples`); without it (and without ``spindle_column``)
+        the whole log is taken as an air cut.
+    spindle_column : str, optional
+        Column of the log with the spindle load: only the samples where the spindle idles are fitted
+        (:func:`~greybox.monitor.fingerprint.spindle_idle_samples`); with ``model`` too, only those both keep.
     fingerprint : FrictionFingerprint, optional
         Settings of the fit; default :class:`FrictionFingerprint()`.
 
@@ -91,13 +98,20 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     target = row_path(history, str(machine), str(name), date, sha)
     if has_log(history, sha) == target:
         return target, False
+    if spindle_column is not None and spindle_column not in log.extras:
+        raise LogError(path, f"no spindle-load column {spindle_column!r}; the log has "
+                             f"{', '.join(sorted(log.extras)) or 'no extra columns'}")
     runs = prepare(log)
     unloaded = None
-    if model is not None:
+    if model is not None or spindle_column is not None:
         unloaded = []
         for run in runs:
-            residual = run.effort - model.predict(run)
-            unloaded.append(unloaded_samples(residual))
+            keep = np.ones(len(run), dtype=bool)
+            if model is not None:
+                keep &= unloaded_samples(run.effort - model.predict(run))
+            if spindle_column is not None:
+                keep &= spindle_idle_samples(run.extras[spindle_column])
+            unloaded.append(keep)
     fitted = (fingerprint or FrictionFingerprint()).fit(runs, unloaded=unloaded)
     written = append_fingerprint(history, machine=str(machine), axis=str(name), date=date, sha256=sha,
                                  source=Path(path).name, n_samples=fitted.n_samples_, values=fitted.values_,
@@ -129,7 +143,7 @@ class MonitorResult:
 
 
 def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
-                model_path=None, baseline_days: int = 28,
+                model_path=None, spindle_column: str | None = None, baseline_days: int = 28,
                 progress: Callable[[str], None] | None = None) -> MonitorResult:
     """Fingerprint ``logs`` into ``history``, detect changes over the whole history, write the dashboard.
 
@@ -147,6 +161,8 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         Axis to read from files of several axes.
     model_path : path-like, optional
         Reference model file (``greybox train``) to find the stretches without process load.
+    spindle_column : str, optional
+        Column of the logs with the spindle load, to find the stretches without process load.
     baseline_days : int, default 28
         Days that set each feature's baseline.
     progress : callable, optional
@@ -167,7 +183,8 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         model = load_model(model_path)
     fitted = known = 0
     for path in logs:
-        row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model)
+        row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model,
+                                    spindle_column=spindle_column)
         fitted, known = fitted + new, known + (not new)
         if progress is not None:
             progress(f"{path}: {'fingerprinted' if new else 'already in the history'} -> {row}")

@@ -60,6 +60,10 @@ MIN_LEVEL_FACTOR = 0.2
 DEFECT_CENTRE_OFFSET_MM = -12.0
 #: Width [mm] of the defect's stretch (a raised cosine of this full width).
 DEFECT_WIDTH_MM = 6.0
+#: Spindle load [%] of an idle spindle, and its rise [%] per ampere of process current over the cut's strength.
+SPINDLE_IDLE_PCT, SPINDLE_CUT_PCT = 5.0, 60.0
+#: Name of the spindle-load column of the production days.
+SPINDLE_COLUMN = "spindle_load_pct"
 #: Feeds [mm/min] of the daily air moves, slowest first.
 AIR_MOVE_FEEDS_MM_MIN = (60.0, 300.0, 900.0, 1500.0, 2400.0)
 #: Dataset label of the daily logs (it seeds their noise with the day's seed).
@@ -342,8 +346,13 @@ def _day_seed(seed: int, day: int, axis: str) -> int:
 
 
 def aged_log(axis: str, day: int, seed: int, drifts: Sequence[Drift] = (), *,
-             start_date: dt.date = dt.date(2026, 1, 1), machine: str = "twin"):
-    """The air-move log of ``axis`` on ``day`` of the ageing twin.
+             start_date: dt.date = dt.date(2026, 1, 1), machine: str = "twin", cutting=None):
+    """The air-move (or production) log of ``axis`` on ``day`` of the ageing twin.
+
+    With ``cutting`` the day is a production day: the same moves, the strokes in the cutting direction
+    cutting across the workpiece (:mod:`greybox.twin.cutting`), the others air moves, and a spindle-load
+    column :data:`SPINDLE_COLUMN` [%]: :data:`SPINDLE_IDLE_PCT` idle, plus :data:`SPINDLE_CUT_PCT` times the
+    process current over the cut's strength, plus 0.5 % of noise.
 
     Parameters
     ----------
@@ -359,6 +368,8 @@ def aged_log(axis: str, day: int, seed: int, drifts: Sequence[Drift] = (), *,
         Calendar date of day 0.
     machine : str, default "twin"
         Machine name written to the log's attributes.
+    cutting : CuttingSpec, optional
+        Cutting conditions of a production day (none: an air-move day).
 
     Returns
     -------
@@ -377,7 +388,11 @@ def aged_log(axis: str, day: int, seed: int, drifts: Sequence[Drift] = (), *,
     defect = float(sum(d.defect_gain(day) for d in drifts))
     plant = AgedPlant(plant, play, defect, geometry.window_centre_mm + DEFECT_CENTRE_OFFSET_MM, DEFECT_WIDTH_MM)
     log = make_dataset(geometry.name, HISTORY_DATASET, _day_seed(seed, day, geometry.name),
-                       plant=plant, trajectory=air_move_trajectory(geometry.name))
+                       plant=plant, trajectory=air_move_trajectory(geometry.name), cutting=cutting)
+    if cutting is not None:
+        spindle = SPINDLE_IDLE_PCT + SPINDLE_CUT_PCT * np.abs(log.extras["truth_process_A"]) / cutting.strength_A
+        spindle = spindle + rng.normal(0.0, 0.5, len(log))
+        log = log.replace(extras={**log.extras, SPINDLE_COLUMN: np.round(spindle, 2)})
     date = start_date + dt.timedelta(days=int(day))
     attrs = {**log.attrs, "date": date.isoformat(), "machine": machine, "day": int(day),
              "drift": {"drifts": [{"kind": d.kind, "start_day": int(d.start_day), "rate": float(d.rate)}
@@ -388,9 +403,9 @@ def aged_log(axis: str, day: int, seed: int, drifts: Sequence[Drift] = (), *,
 
 def synthesize_history(axes: Sequence[str], days: int, seed: int, out_dir, drifts: Sequence[Drift] = (), *,
                        start_date: dt.date = dt.date(2026, 1, 1), machine: str = "twin",
-                       truth_channels: Sequence[str] | None = None,
+                       truth_channels: Sequence[str] | None = None, cutting=None,
                        progress: Callable[[str], None] | None = None) -> list[Path]:
-    """Write ``days`` daily air-move logs per axis as ``out_dir/<axis>_<date>.mcap``.
+    """Write ``days`` daily air-move (or production) logs per axis as ``out_dir/<axis>_<date>.mcap``.
 
     Parameters
     ----------
@@ -410,6 +425,8 @@ def synthesize_history(axes: Sequence[str], days: int, seed: int, out_dir, drift
         Machine name written to the logs.
     truth_channels : sequence of str, optional
         Truth channels kept (:func:`greybox.twin.datasets.stored`); all by default.
+    cutting : CuttingSpec, optional
+        Production days: cutting conditions (:func:`aged_log`); the spindle-load column is kept.
     progress : callable, optional
         Called with one line per axis written.
 
@@ -427,10 +444,13 @@ def synthesize_history(axes: Sequence[str], days: int, seed: int, out_dir, drift
     written = []
     for axis in axes:
         for day in range(days):
-            log = aged_log(axis, day, seed, drifts, start_date=start_date, machine=machine)
+            log = aged_log(axis, day, seed, drifts, start_date=start_date, machine=machine, cutting=cutting)
             path = out / f"{log.axis}_{log.attrs['date']}.mcap"
-            write_log(stored(log, truth_channels), path)
+            kept = stored(log, truth_channels)
+            if SPINDLE_COLUMN in log.extras:
+                kept = kept.replace(extras={**kept.extras, SPINDLE_COLUMN: log.extras[SPINDLE_COLUMN]})
+            write_log(kept, path)
             written.append(path)
         if progress is not None:
-            progress(f"{axis}: {days} daily air-move logs from {start_date.isoformat()} -> {out}")
+            progress(f"{axis}: {days} daily {'production' if cutting is not None else 'air-move'} logs from {start_date.isoformat()} -> {out}")
     return written

@@ -109,7 +109,7 @@ def test_corrupt_history_one_line_exit_2(twin_days, tmp_path, capsys):
     (["--history", "3", "--axis", "X", "--drift", "rust:1:0.1"], "unknown drift kind 'rust'"),
     (["--history", "3", "--axis", "X", "--drift", "lubrication:1"], "expected KIND:START:RATE"),
     (["--history", "3", "--axis", "X", "--drift", "preload:-1:0.1"], "start day must be a non-negative"),
-    (["--history", "3", "--axis", "X", "--cutting"], "--cutting does not apply"),
+    (["--history", "3", "--axis", "X", "--effect", "constant_offset"], "--effect does not apply"),
     (["--history", "3", "--axis", "X", "--start-date", "May 1"], "--start-date 'May 1'"),
     (["--axis", "X", "--drift", "none"], "--drift needs --history DAYS"),
     (["--history", "0", "--axis", "X"], "argument --history"),
@@ -181,3 +181,22 @@ def test_reference_model_leaves_out_a_process_load(twin_days, tmp_path, capsys):
     assert main(["monitor", str(cut), "--model", str(garbage), "--history", str(tmp_path / "h3"),
                  "--out", str(tmp_path / "r")]) == 2
     assert "garbage.gbx" in _error(capsys)
+
+
+def test_production_days_fingerprinted_by_their_spindle_load(tmp_path, capsys):
+    logs = tmp_path / "logs"
+    assert main(["synth", "--history", "3", "--axis", "X", "--seed", "4", "--cutting", "--out", str(logs),
+                 "--truth", "essential"]) == 0
+    files = sorted(str(p) for p in logs.iterdir())
+    log = read_log(files[0])
+    assert "spindle_load_pct" in log.extras and np.count_nonzero(log.extras["truth_process_A"]) > 500
+    capsys.readouterr()
+    assert main(["monitor", files[0], "--history", str(tmp_path / "h"), "--out", str(tmp_path / "r"),
+                 "--spindle-load", "nosuch", "--baseline-days", "3"]) == 2
+    assert "no spindle-load column 'nosuch'" in _error(capsys)
+    assert main(["monitor", *files, "--history", str(tmp_path / "h"), "--out", str(tmp_path / "r"),
+                 "--spindle-load", "spindle_load_pct", "--baseline-days", "3"]) == 0
+    table = read_history(tmp_path / "h")
+    whole = fingerprint_file(files[0], tmp_path / "whole")[0]
+    noise_whole = pq.read_table(whole).column("noise")[0].as_py()
+    assert table.num_rows == 3 and table.column("noise")[0].as_py() < 0.7 * noise_whole  # the cut left out

@@ -8,7 +8,13 @@ import pytest
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.errors import LogError, ParameterError
-from greybox.monitor.fingerprint import FEATURES, FrictionFingerprint, reversal_widths, unloaded_samples
+from greybox.monitor.fingerprint import (
+    FEATURES,
+    FrictionFingerprint,
+    reversal_widths,
+    spindle_idle_samples,
+    unloaded_samples,
+)
 from greybox.twin.ageing import (
     DEFECT_CENTRE_OFFSET_MM,
     DEFECT_WIDTH_MM,
@@ -166,3 +172,35 @@ def test_periodic_amplitude_follows_the_screw_lead_component():
     assert amplitudes[0] < 0.5 * base.lead_gain * level  # the noise floor of an amplitude
     assert amplitudes[1] < amplitudes[2] and amplitudes[2] - amplitudes[1] == pytest.approx(
         base.lead_gain * level, rel=0.4)
+
+
+def test_spindle_idle_samples_pad_the_cuts():
+    load = np.full(1000, 5.0)
+    load[400:500] = 60.0
+    idle = spindle_idle_samples(load, pad=10)
+    assert not idle[390:510].any() and idle[:390].all() and idle[510:].all()
+    assert spindle_idle_samples(load, threshold=70.0).all()  # a threshold above every value: no cut
+    for bad in ([], [1.0, np.nan]):
+        with pytest.raises(ParameterError, match="spindle load"):
+            spindle_idle_samples(bad)
+    with pytest.raises(ParameterError, match="pad"):
+        spindle_idle_samples(load, pad=-1)
+
+
+def test_production_day_fingerprint_by_its_spindle_load():
+    from greybox.twin.ageing import SPINDLE_COLUMN
+    from greybox.twin.cutting import CuttingSpec
+
+    air = FrictionFingerprint(n_boot=20).fit(prepare(aged_log("X", 3, 4)))
+    runs = prepare(aged_log("X", 3, 4, cutting=CuttingSpec()))
+    idle = [spindle_idle_samples(run.extras[SPINDLE_COLUMN]) for run in runs]
+    assert all(np.max(np.abs(run.extras["truth_process_A"][keep])) < 0.05 for run, keep in zip(runs, idle))
+    assert all(np.count_nonzero(run.extras["truth_process_A"]) > 500 for run in runs)  # there was a cut
+    by_spindle = FrictionFingerprint(n_boot=20).fit(runs, unloaded=idle)
+    whole = FrictionFingerprint(n_boot=20).fit(runs)
+    for name in ("noise", "local_excess"):  # the cut (negative strokes) biases a whole-log fit
+        assert abs(by_spindle.values_[name] - air.values_[name]) < 0.5 * abs(whole.values_[name] - air.values_[name])
+    # the idle negative strokes are only their ends: fewer speeds, the level trades off with the viscous part
+    assert abs(by_spindle.values_["sliding_neg"] - air.values_["sliding_neg"]) < abs(
+        whole.values_["sliding_neg"] - air.values_["sliding_neg"])
+    assert by_spindle.values_["sliding_pos"] == pytest.approx(air.values_["sliding_pos"], abs=0.01)
