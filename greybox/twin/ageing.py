@@ -452,5 +452,6 @@ def synthesize_history(axes: Sequence[str], days: int, seed: int, out_dir, drift
             write_log(kept, path)
             written.append(path)
         if progress is not None:
-            progress(f"{axis}: {days} daily {'production' if cutting is not None else 'air-move'} logs from {start_date.isoformat()} -> {out}")
+            kind = "production" if cutting is not None else "air-move"
+            progress(f"{axis}: {days} daily {kind} logs from {start_date.isoformat()} -> {out}")
     return written
