@@ -10,7 +10,9 @@ and the detector were developed, which used seeds below 1000 and 1000-1014 for t
 drift kind at its documented rate (:data:`RATES`) from day ``--start`` (and none) the twin's X axis writes
 ``--days`` daily air-move logs
 (in memory, :func:`greybox.twin.ageing.aged_log`), each is fingerprinted
-(:class:`greybox.monitor.fingerprint.FrictionFingerprint`, defaults) and the history is run through
+(:class:`greybox.monitor.fingerprint.FrictionFingerprint`, defaults but ``--n-boot`` bootstrap replicates,
+20 by default: the detector uses the point estimates, which the replicates do not change; the days before the
+onset, the same for every kind, are fingerprinted once per seed) and the history is run through
 :class:`greybox.monitor.detect.ChangeDetector` (defaults: 28 baseline days, threshold calibrated for one
 false alarm per axis-year). Printed per drift kind: the days from the onset to the first alarm of each
 seed, the feature and direction it named, and the alarms of the stable axes (with the axis-days watched
@@ -34,7 +36,7 @@ from greybox.twin.ageing import Drift, aged_log
 
 DAY0 = dt.date(2026, 1, 1)
 #: The documented rate of each drift kind (per day: a fraction of the level, or mm of play).
-RATES = {"lubrication": 0.01, "preload": 0.01, "backlash": 0.0005, "defect": 0.02, "none": 0.0}
+RATES = {"lubrication": 0.01, "preload": 0.01, "backlash": 0.0005, "defect": 0.03, "none": 0.0}
 #: The first alarm that names the right change: a level in the right direction, the backlash, the local excess.
 RIGHT = {
     "lubrication": lambda a: a.direction == "rises" and a.feature.split("_")[0] in ("sliding", "breakaway"),
@@ -44,22 +46,19 @@ RIGHT = {
 }
 
 
-def history_table(seed: int, days: int, drifts) -> pa.Table:
-    rows = {name: [] for name in SCHEMA.names}
-    for day in range(days):
-        fitted = FrictionFingerprint().fit(prepare(aged_log("X", day, seed, drifts)))
-        key = {"schema_version": SCHEMA_VERSION, "machine": f"twin{seed}", "axis": "X",
-               "date": DAY0 + dt.timedelta(days=day), "log_sha256": f"{day:064x}", "source": "",
-               "n_samples": fitted.n_samples_}
-        for name, value in key.items():
-            rows[name].append(value)
-        for name in FEATURES:
-            rows[name].append(fitted.values_[name])
-            rows[f"{name}_lo"].append(fitted.lower_[name])
-            rows[f"{name}_hi"].append(fitted.upper_[name])
-        rows["map_position_mm"].append(fitted.map_position_mm_.tolist())
-        rows["map_excess_A"].append(fitted.map_excess_A_.tolist())
-    return pa.Table.from_pydict(rows, schema=SCHEMA)
+def fingerprint_row(seed: int, day: int, drifts, n_boot: int) -> dict:
+    fitted = FrictionFingerprint(n_boot=n_boot).fit(prepare(aged_log("X", day, seed, drifts)))
+    row = {"schema_version": SCHEMA_VERSION, "machine": f"twin{seed}", "axis": "X",
+           "date": DAY0 + dt.timedelta(days=day), "log_sha256": f"{day:064x}", "source": "",
+           "n_samples": fitted.n_samples_, "map_position_mm": fitted.map_position_mm_.tolist(),
+           "map_excess_A": fitted.map_excess_A_.tolist()}
+    for name in FEATURES:
+        row[name], row[f"{name}_lo"], row[f"{name}_hi"] = fitted.values_[name], fitted.lower_[name], fitted.upper_[name]
+    return row
+
+
+def history_table(rows: list) -> pa.Table:
+    return pa.Table.from_pylist(rows, schema=SCHEMA)
 
 
 def main() -> None:
@@ -69,15 +68,20 @@ def main() -> None:
     parser.add_argument("--days", type=int, default=56)
     parser.add_argument("--start", type=int, default=35)
     parser.add_argument("--kinds", default=",".join(RATES))
+    parser.add_argument("--n-boot", type=int, default=20)
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     results = {}
     seeds = range(args.first_seed, args.first_seed + args.seeds)
-    for kind in args.kinds.split(","):
+    kinds = args.kinds.split(",")
+    # the days before the onset are the same for every kind (no drift acts yet): fingerprinted once per seed
+    before = {seed: [fingerprint_row(seed, day, [], args.n_boot) for day in range(args.start)] for seed in seeds}
+    for kind in kinds:
         delays, named, right, false_alarms = [], [], 0, 0
         for seed in seeds:
             drifts = [] if kind == "none" else [Drift(kind, args.start, RATES[kind])]
-            detector = ChangeDetector().fit(history_table(seed, args.days, drifts))
+            after = [fingerprint_row(seed, day, drifts, args.n_boot) for day in range(args.start, args.days)]
+            detector = ChangeDetector().fit(history_table(before[seed] + after))
             alarms = detector.alarms_
             if kind == "none":
                 false_alarms += len(alarms)

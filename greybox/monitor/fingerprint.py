@@ -24,12 +24,12 @@ On those samples, per direction of motion:
 - friction along the travel: on the samples at sliding speed, the friction's excess over its direction's
   sliding level [A] (both directions pooled), as a map of mean excess per ``map_bin_mm`` bin of absolute
   position (:attr:`FrictionFingerprint.map_position_mm_`, :attr:`FrictionFingerprint.map_excess_A_`), and
-  two features of it: the local excess, the largest mean residual of a bin under a least-squares fit of a
-  quadratic trend along the travelled stretch and a component periodic in ``period_mm`` (the screw lead)
-  to all samples but those of the bin and its two neighbours, over the bins at least two bins inside the
-  travelled stretch (a stretch of raised friction, a damaged screw section, lifts it and cannot pull the fit
-  up to itself); and the amplitude of the periodic
-  component of the fit without the stretch of the largest local excess.
+  two features of it: the local excess, the largest mean residual of a bin under a linear trend along the
+  travel fitted to all samples but those of the bin and its two neighbours, after the component periodic
+  in ``period_mm`` (the screw lead, fitted with a trend to all samples) is taken off, over the bins at least
+  two bins inside the travelled stretch (a stretch of raised friction, a damaged screw section, lifts it
+  and cannot pull the trend up to itself); and the amplitude of the periodic component, fitted with the
+  trend without the stretch of the largest local excess.
 
 Intervals come from a moving-block bootstrap (the backlash width's from the reversals drawn with
 replacement): blocks of contiguous samples (default 0.2 s, much longer than the
@@ -157,21 +157,23 @@ def _block_indices(n: int, block: int, rng: np.random.Generator) -> np.ndarray:
 
 
 def _travel_design(x: np.ndarray, period_mm: float) -> np.ndarray:
-    """Columns of the fit along the travel: 1, u, u^2 (u the position scaled to [-1, 1]), sin, cos of the period."""
+    """Columns of the fit along the travel: 1, u (the position scaled to [-1, 1]), sin, cos of the period."""
     low, high = float(np.min(x)), float(np.max(x))
     u = (2.0 * x - low - high) / max(high - low, 1e-12)
     phase = 2.0 * np.pi * x / period_mm
-    return np.column_stack([np.ones_like(x), u, u * u, np.sin(phase), np.cos(phase)])
+    return np.column_stack([np.ones_like(x), u, np.sin(phase), np.cos(phase)])
 
 
 def _travel_features(x: np.ndarray, excess: np.ndarray, period_mm: float, bin_mm: float, min_count: int,
                      ) -> tuple[float, float, np.ndarray, np.ndarray]:
     """Periodic amplitude [A], local excess [A] and the map (bin centres [mm], mean excess [A]) of one sample set.
 
-    The local excess of a bin is its mean residual under the fit of trend and periodic part to all samples
-    but those of the bin and its two neighbours (a deleted residual: a raised stretch cannot pull the fit up
-    to itself); the local excess is the largest of them, and the periodic amplitude is that of the fit
-    without the stretch of the largest one.
+    A linear trend and the periodic part are fitted to all samples; the local excess of a bin is its mean
+    residual under the trend refitted (the periodic part kept) to all samples but those of the bin and its
+    two neighbours (a deleted residual: a raised stretch cannot pull the trend up to itself), over the bins
+    at least two bins inside the travelled stretch (no extrapolation). The local excess is the largest of
+    them, and the periodic amplitude that of the fit of trend and periodic part without the stretch of the
+    largest one.
     """
     if len(x) < 6:
         return np.nan, np.nan, np.empty(0), np.empty(0)
@@ -181,36 +183,24 @@ def _travel_features(x: np.ndarray, excess: np.ndarray, period_mm: float, bin_mm
     index = bins - first
     n_bins = int(index.max()) + 1
     counts = np.bincount(index, minlength=n_bins)
-    width = design.shape[1]
-    gram = np.empty((n_bins, width, width))
-    for r in range(width):
-        for c in range(r, width):
-            gram[:, r, c] = gram[:, c, r] = np.bincount(index, weights=design[:, r] * design[:, c], minlength=n_bins)
-    moment = np.stack([np.bincount(index, weights=design[:, c] * excess, minlength=n_bins) for c in range(width)],
-                      axis=1)
-    rows = np.stack([np.bincount(index, weights=design[:, c], minlength=n_bins) for c in range(width)], axis=1)
-    total = np.bincount(index, weights=excess, minlength=n_bins)
     full = np.flatnonzero(counts >= min_count)
-    local = np.full(n_bins, np.nan)
-    fits = {}
-    gram_total, moment_total = gram.sum(axis=0), moment.sum(axis=0)
     interior = full[(full - 2 >= full.min()) & (full + 2 <= full.max())]  # the fit is not extrapolated there
-    for j in interior:
-        near = slice(max(0, j - 1), j + 2)
-        kept_gram = gram_total - gram[near].sum(axis=0)
-        if np.sum(counts) - np.sum(counts[near]) < 2 * width:
-            continue
-        try:
-            coef = np.linalg.solve(kept_gram, moment_total - moment[near].sum(axis=0))
-        except np.linalg.LinAlgError:
-            continue
-        local[j] = (total[j] - rows[j] @ coef) / counts[j]
-        fits[j] = coef
-    if not fits:
-        return np.nan, np.nan, np.empty(0), np.empty(0)
-    worst = max(fits, key=lambda j: local[j])
     centres = (full + first + 0.5) * bin_mm
-    return float(np.hypot(fits[worst][3], fits[worst][4])), float(local[worst]), centres, total[full] / counts[full]
+    level = np.bincount(index, weights=excess, minlength=n_bins)[full] / np.maximum(counts[full], 1)
+    if not len(interior):
+        return np.nan, np.nan, centres, level
+    coef = np.linalg.lstsq(design, excess, rcond=None)[0]
+    trend = excess - design[:, 2:] @ coef[2:]  # the excess less its periodic part
+    local = np.full(n_bins, -np.inf)
+    for j in interior:
+        out = np.abs(index - j) <= 1
+        line = np.linalg.lstsq(design[~out, :2], trend[~out], rcond=None)[0]
+        inside = index == j
+        local[j] = float(np.mean(trend[inside] - design[inside, :2] @ line))
+    worst = int(np.argmax(local))
+    kept = np.abs(index - worst) > 1
+    refit = np.linalg.lstsq(design[kept], excess[kept], rcond=None)[0]
+    return float(np.hypot(refit[2], refit[3])), float(local[worst]), centres, level
 
 
 def _features(x: np.ndarray, v: np.ndarray, a: np.ndarray, y: np.ndarray, sliding_speed: float,
