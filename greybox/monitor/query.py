@@ -4,8 +4,9 @@
 of the last ``days`` days (up to the history's latest day, or ``until``) against the baseline (the first
 ``baseline_days`` days of that axis with a fingerprint, mean and sample standard deviation, as the change
 detector takes it), in baseline standard deviations; per axis the feature with the largest absolute change.
-Only the Parquet files are read (every row file of the history, or the files of a compacted copy): the
-history's layout and schema are those of :mod:`greybox.monitor.history`.
+Every Parquet file of the history is read (row files and compacted files, a log's row file winning over its
+row in a compacted file, as :func:`~greybox.monitor.history.read_history` does); a history of one file per
+log is slow to read (milliseconds per file): :func:`~greybox.monitor.history.compact_history` first.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import pyarrow as pa
 
 from ..errors import ParameterError
 from .fingerprint import FEATURES
-from .history import SCHEMA_VERSION, HistoryError
+from .history import COMPACTED_NAME, SCHEMA_VERSION, HistoryError
 
 __all__ = ["changed_most"]
 
@@ -79,7 +80,11 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
     names = ", ".join(f'"{f}"' for f in chosen)
     end = "(SELECT max(date) FROM daily)" if until is None else f"DATE {_sql_text(until.isoformat())}"
     query = f"""
-        WITH rows AS (SELECT * FROM read_parquet({files}, hive_partitioning = false, union_by_name = true)),
+        WITH rows AS (
+            SELECT * EXCLUDE (filename)
+            FROM read_parquet({files}, hive_partitioning = false, union_by_name = true, filename = true)
+            QUALIFY row_number() OVER (PARTITION BY log_sha256
+                                       ORDER BY filename LIKE '%{COMPACTED_NAME}', filename) = 1),
         daily AS (
             SELECT machine, axis, date, {columns}
             FROM rows GROUP BY machine, axis, date),

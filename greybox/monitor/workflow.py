@@ -15,7 +15,7 @@ from ..data.prepare import prepare
 from ..errors import GreyboxError, LogError
 from .detect import ChangeDetector
 from .fingerprint import FrictionFingerprint, spindle_idle_samples, unloaded_samples
-from .history import append_fingerprint, file_sha256, has_log, read_history, row_path
+from .history import append_fingerprint, file_sha256, find_log, read_history, row_path
 from .report import write_report
 
 __all__ = ["MonitorResult", "fingerprint_file", "log_date", "run_monitor"]
@@ -80,10 +80,9 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
         The history file of the log's row, and whether it was fitted now (False: already in the history).
     """
     if Path(path).is_file():  # a log already in the history under the machine and axis asked for: not read again
-        known = has_log(history, file_sha256(path))
-        if known is not None and machine in (None, known.parts[-4][len("machine="):]) \
-                and axis in (None, known.parts[-3][len("axis="):]):
-            return known, False
+        known = find_log(history, file_sha256(path))
+        if known is not None and machine in (None, known[0]) and axis in (None, known[1]):
+            return known[3], False
     log = read_log(path, axis=axis) if axis is not None else read_log(path)
     machine = machine or (log.attrs.get("machine") if isinstance(log.attrs, dict) else None)
     if not machine:
@@ -95,9 +94,10 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
         raise LogError(path, f"effort in {log.effort_unit}: fingerprints are of motor current in A")
     date = log_date(log, path)
     sha = file_sha256(path)
-    target = row_path(history, str(machine), str(name), date, sha)
-    if has_log(history, sha) == target:
-        return target, False
+    row_path(history, str(machine), str(name), date, sha)  # refuses names unusable in the history before any fit
+    known = find_log(history, sha)
+    if known is not None and known[:3] == (str(machine), str(name), date):
+        return known[3], False
     if spindle_column is not None and spindle_column not in log.extras:
         raise LogError(path, f"no spindle-load column {spindle_column!r}; the log has "
                              f"{', '.join(sorted(log.extras)) or 'no extra columns'}")

@@ -10,7 +10,7 @@ import pytest
 
 from greybox.errors import ParameterError
 from greybox.monitor.fingerprint import FEATURES
-from greybox.monitor.history import HistoryError, append_fingerprint
+from greybox.monitor.history import HistoryError, append_fingerprint, compact_history
 from greybox.monitor.query import changed_most
 
 pytest.importorskip("duckdb")
@@ -42,6 +42,8 @@ def test_axes_ranked_by_their_largest_change(tmp_path):
     assert rows[1]["feature"] == "sliding_neg" and rows[1]["change_sd"] < -3
     assert rows[0]["recent"] == pytest.approx(1.2, abs=0.01) and rows[0]["baseline"] == pytest.approx(1.0, abs=0.01)
     assert abs(rows[2]["change_sd"]) < 5
+    compact_history(history)  # the same answer from the compacted history
+    assert changed_most(history, days=20).equals(table)
     # a period before the shift: no change stands out; limit cuts the list
     before = changed_most(history, days=10, until=DAY0 + dt.timedelta(days=39), limit=2).to_pylist()
     assert len(before) == 2 and all(abs(r["change_sd"]) < 5 for r in before)
