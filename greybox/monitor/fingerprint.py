@@ -39,6 +39,8 @@ refitted on every replicate. The replicates are seeded, so the same log gives th
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ..data.log import AxisLog, as_log_list
@@ -426,7 +428,8 @@ class FrictionFingerprint:
             if len(widths):
                 replicates[b, backlash] = np.median(widths[rng.integers(0, len(widths), len(widths))])
         tail = 50.0 * (1.0 - self.confidence)
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a feature without any value: NaN ends
             low, high = np.nanpercentile(replicates, [tail, 100.0 - tail], axis=0)
         self.values_ = {name: float(value) for name, value in zip(FEATURES, point)}
         self.lower_ = {name: float(value) for name, value in zip(FEATURES, low)}

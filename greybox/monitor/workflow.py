@@ -18,7 +18,10 @@ from .fingerprint import FrictionFingerprint, spindle_idle_samples, unloaded_sam
 from .history import append_fingerprint, file_sha256, find_log, read_history, row_path
 from .report import write_report
 
-__all__ = ["MonitorResult", "fingerprint_file", "log_date", "run_monitor"]
+__all__ = ["FingerprintJob", "MonitorResult", "fingerprint_file", "fingerprint_job", "log_date", "run_monitor"]
+
+#: ``format`` of the manifest a fleet run of the fingerprints leaves in the history (``_manifest.json``).
+MONITOR_FORMAT = "greybox-monitor"
 
 _DATE_IN_NAME = re.compile(r"(\d{4}-\d{2}-\d{2})")
 
@@ -120,6 +123,89 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     return written, True
 
 
+@dataclass(frozen=True)
+class FingerprintJob:
+    """One log of a fleet run of ``greybox monitor``: what to read and where its fingerprint goes.
+
+    Parameters
+    ----------
+    path : str
+        Log file.
+    history : str
+        History directory.
+    machine, axis : str or None
+        As :func:`fingerprint_file` takes them.
+    model_path : str or None
+        Reference model file, loaded by the worker.
+    spindle_column : str or None
+        Spindle-load column.
+    """
+
+    path: str
+    history: str
+    machine: str | None = None
+    axis: str | None = None
+    model_path: str | None = None
+    spindle_column: str | None = None
+
+
+def fingerprint_job(job: FingerprintJob) -> dict:
+    """Fingerprint one log on a fleet worker (:func:`greybox.fleet.run_tasks`); never raises for bad input.
+
+    Parameters
+    ----------
+    job : FingerprintJob
+        The log and its settings.
+
+    Returns
+    -------
+    dict
+        The manifest entry (:func:`greybox.fleet.attempt`): ``output``, the history file of the log's row,
+        and ``fitted``, whether it was fitted now.
+    """
+    from ..fleet import attempt
+
+    def work() -> dict:
+        model = None
+        if job.model_path is not None:
+            from ..persistence import load_model
+
+            model = load_model(job.model_path)
+        row, new = fingerprint_file(job.path, job.history, machine=job.machine, axis=job.axis, model=model,
+                                    spindle_column=job.spindle_column)
+        return {"output": str(row), "fitted": bool(new)}
+
+    return attempt(str(job.path), work)
+
+
+def _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, scheduler, workers,
+                       progress) -> tuple[int, int]:
+    """Fingerprint ``logs`` on a Dask cluster (:func:`greybox.fleet.run_tasks`); the logs fitted and known."""
+    from ..fleet import log_stamp, run_tasks
+
+    jobs = [FingerprintJob(str(path), str(history), machine, axis, None if model_path is None else str(model_path),
+                           spindle_column) for path in logs]
+    for job in jobs:
+        if not Path(job.path).is_file():
+            raise LogError(job.path, "no such log file")
+    stamps = [{"log": job.path, **log_stamp(job.path), "machine": machine, "axis": axis,
+               "model": job.model_path, "spindle_column": spindle_column} for job in jobs]
+
+    def report(done: int, total: int, entry: dict) -> None:
+        if progress is not None:
+            state = entry.get("error") or ("fingerprinted" if entry.get("fitted") else "already in the history")
+            progress(f"[{done}/{total}] {entry['log']}: {state}")
+
+    manifest = run_tasks(fingerprint_job, jobs, stamps, out_dir=history, header={"format": MONITOR_FORMAT},
+                         items="logs", scheduler=scheduler, workers=workers, progress=report)
+    failed = [entry for entry in manifest["logs"] if entry["status"] == "failed"]
+    if failed:
+        raise GreyboxError(f"{len(failed)} of {len(jobs)} logs failed (listed in {Path(history) / '_manifest.json'});"
+                           f" the first: {failed[0]['error']}")
+    fitted = sum(bool(entry.get("fitted")) and entry["status"] == "ok" for entry in manifest["logs"])
+    return fitted, len(jobs) - fitted
+
+
 @dataclass
 class MonitorResult:
     """What ``greybox monitor`` did.
@@ -144,6 +230,7 @@ class MonitorResult:
 
 def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
                 model_path=None, spindle_column: str | None = None, baseline_days: int = 28,
+                scheduler: str | None = None, workers: int | None = None,
                 progress: Callable[[str], None] | None = None) -> MonitorResult:
     """Fingerprint ``logs`` into ``history``, detect changes over the whole history, write the dashboard.
 
@@ -165,6 +252,12 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         Column of the logs with the spindle load, to find the stretches without process load.
     baseline_days : int, default 28
         Days that set each feature's baseline.
+    scheduler : str, optional
+        Address of a Dask scheduler: the logs are fingerprinted on that cluster (:mod:`greybox.fleet`).
+    workers : int, optional
+        Fingerprint the logs on a local Dask cluster of this many processes (:mod:`greybox.fleet`); without
+        it and ``scheduler`` one after the other in this process. A fleet run leaves its manifest
+        ``_manifest.json`` in the history and skips the logs it lists as done, unchanged.
     progress : callable, optional
         Called with one line per log.
 
@@ -176,12 +269,19 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
     detector._check_params()  # refuse bad options before any work
     if Path(history).exists() and not Path(history).is_dir():
         raise GreyboxError(f"{history}: history is a file, not a directory")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise GreyboxError(f"workers must be a positive whole number, got {workers!r}")
+    if logs and (scheduler is not None or workers is not None):
+        fitted, known = _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, scheduler,
+                                           workers, progress)
+        logs = []
+    else:
+        fitted = known = 0
     model = None
-    if model_path is not None:
+    if model_path is not None and logs:
         from ..persistence import load_model
 
         model = load_model(model_path)
-    fitted = known = 0
     for path in logs:
         row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model,
                                     spindle_column=spindle_column)

@@ -50,7 +50,9 @@ def test_monitor_fingerprints_once_and_writes_the_page(twin_days, tmp_path, caps
     page = (report / "index.html").read_text()
     assert "Axes, most severe first" in page and "mill7" in page and "data:image/png;base64," in page
     row = pq.read_table(files[0])
-    assert row.num_rows == 1 and all(row.column(name)[0].as_py() > 0 for name in FEATURES)
+    assert row.num_rows == 1 and all(np.isfinite(row.column(name)[0].as_py()) for name in FEATURES)
+    assert all(row.column(name)[0].as_py() > 0 for name in FEATURES if name != "local_excess")  # may be < 0
+    assert len(row.column("map_position_mm")[0]) == len(row.column("map_excess_A")[0]) > 3
 
 
 def test_fingerprinting_again_is_idempotent(twin_days, tmp_path):
@@ -200,3 +202,25 @@ def test_production_days_fingerprinted_by_their_spindle_load(tmp_path, capsys):
     whole = fingerprint_file(files[0], tmp_path / "whole")[0]
     noise_whole = pq.read_table(whole).column("noise")[0].as_py()
     assert table.num_rows == 3 and table.column("noise")[0].as_py() < 0.7 * noise_whole  # the cut left out
+
+
+def test_fleet_run_matches_the_sequential_one(twin_days, tmp_path, capsys):
+    logs = sorted(str(p) for p in twin_days.iterdir())[:3]
+    fleet, alone = tmp_path / "fleet", tmp_path / "alone"
+    assert main(["monitor", *logs, "--history", str(fleet), "--out", str(tmp_path / "r1"), "--baseline-days", "3",
+                 "--workers", "1"]) == 0
+    assert "3 logs fingerprinted, 0 already in the history" in capsys.readouterr().out
+    assert (fleet / "_manifest.json").is_file()
+    assert main(["monitor", *logs, "--history", str(alone), "--out", str(tmp_path / "r2"),
+                 "--baseline-days", "3"]) == 0
+    capsys.readouterr()
+    assert read_history(fleet).equals(read_history(alone))  # the same rows, whoever fitted them
+    assert main(["monitor", *logs, "--history", str(fleet), "--out", str(tmp_path / "r1"), "--baseline-days", "3",
+                 "--workers", "1"]) == 0
+    assert "0 logs fingerprinted, 3 already in the history" in capsys.readouterr().out
+    bad = tmp_path / "bad_2026-05-09.csv"
+    bad.write_text("time_s,position_mm,current_A\n0,0,nan\n")
+    assert main(["monitor", str(bad), "--history", str(fleet), "--out", str(tmp_path / "r1"), "--workers", "1"]) == 2
+    err = capsys.readouterr().err  # (Dask may note a busy dashboard port before it on a shared machine)
+    assert "Traceback" not in err and "1 of 1 logs failed" in err.strip().splitlines()[-1]
+    assert "at least 2 are needed" in err.strip().splitlines()[-1]
