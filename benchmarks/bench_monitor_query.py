@@ -9,7 +9,8 @@ the history's own layout (one Parquet file per log: ``machine=/axis=/date=/<sha2
 :mod:`greybox.monitor.history`; random features, 1 % spread, a few axes with a shift in the last month) into a
 temporary directory, then times :func:`greybox.monitor.query.changed_most` (the last 30 days against the first
 28) ``--repeat`` times after one warm-up, one DuckDB thread, on the history as written and after
-:func:`greybox.monitor.history.compact_history` (one file per machine and axis). Printed: the files, the
+:func:`greybox.monitor.history.compact_history` (one file per machine and axis); ``--write-compacted`` writes
+the compacted files directly instead (the same files compaction writes). Printed: the files, the
 median and largest wall time per query, and whether the shifted axes came first.
 """
 
@@ -27,16 +28,17 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from greybox.monitor.fingerprint import FEATURES
-from greybox.monitor.history import SCHEMA, SCHEMA_VERSION, compact_history, row_path
+from greybox.monitor.history import COMPACTED_NAME, SCHEMA, SCHEMA_VERSION, compact_history, row_path
 from greybox.monitor.query import changed_most
 
 DAY0 = dt.date(2026, 1, 1)
 
 
-def write_history(root: Path, machines: int, axes: int, days: int, rng) -> list:
+def write_history(root: Path, machines: int, axes: int, days: int, rng, compacted: bool = False) -> list:
     shifted = []
     for m in range(machines):
         for a in range(axes):
+            rows = []
             shift = m % 25 == 0 and a == 0
             if shift:
                 shifted.append((f"m{m:03d}", f"A{a}"))
@@ -49,9 +51,15 @@ def write_history(root: Path, machines: int, axes: int, days: int, rng) -> list:
                     value = float(rng.normal(1.0, 0.01)) + (0.1 if shift and f == "sliding_pos" and day >= days - 20
                                                             else 0.0)
                     row[f], row[f"{f}_lo"], row[f"{f}_hi"] = value, value - 0.02, value + 0.02
-                path = row_path(root / "history", row["machine"], row["axis"], date, row["log_sha256"])
+                rows.append(row)
+                if not compacted:
+                    path = row_path(root / "history", row["machine"], row["axis"], date, row["log_sha256"])
+                    path.parent.mkdir(parents=True, exist_ok=True)
+                    pq.write_table(pa.Table.from_pylist([row], schema=SCHEMA), path)
+            if compacted:  # what compact_history writes, without the row files first
+                path = root / "history" / f"machine=m{m:03d}" / f"axis=A{a}" / COMPACTED_NAME
                 path.parent.mkdir(parents=True, exist_ok=True)
-                pq.write_table(pa.Table.from_pylist([row], schema=SCHEMA), path)
+                pq.write_table(pa.Table.from_pylist(rows, schema=SCHEMA), path)
     return shifted
 
 
@@ -73,16 +81,19 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--only-compacted", action="store_true",
                         help="time the query only after compaction (the history as written takes ms per file)")
+    parser.add_argument("--write-compacted", action="store_true",
+                        help="write the compacted files directly (a year of row files takes long to write)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     results = {}
     with tempfile.TemporaryDirectory() as scratch:
         root = Path(scratch)
-        shifted = write_history(root, args.machines, args.axes, args.days, np.random.default_rng(0))
+        shifted = write_history(root, args.machines, args.axes, args.days, np.random.default_rng(0),
+                                args.write_compacted)
         files_before = sum(1 for _ in (root / "history").rglob("*.parquet"))
-        names = ("compacted",) if args.only_compacted else ("history", "compacted")
+        names = ("compacted",) if args.only_compacted or args.write_compacted else ("history", "compacted")
         for name in names:
-            if name == "compacted":
+            if name == "compacted" and not args.write_compacted:
                 start = time.perf_counter()
                 compact_history(root / "history")
                 results["compaction_s"] = time.perf_counter() - start
@@ -97,7 +108,8 @@ def main() -> None:
     if args.json:
         print(json.dumps(results, indent=2))
         return
-    print(f"compact_history of {results['files_before_compaction']} row files took {results['compaction_s']:.1f} s")
+    if "compaction_s" in results:
+        print(f"compact_history of {results['files_before_compaction']} row files took {results['compaction_s']:.1f} s")
     for name in names:
         r = results[name]
         print(f"{name}: {r['files']} Parquet files, changed_most median {r['median_s']:.3f} s, max {r['max_s']:.3f} s, "

@@ -80,20 +80,18 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
     names = ", ".join(f'"{f}"' for f in chosen)
     end = "(SELECT max(date) FROM daily)" if until is None else f"DATE {_sql_text(until.isoformat())}"
     query = f"""
-        WITH rows AS (
-            SELECT * EXCLUDE (filename)
-            FROM read_parquet({files}, hive_partitioning = false, union_by_name = true, filename = true)
-            QUALIFY row_number() OVER (PARTITION BY log_sha256
-                                       ORDER BY filename LIKE '%{COMPACTED_NAME}', filename) = 1),
-        daily AS (
+        WITH daily AS (
             SELECT machine, axis, date, {columns}
             FROM rows GROUP BY machine, axis, date),
-        long AS (UNPIVOT daily ON {names} INTO NAME feature VALUE value),
         numbered AS (
-            SELECT *, dense_rank() OVER (PARTITION BY machine, axis ORDER BY date) AS day_number FROM long),
+            SELECT *, dense_rank() OVER (PARTITION BY machine, axis ORDER BY date) AS day_number FROM daily),
+        kept AS (
+            SELECT * FROM numbered
+            WHERE day_number <= {int(baseline_days)} OR (date > {end} - INTERVAL {int(days)} DAY AND date <= {end})),
+        long AS (UNPIVOT kept ON {names} INTO NAME feature VALUE value),
         base AS (
             SELECT machine, axis, feature, avg(value) AS mean, stddev_samp(value) AS sd
-            FROM numbered WHERE day_number <= {int(baseline_days)} AND isfinite(value)
+            FROM long WHERE day_number <= {int(baseline_days)} AND isfinite(value)
             GROUP BY machine, axis, feature),
         recent AS (
             SELECT machine, axis, feature, avg(value) AS mean, count(*) AS n
@@ -111,11 +109,17 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
             FROM change GROUP BY machine, axis)
         ORDER BY abs(change_sd) DESC, machine, axis
         LIMIT {int(limit)}"""
+    needed = ", ".join(["schema_version", "machine", "axis", "date", "log_sha256", *(f'"{f}"' for f in chosen)])
     with duckdb.connect() as connection:
         connection.execute("SET threads TO 1")
-        try:
-            versions = connection.execute(f"SELECT DISTINCT schema_version FROM read_parquet({files}, "
-                                          "hive_partitioning = false, union_by_name = true)").fetchall()
+        try:  # the files are read once, only the columns needed; a log's row file wins over a compacted row
+            connection.execute(f"""
+                CREATE TEMP TABLE rows AS
+                SELECT {needed}
+                FROM read_parquet({files}, hive_partitioning = false, union_by_name = true, filename = true)
+                QUALIFY row_number() OVER (PARTITION BY log_sha256
+                                           ORDER BY filename LIKE '%{COMPACTED_NAME}', filename) = 1""")
+            versions = connection.execute("SELECT DISTINCT schema_version FROM rows").fetchall()
             if sorted(v for (v,) in versions) != [SCHEMA_VERSION]:
                 found = ", ".join(str(v) for (v,) in versions)
                 raise HistoryError(f"{root}: history rows of schema version {found}; this greybox reads "
