@@ -28,6 +28,14 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--model", metavar="FILE",
                         help="reference model of the axis (greybox train): fit only where its residual stays "
                              "within its noise (default: every log is an air cut)")
+    parser.add_argument("--spindle-load", metavar="COLUMN",
+                        help="column of the logs with the spindle load: fit only where the spindle idles (below "
+                             "its 5th percentile plus a fifth of its span to the 99th, 0.2 s apart from any cut)")
+    parser.add_argument("--workers", type=NumberRange(int, low=1), metavar="N",
+                        help="fingerprint the logs on a local Dask cluster of N processes (greybox.fleet); default "
+                             "one after the other in this process")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="fingerprint the logs on the Dask cluster of this scheduler (tcp://host:8786)")
     parser.add_argument("--baseline-days", type=NumberRange(int, low=3), default=28, metavar="N",
                         help="first days with a fingerprint that set each feature's baseline (default %(default)s)")
     parser.set_defaults(run=run)
@@ -37,7 +45,9 @@ def run(args: argparse.Namespace) -> int:
     from ..monitor.workflow import run_monitor
 
     result = run_monitor(args.logs, args.history, args.out, machine=args.machine, axis=args.axis,
-                         model_path=args.model, baseline_days=args.baseline_days, progress=print)
+                         model_path=args.model, spindle_column=args.spindle_load,
+                         baseline_days=args.baseline_days, scheduler=args.scheduler, workers=args.workers,
+                         progress=print)
     trends = result.detector.trends_
     print(f"{result.fitted} logs fingerprinted, {result.known} already in the history; "
           f"{len(trends)} axes, {len(result.detector.alarms_)} alarms")

@@ -83,10 +83,11 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--history", type=POSITIVE_INT, metavar="DAYS",
                         help="write an ageing machine instead: one short air-move log per axis and day, "
                              "DIR/<axis>_<YYYY-MM-DD>.mcap, with a day-to-day spread and the --drift given "
-                             "(for greybox monitor)")
+                             "(for greybox monitor); with --cutting production days: the strokes in the cutting "
+                             "direction cut, and the log has a spindle_load_pct column")
     parser.add_argument("--drift", action="append", default=[], metavar="KIND:START:RATE",
-                        help="with --history: a drift of every axis from day START (counted from 0) at RATE (a "
-                             "fraction of the friction level per day); KIND: " + "; ".join(DRIFT_KINDS.values())
+                        help="with --history: a drift of every axis from day START (counted from 0) at RATE per "
+                             "day; KIND: " + "; ".join(DRIFT_KINDS.values())
                              + " (repeatable)")
     parser.add_argument("--start-date", metavar="YYYY-MM-DD", default="2026-01-01",
                         help="with --history: the date of day 0 (default %(default)s)")
@@ -256,7 +257,7 @@ def _run_history(args: argparse.Namespace) -> int:
     import datetime as dt
 
     given = [flag for flag, value in (("--family", args.family), ("--plan", args.plan), ("--effect", args.effect),
-                                      ("--cutting", args.cutting), ("--duration", args.duration),
+                                      ("--duration", args.duration),
                                       ("--one-file", args.one_file)) if value]
     if given:
         raise GreyboxError(f"--history writes the daily air moves of the ageing twin; {', '.join(given)} "
@@ -270,9 +271,13 @@ def _run_history(args: argparse.Namespace) -> int:
     drifts = [Drift.parse(text) for text in args.drift]
     axes = list(dict.fromkeys(a.strip().upper() for a in args.axis if a.strip()))
     _check_out_dir(args)
+    cutting = None
+    if args.cutting:  # production days: the strokes in the cutting direction cut, with a spindle-load column
+        cutting = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm, teeth=args.teeth,
+                              return_pass=args.cutting_return_pass)
     synthesize_history(axes, args.history, args.seed, args.out, drifts, start_date=start, machine=args.machine,
                        truth_channels=ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None,
-                       progress=print)
+                       cutting=cutting, progress=print)
     return 0
 
 

@@ -18,14 +18,17 @@ sets ``h`` so that the expected number of false alarms is ``false_alarms_per_yea
 
 The alarm names the feature, the direction of the change (``rises`` for S+, ``falls`` for S-), the day
 the change started (the last day that sum was zero before it rose to ``h``), the day it was detected, the
-mean shift since the start in baseline standard deviations, and a one-sided Welch t-test p-value of the
-days since the start against the baseline days (how sure).
+mean shift since the start in baseline standard deviations, a one-sided Welch t-test p-value of the
+days since the start against the baseline days (how sure), and where along the travel the friction departed
+most from its baseline: the bin of the friction-along-travel map whose mean over the days since the start
+differs most from its mean over the baseline days (:func:`travel_departure`).
 """
 
 from __future__ import annotations
 
 import datetime as dt
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pyarrow as pa
@@ -34,7 +37,7 @@ from scipy import stats
 from ..errors import ParameterError
 from .fingerprint import FEATURES
 
-__all__ = ["Alarm", "AxisTrend", "ChangeDetector", "calibrated_threshold", "cusum"]
+__all__ = ["Alarm", "AxisTrend", "ChangeDetector", "calibrated_threshold", "cusum", "travel_departure"]
 
 
 def cusum(z, *, k: float = 0.5, h: float = 5.0, clip: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
@@ -43,7 +46,8 @@ def cusum(z, *, k: float = 0.5, h: float = 5.0, clip: float = np.inf) -> tuple[n
     Parameters
     ----------
     z : array_like, shape (n,)
-        Standardised values (in baseline standard deviations).
+        Standardised values (in baseline standard deviations); NaN (a day without a value) leaves the sums
+        unchanged.
     k : float, default 0.5
         Allowance (reference value) per step [standard deviations].
     h : float, default 5.0
@@ -60,8 +64,9 @@ def cusum(z, *, k: float = 0.5, h: float = 5.0, clip: float = np.inf) -> tuple[n
     upper, lower = np.zeros(len(z)), np.zeros(len(z))
     s_up = s_low = 0.0
     for i, value in enumerate(z):
-        s_up = max(0.0, s_up + value - k)
-        s_low = max(0.0, s_low - value - k)
+        if np.isfinite(value):  # a day without a value leaves both sums as they were
+            s_up = max(0.0, s_up + value - k)
+            s_low = max(0.0, s_low - value - k)
         upper[i], lower[i] = s_up, s_low
     return upper, lower
 
@@ -134,6 +139,11 @@ class Alarm:
     p_value : float
         One-sided Welch t-test of the days since ``start`` against the baseline days (NaN with fewer
         than two days since the start).
+    position_mm : float, default NaN
+        Where along the travel [mm] the friction departed most from its baseline since ``start`` (NaN
+        without a friction-along-travel map).
+    departure_A : float, default NaN
+        That departure [A], signed.
     """
 
     machine: str
@@ -144,12 +154,16 @@ class Alarm:
     detected: dt.date
     shift: float
     p_value: float
+    position_mm: float = float("nan")
+    departure_A: float = float("nan")
 
     def describe(self) -> str:
-        """One line for people: what changed, which way, since when, how sure."""
+        """One line for people: what changed, which way, since when, how sure, where along the travel."""
         sure = "" if not np.isfinite(self.p_value) else f", p = {self.p_value:.2g}"
+        where = "" if not np.isfinite(self.position_mm) else \
+            f"; friction departs most at {self.position_mm:.1f} mm ({self.departure_A:+.3f} A)"
         return (f"{self.machine}/{self.axis}: {self.feature} {self.direction} since {self.start.isoformat()} "
-                f"(detected {self.detected.isoformat()}; shift {self.shift:+.1f} sd{sure})")
+                f"(detected {self.detected.isoformat()}; shift {self.shift:+.1f} sd{sure}{where})")
 
 
 @dataclass
@@ -172,6 +186,9 @@ class AxisTrend:
         The first alarm of each feature and direction that has one, earliest first.
     severity : float
         Largest CUSUM sum of any feature over the threshold ``h`` (1 or more: an alarm).
+    travel_map : tuple of (ndarray, ndarray)
+        The friction-along-travel map per day: bin centres [mm] (shape (m,)) and the days' mean excess [A]
+        (shape (n_days, m), NaN where a day has no value); empty arrays without maps.
     """
 
     machine: str
@@ -185,6 +202,55 @@ class AxisTrend:
     lower_sum: dict = field(default_factory=dict)
     alarms: list = field(default_factory=list)
     severity: float = 0.0
+    travel_map: tuple = (np.empty(0), np.empty((0, 0)))
+
+
+def _daily_map(table: pa.Table, days: list) -> tuple[np.ndarray, np.ndarray]:
+    """Bin centres [mm] and the daily mean excess [A] (days x bins, NaN where missing) of one axis' rows."""
+    if "map_position_mm" not in table.column_names:
+        return np.empty(0), np.empty((len(days), 0))
+    positions = table.column("map_position_mm").to_pylist()
+    excess = table.column("map_excess_A").to_pylist()
+    centres = np.unique(np.round(np.concatenate([np.empty(0)] + [np.asarray(p or [], float) for p in positions]), 6))
+    sums, counts = np.zeros((len(days), len(centres))), np.zeros((len(days), len(centres)))
+    for date, where, values in zip(table.column("date").to_pylist(), positions, excess):
+        if not where:
+            continue
+        columns = np.searchsorted(centres, np.round(np.asarray(where, float), 6))
+        sums[days.index(date), columns] += np.asarray(values, float)
+        counts[days.index(date), columns] += 1.0
+    with np.errstate(invalid="ignore"):
+        return centres, np.where(counts > 0, sums / np.maximum(counts, 1.0), np.nan)
+
+
+def travel_departure(centres, daily, baseline: slice, since: slice) -> tuple[float, float]:
+    """Where along the travel the friction departs most from its baseline, and by how much.
+
+    Parameters
+    ----------
+    centres : ndarray, shape (m,)
+        Bin centres [mm] of the friction-along-travel map.
+    daily : ndarray, shape (n_days, m)
+        Daily mean friction excess [A] per bin (NaN where missing).
+    baseline, since : slice
+        Days of the baseline and days since the change started.
+
+    Returns
+    -------
+    (float, float)
+        The bin centre [mm] of the largest absolute difference of the two periods' means, and that
+        difference [A] (both NaN when no bin has values in both periods).
+    """
+    daily = np.asarray(daily, dtype=float)
+    if daily.size == 0:
+        return np.nan, np.nan
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        change = np.nanmean(daily[since], axis=0) - np.nanmean(daily[baseline], axis=0)
+    if not np.any(np.isfinite(change)):
+        return np.nan, np.nan
+    worst = int(np.nanargmax(np.abs(change)))
+    return float(centres[worst]), float(change[worst])
 
 
 def _daily(table: pa.Table) -> tuple[list, dict, dict, dict]:
@@ -192,13 +258,16 @@ def _daily(table: pa.Table) -> tuple[list, dict, dict, dict]:
     dates = table.column("date").to_pylist()
     days = sorted(set(dates))
     index = np.array([days.index(d) for d in dates])
-    counts = np.bincount(index, minlength=len(days))
 
     def mean(name):
-        return np.bincount(index, weights=table.column(name).to_numpy(zero_copy_only=False),
-                           minlength=len(days)) / counts
+        values = table.column(name).to_numpy(zero_copy_only=False).astype(float)
+        finite = np.isfinite(values)
+        total = np.bincount(index[finite], weights=values[finite], minlength=len(days))
+        counts = np.bincount(index[finite], minlength=len(days))
+        return np.where(counts > 0, total / np.maximum(counts, 1), np.nan)
 
-    values = {f: mean(f) for f in FEATURES}
+    with np.errstate(invalid="ignore"):
+        values = {f: mean(f) for f in FEATURES}
     return days, values, {f: mean(f"{f}_lo") for f in FEATURES}, {f: mean(f"{f}_hi") for f in FEATURES}
 
 
@@ -285,15 +354,19 @@ class ChangeDetector:
 
     def _trend(self, machine: str, axis: str, rows: pa.Table, features) -> AxisTrend:
         days, values, lower, upper = _daily(rows)
-        trend = AxisTrend(machine, axis, days, values, lower, upper)
+        trend = AxisTrend(machine, axis, days, values, lower, upper, travel_map=_daily_map(rows, days))
         n_base = min(self.baseline_days, len(days))
         for feature in features:
             x = values[feature]
-            base = x[:n_base]
+            base = x[:n_base][np.isfinite(x[:n_base])]
+            if len(base) < 2:  # a feature without values in the baseline days (e.g. no reversals) is not watched
+                continue
             mean = float(np.mean(base))
-            sd = float(np.std(base, ddof=1)) if n_base > 1 else 0.0
+            sd = float(np.std(base, ddof=1))
             if not sd > 0.0:  # a constant baseline: the intervals give the scale
-                sd = float(np.median(upper[feature][:n_base] - lower[feature][:n_base])) / (2 * 1.96) or 1e-12
+                width = (upper[feature][:n_base] - lower[feature][:n_base])
+                sd = float(np.nanmedian(width)) / (2 * 1.96) if np.any(np.isfinite(width)) else 0.0
+                sd = sd or 1e-12
             trend.baseline[feature] = (mean, sd)
             up, low = cusum((x - mean) / sd, k=self.k, h=self.threshold_, clip=self.clip)
             trend.upper_sum[feature], trend.lower_sum[feature] = up, low
@@ -303,7 +376,10 @@ class ChangeDetector:
             for direction, sums in (("rises", up), ("falls", low)):
                 alarm = self._alarm(machine, axis, feature, direction, days, x, base, mean, sd, sums)
                 if alarm is not None:
-                    trend.alarms.append(alarm)
+                    start, detected = days.index(alarm.start), days.index(alarm.detected)
+                    where, departure = travel_departure(trend.travel_map[0], trend.travel_map[1], slice(0, n_base),
+                                                        slice(start, detected + 1))
+                    trend.alarms.append(replace(alarm, position_mm=where, departure_A=departure))
         trend.alarms.sort(key=lambda a: (a.detected, -abs(a.shift)))
         return trend
 
@@ -316,6 +392,7 @@ class ChangeDetector:
         zeros = np.flatnonzero(sums[:detected] == 0.0)
         start = int(zeros[-1]) + 1 if len(zeros) else 0
         since = x[start:detected + 1]
+        since = since[np.isfinite(since)]
         p_value = np.nan
         if len(since) >= 2:
             p_value = float(stats.ttest_ind(since, base, equal_var=False,

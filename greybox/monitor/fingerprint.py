@@ -5,7 +5,8 @@ The fingerprint is fitted on the stretches of a log without process load:
 - an air cut (a dedicated run, e.g. of ``greybox plan``, or the twin's daily air moves) is unloaded
   throughout;
 - in a production log, the samples where a reference model's residual stays within its noise
-  (:func:`unloaded_samples`).
+  (:func:`unloaded_samples`), or where a spindle-load column says the spindle idles
+  (:func:`spindle_idle_samples`).
 
 On those samples, per direction of motion:
 
@@ -14,14 +15,31 @@ On those samples, per direction of motion:
   ``sliding_speed``, where the Stribeck rise has died out;
 - the break-away level: the mean friction current (the effort less the fitted inertial and viscous parts) of
   the samples slower than ``breakaway_speed`` (but moving), where friction is near its static level;
-- the residual noise: the root-mean-square residual of the sliding fit.
+- the residual noise: the root-mean-square residual of the sliding fit;
+- the backlash width: after every reversal (a start from rest against the previous direction of motion),
+  the travel [mm] from the last position at rest until the friction current (the effort less the fitted
+  inertial and viscous parts) first reaches half the sliding level of the new direction (linearly
+  interpolated between samples), the median over the log's reversals. Without play this is the
+  pre-sliding distance to half the level (fractions of a micrometre on the twin); a play adds its width;
+- friction along the travel: on the samples at sliding speed, the friction's excess over its direction's
+  sliding level [A] (both directions pooled), as a map of mean excess per ``map_bin_mm`` bin of absolute
+  position (:attr:`FrictionFingerprint.map_position_mm_`, :attr:`FrictionFingerprint.map_excess_A_`), and
+  two features of it: the local excess, the largest mean residual of a bin under a linear trend along the
+  travel fitted to all samples but those of the bin and its two neighbours, after the component periodic
+  in ``period_mm`` (the screw lead, fitted with a trend to all samples) is taken off, over the bins at least
+  two bins inside the travelled stretch (a stretch of raised friction, a damaged screw section, lifts it
+  and cannot pull the trend up to itself); and the amplitude of the periodic component, fitted with the
+  trend without the stretch of the largest local excess.
 
-Intervals come from a moving-block bootstrap: blocks of contiguous samples (default 0.2 s, much longer than the
+Intervals come from a moving-block bootstrap (the backlash width's from the reversals drawn with
+replacement): blocks of contiguous samples (default 0.2 s, much longer than the
 correlation of the current noise and of the friction memory) are drawn with replacement and everything is
 refitted on every replicate. The replicates are seeded, so the same log gives the same fingerprint.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 
@@ -29,7 +47,8 @@ from ..data.log import AxisLog, as_log_list
 from ..errors import LogError, ParameterError
 from ..identify.static import fit_coulomb
 
-__all__ = ["FEATURES", "FEATURE_UNITS", "FrictionFingerprint", "unloaded_samples"]
+__all__ = ["FEATURES", "FEATURE_UNITS", "FrictionFingerprint", "reversal_widths", "spindle_idle_samples",
+           "unloaded_samples"]
 
 #: The fingerprint's features, in the order of every table, with their unit.
 FEATURE_UNITS = {
@@ -40,6 +59,9 @@ FEATURE_UNITS = {
     "viscous_pos": "A s/mm",
     "viscous_neg": "A s/mm",
     "noise": "A",
+    "backlash": "mm",
+    "periodic_amp": "A",
+    "local_excess": "A",
 }
 #: Feature names, in order.
 FEATURES = tuple(FEATURE_UNITS)
@@ -95,6 +117,40 @@ def unloaded_samples(residual, *, noise_A: float | None = None, factor: float = 
     return _moving_rms(r - np.median(r), int(window)) <= factor * noise_A
 
 
+def spindle_idle_samples(load, *, threshold: float | None = None, pad: int = 100) -> np.ndarray:
+    """Samples without process load by a spindle-load column: the spindle idles, and did so for a while.
+
+    Parameters
+    ----------
+    load : array_like, shape (n,)
+        Spindle load (any unit: %, A, kW); larger under cut.
+    threshold : float, optional
+        Load above which the spindle cuts, in the column's unit. By default the log's 5th percentile plus
+        a fifth of the span from its 5th to its 99th percentile (a log without a cut then has a span of
+        noise only: use ``threshold`` when whole logs may be without a cut).
+    pad : int, default 100
+        Samples (200 ms at 2 ms) on either side of a cut that count as loaded too (the axis load ramps in
+        and out with the engagement).
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        True where the sample is without process load.
+    """
+    values = np.asarray(load, dtype=float)
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise ParameterError("spindle load: the column is empty or has NaN or infinite values")
+    if threshold is None:
+        low, high = np.percentile(values, [5.0, 99.0])
+        threshold = low + 0.2 * (high - low)
+    if not np.isfinite(threshold) or isinstance(pad, bool) or not isinstance(pad, (int, np.integer)) or pad < 0:
+        raise ParameterError(f"spindle load: need a finite threshold and a non-negative pad, got {threshold}, {pad}")
+    cutting = (values > threshold).astype(float)
+    if pad:
+        cutting = np.convolve(cutting, np.ones(2 * int(pad) + 1), mode="same")
+    return cutting == 0.0
+
+
 def _block_indices(n: int, block: int, rng: np.random.Generator) -> np.ndarray:
     """Row indices of one moving-block bootstrap replicate of ``n`` rows in blocks of ``block`` rows."""
     block = min(block, n)
@@ -102,9 +158,58 @@ def _block_indices(n: int, block: int, rng: np.random.Generator) -> np.ndarray:
     return (starts[:, None] + np.arange(block)[None, :]).ravel()[:n]
 
 
-def _features(v: np.ndarray, a: np.ndarray, y: np.ndarray, sliding_speed: float, breakaway_speed: float,
-              ) -> tuple[np.ndarray, float]:
-    """The features of :data:`FEATURES` of the samples ``v, a, y`` [mm/s, mm/s^2, A], and the inertia."""
+def _travel_design(x: np.ndarray, period_mm: float) -> np.ndarray:
+    """Columns of the fit along the travel: 1, u (the position scaled to [-1, 1]), sin, cos of the period."""
+    low, high = float(np.min(x)), float(np.max(x))
+    u = (2.0 * x - low - high) / max(high - low, 1e-12)
+    phase = 2.0 * np.pi * x / period_mm
+    return np.column_stack([np.ones_like(x), u, np.sin(phase), np.cos(phase)])
+
+
+def _travel_features(x: np.ndarray, excess: np.ndarray, period_mm: float, bin_mm: float, min_count: int,
+                     ) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """Periodic amplitude [A], local excess [A] and the map (bin centres [mm], mean excess [A]) of one sample set.
+
+    A linear trend and the periodic part are fitted to all samples; the local excess of a bin is its mean
+    residual under the trend refitted (the periodic part kept) to all samples but those of the bin and its
+    two neighbours (a deleted residual: a raised stretch cannot pull the trend up to itself), over the bins
+    at least two bins inside the travelled stretch (no extrapolation). The local excess is the largest of
+    them, and the periodic amplitude that of the fit of trend and periodic part without the stretch of the
+    largest one.
+    """
+    if len(x) < 6:
+        return np.nan, np.nan, np.empty(0), np.empty(0)
+    design = _travel_design(x, period_mm)
+    bins = np.floor(x / bin_mm).astype(np.int64)
+    first = int(bins.min())
+    index = bins - first
+    n_bins = int(index.max()) + 1
+    counts = np.bincount(index, minlength=n_bins)
+    full = np.flatnonzero(counts >= min_count)
+    interior = full[(full - 2 >= full.min()) & (full + 2 <= full.max())]  # the fit is not extrapolated there
+    centres = (full + first + 0.5) * bin_mm
+    level = np.bincount(index, weights=excess, minlength=n_bins)[full] / np.maximum(counts[full], 1)
+    if not len(interior):
+        return np.nan, np.nan, centres, level
+    coef = np.linalg.lstsq(design, excess, rcond=None)[0]
+    trend = excess - design[:, 2:] @ coef[2:]  # the excess less its periodic part
+    local = np.full(n_bins, -np.inf)
+    for j in interior:
+        out = np.abs(index - j) <= 1
+        line = np.linalg.lstsq(design[~out, :2], trend[~out], rcond=None)[0]
+        inside = index == j
+        local[j] = float(np.mean(trend[inside] - design[inside, :2] @ line))
+    worst = int(np.argmax(local))
+    kept = np.abs(index - worst) > 1
+    refit = np.linalg.lstsq(design[kept], excess[kept], rcond=None)[0]
+    return float(np.hypot(refit[2], refit[3])), float(local[worst]), centres, level
+
+
+def _features(x: np.ndarray, v: np.ndarray, a: np.ndarray, y: np.ndarray, sliding_speed: float,
+              breakaway_speed: float, period_mm: float, bin_mm: float, min_count: int,
+              ) -> tuple[np.ndarray, dict, tuple]:
+    """The features of :data:`FEATURES` but the backlash of the samples ``x, v, a, y`` [mm, mm/s, mm/s^2, A],
+    the fitted parameters of :func:`fit_coulomb` and the map along the travel."""
     fast = np.abs(v) >= sliding_speed
     params = fit_coulomb(v[fast], a[fast], y[fast], asymmetric=True)
     viscous = np.where(v > 0.0, params["viscous_pos"], params["viscous_neg"])
@@ -115,9 +220,69 @@ def _features(v: np.ndarray, a: np.ndarray, y: np.ndarray, sliding_speed: float,
     slow_pos, slow_neg = friction[slow & (v > 0.0)], friction[slow & (v < 0.0)]
     breakaway_pos = float(np.mean(slow_pos)) if len(slow_pos) else np.nan
     breakaway_neg = -float(np.mean(slow_neg)) if len(slow_neg) else np.nan
+    sign = np.sign(v[fast])
+    excess = sign * friction[fast] - np.where(sign > 0.0, params["coulomb_pos"], params["coulomb_neg"])
+    periodic, local, centres, level = _travel_features(x[fast], excess, period_mm, bin_mm, min_count)
     values = np.array([params["coulomb_pos"], params["coulomb_neg"], breakaway_pos, breakaway_neg,
-                       params["viscous_pos"], params["viscous_neg"], float(np.sqrt(np.mean(residual * residual)))])
-    return values, params["J"]
+                       params["viscous_pos"], params["viscous_neg"], float(np.sqrt(np.mean(residual * residual))),
+                       np.nan, periodic, local])
+    return values, params, (centres, level)
+
+
+def reversal_widths(position, velocity, friction, level_pos: float, level_neg: float, *, keep=None,
+                    max_samples: int = 200) -> np.ndarray:
+    """Travel [mm] after each reversal until the friction reaches half the new direction's sliding level.
+
+    A reversal is a start of motion (from rest or straight through zero) against the direction of the
+    previous motion. Its travel is counted from the last position before the start; the crossing of half
+    the level is interpolated linearly between the two samples around it.
+
+    Parameters
+    ----------
+    position, velocity, friction : array_like, shape (n,)
+        Position [mm], velocity [mm/s] and friction current [A] (the effort less inertia and viscous part)
+        of one run, in time order.
+    level_pos, level_neg : float
+        Sliding levels [A] (magnitudes) of positive and negative motion.
+    keep : array_like of bool, shape (n,), optional
+        Samples that may be used (e.g. unloaded); a reversal whose samples up to the crossing are not all
+        kept is skipped.
+    max_samples : int, default 200
+        A reversal whose friction does not reach the half level within this many samples of motion in the
+        new direction is skipped.
+
+    Returns
+    -------
+    ndarray
+        One width [mm] per reversal found (possibly none).
+    """
+    x, v, f = (np.asarray(values, dtype=float) for values in (position, velocity, friction))
+    keep = np.ones(len(x), dtype=bool) if keep is None else np.asarray(keep, dtype=bool)
+    direction = np.sign(v)
+    moving = np.flatnonzero(direction != 0.0)
+    widths = []
+    if len(moving) < 2:
+        return np.empty(0)
+    starts = moving[1:][(direction[moving[1:]] != direction[moving[:-1]])]
+    for start in starts:
+        if start == 0:
+            continue
+        s = direction[start]
+        half = 0.5 * (level_pos if s > 0.0 else level_neg)
+        origin = x[start - 1]
+        stop = min(len(x), start + max_samples)
+        run = np.flatnonzero(direction[start:stop] != s)
+        stop = start + int(run[0]) if len(run) else stop
+        above = np.flatnonzero(s * f[start:stop] >= half)
+        if not len(above):
+            continue
+        k = start + int(above[0])
+        if not np.all(keep[start - 1:k + 1]):
+            continue
+        before, after = s * f[k - 1], s * f[k]
+        share = 1.0 if after == before else float(np.clip((half - before) / (after - before), 0.0, 1.0))
+        widths.append(abs(x[k - 1] + share * (x[k] - x[k - 1]) - origin))
+    return np.asarray(widths)
 
 
 class FrictionFingerprint:
@@ -138,6 +303,12 @@ class FrictionFingerprint:
         Coverage of the percentile intervals.
     seed : int, default 0
         Seed of the bootstrap (the same log and seed give the same fingerprint).
+    period_mm : float, default 10.0
+        Period [mm] of the position-periodic friction sought (the screw lead; on a rotary axis in deg).
+    map_bin_mm : float, default 2.5
+        Bin width [mm] of the friction-along-travel map.
+    map_min_samples : int, default 20
+        Fewest samples at sliding speed in a bin of the map.
 
     Attributes
     ----------
@@ -149,16 +320,26 @@ class FrictionFingerprint:
         Inertia [A s^2/mm] fitted with the sliding friction.
     n_samples_ : int
         Number of unloaded moving samples used.
+    n_reversals_ : int
+        Number of reversals that gave a backlash width (the width is NaN without any).
+    map_position_mm_ : ndarray
+        Centres [mm] of the bins of the friction-along-travel map.
+    map_excess_A_ : ndarray
+        Mean friction excess [A] over the direction's sliding level in each bin.
     """
 
     def __init__(self, *, sliding_speed: float = 10.0, breakaway_speed: float = 2.0, n_boot: int = 200,
-                 block_s: float = 0.2, confidence: float = 0.95, seed: int = 0):
+                 block_s: float = 0.2, confidence: float = 0.95, seed: int = 0, period_mm: float = 10.0,
+                 map_bin_mm: float = 2.5, map_min_samples: int = 20):
         self.sliding_speed = sliding_speed
         self.breakaway_speed = breakaway_speed
         self.n_boot = n_boot
         self.block_s = block_s
         self.confidence = confidence
         self.seed = seed
+        self.period_mm = period_mm
+        self.map_bin_mm = map_bin_mm
+        self.map_min_samples = map_min_samples
 
     def _check_params(self) -> None:
         if not (isinstance(self.n_boot, (int, np.integer)) and self.n_boot >= 10):
@@ -171,6 +352,12 @@ class FrictionFingerprint:
                 and np.isfinite(self.sliding_speed)):
             raise ParameterError(f"need 0 < breakaway_speed < sliding_speed, got {self.breakaway_speed} and "
                                  f"{self.sliding_speed} mm/s")
+        if not (np.isfinite(self.period_mm) and self.period_mm > 0.0 and np.isfinite(self.map_bin_mm)
+                and self.map_bin_mm > 0.0):
+            raise ParameterError(f"period_mm and map_bin_mm must be positive lengths, got {self.period_mm} and "
+                                 f"{self.map_bin_mm} mm")
+        if not (isinstance(self.map_min_samples, (int, np.integer)) and self.map_min_samples >= 1):
+            raise ParameterError(f"map_min_samples must be a positive integer, got {self.map_min_samples!r}")
 
     def fit(self, logs: AxisLog | list[AxisLog], *, unloaded=None) -> "FrictionFingerprint":
         """Fit the fingerprint on the unloaded moving samples of prepared runs.
@@ -199,19 +386,21 @@ class FrictionFingerprint:
         masks = [None] * len(runs) if unloaded is None else list(unloaded)
         if len(masks) != len(runs):
             raise ParameterError(f"unloaded: {len(masks)} masks for {len(runs)} runs")
-        pieces, sample_time = [], None
+        pieces, loads, sample_time = [], [], None
         for run, mask in zip(runs, masks):
             if run.velocity is None or run.acceleration is None:
                 raise LogError(run.source or None, "not prepared: velocity and acceleration are needed")
             keep = run.velocity != 0.0
+            unloaded = np.ones(len(run), dtype=bool)
             if mask is not None:
-                mask = np.asarray(mask, dtype=bool)
-                if mask.shape != keep.shape:
-                    raise ParameterError(f"unloaded mask has {mask.size} samples, the run {len(run)}")
-                keep &= mask
-            pieces.append((run.velocity[keep], run.acceleration[keep], run.effort[keep]))
+                unloaded = np.asarray(mask, dtype=bool)
+                if unloaded.shape != keep.shape:
+                    raise ParameterError(f"unloaded mask has {unloaded.size} samples, the run {len(run)}")
+                keep &= unloaded
+            loads.append(unloaded)
+            pieces.append((run.position[keep], run.velocity[keep], run.acceleration[keep], run.effort[keep]))
             sample_time = sample_time or run.sample_time
-        v, a, y = (np.concatenate([p[k] for p in pieces]) for k in range(3))
+        x, v, a, y = (np.concatenate([p[k] for p in pieces]) for k in range(4))
         source = runs[0].source or None
         for sign, name in ((1.0, "positive"), (-1.0, "negative")):
             fast = int(np.sum(sign * v >= self.sliding_speed))
@@ -220,18 +409,34 @@ class FrictionFingerprint:
                 raise LogError(source, f"{fast} unloaded samples of {name} motion at {self.sliding_speed:g} mm/s "
                                f"or faster and {slow} below {self.breakaway_speed:g} mm/s; a fingerprint needs at "
                                f"least {MIN_SAMPLES_PER_DIRECTION} and 1 in each direction")
-        point, inertia = _features(v, a, y, self.sliding_speed, self.breakaway_speed)
+        settings = (self.sliding_speed, self.breakaway_speed, self.period_mm, self.map_bin_mm, self.map_min_samples)
+        point, params, (centres, level) = _features(x, v, a, y, *settings)
+        widths = np.concatenate([np.empty(0)] + [
+            reversal_widths(run.position, run.velocity,
+                            run.effort - params["J"] * run.acceleration
+                            - np.where(run.velocity > 0.0, params["viscous_pos"], params["viscous_neg"]) * run.velocity,
+                            params["coulomb_pos"], params["coulomb_neg"], keep=unloaded)
+            for run, unloaded in zip(runs, loads)])
+        backlash = FEATURES.index("backlash")
+        point[backlash] = float(np.median(widths)) if len(widths) else np.nan
         rng = np.random.default_rng(self.seed)
         block = max(1, int(round(self.block_s / sample_time)))
         replicates = np.empty((self.n_boot, len(FEATURES)))
         for b in range(self.n_boot):
             rows = _block_indices(len(y), block, rng)
-            replicates[b] = _features(v[rows], a[rows], y[rows], self.sliding_speed, self.breakaway_speed)[0]
+            replicates[b] = _features(x[rows], v[rows], a[rows], y[rows], *settings)[0]
+            if len(widths):
+                replicates[b, backlash] = np.median(widths[rng.integers(0, len(widths), len(widths))])
         tail = 50.0 * (1.0 - self.confidence)
-        low, high = np.nanpercentile(replicates, [tail, 100.0 - tail], axis=0)
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a feature without any value: NaN ends
+            low, high = np.nanpercentile(replicates, [tail, 100.0 - tail], axis=0)
         self.values_ = {name: float(value) for name, value in zip(FEATURES, point)}
         self.lower_ = {name: float(value) for name, value in zip(FEATURES, low)}
         self.upper_ = {name: float(value) for name, value in zip(FEATURES, high)}
-        self.inertia_ = float(inertia)
+        self.inertia_ = float(params["J"])
         self.n_samples_ = int(len(y))
+        self.n_reversals_ = int(len(widths))
+        self.map_position_mm_ = centres
+        self.map_excess_A_ = level
         return self

@@ -1,25 +1,29 @@
 """The plant dashboard: one static HTML page of the axes, most severe first.
 
-The page (``index.html``, readable in a browser without a server; figures embedded) has a table of the
-axes sorted by severity, a table of the alarms, and per axis a figure of every feature over the days:
+The page (``index.html``, readable in a browser without a server: figures embedded, plotly.js inline) has a
+table of the axes sorted by severity, a table of the alarms, and per axis a figure of every feature over the days:
 the daily value with its bootstrap interval, the baseline band (mean +- 2 standard deviations) over the
-baseline days, and the start and detection day of each alarm.
+baseline days, and the start and detection day of each alarm; and the friction-along-travel map: per day
+and position bin the friction's departure from its mean over the baseline days. After them the same
+features per axis as interactive plotly charts (zoom, hover), with plotly.js included once in the page.
 """
 
 from __future__ import annotations
 
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..evaluate.html import write_html
+from ..atomic import write_text_atomic
+from ..evaluate.html import render_html
 from ..evaluate.plots import import_pyplot, save_figure
 from ..evaluate.table import Table
 from .detect import ChangeDetector
 from .fingerprint import FEATURE_UNITS
 
-__all__ = ["axis_figure", "write_report"]
+__all__ = ["axis_figure", "interactive_axis_html", "travel_map_figure", "write_report"]
 
 
 def axis_figure(trend, detector: ChangeDetector, path) -> Path:
@@ -71,6 +75,107 @@ def axis_figure(trend, detector: ChangeDetector, path) -> Path:
     return saved
 
 
+def travel_map_figure(trend, detector: ChangeDetector, path) -> Path | None:
+    """Write the friction-along-travel map of one axis: the departure from the baseline per day and position.
+
+    Parameters
+    ----------
+    trend : AxisTrend
+        The axis (:attr:`ChangeDetector.trends_`), with its daily map.
+    detector : ChangeDetector
+        The fitted detector (its baseline length).
+    path : path-like
+        PNG file to write.
+
+    Returns
+    -------
+    Path or None
+        ``path``, or None when the axis has no map.
+    """
+    centres, daily = trend.travel_map
+    if len(centres) == 0 or not np.any(np.isfinite(daily)):
+        return None
+    n_base = min(detector.baseline_days, len(trend.dates))
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        departure = daily - np.nanmean(daily[:n_base], axis=0)
+    plt = import_pyplot(path)
+    figure, ax = plt.subplots(figsize=(9, 2.8))
+    limit = float(np.nanmax(np.abs(departure))) or 1e-3
+    dates = np.array(trend.dates, dtype="datetime64[D]")
+    step = np.median(np.diff(centres)) if len(centres) > 1 else 1.0
+    image = ax.pcolormesh(np.append(dates, dates[-1] + np.timedelta64(1, "D")),
+                          np.append(centres - step / 2, centres[-1] + step / 2), np.ma.masked_invalid(departure.T),
+                          cmap="RdBu_r", vmin=-limit, vmax=limit, shading="flat")
+    figure.colorbar(image, ax=ax, label="friction vs baseline [A]")
+    for alarm in trend.alarms:
+        if np.isfinite(alarm.position_mm):
+            ax.plot(np.datetime64(alarm.detected, "D"), alarm.position_mm, "k*", ms=9)
+    ax.set_ylabel("position [mm]", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.set_title(f"{trend.machine} / {trend.axis}: friction along the travel, departure from the first {n_base} days "
+                 "(star: where an alarm found the largest departure)", fontsize=8)
+    figure.autofmt_xdate()
+    figure.tight_layout()
+    saved = save_figure(figure, path, dpi=90)
+    plt.close(figure)
+    return saved
+
+
+def interactive_axis_html(trend, detector: ChangeDetector, div_id: str) -> str:
+    """The features of one axis over the days as an interactive plotly chart (an HTML ``div``, no script).
+
+    The same content as :func:`axis_figure`: daily values with their intervals, the baseline band and the
+    alarms' start and detection, one row per feature sharing the day axis, zoomable in the browser.
+
+    Parameters
+    ----------
+    trend : AxisTrend
+        The axis (:attr:`ChangeDetector.trends_`).
+    detector : ChangeDetector
+        The fitted detector (its baseline length).
+    div_id : str
+        HTML id of the chart's ``div``.
+
+    Returns
+    -------
+    str
+        The ``div`` and its inline call of plotly (plotly.js itself is included once per page).
+    """
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    features = list(trend.baseline)
+    dates = [d.isoformat() for d in trend.dates]
+    figure = make_subplots(rows=len(features), cols=1, shared_xaxes=True, vertical_spacing=0.012,
+                           subplot_titles=[f"{f} [{FEATURE_UNITS[f]}]" for f in features])
+    n_base = min(detector.baseline_days, len(dates))
+    for row, feature in enumerate(features, start=1):
+        mean, sd = trend.baseline[feature]
+        lower, upper = trend.lower[feature].tolist(), trend.upper[feature].tolist()
+        figure.add_trace(go.Scatter(x=dates + dates[::-1], y=upper + lower[::-1], fill="toself", line={"width": 0},
+                                    fillcolor="rgba(31,119,180,0.2)", hoverinfo="skip", showlegend=False),
+                         row=row, col=1)
+        figure.add_trace(go.Scatter(x=dates, y=trend.values[feature].tolist(), mode="lines+markers",
+                                    line={"color": "#1f77b4", "width": 1}, marker={"size": 4}, name=feature,
+                                    showlegend=False), row=row, col=1)
+        figure.add_hrect(y0=mean - 2 * sd, y1=mean + 2 * sd, fillcolor="rgba(44,160,44,0.15)", line_width=0,
+                         row=row, col=1)
+        figure.add_vrect(x0=dates[0], x1=dates[n_base - 1], fillcolor="rgba(150,150,150,0.1)", line_width=0,
+                         row=row, col=1)
+        for alarm in trend.alarms:
+            if alarm.feature == feature:
+                figure.add_vline(x=alarm.start.isoformat(), line={"color": "#ff7f0e", "dash": "dash", "width": 1},
+                                 row=row, col=1)
+                figure.add_vline(x=alarm.detected.isoformat(), line={"color": "#d62728", "width": 1.5},
+                                 row=row, col=1)
+    figure.update_layout(height=170 * len(features) + 80, margin={"l": 60, "r": 20, "t": 40, "b": 40},
+                         title={"text": f"{trend.machine} / {trend.axis}: drag to zoom, double-click to reset",
+                                "font": {"size": 13}}, template="simple_white")
+    figure.update_annotations(font_size=10)
+    return figure.to_html(full_html=False, include_plotlyjs=False, div_id=div_id)
+
+
 def write_report(detector: ChangeDetector, out_dir) -> Path:
     """Write the dashboard ``out_dir/index.html`` of a fitted detector.
 
@@ -112,8 +217,20 @@ def write_report(detector: ChangeDetector, out_dir) -> Path:
         for i, trend in enumerate(detector.trends_):
             png = axis_figure(trend, detector, Path(scratch) / f"axis_{i}.png")
             figures.append((f"{trend.machine} / {trend.axis} (severity {trend.severity:.2f})", png))
-        return write_html(out / "index.html", title="Friction fingerprints", tables=[axes_table, alarm_table],
-                          figures=figures, embed=True,
+            travel = travel_map_figure(trend, detector, Path(scratch) / f"travel_{i}.png")
+            if travel is not None:
+                figures.append((f"{trend.machine} / {trend.axis}: friction along the travel", travel))
+        page = render_html(title="Friction fingerprints", tables=[axes_table, alarm_table],
+                           figures=figures, embed=True, page_dir=out,
                           intro="Per axis and day: sliding and break-away friction levels per direction, viscous "
-                                "coefficients and residual noise, fitted on the logs' stretches without process "
-                                "load, with 95 % block-bootstrap intervals.")
+                                "coefficients, residual noise, backlash width, amplitude of the lead-periodic "
+                                "friction and the largest local friction excess along the travel, fitted on the "
+                                "logs' stretches without process load, with 95 % bootstrap intervals; and the "
+                                "friction along the travel against its baseline.")
+    from plotly.offline import get_plotlyjs
+
+    charts = [interactive_axis_html(trend, detector, f"axis-{i}") for i, trend in enumerate(detector.trends_)]
+    interactive = ('<h2 id="interactive">Interactive charts</h2>\n<script type="text/javascript">'
+                   + get_plotlyjs() + "</script>\n" + "\n".join(charts) + "\n")
+    page = page.replace("</body></html>", interactive + "</body></html>")
+    return write_text_atomic(out / "index.html", page)

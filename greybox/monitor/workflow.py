@@ -8,15 +8,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
+import numpy as np
+
 from ..data.io import read_log
 from ..data.prepare import prepare
 from ..errors import GreyboxError, LogError
 from .detect import ChangeDetector
-from .fingerprint import FrictionFingerprint, unloaded_samples
-from .history import append_fingerprint, file_sha256, has_log, read_history, row_path
+from .fingerprint import FrictionFingerprint, spindle_idle_samples, unloaded_samples
+from .history import append_fingerprint, file_sha256, find_log, read_history, row_path
 from .report import write_report
 
-__all__ = ["MonitorResult", "fingerprint_file", "log_date", "run_monitor"]
+__all__ = ["FingerprintJob", "MonitorResult", "fingerprint_file", "fingerprint_job", "log_date", "run_monitor"]
+
+#: ``format`` of the manifest a fleet run of the fingerprints leaves in the history (``_manifest.json``).
+MONITOR_FORMAT = "greybox-monitor"
 
 _DATE_IN_NAME = re.compile(r"(\d{4}-\d{2}-\d{2})")
 
@@ -48,6 +53,7 @@ def log_date(log, path) -> dt.date:
 
 
 def fingerprint_file(path, history, *, machine: str | None = None, axis: str | None = None, model=None,
+                     spindle_column: str | None = None,
                      fingerprint: FrictionFingerprint | None = None) -> tuple[Path, bool]:
     """Fingerprint one log file into the history, unless the same file is there already.
 
@@ -63,7 +69,11 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
         Axis to read from a file of several axes (and its name); default the log's own axis.
     model : estimator, optional
         Reference model of the axis: only the samples where its residual stays within its noise are fitted
-        (:func:`~greybox.monitor.fingerprint.unloaded_samples`); without it the whole log is taken as an air cut.
+        (:func:`~greybox.monitor.fingerprint.unloaded_samples`); without it (and without ``spindle_column``)
+        the whole log is taken as an air cut.
+    spindle_column : str, optional
+        Column of the log with the spindle load: only the samples where the spindle idles are fitted
+        (:func:`~greybox.monitor.fingerprint.spindle_idle_samples`); with ``model`` too, only those both keep.
     fingerprint : FrictionFingerprint, optional
         Settings of the fit; default :class:`FrictionFingerprint()`.
 
@@ -73,10 +83,9 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
         The history file of the log's row, and whether it was fitted now (False: already in the history).
     """
     if Path(path).is_file():  # a log already in the history under the machine and axis asked for: not read again
-        known = has_log(history, file_sha256(path))
-        if known is not None and machine in (None, known.parts[-4][len("machine="):]) \
-                and axis in (None, known.parts[-3][len("axis="):]):
-            return known, False
+        known = find_log(history, file_sha256(path))
+        if known is not None and machine in (None, known[0]) and axis in (None, known[1]):
+            return known[3], False
     log = read_log(path, axis=axis) if axis is not None else read_log(path)
     machine = machine or (log.attrs.get("machine") if isinstance(log.attrs, dict) else None)
     if not machine:
@@ -88,21 +97,113 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
         raise LogError(path, f"effort in {log.effort_unit}: fingerprints are of motor current in A")
     date = log_date(log, path)
     sha = file_sha256(path)
-    target = row_path(history, str(machine), str(name), date, sha)
-    if has_log(history, sha) == target:
-        return target, False
+    row_path(history, str(machine), str(name), date, sha)  # refuses names unusable in the history before any fit
+    known = find_log(history, sha)
+    if known is not None and known[:3] == (str(machine), str(name), date):
+        return known[3], False
+    if spindle_column is not None and spindle_column not in log.extras:
+        raise LogError(path, f"no spindle-load column {spindle_column!r}; the log has "
+                             f"{', '.join(sorted(log.extras)) or 'no extra columns'}")
     runs = prepare(log)
     unloaded = None
-    if model is not None:
+    if model is not None or spindle_column is not None:
         unloaded = []
         for run in runs:
-            residual = run.effort - model.predict(run)
-            unloaded.append(unloaded_samples(residual))
+            keep = np.ones(len(run), dtype=bool)
+            if model is not None:
+                keep &= unloaded_samples(run.effort - model.predict(run))
+            if spindle_column is not None:
+                keep &= spindle_idle_samples(run.extras[spindle_column])
+            unloaded.append(keep)
     fitted = (fingerprint or FrictionFingerprint()).fit(runs, unloaded=unloaded)
     written = append_fingerprint(history, machine=str(machine), axis=str(name), date=date, sha256=sha,
                                  source=Path(path).name, n_samples=fitted.n_samples_, values=fitted.values_,
-                                 lower=fitted.lower_, upper=fitted.upper_)
+                                 lower=fitted.lower_, upper=fitted.upper_,
+                                 map_position_mm=fitted.map_position_mm_, map_excess_A=fitted.map_excess_A_)
     return written, True
+
+
+@dataclass(frozen=True)
+class FingerprintJob:
+    """One log of a fleet run of ``greybox monitor``: what to read and where its fingerprint goes.
+
+    Parameters
+    ----------
+    path : str
+        Log file.
+    history : str
+        History directory.
+    machine, axis : str or None
+        As :func:`fingerprint_file` takes them.
+    model_path : str or None
+        Reference model file, loaded by the worker.
+    spindle_column : str or None
+        Spindle-load column.
+    """
+
+    path: str
+    history: str
+    machine: str | None = None
+    axis: str | None = None
+    model_path: str | None = None
+    spindle_column: str | None = None
+
+
+def fingerprint_job(job: FingerprintJob) -> dict:
+    """Fingerprint one log on a fleet worker (:func:`greybox.fleet.run_tasks`); never raises for bad input.
+
+    Parameters
+    ----------
+    job : FingerprintJob
+        The log and its settings.
+
+    Returns
+    -------
+    dict
+        The manifest entry (:func:`greybox.fleet.attempt`): ``output``, the history file of the log's row,
+        and ``fitted``, whether it was fitted now.
+    """
+    from ..fleet import attempt
+
+    def work() -> dict:
+        model = None
+        if job.model_path is not None:
+            from ..persistence import load_model
+
+            model = load_model(job.model_path)
+        row, new = fingerprint_file(job.path, job.history, machine=job.machine, axis=job.axis, model=model,
+                                    spindle_column=job.spindle_column)
+        return {"output": str(row), "fitted": bool(new)}
+
+    return attempt(str(job.path), work)
+
+
+def _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, scheduler, workers,
+                       progress) -> tuple[int, int]:
+    """Fingerprint ``logs`` on a Dask cluster (:func:`greybox.fleet.run_tasks`); the logs fitted and known."""
+    from ..fleet import log_stamp, run_tasks
+
+    jobs = [FingerprintJob(str(path), str(history), machine, axis, None if model_path is None else str(model_path),
+                           spindle_column) for path in logs]
+    for job in jobs:
+        if not Path(job.path).is_file():
+            raise LogError(job.path, "no such log file")
+    stamps = [{"log": job.path, **log_stamp(job.path), "machine": machine, "axis": axis,
+               "model": job.model_path, "spindle_column": spindle_column} for job in jobs]
+
+    def report(done: int, total: int, entry: dict) -> None:
+        if progress is not None:
+            state = entry.get("error") or ("fingerprinted" if entry.get("fitted") else "already in the history")
+            progress(f"[{done}/{total}] {entry['log']}: {state}")
+
+    manifest = run_tasks(fingerprint_job, jobs, stamps, out_dir=history, header={"format": MONITOR_FORMAT},
+                         items="logs", scheduler=scheduler, workers=workers, progress=report)
+    failed = [entry for entry in manifest["logs"] if entry["status"] == "failed"]
+    if failed:
+        raise GreyboxError(f"{len(failed)} of {len(jobs)} logs failed (listed in {Path(history) / '_manifest.json'});"
+                           f" the first: {failed[0]['error']}")
+    fitted = sum(bool(entry.get("fitted")) and entry["status"] == "ok" for entry in manifest["logs"])
+    return fitted, len(jobs) - fitted
 
 
 @dataclass
@@ -128,7 +229,8 @@ class MonitorResult:
 
 
 def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
-                model_path=None, baseline_days: int = 28,
+                model_path=None, spindle_column: str | None = None, baseline_days: int = 28,
+                scheduler: str | None = None, workers: int | None = None,
                 progress: Callable[[str], None] | None = None) -> MonitorResult:
     """Fingerprint ``logs`` into ``history``, detect changes over the whole history, write the dashboard.
 
@@ -146,8 +248,16 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         Axis to read from files of several axes.
     model_path : path-like, optional
         Reference model file (``greybox train``) to find the stretches without process load.
+    spindle_column : str, optional
+        Column of the logs with the spindle load, to find the stretches without process load.
     baseline_days : int, default 28
         Days that set each feature's baseline.
+    scheduler : str, optional
+        Address of a Dask scheduler: the logs are fingerprinted on that cluster (:mod:`greybox.fleet`).
+    workers : int, optional
+        Fingerprint the logs on a local Dask cluster of this many processes (:mod:`greybox.fleet`); without
+        it and ``scheduler`` one after the other in this process. A fleet run leaves its manifest
+        ``_manifest.json`` in the history and skips the logs it lists as done, unchanged.
     progress : callable, optional
         Called with one line per log.
 
@@ -159,14 +269,22 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
     detector._check_params()  # refuse bad options before any work
     if Path(history).exists() and not Path(history).is_dir():
         raise GreyboxError(f"{history}: history is a file, not a directory")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise GreyboxError(f"workers must be a positive whole number, got {workers!r}")
+    if logs and (scheduler is not None or workers is not None):
+        fitted, known = _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, scheduler,
+                                           workers, progress)
+        logs = []
+    else:
+        fitted = known = 0
     model = None
-    if model_path is not None:
+    if model_path is not None and logs:
         from ..persistence import load_model
 
         model = load_model(model_path)
-    fitted = known = 0
     for path in logs:
-        row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model)
+        row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model,
+                                    spindle_column=spindle_column)
         fitted, known = fitted + new, known + (not new)
         if progress is not None:
             progress(f"{path}: {'fingerprinted' if new else 'already in the history'} -> {row}")

@@ -50,7 +50,9 @@ def test_monitor_fingerprints_once_and_writes_the_page(twin_days, tmp_path, caps
     page = (report / "index.html").read_text()
     assert "Axes, most severe first" in page and "mill7" in page and "data:image/png;base64," in page
     row = pq.read_table(files[0])
-    assert row.num_rows == 1 and all(row.column(name)[0].as_py() > 0 for name in FEATURES)
+    assert row.num_rows == 1 and all(np.isfinite(row.column(name)[0].as_py()) for name in FEATURES)
+    assert all(row.column(name)[0].as_py() > 0 for name in FEATURES if name != "local_excess")  # may be < 0
+    assert len(row.column("map_position_mm")[0]) == len(row.column("map_excess_A")[0]) > 3
 
 
 def test_fingerprinting_again_is_idempotent(twin_days, tmp_path):
@@ -109,7 +111,7 @@ def test_corrupt_history_one_line_exit_2(twin_days, tmp_path, capsys):
     (["--history", "3", "--axis", "X", "--drift", "rust:1:0.1"], "unknown drift kind 'rust'"),
     (["--history", "3", "--axis", "X", "--drift", "lubrication:1"], "expected KIND:START:RATE"),
     (["--history", "3", "--axis", "X", "--drift", "preload:-1:0.1"], "start day must be a non-negative"),
-    (["--history", "3", "--axis", "X", "--cutting"], "--cutting does not apply"),
+    (["--history", "3", "--axis", "X", "--effect", "constant_offset"], "--effect does not apply"),
     (["--history", "3", "--axis", "X", "--start-date", "May 1"], "--start-date 'May 1'"),
     (["--axis", "X", "--drift", "none"], "--drift needs --history DAYS"),
     (["--history", "0", "--axis", "X"], "argument --history"),
@@ -181,3 +183,44 @@ def test_reference_model_leaves_out_a_process_load(twin_days, tmp_path, capsys):
     assert main(["monitor", str(cut), "--model", str(garbage), "--history", str(tmp_path / "h3"),
                  "--out", str(tmp_path / "r")]) == 2
     assert "garbage.gbx" in _error(capsys)
+
+
+def test_production_days_fingerprinted_by_their_spindle_load(tmp_path, capsys):
+    logs = tmp_path / "logs"
+    assert main(["synth", "--history", "3", "--axis", "X", "--seed", "4", "--cutting", "--out", str(logs),
+                 "--truth", "essential"]) == 0
+    files = sorted(str(p) for p in logs.iterdir())
+    log = read_log(files[0])
+    assert "spindle_load_pct" in log.extras and np.count_nonzero(log.extras["truth_process_A"]) > 500
+    capsys.readouterr()
+    assert main(["monitor", files[0], "--history", str(tmp_path / "h"), "--out", str(tmp_path / "r"),
+                 "--spindle-load", "nosuch", "--baseline-days", "3"]) == 2
+    assert "no spindle-load column 'nosuch'" in _error(capsys)
+    assert main(["monitor", *files, "--history", str(tmp_path / "h"), "--out", str(tmp_path / "r"),
+                 "--spindle-load", "spindle_load_pct", "--baseline-days", "3"]) == 0
+    table = read_history(tmp_path / "h")
+    whole = fingerprint_file(files[0], tmp_path / "whole")[0]
+    noise_whole = pq.read_table(whole).column("noise")[0].as_py()
+    assert table.num_rows == 3 and table.column("noise")[0].as_py() < 0.7 * noise_whole  # the cut left out
+
+
+def test_fleet_run_matches_the_sequential_one(twin_days, tmp_path, capsys):
+    logs = sorted(str(p) for p in twin_days.iterdir())[:3]
+    fleet, alone = tmp_path / "fleet", tmp_path / "alone"
+    assert main(["monitor", *logs, "--history", str(fleet), "--out", str(tmp_path / "r1"), "--baseline-days", "3",
+                 "--workers", "1"]) == 0
+    assert "3 logs fingerprinted, 0 already in the history" in capsys.readouterr().out
+    assert (fleet / "_manifest.json").is_file()
+    assert main(["monitor", *logs, "--history", str(alone), "--out", str(tmp_path / "r2"),
+                 "--baseline-days", "3"]) == 0
+    capsys.readouterr()
+    assert read_history(fleet).equals(read_history(alone))  # the same rows, whoever fitted them
+    assert main(["monitor", *logs, "--history", str(fleet), "--out", str(tmp_path / "r1"), "--baseline-days", "3",
+                 "--workers", "1"]) == 0
+    assert "0 logs fingerprinted, 3 already in the history" in capsys.readouterr().out
+    bad = tmp_path / "bad_2026-05-09.csv"
+    bad.write_text("time_s,position_mm,current_A\n0,0,nan\n")
+    assert main(["monitor", str(bad), "--history", str(fleet), "--out", str(tmp_path / "r1"), "--workers", "1"]) == 2
+    err = capsys.readouterr().err  # (Dask may note a busy dashboard port before it on a shared machine)
+    assert "Traceback" not in err and "1 of 1 logs failed" in err.strip().splitlines()[-1]
+    assert "at least 2 are needed" in err.strip().splitlines()[-1]

@@ -32,8 +32,10 @@ def test_dashboard_renders_in_chromium(tmp_path):
     page = (tmp_path / "r" / "index.html").as_uri()
     dom = _chromium(tmp_path, "--dump-dom", page)
     assert dom.returncode == 0
-    for text in ("Axes, most severe first", "Alarms", "twin / X (severity"):
+    for text in ("Axes, most severe first", "Alarms", "twin / X (severity", "Interactive charts"):
         assert text in dom.stdout
+    # plotly drew the interactive chart offline (its script is inline): the div holds its SVG, titled per feature
+    assert 'id="axis-0"' in dom.stdout and 'class="main-svg"' in dom.stdout and "local_excess [A]" in dom.stdout
     shot = tmp_path / "shot.png"
     run = _chromium(tmp_path, "--window-size=1200,2400", f"--screenshot={shot}", page)
     assert run.returncode == 0 and shot.is_file()

@@ -11,7 +11,7 @@ import pytest
 from greybox.errors import ParameterError
 from greybox.monitor.detect import ChangeDetector, calibrated_threshold, cusum
 from greybox.monitor.fingerprint import FEATURES
-from greybox.monitor.history import SCHEMA
+from greybox.monitor.history import SCHEMA, SCHEMA_VERSION
 
 DAY0 = dt.date(2026, 1, 1)
 
@@ -19,13 +19,14 @@ DAY0 = dt.date(2026, 1, 1)
 def _table(series: dict, axis="X", machine="m", default=None) -> pa.Table:
     """A history table of one axis: one row per day, ``series[feature]`` or ``default`` (a noise series)."""
     n = len(next(iter(series.values()))) if series else len(default)
-    rows = {"schema_version": [1] * n, "machine": [machine] * n, "axis": [axis] * n,
+    rows = {"schema_version": [SCHEMA_VERSION] * n, "machine": [machine] * n, "axis": [axis] * n,
             "date": [DAY0 + dt.timedelta(days=i) for i in range(n)], "log_sha256": [f"{i:064x}" for i in range(n)],
             "source": ["log"] * n, "n_samples": [1000] * n}
     rng = np.random.default_rng(1)
     for name in FEATURES:
         values = np.asarray(series.get(name, rng.normal(1.0, 0.01, n) if default is None else default), float)
         rows[name], rows[f"{name}_lo"], rows[f"{name}_hi"] = values, values - 0.02, values + 0.02
+    rows["map_position_mm"], rows["map_excess_A"] = [[]] * n, [[]] * n
     return pa.Table.from_pydict(rows, schema=SCHEMA)
 
 

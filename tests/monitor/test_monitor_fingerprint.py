@@ -8,8 +8,24 @@ import pytest
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.errors import LogError, ParameterError
-from greybox.monitor.fingerprint import FEATURES, FrictionFingerprint, unloaded_samples
-from greybox.twin.ageing import Drift, aged_log
+from greybox.monitor.fingerprint import (
+    FEATURES,
+    FrictionFingerprint,
+    reversal_widths,
+    spindle_idle_samples,
+    unloaded_samples,
+)
+from greybox.twin.ageing import (
+    DEFECT_CENTRE_OFFSET_MM,
+    DEFECT_WIDTH_MM,
+    AgedPlant,
+    Drift,
+    aged_log,
+    air_move_trajectory,
+)
+from greybox.twin.axes import axis_geometry
+from greybox.twin.datasets import make_dataset
+from greybox.twin.plant import default_plant_parameters
 
 LEVELS = ("sliding_pos", "sliding_neg", "breakaway_pos", "breakaway_neg")
 
@@ -86,3 +102,105 @@ def test_unprepared_log_and_bad_settings_are_refused(day_logs):
         FrictionFingerprint(breakaway_speed=20.0).fit(prepare(day_logs[0]))
     with pytest.raises(ParameterError, match="n_boot"):
         FrictionFingerprint(n_boot=3).fit(prepare(day_logs[0]))
+
+
+def _reference_widths(x, v, f, level_pos, level_neg):
+    """Reversal widths written out: each start against the previous direction, travel to half the new level."""
+    widths, previous = [], 0.0
+    for i in range(1, len(x)):
+        s = np.sign(v[i])
+        if s == 0.0:
+            continue
+        if previous != 0.0 and s != previous:
+            half = 0.5 * (level_pos if s > 0 else level_neg)
+            k = i
+            while k < len(x) and np.sign(v[k]) == s and s * f[k] < half:
+                k += 1
+            if k < len(x) and np.sign(v[k]) == s:
+                share = (half - s * f[k - 1]) / (s * f[k] - s * f[k - 1])
+                widths.append(abs(x[k - 1] + min(max(share, 0.0), 1.0) * (x[k] - x[k - 1]) - x[i - 1]))
+        previous = s
+    return np.array(widths)
+
+
+def test_reversal_widths_measure_a_known_play():
+    # back and forth at 1 mm/s with rests; the friction flips to the new level 0.02 mm after each reversal
+    t = np.arange(0.0, 12.0, 0.002)
+    v = np.where(np.sin(2 * np.pi * t / 4) > 0.2, 1.0, np.where(np.sin(2 * np.pi * t / 4) < -0.2, -1.0, 0.0))
+    x = np.concatenate([[0.0], np.cumsum(v[1:] * 0.002)])
+    f = np.zeros_like(t)
+    state, anchor = 0.0, 0.0
+    for i in range(len(t)):
+        if v[i] != 0.0 and np.sign(v[i]) != state and abs(x[i] - anchor) >= 0.02:
+            state = np.sign(v[i])
+        if v[i] == 0.0 or np.sign(v[i]) == state:
+            anchor = x[i]
+        f[i] = 1.0 * state
+    widths = reversal_widths(x, v, f, 1.0, 1.0)
+    np.testing.assert_allclose(widths, _reference_widths(x, v, f, 1.0, 1.0))
+    assert len(widths) >= 4 and np.all(np.abs(widths - 0.02) <= 0.0021)  # within one sample of travel
+    keep = np.ones(len(t), dtype=bool)
+    keep[: len(t) // 2] = False
+    assert 0 < len(reversal_widths(x, v, f, 1.0, 1.0, keep=keep)) < len(widths)
+
+
+def test_backlash_and_local_defect_show_in_the_fingerprint():
+    plain, play, defect = (FrictionFingerprint(n_boot=30).fit(prepare(aged_log("X", 4, 8, drifts)))
+                           for drifts in ([], [Drift("backlash", 0, 0.004)], [Drift("defect", 0, 0.05)]))
+    assert plain.n_reversals_ >= 5 and plain.values_["backlash"] < 0.005  # pre-sliding only: micrometres
+    assert play.values_["backlash"] - plain.values_["backlash"] == pytest.approx(0.016, abs=0.003)  # 16 um play
+    assert play.lower_["backlash"] <= play.values_["backlash"] <= play.upper_["backlash"]
+    for name in ("sliding_pos", "sliding_neg", "local_excess"):  # the play leaves the sliding friction alone
+        assert play.values_[name] == pytest.approx(plain.values_[name], abs=0.01)
+    assert defect.values_["local_excess"] > plain.values_["local_excess"] + 0.03  # 20 % raised at its centre
+    np.testing.assert_array_equal(defect.map_position_mm_, plain.map_position_mm_)
+    rise = defect.map_excess_A_ - plain.map_excess_A_
+    centre = axis_geometry("X").window_centre_mm + DEFECT_CENTRE_OFFSET_MM
+    assert abs(defect.map_position_mm_[np.argmax(rise)] - centre) <= 2.5  # the map finds the stretch
+    far = np.abs(defect.map_position_mm_ - centre) > DEFECT_WIDTH_MM / 2 + 2.5
+    assert np.max(np.abs(rise[far])) < 0.5 * np.max(rise)
+
+
+def test_periodic_amplitude_follows_the_screw_lead_component():
+    base = default_plant_parameters("X")
+    amplitudes = []
+    for gain in (0.0, base.lead_gain, 2 * base.lead_gain):
+        log = make_dataset("X", "H", 3, plant=AgedPlant(base.replace(lead_gain=gain)),
+                           trajectory=air_move_trajectory("X"))
+        amplitudes.append(FrictionFingerprint(n_boot=20).fit(prepare(log)).values_["periodic_amp"])
+    level = base.coulomb_ratio * base.static_friction_A
+    assert amplitudes[0] < 0.5 * base.lead_gain * level  # the noise floor of an amplitude
+    assert amplitudes[1] < amplitudes[2] and amplitudes[2] - amplitudes[1] == pytest.approx(
+        base.lead_gain * level, rel=0.4)
+
+
+def test_spindle_idle_samples_pad_the_cuts():
+    load = np.full(1000, 5.0)
+    load[400:500] = 60.0
+    idle = spindle_idle_samples(load, pad=10)
+    assert not idle[390:510].any() and idle[:390].all() and idle[510:].all()
+    assert spindle_idle_samples(load, threshold=70.0).all()  # a threshold above every value: no cut
+    for bad in ([], [1.0, np.nan]):
+        with pytest.raises(ParameterError, match="spindle load"):
+            spindle_idle_samples(bad)
+    with pytest.raises(ParameterError, match="pad"):
+        spindle_idle_samples(load, pad=-1)
+
+
+def test_production_day_fingerprint_by_its_spindle_load():
+    from greybox.twin.ageing import SPINDLE_COLUMN
+    from greybox.twin.cutting import CuttingSpec
+
+    air = FrictionFingerprint(n_boot=20).fit(prepare(aged_log("X", 3, 4)))
+    runs = prepare(aged_log("X", 3, 4, cutting=CuttingSpec()))
+    idle = [spindle_idle_samples(run.extras[SPINDLE_COLUMN]) for run in runs]
+    assert all(np.max(np.abs(run.extras["truth_process_A"][keep])) < 0.05 for run, keep in zip(runs, idle))
+    assert all(np.count_nonzero(run.extras["truth_process_A"]) > 500 for run in runs)  # there was a cut
+    by_spindle = FrictionFingerprint(n_boot=20).fit(runs, unloaded=idle)
+    whole = FrictionFingerprint(n_boot=20).fit(runs)
+    for name in ("noise", "local_excess"):  # the cut (negative strokes) biases a whole-log fit
+        assert abs(by_spindle.values_[name] - air.values_[name]) < 0.5 * abs(whole.values_[name] - air.values_[name])
+    # the idle negative strokes are only their ends: fewer speeds, the level trades off with the viscous part
+    assert abs(by_spindle.values_["sliding_neg"] - air.values_["sliding_neg"]) < abs(
+        whole.values_["sliding_neg"] - air.values_["sliding_neg"])
+    assert by_spindle.values_["sliding_pos"] == pytest.approx(air.values_["sliding_pos"], abs=0.01)

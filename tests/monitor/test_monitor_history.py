@@ -10,10 +10,13 @@ import pytest
 
 from greybox.monitor.fingerprint import FEATURES
 from greybox.monitor.history import (
+    COMPACTED_NAME,
     SCHEMA_VERSION,
     HistoryError,
     append_fingerprint,
+    compact_history,
     file_sha256,
+    find_log,
     has_log,
     read_history,
     row_path,
@@ -90,3 +93,26 @@ def test_bad_names_are_refused(tmp_path):
     (tmp_path / "file").write_text("")
     with pytest.raises(HistoryError, match="is a file"):
         read_history(tmp_path / "file")
+
+
+def test_compaction_keeps_every_row_and_the_logs_known(tmp_path):
+    shas = [c * 64 for c in "abcdef"]
+    for i, sha in enumerate(shas):
+        _append(tmp_path, sha, axis="XY"[i % 2], date=dt.date(2026, 3, 1 + i), level=1.0 + i)
+    before = read_history(tmp_path)
+    assert compact_history(tmp_path) == 6
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*.parquet")) == [
+        f"machine=mill1/axis={a}/{COMPACTED_NAME}" for a in "XY"]
+    assert read_history(tmp_path).equals(before)
+    assert read_history(tmp_path, axis="Y", since=dt.date(2026, 3, 4)).column("sliding_pos").to_pylist() == [4.0, 6.0]
+    assert find_log(tmp_path, shas[2]) == ("mill1", "X", dt.date(2026, 3, 3),
+                                            tmp_path / "machine=mill1" / "axis=X" / COMPACTED_NAME)
+    assert find_log(tmp_path, "9" * 64) is None and has_log(tmp_path, shas[2]) is None
+    # the same log filed again: its own row file wins; compacting again merges it without a duplicate
+    _append(tmp_path, shas[2], axis="X", date=dt.date(2026, 3, 3), level=9.0)
+    assert read_history(tmp_path).num_rows == 6
+    assert 9.0 in read_history(tmp_path).column("sliding_pos").to_pylist()
+    assert compact_history(tmp_path) == 1 and read_history(tmp_path).num_rows == 6
+    assert 9.0 in read_history(tmp_path).column("sliding_pos").to_pylist()
+    with pytest.raises(HistoryError, match="not a directory"):
+        compact_history(tmp_path / "none")
