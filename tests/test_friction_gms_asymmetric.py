@@ -153,8 +153,7 @@ def test_identification_recovers_the_two_directions_levels():
     rmse = np.sqrt(np.mean((model.predict(log) - log.effort) ** 2))
     assert rmse < 0.004  # at the noise (0.002 A), where the symmetric model cannot get
     assert np.sqrt(np.mean((symmetric.predict(log) - log.effort) ** 2)) > 3 * rmse
-    # three more curve parameters and a viscous coefficient, two parameters (alpha_i, k_i) per element pruned
-    assert model.n_params - symmetric.n_params == 4 + 2 * (symmetric.n_pruned_ - model.n_pruned_)
+    assert model.n_params == symmetric.n_params + 4
 
 
 def test_asymmetric_model_refuses_an_offset():
@@ -175,18 +174,3 @@ def test_parameter_table_names_each_direction():
     assert rows["s_0_neg"].value == 0.034 and "negative" in rows["s_0_neg"].description
     assert rows["s_0"].value == 0.02 and "positive" in rows["s_0"].description
     assert rows["viscous_neg"].unit.endswith("s/mm")
-
-
-@pytest.mark.parametrize("asymmetric", [False, True])
-def test_identified_break_away_at_rest_is_not_below_the_sliding_one(asymmetric):
-    # friction that rises from rest to sliding (s_0 < s_inf) in one direction: the identification keeps the
-    # break-away deflection at rest at least the sliding one (friction at rest not below sliding friction)
-    rising = {**ASYMMETRIC, "s_0": (0.006, 0.03), "s_inf": (0.02, 0.026)}
-    velocity = velocity_profile(4.0, seed=3)
-    friction, _ = simulate_gms(velocity, STEP, **rising)
-    log = motion_log(velocity)
-    log = log.replace(effort=friction + 0.002 * np.random.default_rng(3).standard_normal(velocity.size))
-    model = GMSModel(asymmetric=asymmetric, n_elements=2, n_starts=2, max_iter=150, inertia=0.0).fit(log)
-    assert model.s_0_ >= model.s_inf_ * (1 - 1e-12)
-    if asymmetric:
-        assert model.s_0_neg_ >= model.s_inf_neg_ * (1 - 1e-12)

@@ -42,13 +42,6 @@ from .plant_laws import gms_plant_law
 
 __all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_trajectory"]
 
-#: Smallest ``s_0 / s_inf`` the identification allows: 1, the break-away deflection at rest is at least the one in
-#: sliding (the friction at rest at least the sliding friction). Without it the asymmetric fits on the ARTS device
-#: reached a break-away deflection near 0 at rest in one direction and of metres in the other, a speed law that
-#: mimics the backlash's dwell at the reversals, scored its training cost 8 % lower, depended on the seed of the
-#: perturbed starts, and did not carry to other speeds (docs/arts-benchmark.md).
-MIN_STRIBECK_RATIO = 1.0
-
 #: Largest ``T C / min(s_0, s_inf)`` the identification allows: the slip step
 #: then relaxes monotonically (no overshoot), well inside the stability limit 2.
 MAX_SLIP_STEP_RATIO = 1.0
@@ -441,20 +434,15 @@ class GMSModel(CurrentModel):
     def _shape(self, theta, max_step):
         """``alpha, s_0, s_inf, v_s, C`` from the search vector ``theta``.
 
-        ``theta = (u_2..u_N, log s_inf, log(s_0 / s_inf), log v_s, log r)``, or
-        with ``log s_inf, log(s_0 / s_inf), log v_s`` of positive then of
-        negative motion when ``asymmetric`` (then ``s_0``, ``s_inf``, ``v_s``
-        are pairs). The Stribeck excess ``log(s_0 / s_inf)`` is bounded below
-        by 0 (:data:`MIN_STRIBECK_RATIO`): the break-away deflection at rest is
-        not below the one in sliding, as the friction at rest is not below
-        the sliding friction. Since ``s_inf <= s_0``, ``C = r s_inf / T``.
+        ``theta = (u_2..u_N, log s_0, log s_inf, log v_s, log r)``, or with
+        ``log s_0, log s_inf, log v_s`` of positive then of negative motion
+        when ``asymmetric`` (then ``s_0``, ``s_inf``, ``v_s`` are pairs).
         """
         n = self.n_elements
         alpha = _alpha_from_logits(theta[: n - 1])
-        logs = theta[n - 1:-1].reshape(-1, 3)
-        curve = np.exp(np.column_stack((logs[:, 0] + logs[:, 1], logs[:, 0], logs[:, 2])))
+        curve = np.exp(theta[n - 1:-1]).reshape(-1, 3)
         s_0, s_inf, v_s = (curve[:, j] if self.asymmetric else float(curve[0, j]) for j in range(3))
-        return alpha, s_0, s_inf, v_s, float(np.exp(theta[-1])) * float(curve[:, 1].min()) / max_step
+        return alpha, s_0, s_inf, v_s, float(np.exp(theta[-1])) * float(curve[:, :2].min()) / max_step
 
     def _initial_shape(self, runs):
         """Stage 1: initial shape vector and its bounds from a static fit and the reversals.
@@ -470,14 +458,13 @@ class GMSModel(CurrentModel):
         v_lo, v_hi = velocity_range(np.concatenate([run.velocity for run in runs]))
         logits = np.linspace(0.0, np.log(_ALPHA_SPREAD), n)[1:]
         s_0 = delta / _alpha_from_logits(logits).max()  # the largest element breaks away after delta
-        ratio = np.clip(static["coulomb"] / static["static"], 0.05, 1.0) if static["static"] > 0 else 1.0
-        s_inf = s_0 * ratio
-        curve = np.array([np.log(s_inf), -np.log(ratio), np.log(np.clip(static["v_s"], v_lo, v_hi))])
-        curve_lower = np.array([curve[0] - np.log(1e3), np.log(MIN_STRIBECK_RATIO), np.log(v_lo)])
-        curve_upper = np.array([curve[0] + np.log(1e3), np.log(1e3), np.log(v_hi)])
+        ratio = np.clip(static["coulomb"] / static["static"], 0.05, 20.0) if static["static"] > 0 else 1.0
+        curve = np.log([s_0, s_0 * ratio, np.clip(static["v_s"], v_lo, v_hi)])
+        curve_lower = np.array([curve[0] - np.log(1e3), curve[1] - np.log(1e3), np.log(v_lo)])
+        curve_upper = np.array([curve[0] + np.log(1e3), curve[1] + np.log(1e3), np.log(v_hi)])
         if self.asymmetric:
             q = np.log(direction_level_ratio(runs))  # log(level of negative / positive motion)
-            shift = np.array([q, 0.0, 0.0])
+            shift = np.array([q, q, 0.0])
             curve = np.concatenate((curve - shift / 2.0, curve + shift / 2.0))
             curve_lower = np.concatenate((curve_lower - shift / 2.0, curve_lower + shift / 2.0))
             curve_upper = np.concatenate((curve_upper - shift / 2.0, curve_upper + shift / 2.0))
@@ -511,7 +498,7 @@ class GMSModel(CurrentModel):
             # stage 2: fractions, common deflection scale (and the ratio of the directions), slip rate;
             # the Stribeck velocities and the ratio s_0 / s_inf of each direction kept
             deflections = np.zeros(theta.size, dtype=bool)
-            deflections[n - 1:-1] = np.tile([True, False, False], n_curves)
+            deflections[n - 1:-1] = np.tile([True, True, False], n_curves)
             negative = np.zeros(theta.size, dtype=bool)
             negative[n + 2:-1] = self.asymmetric
             negative &= deflections
