@@ -154,11 +154,11 @@ def _intervals(model, args: argparse.Namespace, runs) -> None:
               f"in {time.perf_counter() - started:.1f} s")
 
 
-def _axis_inertia(config, runs) -> tuple[float | None, str]:
-    """The inertia an axis file gives, in the effort unit of ``runs`` [effort s^2/length], and its source."""
+def _axis_inertia(config, runs, source: str) -> tuple[float | None, str]:
+    """The inertia an axis configuration gives, in the effort unit of ``runs`` [effort s^2/length], and ``source``."""
     if config is None or not runs:
         return None, ""
-    return config.model_inertia(runs[0].effort_unit), f"the axis file {Path(config.source).name or config.name}"
+    return config.model_inertia(runs[0].effort_unit), source
 
 
 def _read_axis_inertia(args: argparse.Namespace, runs) -> tuple[float | None, str]:
@@ -171,7 +171,7 @@ def _read_axis_inertia(args: argparse.Namespace, runs) -> tuple[float | None, st
     if config.inertia_kg_m2 is None:
         raise GreyboxError(f"{args.axis_config}: gives no {INERTIA}, the axis's inertia at the motor shaft that "
                            "--axis-config of greybox train checks the model against")
-    return _axis_inertia(config, runs)
+    return _axis_inertia(config, runs, f"the axis file {Path(args.axis_config).name}")
 
 
 def _check_inertia(model, expected: float | None, source: str) -> None:
@@ -231,7 +231,7 @@ def _run_machine(args: argparse.Namespace) -> int:
         model = build_model(args.model, args)
         started = time.perf_counter()
         names, runs = _fit(model, args, *data[axis.name])
-        _check_inertia(model, *_axis_inertia(axis.config, runs))
+        _check_inertia(model, *_axis_inertia(axis.config, runs, f"axis {axis.name} of the machine file"))
         predictions[axis.name] = (runs, _report_fit(model, names, runs, time.perf_counter() - started,
                                                     f"{args.model} for axis {axis.name}"))
         records[axis.name] = record_training(args, list(args.train) + list(args.stage2 or ()), names, runs,

@@ -86,3 +86,24 @@ def test_an_axis_file_without_inertia_is_refused_before_the_fit(logs, tmp_path, 
     assert status == 2
     assert "gives no inertia_kg_m2" in stderr and len(stderr.strip().splitlines()) == 1
     assert not (tmp_path / "m.gbm").exists()
+
+
+def test_a_machine_files_axis_inertia_checks_that_axis_model(tmp_path, capsys):
+    from greybox.machine_model import load_machine
+
+    velocity = velocity_profile(5.0, seed=4, v_max=60.0)
+    log = motion_log(velocity)
+    log = log.replace(effort=J_TRUE * log.acceleration + 0.9 * np.sign(velocity) + 0.01 * velocity,
+                      velocity=None, acceleration=None)
+    path = tmp_path / "machine.csv"
+    write_log([log.replace(axis="X"), log.replace(axis="Y")], path)
+    machine = tmp_path / "machine.toml"
+    machine.write_text("".join(f"[axes.{name}]\n{AXIS}inertia_kg_m2 = {_motor_inertia(factor * J_TRUE)!r}\n\n"
+                               for name, factor in (("X", 1.1), ("Y", 3 * AXIS_INERTIA_FACTOR))))
+    out = tmp_path / "machine_model"
+    status, stdout, _ = _main(capsys, "train", "--model", "coulomb", "--train", path, "--machine", machine,
+                              "--out", out, "--quiet", "--intervals", "none")
+    assert status == 0
+    models = load_machine(out).models
+    assert not [note for note in models["X"].fit_notes() if "machine file" in note]
+    assert [note for note in models["Y"].fit_notes() if "axis Y of the machine file" in note]
