@@ -23,7 +23,7 @@ from .base import EFFORT, LENGTH, ModelProtocol, Parameter
 from .data.log import AxisLog, as_log_list
 from .data.quantities import MOTIONS, Motion
 from .errors import LogError, ParameterError, Setting
-from .identify.inertia import inertia_note
+from .identify.inertia import axis_inertia_note, inertia_note
 from .identify.intervals import check_intervals, with_intervals
 from .identify.progress import make_progress
 from .identify.selection import check_selection_record
@@ -154,6 +154,37 @@ class CurrentModel(ModelProtocol):
         self.J_ = known
         self.notes_ = []
         return self
+
+    def check_axis_inertia(self, expected: float, source: str = "the axis file") -> str | None:
+        """Flag an identified inertia that disagrees with the one the axis file gives.
+
+        Nothing is refitted: when ``J_`` was identified (``inertia`` None, also of a stage) and
+        differs from ``expected`` by more than
+        :data:`~greybox.identify.inertia.AXIS_INERTIA_FACTOR`, a note is added to
+        :meth:`fit_notes` (and so to the model file and ``greybox info``).
+
+        Parameters
+        ----------
+        expected : float
+            The axis's inertia in the model's unit [effort s^2/length]
+            (:meth:`greybox.data.axis_config.AxisConfig.model_inertia`).
+        source : str, default "the axis file"
+            Where ``expected`` comes from, for the note.
+
+        Returns
+        -------
+        str or None
+            The note added, or None.
+        """
+        check_is_fitted(self)
+        settings = self.get_params(deep=True)  # a model with a stage (or a base) has the inertia there
+        if any(value is not None for name, value in settings.items() if name.split("__")[-1] == "inertia"):
+            return None  # given, not identified
+        note = axis_inertia_note(float(self.J_), float(expected), f"{self.effort_unit_} s^2/{self.units_.length}",
+                                 source)
+        if note is not None:
+            self.notes_ = list(getattr(self, "notes_", [])) + [note]
+        return note
 
     def fit_notes(self) -> list[str]:
         """What the fit could not settle from the runs, one sentence each (empty when nothing).

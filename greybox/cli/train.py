@@ -65,6 +65,11 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--machine", metavar="TOML",
                         help="machine file: the axes, their channels in the logs and mechanics (see "
                         "examples/machine.toml)")
+    parser.add_argument("--axis-config", metavar="TOML",
+                        help="axis file with the axis's inertia (inertia_kg_m2 at the motor shaft, see "
+                        "examples/axis_x.toml): an identified inertia more than a factor 2 from it is noted in the "
+                        "output and the model file; --model auto fits every candidate with it as the known inertia "
+                        "(unless --inertia or --load-side is given). With --machine, the machine file's axes give it")
     parser.add_argument("--force", action="store_true",
                         help="overwrite MODEL (the machine model) if it exists; with --per-machine, train every "
                         "model again, also those complete from an earlier run")
@@ -150,6 +155,32 @@ def _intervals(model, args: argparse.Namespace, runs) -> None:
               f"in {time.perf_counter() - started:.1f} s")
 
 
+def _axis_inertia(config, runs, source: str) -> tuple[float | None, str]:
+    """The inertia an axis configuration gives, in the effort unit of ``runs`` [effort s^2/length], and ``source``."""
+    if config is None or not runs:
+        return None, ""
+    return config.model_inertia(runs[0].effort_unit), source
+
+
+def _read_axis_inertia(args: argparse.Namespace, runs) -> tuple[float | None, str]:
+    """The inertia of --axis-config for ``runs`` and its source; (None, "") without the option."""
+    if not args.axis_config:
+        return None, ""
+    from ..data.axis_config import INERTIA, read_axis_config
+
+    config = read_axis_config(args.axis_config)
+    if config.inertia_kg_m2 is None:
+        raise GreyboxError(f"{args.axis_config}: gives no {INERTIA}, the axis's inertia at the motor shaft that "
+                           "--axis-config of greybox train checks the model against")
+    return _axis_inertia(config, runs, f"the axis file {Path(args.axis_config).name}")
+
+
+def _check_inertia(model, expected: float | None, source: str) -> None:
+    """Note on the model (and so in its output and file) an identified inertia that disagrees with ``expected``."""
+    if expected is not None:
+        model.check_axis_inertia(expected, source)
+
+
 def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
     """The machine's name and the axes to fit (:class:`~greybox.data.machine_config.MachineAxis`)."""
     from ..data.machine_config import MachineAxis, read_machine_config
@@ -202,6 +233,7 @@ def _run_machine(args: argparse.Namespace) -> int:
         model = build_model(args.model, args)
         started = time.perf_counter()
         names, runs = _fit(model, args, *data[axis.name])
+        _check_inertia(model, *_axis_inertia(axis.config, runs, f"axis {axis.name} of the machine file"))
         predictions[axis.name] = (runs, _report_fit(model, names, runs, time.perf_counter() - started,
                                                     f"{args.model} for axis {axis.name}"))
         records[axis.name] = record_training(args, list(args.train) + list(args.stage2 or ()), names, runs,
@@ -231,7 +263,7 @@ def _run_per_machine(args: argparse.Namespace) -> int:
     if args.intervals != "sandwich" or args.bootstrap is not None:
         raise GreyboxError("--intervals and --bootstrap do not apply with --per-machine: a fleet's models get the "
                            "sandwich intervals")
-    for option, value in (("--stage2", args.stage2), ("--machine", args.machine)):
+    for option, value in (("--stage2", args.stage2), ("--machine", args.machine), ("--axis-config", args.axis_config)):
         if value:
             raise GreyboxError(f"{option} does not apply with --per-machine: every machine's model is fitted on "
                                "its logs in --train (give the axes of logs of several with --axes)")
@@ -288,7 +320,13 @@ def _run_auto(args: argparse.Namespace) -> int:
     check_one_effort(runs)
     started = time.perf_counter()
     report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
-    model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.model_inertia,
+    inertia, source = _read_axis_inertia(args, runs)
+    if args.model_inertia is not None:
+        inertia = args.model_inertia  # --inertia or --load-side say more than the axis file
+    elif inertia is not None:
+        unit = f"{runs[0].effort_unit} s^2/{runs[0].units.length}"
+        print(f"inertia J = {inertia:.4g} {unit} from {source}: every candidate is fitted with it")
+    model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=inertia,
                          workers=args.workers or os.cpu_count() or 1, progress=report)
     _intervals(model, args, runs)
     names = [Path(group).name for group in groups]
@@ -320,6 +358,9 @@ def run(args: argparse.Namespace) -> int:
     _refuse_fleet_items(args.train)
     inputs = list(args.train) + list(args.stage2 or ())
     if args.axes is not None or args.machine:
+        if args.axis_config:
+            raise GreyboxError("--axis-config does not apply with --axes or --machine: give each axis's "
+                               "inertia_kg_m2 in the machine file's [axes.NAME] table")
         out = Path(args.out)
         if any(out.resolve() == Path(path).resolve() for path in inputs):
             raise ModelFileError(f"{out}: is one of the training logs; choose another output directory")
@@ -329,7 +370,10 @@ def run(args: argparse.Namespace) -> int:
                       inputs_name="one of the training logs")
     model = build_model(args.model, args)
     started = time.perf_counter()
-    names, runs = _fit(model, args, *_read_all(args))
+    data = _read_all(args)
+    expected, source = _read_axis_inertia(args, data[1])  # a bad axis file stops before the fit
+    names, runs = _fit(model, args, *data)
+    _check_inertia(model, expected, source)
     predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
     _save_checked(model, out, args.force, runs, predictions, record_training(args, inputs, names, runs, predictions))
     return 0

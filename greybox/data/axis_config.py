@@ -10,6 +10,8 @@ axis, ``examples/axis_c.toml``)::
     efficiency_driving = 0.92         # motor drives the table against the load, 0 < eta <= 1 [-]
     efficiency_backdriven = 0.88      # the load drives the table along, the motor brakes [-]
 
+    inertia_kg_m2 = 0.0042            # optional: moment of inertia at the motor shaft [kg m^2]
+
     [channels]                        # optional: columns of the log if not named by convention
     position_mm = "X1_ActualPosition"
     current_A = "X1_CurrentFeedback"
@@ -28,6 +30,14 @@ an error asking for the conversion rather than a silent factor of 1000. The
 same efficiency. The ``[channels]`` table is the column mapping of ``greybox.data.io.read_log``
 (``{canonical_name: name_in_file}``; the canonical name may carry any supported
 unit, e.g. ``position_um``).
+
+The optional ``inertia_kg_m2`` is the axis's whole moment of inertia as the
+motor shaft sees it (motor, coupling, gear and screw, and the moved mass
+reflected through the screw: ``m (h / 2 pi)^2 / i^2``), as the drive's
+commissioning measures it or the data sheets add it up. It gives the inertia
+``J`` a model of the axis should find (:meth:`AxisConfig.model_inertia`), which
+``greybox train --axis-config`` compares with the fitted one and ``--model auto``
+takes as known.
 
 The load (force or torque) these constants give is derived in :mod:`greybox.predict.process`.
 """
@@ -49,7 +59,8 @@ from ..errors import GreyboxError
 from .quantities import MOTIONS, Motion
 from .units import CANONICAL_NAMES, known_column, parse_column_name
 
-__all__ = ["AxisConfig", "read_axis_config", "parse_axis_config", "check_channels", "read_toml", "QUANTITIES"]
+__all__ = ["AxisConfig", "read_axis_config", "parse_axis_config", "check_channels", "read_toml", "QUANTITIES",
+           "OPTIONAL_QUANTITIES", "INERTIA"]
 
 #: Accepted keys: key -> (quantity in words, unit, hint for the missing key).
 QUANTITIES = {
@@ -63,13 +74,20 @@ QUANTITIES = {
                               "the load pushes the table along, the motor brakes; about 0.85, below eta_d"),
 }
 
+#: Optional quantity: key -> (quantity in words, unit, hint).
+INERTIA = "inertia_kg_m2"
+OPTIONAL_QUANTITIES = {
+    INERTIA: ("moment of inertia at the motor shaft J_m", "kg m^2",
+              "motor, coupling, gear, screw and the moved mass reflected, from the drive's commissioning"),
+}
+
 #: One efficiency for both directions (older axis files): stands for both keys above.
 SHARED_EFFICIENCY = "efficiency"
 _EFFICIENCIES = ("efficiency_driving", "efficiency_backdriven")
 
 #: Stems of the keys above: a key starting with one of these but naming another unit is a unit error.
 _STEMS = {"torque_constant": "torque_constant_Nm_per_A", "screw_lead": "screw_lead_mm", "lead": "screw_lead_mm",
-          "gear_ratio": "gear_ratio", "efficiency": "efficiency_driving"}
+          "gear_ratio": "gear_ratio", "efficiency": "efficiency_driving", "inertia": INERTIA}
 
 #: Optional keys besides the quantities.
 _OPTIONAL = ("name", "motion")
@@ -118,6 +136,8 @@ class AxisConfig:
         ``eta_b`` [-], 0 < eta <= 1: share of the table's mechanical power that
         reaches the motor while the load drives the table along its motion and
         the motor brakes (a back-driven screw); default ``efficiency_driving``.
+    inertia_kg_m2 : float, optional
+        Moment of inertia of the whole axis at the motor shaft ``J_m`` [kg m^2]; None when not known.
     name : str, default ""
         Axis name.
     motion : {"linear", "rotary"}, default "linear"
@@ -133,6 +153,7 @@ class AxisConfig:
     gear_ratio: float
     efficiency_driving: float
     efficiency_backdriven: float | None = None
+    inertia_kg_m2: float | None = None
     name: str = ""
     motion: str = "linear"
     channels: Mapping[str, str] = field(default_factory=dict)
@@ -149,6 +170,8 @@ class AxisConfig:
             _fail(where, f"a rotary axis has no {_SCREW}; give gear_ratio as motor revolutions per axis revolution")
         values = {key: getattr(self, key) for key in self.quantities}
         _check_values(values, where)
+        if self.inertia_kg_m2 is not None:
+            _check_values({INERTIA: self.inertia_kg_m2}, where)
         object.__setattr__(self, "channels", dict(self.channels))
 
     @property
@@ -181,6 +204,43 @@ class AxisConfig:
         lossless = self.lossless_load_constant
         return lossless * self.efficiency_driving, lossless / self.efficiency_backdriven
 
+    def model_inertia(self, effort_unit: str) -> float | None:
+        """The inertia ``J`` a model of this axis should find, in its effort's unit per acceleration.
+
+        ``J_m`` at the motor shaft, seen through the drive train: per ampere
+        of current ``J = J_m (2 pi i / h) / k_t`` [A s^2/mm] (``h`` in mm) on a
+        linear axis, ``J = J_m i (pi / 180) / k_t`` [A s^2/deg] on a rotary
+        one; for an effort in the load's unit (N, Nm) that times the lossless
+        load constant ``K_0`` (:attr:`lossless_load_constant`), e.g.
+        ``J_m (2 pi i / h)^2`` [kg] / 1000 in N s^2/mm.
+
+        Parameters
+        ----------
+        effort_unit : str
+            Unit of the model's effort: ``"A"``, or the load's unit (``"N"`` linear, ``"Nm"`` rotary).
+
+        Returns
+        -------
+        float or None
+            ``J`` [effort_unit s^2/mm, or s^2/deg rotary]; None when the file gives no ``inertia_kg_m2``.
+
+        Raises
+        ------
+        GreyboxError
+            For an effort unit the axis does not carry.
+        """
+        if effort_unit not in self.units.effort_units:
+            _fail(self.source or "<axis config>", f"a {self.motion} axis has no effort in {effort_unit!r}; "
+                                                  f"expected one of {', '.join(self.units.effort_units)}")
+        if self.inertia_kg_m2 is None:
+            return None
+        if self.motion == "rotary":
+            per_current = self.inertia_kg_m2 * self.gear_ratio * math.pi / 180.0 / self.torque_constant_Nm_per_A
+        else:
+            per_current = (self.inertia_kg_m2 * 2.0 * math.pi * self.gear_ratio
+                           / (self.screw_lead_mm * self.torque_constant_Nm_per_A))
+        return per_current if effort_unit == "A" else per_current * self.lossless_load_constant
+
     def without_torque_constant(self) -> "AxisConfig":
         """The same drive train for a log whose effort is the motor torque [Nm], not the current: ``k_t = 1``."""
         return dataclasses.replace(self, torque_constant_Nm_per_A=1.0)
@@ -210,8 +270,10 @@ class AxisConfig:
 
     def to_dict(self) -> dict:
         """The constants (and name, motion and channels) as a JSON-able dict, the keys of an axis file."""
+        inertia = {} if self.inertia_kg_m2 is None else {INERTIA: float(self.inertia_kg_m2)}
         return {"name": self.name, "motion": self.motion,
-                **{key: float(getattr(self, key)) for key in self.quantities}, "channels": dict(self.channels)}
+                **{key: float(getattr(self, key)) for key in self.quantities}, **inertia,
+                "channels": dict(self.channels)}
 
     def to_toml(self) -> str:
         """The axis file's text (TOML), which :func:`read_axis_config` reads back to an equal configuration."""
@@ -219,6 +281,9 @@ class AxisConfig:
         lines += [f"motion = {json.dumps(self.motion)}"] if self.motion != "linear" else []
         lines += [f"{key} = {float(getattr(self, key))!r}  # {QUANTITIES[key][0]} [{QUANTITIES[key][1]}]"
                   for key in self.quantities]
+        if self.inertia_kg_m2 is not None:
+            words, unit, _ = OPTIONAL_QUANTITIES[INERTIA]
+            lines.append(f"{INERTIA} = {float(self.inertia_kg_m2)!r}  # {words} [{unit}]")
         if self.channels:
             lines += ["", "[channels]"] + [f"{key} = {json.dumps(value)}" for key, value in self.channels.items()]
         return "\n".join(lines) + "\n"
@@ -235,7 +300,7 @@ def _check_values(values: Mapping[str, object], where: str, names: Mapping[str, 
     """
     names = names or {}
     for key, value in values.items():
-        words, unit, _ = QUANTITIES[key]
+        words, unit, _ = {**QUANTITIES, **OPTIONAL_QUANTITIES}[key]
         written = names.get(key, key)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             shown = f"the text {value!r}" if isinstance(value, str) else f"a {type(value).__name__}"
@@ -243,7 +308,7 @@ def _check_values(values: Mapping[str, object], where: str, names: Mapping[str, 
                          "the unit is in the key")
         if not math.isfinite(value) or value <= 0:
             _fail(where, f"{written} must be a positive number ({words} in {unit}), got {value}")
-    for key in _EFFICIENCIES:
+    for key in (key for key in _EFFICIENCIES if key in values):
         efficiency = values[key]
         if efficiency > 1.0:
             if PERCENT_EFFICIENCY[0] <= efficiency <= PERCENT_EFFICIENCY[1]:
@@ -347,7 +412,7 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
             values[key] = value
         elif key == SHARED_EFFICIENCY:
             values.update({name: value for name in _EFFICIENCIES})
-        elif key == "channels":
+        elif key == "channels" or key in OPTIONAL_QUANTITIES:
             continue
         elif key in _OPTIONAL:
             if not isinstance(value, str):
@@ -356,10 +421,11 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
             stem = next((s for s in sorted(_STEMS, key=len, reverse=True) if key == s or key.startswith(s + "_")), None)
             if stem is not None:
                 accepted = _STEMS[stem]
-                words, unit, _ = QUANTITIES[accepted]
+                words, unit, _ = {**QUANTITIES, **OPTIONAL_QUANTITIES}[accepted]
                 problem = "no unit in the key" if key == stem else "unit not accepted"
                 _fail(where, f"'{key}': {problem}; give the {words} as '{accepted}' (in {unit})")
-            expected = ", ".join(list(QUANTITIES) + [SHARED_EFFICIENCY] + list(_OPTIONAL) + ["[channels]"])
+            expected = ", ".join(list(QUANTITIES) + [SHARED_EFFICIENCY] + list(OPTIONAL_QUANTITIES) + list(_OPTIONAL)
+                                 + ["[channels]"])
             _fail(where, f"unknown key '{key}'; expected {expected}")
     values = {**{key: value for key, value in DEFAULTS.items() if key in required}, **values}
     missing = [key for key in required if key not in values]
@@ -381,8 +447,12 @@ def parse_axis_config(document: Mapping[str, object], source: str = "") -> AxisC
     _note_low_efficiencies(values, where, written)
     channels = check_channels(document.get("channels", {}), where)
     constants = {_SCREW: None, **{key: float(values[key]) for key in required}}
-    return AxisConfig(**constants, name=str(document.get("name", "")), motion=motion, channels=channels,
-                      source=source)
+    inertia = document.get(INERTIA)
+    if inertia is not None:
+        _check_values({INERTIA: inertia}, where)
+        inertia = float(inertia)
+    return AxisConfig(**constants, inertia_kg_m2=inertia, name=str(document.get("name", "")), motion=motion,
+                      channels=channels, source=source)
 
 
 def read_toml(path, what: str = "axis configuration") -> dict:

@@ -27,7 +27,13 @@ from typing import Sequence
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
-__all__ = ["BAND_HARMONICS", "SPRING_SHARE_LIMIT", "spring_share", "inertia_note"]
+__all__ = ["AXIS_INERTIA_FACTOR", "BAND_HARMONICS", "SPRING_SHARE_LIMIT", "spring_share", "inertia_note",
+           "axis_inertia_note"]
+
+#: Factor by which an identified inertia may exceed, or fall short of, the axis file's before it is flagged: a
+#: drive's commissioning and the data sheets give the inertia to some ten percent, the moved mass (workpiece,
+#: fixtures) changes it by tens of percent, but not by half or twice.
+AXIS_INERTIA_FACTOR = 2.0
 
 #: Share of the acceleration's variance one spring law ``a = -c x`` may explain before an identified
 #: inertia counts as a stand-in for a stiffness (0.8: a variance inflation factor of 5).
@@ -112,3 +118,36 @@ def inertia_note(runs: Sequence, inertia: float, unit: str) -> str | None:
             "for a stiffness and will not carry to other frequencies; for an effort measured at the load give "
             "--load-side (J = 0), else give the drive's inertia with --inertia J, or train on runs with other "
             "accelerations")
+
+
+def axis_inertia_note(inertia: float, expected: float, unit: str, source: str = "the axis file") -> str | None:
+    """A note when an identified inertia disagrees with the one the axis file gives; None when they agree.
+
+    They disagree when one exceeds the other by more than :data:`AXIS_INERTIA_FACTOR` (an identified
+    ``J = 0`` against a positive expected one included).
+
+    Parameters
+    ----------
+    inertia : float
+        The identified inertia [effort s^2/length].
+    expected : float
+        The inertia the axis file gives, in the same unit [effort s^2/length].
+    unit : str
+        Their unit, for the note (e.g. ``"A s^2/mm"``).
+    source : str, default "the axis file"
+        Where ``expected`` comes from, for the note.
+
+    Returns
+    -------
+    str or None
+        One sentence naming both values, their ratio and what to do, or None.
+    """
+    if not expected > 0.0:
+        return None
+    ratio = inertia / expected
+    if 1.0 / AXIS_INERTIA_FACTOR <= ratio <= AXIS_INERTIA_FACTOR:
+        return None
+    return (f"the identified inertia J = {inertia:.4g} {unit} is {ratio:.3g} times the {expected:.4g} {unit} of "
+            f"{source} (more than a factor {AXIS_INERTIA_FACTOR:g} apart): it stands in for another force (a "
+            "spring, an effort measured at the load) or the axis file is wrong; give the axis file's inertia "
+            "with --inertia, or --load-side for an effort measured at the load")

@@ -25,12 +25,13 @@ from typing import Callable
 
 import numpy as np
 from scipy.optimize import least_squares, minimize
+from scipy.special import ndtri
 from threadpoolctl import threadpool_limits
 
 from ..errors import ParameterError, Setting
 from .progress import ProgressEvent
 
-__all__ = ["METHODS", "SearchResult", "local_search", "multistart", "multistart_results"]
+__all__ = ["METHODS", "SearchResult", "local_search", "multistart", "multistart_results", "fixed_design"]
 
 #: Names of the local search methods.
 METHODS = ("nelder-mead", "least-squares")
@@ -189,6 +190,34 @@ def local_search(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper
     return SearchResult(tracked.best_x, tracked.best_cost, tracked.n_evaluations, start)
 
 
+def fixed_design(n_points: int, n_dims: int) -> np.ndarray:
+    """Standard-normal deviates of a fixed low-discrepancy design: the same points for every seed and call.
+
+    Point ``k`` (from 1) of the Kronecker sequence ``u_k = frac(k g)``, with
+    ``g_j = phi_d^-(j+1)`` and ``phi_d`` the positive root of ``x^(d+1) = x + 1``
+    (the generalised golden ratio: the sequence fills the unit cube evenly
+    for any number of points), mapped through the normal quantile function.
+
+    Parameters
+    ----------
+    n_points : int
+        Number of points (>= 0).
+    n_dims : int
+        Dimension d (>= 1).
+
+    Returns
+    -------
+    ndarray, shape (n_points, n_dims)
+        Deviates [-] with the spread of ``N(0, 1)`` draws, for perturbed starts shared by all seeds.
+    """
+    phi = 2.0
+    for _ in range(64):  # fixed-point iteration of x = (1 + x)^(1 / (d + 1))
+        phi = (1.0 + phi) ** (1.0 / (n_dims + 1))
+    g = phi ** -np.arange(1.0, n_dims + 1.0)
+    u = np.mod(0.5 + np.outer(np.arange(1.0, n_points + 1.0), g), 1.0)
+    return ndtri(u)
+
+
 def multistart(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, scale,
                n_starts: int = 1, random_state=0, method: str = "nelder-mead",
                max_iter: int = 500, stage: str = "fit", progress=None) -> SearchResult:
@@ -222,7 +251,7 @@ def multistart(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, 
 def multistart_results(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, scale,
                        n_starts: int = 1, random_state=0, method: str = "nelder-mead",
                        max_iter: int = 500, stage: str = "fit", progress=None,
-                       fixed_starts=()) -> list[SearchResult]:
+                       fixed_starts=(), deviates=None) -> list[SearchResult]:
     """The result of every start, in the order of the starts.
 
     The starts are ``x0``, then the ``fixed_starts`` (the same for every
@@ -236,6 +265,9 @@ def multistart_results(residuals: Callable[[np.ndarray], np.ndarray], x0, lower,
         As in :func:`multistart`.
     fixed_starts : sequence of array_like, optional
         Further deterministic starts (clipped into the bounds).
+    deviates : array_like, shape (n_starts - 1, p), optional
+        The perturbations of ``x0`` in units of ``scale`` (e.g. :func:`fixed_design`), instead of
+        seeded ``N(0, 1)`` draws; ``random_state`` is then not used.
 
     Returns
     -------
@@ -247,9 +279,13 @@ def multistart_results(residuals: Callable[[np.ndarray], np.ndarray], x0, lower,
         raise ValueError(f"n_starts must be at least 1, got {n_starts}")
     x0, lower, upper = _check_bounds(x0, lower, upper)
     scale = np.broadcast_to(np.asarray(scale, dtype=float), x0.shape)
-    rng = np.random.default_rng(random_state)
-    starts = [x0] + [np.clip(x0 + scale * rng.standard_normal(x0.size), lower, upper)
-                     for _ in range(n_starts - 1)]
+    if deviates is None:
+        rng = np.random.default_rng(random_state)
+        deviates = [rng.standard_normal(x0.size) for _ in range(n_starts - 1)]
+    deviates = np.asarray(deviates, dtype=float).reshape(-1, x0.size)
+    if len(deviates) != n_starts - 1:
+        raise ValueError(f"{len(deviates)} deviates for {n_starts - 1} perturbed starts")
+    starts = [x0] + [np.clip(x0 + scale * deviate, lower, upper) for deviate in deviates]
     starts[1:1] = [np.clip(np.asarray(start, dtype=float), lower, upper) for start in fixed_starts]
     results = []
     for index, start in enumerate(starts):

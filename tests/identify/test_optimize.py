@@ -90,3 +90,26 @@ def test_make_progress():
     assert make_progress(callback) is callback
     with pytest.raises(TypeError):
         make_progress("yes")
+
+
+def test_fixed_design_fills_the_cube_evenly_and_replaces_the_seeded_draws():
+    from scipy.special import ndtr
+
+    from greybox.identify.optimize import fixed_design, multistart_results
+
+    design = fixed_design(64, 3)
+    np.testing.assert_array_equal(design, fixed_design(64, 3))
+    u = ndtr(design)
+    for j in range(3):  # every eighth of each axis holds 8 of the 64 points, give or take three
+        counts = np.histogram(u[:, j], bins=8, range=(0.0, 1.0))[0]
+        assert counts.min() >= 5 and counts.max() <= 11
+
+    def residuals(theta):
+        return np.array([theta[0] - 1.0, 3.0 * (theta[1] + 0.5)])
+
+    starts = {}
+    for seed in (0, 1):
+        results = multistart_results(residuals, [0.0, 0.0], [-2.0, -2.0], [2.0, 2.0], scale=0.5, n_starts=3,
+                                     random_state=seed, deviates=fixed_design(2, 2), max_iter=5)
+        starts[seed] = [result.x for result in results]
+    np.testing.assert_array_equal(starts[0], starts[1])
