@@ -61,7 +61,8 @@ from .atomic import atomic_output
 from .errors import GreyboxError, ModelFileError
 from .provenance import TRAINING_RECORD, check_training_record
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RECORD_CHECKS", "save_model", "load_model"]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RECORD_CHECKS", "save_model", "save_verified", "load_model",
+           "check_reproduces"]
 
 #: Check of each record a model file may hold, by name: returns the record or raises ValueError.
 RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
@@ -237,6 +238,68 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
             for member, data in encoder.arrays.items():
                 _write_member(archive, member, data)
     return path
+
+
+def save_verified(model, path: str | PathLike, runs, *, predictions=None, overwrite: bool = False,
+                  records: dict | None = None) -> Path:
+    """Save a fitted model atomically, load the file back and check it predicts what the model did.
+
+    Parameters
+    ----------
+    model : estimator
+        A fitted instance of a class in :data:`greybox.registry.MODEL_CLASSES`.
+    path : str or path-like
+        File to write (``.gbm`` by convention).
+    runs : sequence of AxisLog
+        Runs (the training runs, say) both models predict; the comparison is bit for bit.
+    predictions : sequence of ndarray, optional
+        The fitted model's predictions of ``runs`` [A or N m] when already computed; else computed here.
+    overwrite : bool, default False
+        Replace an existing file; otherwise an existing file is an error.
+    records : dict, optional
+        Records about the model by name, as :func:`save_model` takes them.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    ModelFileError
+        As :func:`save_model` and :func:`load_model` do, and if the file's model predicts any run
+        differently (the message names the file).
+    """
+    if predictions is None:
+        predictions = [model.predict(run) for run in runs]
+    path = save_model(model, path, overwrite=overwrite, records=records)
+    check_reproduces(load_model(path), runs, predictions, path)
+    return path
+
+
+def check_reproduces(loaded, runs, predictions, path: str | PathLike, *, label: str = "the saved model") -> None:
+    """Refuse a model read back from a file that does not predict what the fitted model did, bit for bit.
+
+    Parameters
+    ----------
+    loaded : estimator
+        The model read back from ``path``.
+    runs : sequence of AxisLog
+        Runs to predict.
+    predictions : sequence of ndarray
+        The fitted model's predictions of ``runs`` [A or N m].
+    path : str or path-like
+        The file (or machine model directory) named in the message.
+    label : str, default "the saved model"
+        What the message calls the model (``"the saved model of axis X"``).
+
+    Raises
+    ------
+    ModelFileError
+        If any run's prediction differs.
+    """
+    if not all(np.array_equal(loaded.predict(run), expected) for run, expected in zip(runs, predictions)):
+        raise ModelFileError(f"{path}: {label} does not reproduce the fitted model's predictions")
 
 
 # ------------------------------------------------------------------- reading

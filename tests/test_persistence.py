@@ -392,3 +392,31 @@ def test_every_single_flipped_byte_is_one_model_file_error(tmp_path, gms_file):
         except Exception as error:  # noqa: BLE001 - the test looks for any other exception
             failures.append(f"byte {position}: {type(error).__name__}: {error}")
     assert not failures, "\n".join(failures[:5])
+
+
+def test_save_verified_writes_a_file_that_predicts_what_the_model_did(tmp_path):
+    from greybox.friction import CoulombModel
+    from greybox.persistence import save_verified
+
+    runs = [_axis_run(1), _axis_run(2)]
+    model = CoulombModel().fit(runs)
+    path = save_verified(model, tmp_path / "c.gbm", runs)
+    loaded = load_model(path)
+    for run in runs:
+        np.testing.assert_array_equal(loaded.predict(run), model.predict(run))
+    with pytest.raises(ModelFileError, match="file exists"):
+        save_verified(model, path, runs)
+
+
+def test_a_saved_model_that_predicts_otherwise_is_refused_naming_the_file(tmp_path):
+    """The comparison is bit for bit: predictions off by one ulp on one run are refused."""
+    from greybox.friction import CoulombModel
+    from greybox.persistence import save_verified
+
+    runs = [_axis_run(1), _axis_run(2)]
+    model = CoulombModel().fit(runs)
+    fitted = [model.predict(run) for run in runs]
+    fitted[1] = np.nextafter(fitted[1], np.inf)
+    with pytest.raises(ModelFileError, match=r"c\.gbm: the saved model does not reproduce"):
+        save_verified(model, tmp_path / "c.gbm", runs, predictions=fitted)
+
