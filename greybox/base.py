@@ -179,15 +179,7 @@ class ModelProtocol(BaseEstimator):
     :meth:`linear_coefficients` and :meth:`set_linear_coefficients`, a model
     that defines friction at rest :meth:`plant_law`; every model its
     :meth:`parameter_table`.
-
-    Attributes
-    ----------
-    renamed_attributes : dict of str to str
-        Learned attributes that model files of format version 1 hold under an
-        older name: ``{old name: new name}`` (read by :mod:`greybox.persistence`).
     """
-
-    renamed_attributes: dict[str, str] = {}
 
     def initial_state(self):
         """State before the first sample of a run.

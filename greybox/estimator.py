@@ -24,9 +24,8 @@ from .data.log import AxisLog, as_log_list
 from .data.quantities import MOTIONS, Motion
 from .errors import LogError, ParameterError, Setting
 from .identify.inertia import axis_inertia_note, inertia_note
-from .identify.intervals import check_intervals, with_intervals
+from .identify.intervals import with_intervals
 from .identify.progress import make_progress
-from .identify.selection import check_selection_record
 from .metrics import rmse
 
 __all__ = ["CurrentModel", "StreamView", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
@@ -434,63 +433,6 @@ class CurrentModel(ModelProtocol):
         check_is_fitted(self)
         return MOTIONS[getattr(self, "motion_", "linear")]
 
-    def validate_fitted(self) -> None:
-        """Check that the learned state is complete and usable, as a model read from a file must be.
-
-        Checks the hyperparameters, that the parameter table is finite, and
-        predicts a short probe run (a reversal at the fitted sample time) in
-        chunks and at once.
-
-        Raises
-        ------
-        ParameterError
-            Naming the missing or malformed learned attribute, a parameter that is not finite or
-            beyond :data:`MAX_PARAMETER_MAGNITUDE`, the invalid hyperparameter, or the error the
-            probe prediction gave.
-        """
-        self._check_params()
-        check_inertia(self.inertia)
-        try:
-            check_is_fitted(self)
-            motion = getattr(self, "motion_", "linear")
-            if motion not in MOTIONS:
-                raise ParameterError(f"motion_ must be one of {', '.join(MOTIONS)}, got {motion!r}")
-            if self.effort_unit_ not in MOTIONS[motion].effort_units:
-                raise ParameterError(f"effort_unit_ of a {motion} axis must be one of "
-                                     f"{MOTIONS[motion].effort_units}, got {self.effort_unit_!r}")
-            for row in self.parameter_table():
-                values = np.asarray(row.value, dtype=float)
-                if not np.all(np.isfinite(values)):
-                    raise ParameterError(f"parameter {row.name} is not finite: {row.value!r}")
-                if values.size and np.max(np.abs(values)) > MAX_PARAMETER_MAGNITUDE:
-                    raise ParameterError(f"parameter {row.name} = {np.max(np.abs(values)):.3g} in magnitude, beyond "
-                                         f"{MAX_PARAMETER_MAGNITUDE:g}: not a model of a feed axis")
-            record = getattr(self, "selection_", None)  # only a model chosen by cross-validation has one
-            if record is not None:
-                check_selection_record(record)
-            notes = getattr(self, "notes_", [])
-            if not (isinstance(notes, list) and all(isinstance(note, str) and len(note) <= 2000 for note in notes)):
-                raise ParameterError("notes_ must be a list of sentences (text of at most 2000 characters each)")
-            check_intervals(self)
-            step = float(self.sample_time_)
-            if not (np.isfinite(step) and step > 0.0):
-                raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")
-            probe = _probe_run(step, self.effort_unit_, motion)
-            whole = self.predict(probe)
-            first, state = self.predict_chunk(probe.select(slice(0, 50)), sample_time=step)
-            second, _ = self.predict_chunk(probe.select(slice(50, None)), state, sample_time=step)
-            if whole.shape != (len(probe),) or not np.all(np.isfinite(whole)):
-                raise ParameterError("the prediction of a probe run is not finite")
-            if not np.allclose(np.concatenate((first, second)), whole, rtol=0, atol=1e-9 * (1 + np.abs(whole).max())):
-                raise ParameterError("chunked and one-shot prediction of a probe run differ")
-        except AttributeError as error:
-            missing = getattr(error, "name", None)  # the attribute's name; else Python's message
-            raise ParameterError(f"a learned attribute is missing: {missing or error}") from None
-        except (TypeError, ValueError, IndexError, KeyError) as error:
-            if isinstance(error, ParameterError):
-                raise
-            raise ParameterError(f"a learned attribute is malformed: {error}") from None
-
     def fit_summary(self) -> dict:
         """Figures of the fit itself rather than of the model: data fitted on and what the search reports.
 
@@ -636,19 +578,6 @@ class CurrentModel(ModelProtocol):
 
     def _fit_statistics(self) -> dict:
         return {}
-
-
-def _probe_run(sample_time: float, effort_unit: str, motion: str) -> AxisLog:
-    """A short prepared run with a reversal and a dwell: 200 samples at ``sample_time`` [s]."""
-    n = 200
-    time = np.arange(n) * sample_time
-    phase = np.linspace(0.0, 2.0 * np.pi, n)
-    velocity = 10.0 * np.sin(phase)
-    velocity[150:] = 0.0
-    position = np.concatenate(([0.0], np.cumsum(velocity[:-1] * sample_time)))
-    acceleration = np.gradient(velocity, sample_time)
-    return AxisLog(time=time, position=position, effort=np.zeros(n), velocity=velocity,
-                   acceleration=acceleration, effort_unit=effort_unit, motion=motion)
 
 
 class StreamView:

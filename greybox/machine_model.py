@@ -29,7 +29,7 @@ from typing import Mapping
 
 from .atomic import write_text_atomic
 from .errors import ModelFileError
-from .persistence import load_model, save_model
+from .persistence import check_reproduces, load_model, save_model
 from .registry import model_kind
 
 __all__ = ["MACHINE_FORMAT", "MACHINE_FORMAT_VERSION", "MANIFEST", "MachineModel", "is_machine_model",
@@ -129,7 +129,7 @@ def check_machine_output(directory: str | PathLike, axes, *, overwrite: bool = F
 
 
 def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite: bool = False,
-                 records: dict | None = None) -> list[Path]:
+                 records: dict | None = None, verify: Mapping[str, tuple] | None = None) -> list[Path]:
     """Write a machine model: one model file per axis, then the manifest.
 
     Parameters
@@ -142,6 +142,9 @@ def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite:
         Replace the files of an existing machine model in ``directory``.
     records : dict, optional
         ``{axis: records}``: the records of each axis's model file (:func:`greybox.persistence.save_model`).
+    verify : mapping, optional
+        ``{axis: (runs, predictions)}``: read the machine model back and check that each axis's model
+        predicts these runs exactly as the fitted one did (:func:`greybox.persistence.check_reproduces`).
 
     Returns
     -------
@@ -152,7 +155,8 @@ def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite:
     ------
     ModelFileError
         For a path that is a file, a directory holding a machine model (or an axis's file)
-        without ``overwrite``, an invalid axis name, or a model that cannot be saved.
+        without ``overwrite``, an invalid axis name, a model that cannot be saved, or (with ``verify``)
+        a saved model that does not reproduce the fitted one's predictions.
     """
     from . import __version__
 
@@ -166,6 +170,11 @@ def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite:
     manifest = {"format": MACHINE_FORMAT, "format_version": MACHINE_FORMAT_VERSION,
                 "greybox_version": __version__, "name": machine.name, "axes": axes}
     write_text_atomic(directory / MANIFEST, json.dumps(manifest, indent=1) + "\n")
+    if verify:
+        reloaded = load_machine(directory)
+        for axis, (runs, predictions) in verify.items():
+            check_reproduces(reloaded.models[axis], runs, predictions, directory,
+                             label=f"the saved model of axis {axis}")
     return [*targets.values(), directory / MANIFEST]
 
 

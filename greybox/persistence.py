@@ -55,13 +55,20 @@ from os import PathLike
 from pathlib import Path
 
 import numpy as np
+from sklearn.utils.validation import check_is_fitted
 
 from . import registry
 from .atomic import atomic_output
-from .errors import GreyboxError, ModelFileError
+from .data.log import AxisLog
+from .data.quantities import MOTIONS
+from .errors import GreyboxError, ModelFileError, ParameterError
+from .estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
+from .identify.intervals import check_intervals
+from .identify.selection import check_selection_record
 from .provenance import TRAINING_RECORD, check_training_record
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RECORD_CHECKS", "save_model", "load_model"]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RECORD_CHECKS", "RENAMED_ATTRIBUTES", "save_model", "save_verified",
+           "load_model", "check_fitted", "check_reproduces"]
 
 #: Check of each record a model file may hold, by name: returns the record or raises ValueError.
 RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
@@ -69,8 +76,12 @@ RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
 #: Value of the ``format`` field of every model file.
 FORMAT_NAME = "greybox-model"
 #: Newest format version this greybox writes and reads. Version 2 renamed learned attributes
-#: (a class's ``renamed_attributes``); version-1 files are read with the old names mapped.
+#: (:data:`RENAMED_ATTRIBUTES`); version-1 files are read with the old names mapped.
 FORMAT_VERSION = 2
+
+#: Learned attributes that files of format version 1 hold under an older name, by model kind:
+#: ``{kind: {old name: new name}}`` (the GMS slip rate and viscous coefficient had names other models use).
+RENAMED_ATTRIBUTES = {"gms": {"C_": "slip_rate_", "mu_": "viscous_", "s0_": "s_0_"}}
 
 _JSON_MEMBER = "model.json"
 _ARRAY_DIR = "arrays/"
@@ -239,6 +250,68 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
     return path
 
 
+def save_verified(model, path: str | PathLike, runs, *, predictions=None, overwrite: bool = False,
+                  records: dict | None = None) -> Path:
+    """Save a fitted model atomically, load the file back and check it predicts what the model did.
+
+    Parameters
+    ----------
+    model : estimator
+        A fitted instance of a class in :data:`greybox.registry.MODEL_CLASSES`.
+    path : str or path-like
+        File to write (``.gbm`` by convention).
+    runs : sequence of AxisLog
+        Runs (the training runs, say) both models predict; the comparison is bit for bit.
+    predictions : sequence of ndarray, optional
+        The fitted model's predictions of ``runs`` [A or N m] when already computed; else computed here.
+    overwrite : bool, default False
+        Replace an existing file; otherwise an existing file is an error.
+    records : dict, optional
+        Records about the model by name, as :func:`save_model` takes them.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    ModelFileError
+        As :func:`save_model` and :func:`load_model` do, and if the file's model predicts any run
+        differently (the message names the file).
+    """
+    if predictions is None:
+        predictions = [model.predict(run) for run in runs]
+    path = save_model(model, path, overwrite=overwrite, records=records)
+    check_reproduces(load_model(path), runs, predictions, path)
+    return path
+
+
+def check_reproduces(loaded, runs, predictions, path: str | PathLike, *, label: str = "the saved model") -> None:
+    """Refuse a model read back from a file that does not predict what the fitted model did, bit for bit.
+
+    Parameters
+    ----------
+    loaded : estimator
+        The model read back from ``path``.
+    runs : sequence of AxisLog
+        Runs to predict.
+    predictions : sequence of ndarray
+        The fitted model's predictions of ``runs`` [A or N m].
+    path : str or path-like
+        The file (or machine model directory) named in the message.
+    label : str, default "the saved model"
+        What the message calls the model (``"the saved model of axis X"``).
+
+    Raises
+    ------
+    ModelFileError
+        If any run's prediction differs.
+    """
+    if not all(np.array_equal(loaded.predict(run), expected) for run, expected in zip(runs, predictions)):
+        raise ModelFileError(f"{path}: {label} does not reproduce the fitted model's predictions")
+
+
 # ------------------------------------------------------------------- reading
 class _Decoder:
     """Rebuild values (and nested models) from the JSON and the ``.npy`` members."""
@@ -271,7 +344,7 @@ class _Decoder:
             self.fail(f"{kind} model in {where} has parameters this greybox does not know: {', '.join(unknown)}")
         model = cls(**{name: self.value(value, f"{where}.{name}") for name, value in params.items()})
         if self.version < 2:
-            renamed = getattr(cls, "renamed_attributes", {})
+            renamed = RENAMED_ATTRIBUTES.get(kind, {})
             attributes = {renamed.get(name, name): value for name, value in attributes.items()}
         for name, value in attributes.items():
             if not isinstance(name, str) or not _ATTRIBUTE_NAME.match(name):
@@ -427,9 +500,93 @@ def load_model(path: str | PathLike, *, records: bool = False):
         raise ModelFileError(f"{path}: cannot read model file: {error}") from None
     if any(name.endswith("_") and not name.startswith("_") for name in vars(model)):  # fitted: check it works
         try:
-            model.validate_fitted()
+            check_fitted(model)
         except GreyboxError as error:
             raise ModelFileError(f"{path}: invalid {type(model).__name__} in the model file: {error}") from None
     if unused:
         raise ModelFileError(f"{path}: member {unused[0]} is not part of the model (no value refers to it)")
     return (model, held) if records else model
+
+
+# ------------------------------------------------------------------- checking
+def check_fitted(model) -> None:
+    """Check that a model's learned state is complete and usable, as one read from a file must be.
+
+    Checks the hyperparameters, the records of the learned state (kind of axis, effort unit,
+    selection, notes, intervals, sample time), that every identified parameter is finite and of a
+    plausible magnitude, and predicts a short probe run (a reversal and a dwell at the fitted sample
+    time) at once and in two chunks.
+
+    The probe simulation is needed, not a formality: a model file holds the learned state of a
+    dynamic model (element states, support vectors, effect shapes) that no table of parameters
+    shows in full, so a file whose numbers are each finite can still predict non-finite values, or
+    predict differently chunk by chunk (``greybox predict`` streaming a log) than at once. Running
+    200 samples finds such a file at load, with the file's name, instead of midway through a log.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        A fitted model (:class:`greybox.estimator.CurrentModel`).
+
+    Raises
+    ------
+    ParameterError
+        Naming the missing or malformed learned attribute, a parameter that is not finite or
+        beyond :data:`~greybox.estimator.MAX_PARAMETER_MAGNITUDE`, the invalid hyperparameter, or the
+        error the probe prediction gave.
+    """
+    model._check_params()  # the model's own hyperparameter check, as fit runs it first
+    check_inertia(model.inertia)
+    try:
+        check_is_fitted(model)
+        motion = getattr(model, "motion_", "linear")
+        if motion not in MOTIONS:
+            raise ParameterError(f"motion_ must be one of {', '.join(MOTIONS)}, got {motion!r}")
+        if model.effort_unit_ not in MOTIONS[motion].effort_units:
+            raise ParameterError(f"effort_unit_ of a {motion} axis must be one of "
+                                 f"{MOTIONS[motion].effort_units}, got {model.effort_unit_!r}")
+        for row in model.parameter_table():
+            values = np.asarray(row.value, dtype=float)
+            if not np.all(np.isfinite(values)):
+                raise ParameterError(f"parameter {row.name} is not finite: {row.value!r}")
+            if values.size and np.max(np.abs(values)) > MAX_PARAMETER_MAGNITUDE:
+                raise ParameterError(f"parameter {row.name} = {np.max(np.abs(values)):.3g} in magnitude, beyond "
+                                     f"{MAX_PARAMETER_MAGNITUDE:g}: not a model of a feed axis")
+        record = getattr(model, "selection_", None)  # only a model chosen by cross-validation has one
+        if record is not None:
+            check_selection_record(record)
+        notes = getattr(model, "notes_", [])
+        if not (isinstance(notes, list) and all(isinstance(note, str) and len(note) <= 2000 for note in notes)):
+            raise ParameterError("notes_ must be a list of sentences (text of at most 2000 characters each)")
+        check_intervals(model)
+        step = float(model.sample_time_)
+        if not (np.isfinite(step) and step > 0.0):
+            raise ParameterError(f"sample_time_ must be a positive number of seconds, got {step!r}")
+        probe = _probe_run(step, model.effort_unit_, motion)
+        whole = model.predict(probe)
+        first, state = model.predict_chunk(probe.select(slice(0, 50)), sample_time=step)
+        second, _ = model.predict_chunk(probe.select(slice(50, None)), state, sample_time=step)
+        if whole.shape != (len(probe),) or not np.all(np.isfinite(whole)):
+            raise ParameterError("the prediction of a probe run is not finite")
+        if not np.allclose(np.concatenate((first, second)), whole, rtol=0, atol=1e-9 * (1 + np.abs(whole).max())):
+            raise ParameterError("chunked and one-shot prediction of a probe run differ")
+    except AttributeError as error:
+        missing = getattr(error, "name", None)  # the attribute's name; else Python's message
+        raise ParameterError(f"a learned attribute is missing: {missing or error}") from None
+    except (TypeError, ValueError, IndexError, KeyError) as error:
+        if isinstance(error, ParameterError):
+            raise
+        raise ParameterError(f"a learned attribute is malformed: {error}") from None
+
+
+def _probe_run(sample_time: float, effort_unit: str, motion: str) -> AxisLog:
+    """A short prepared run with a reversal and a dwell: 200 samples at ``sample_time`` [s]."""
+    n = 200
+    time = np.arange(n) * sample_time
+    phase = np.linspace(0.0, 2.0 * np.pi, n)
+    velocity = 10.0 * np.sin(phase)
+    velocity[150:] = 0.0
+    position = np.concatenate(([0.0], np.cumsum(velocity[:-1] * sample_time)))
+    acceleration = np.gradient(velocity, sample_time)
+    return AxisLog(time=time, position=position, effort=np.zeros(n), velocity=velocity,
+                   acceleration=acceleration, effort_unit=effort_unit, motion=motion)

@@ -30,7 +30,7 @@ from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError, ModelFileError
 from greybox.friction import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
-from greybox.persistence import MAX_MEMBER_BYTES, load_model, save_model
+from greybox.persistence import MAX_MEMBER_BYTES, check_fitted, load_model, save_model
 from greybox.twin import make_dataset
 
 FORMATS = (".csv", ".parquet", ".mcap", ".mat", ".tdms")
@@ -132,7 +132,7 @@ def test_mutated_model_files_load_or_fail_clearly(tmp_path, kind, mutation):
     path.write_bytes(_mutate(_valid_model(kind), mutation))
     result = _outcome_of(lambda: load_model(path))
     if not isinstance(result, GreyboxError):
-        result.validate_fitted()
+        check_fitted(result)
 
 
 def _members(kind: str = "gms") -> dict[str, bytes]:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from sklearn.base import BaseEstimator
 
-from greybox import atomic, registry
+from greybox import atomic, persistence, registry
 from greybox.errors import ModelFileError, ParameterError
 from greybox.persistence import FORMAT_VERSION, load_model, save_model
 
@@ -38,20 +38,24 @@ class ToyModel(BaseEstimator):
         self.limit_ = float("-inf")
         return self
 
-    def validate_fitted(self):
-        """Part of the model protocol: refuse an incomplete learned state (here: coef_ must hold 3 numbers)."""
-        if np.shape(getattr(self, "coef_", None)) != (3,):
-            raise ParameterError("coef_ must hold 3 coefficients")
-
     def predict(self, x):
         x = np.asarray(x, dtype=float)
         base = 0.0 if self.first_stage is None else self.first_stage.predict(x)
         return self.gain * (self.coef_[0] * x + self.coef_[1] * np.sin(x) + self.coef_[2]) + self.offset_ + base
 
 
+def _check_toy(model):
+    """The load check of the toy kind: refuse an incomplete learned state (coef_ must hold 3 numbers)."""
+    if np.shape(getattr(model, "coef_", None)) != (3,):
+        raise ParameterError("coef_ must hold 3 coefficients")
+
+
 @pytest.fixture(autouse=True)
 def toy_registered(monkeypatch):
     monkeypatch.setitem(registry.MODEL_CLASSES, "toy", ToyModel)
+    real_check = persistence.check_fitted
+    monkeypatch.setattr(persistence, "check_fitted",
+                        lambda model: _check_toy(model) if isinstance(model, ToyModel) else real_check(model))
 
 
 @pytest.fixture
@@ -392,3 +396,50 @@ def test_every_single_flipped_byte_is_one_model_file_error(tmp_path, gms_file):
         except Exception as error:  # noqa: BLE001 - the test looks for any other exception
             failures.append(f"byte {position}: {type(error).__name__}: {error}")
     assert not failures, "\n".join(failures[:5])
+
+
+def test_save_verified_writes_a_file_that_predicts_what_the_model_did(tmp_path):
+    from greybox.friction import CoulombModel
+    from greybox.persistence import save_verified
+
+    runs = [_axis_run(1), _axis_run(2)]
+    model = CoulombModel().fit(runs)
+    path = save_verified(model, tmp_path / "c.gbm", runs)
+    loaded = load_model(path)
+    for run in runs:
+        np.testing.assert_array_equal(loaded.predict(run), model.predict(run))
+    with pytest.raises(ModelFileError, match="file exists"):
+        save_verified(model, path, runs)
+
+
+def test_a_saved_model_that_predicts_otherwise_is_refused_naming_the_file(tmp_path):
+    """The comparison is bit for bit: predictions off by one ulp on one run are refused."""
+    from greybox.friction import CoulombModel
+    from greybox.persistence import save_verified
+
+    runs = [_axis_run(1), _axis_run(2)]
+    model = CoulombModel().fit(runs)
+    fitted = [model.predict(run) for run in runs]
+    fitted[1] = np.nextafter(fitted[1], np.inf)
+    with pytest.raises(ModelFileError, match=r"c\.gbm: the saved model does not reproduce"):
+        save_verified(model, tmp_path / "c.gbm", runs, predictions=fitted)
+
+
+def test_check_fitted_refuses_an_implausible_parameter_and_a_state_that_streams_otherwise(gms_file):
+    from greybox.persistence import check_fitted
+
+    model = load_model(gms_file)
+    check_fitted(model)
+    model.J_ = 1e300
+    with pytest.raises(ParameterError, match="J = 1e.300 in magnitude"):
+        check_fitted(model)
+    model = load_model(gms_file)
+    whole = model.predict_chunk
+
+    def drifting(run, state=None, *, sample_time):  # a state that predicts otherwise chunk by chunk
+        current, after = whole(run, state, sample_time=sample_time)
+        return (current if state is None else current + 1.0), after
+
+    model.predict_chunk = drifting
+    with pytest.raises(ParameterError, match="chunked and one-shot prediction of a probe run differ"):
+        check_fitted(model)

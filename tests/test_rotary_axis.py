@@ -21,7 +21,7 @@ from greybox.data.validate import check_velocity_units
 from greybox.errors import GreyboxError, LogError, ParameterError
 from greybox.evaluate.plots import plot_log
 from greybox.friction import StribeckModel
-from greybox.persistence import load_model, save_model
+from greybox.persistence import check_fitted, load_model, save_model
 from greybox.predict.plot import plot_process
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
@@ -146,7 +146,7 @@ def test_a_rotary_model_speaks_deg_and_refuses_a_linear_log(rotary):
         loaded.predict(linear)
     loaded.motion_ = "angular"
     with pytest.raises(ParameterError, match="motion_ must be one of linear, rotary"):
-        loaded.validate_fitted()
+        check_fitted(loaded)
 
 
 def test_a_linear_axis_file_is_refused_for_a_rotary_log(rotary):

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..data.effort import EFFORT_UNITS, check_one_effort
 from ..data.prepare import MAX_GAP_STEPS
+from ..json_values import jsonable
 from ..metrics import metrics_table
 from ..provenance import TRAINING_RECORD, file_identity, preparation_warning, training_record
 from ..provenance import preparation_of as prepared_as
@@ -56,7 +57,7 @@ def record_training(args: argparse.Namespace, files, names, runs, predictions) -
 
     def figures(table) -> dict:
         re = float(table["re"])
-        return {"samples": int(table["n"]), "rmse": float(table["rmse"]), "re_percent": re if np.isfinite(re) else None}
+        return {"samples": int(table["n"]), "rmse": float(table["rmse"]), "re_percent": jsonable(re)}
 
     ranges = {}
     for channel in ("position", "velocity", "acceleration"):

@@ -7,7 +7,7 @@ import os
 import time
 from pathlib import Path
 
-from ..errors import GreyboxError, ModelFileError
+from ..errors import GreyboxError
 from ._types import FINITE, NON_NEGATIVE, POSITIVE, SEED, WordOrNumber, positive
 
 __all__ = ["add_parser", "run"]
@@ -94,23 +94,9 @@ def _say(args, text: str) -> None:
         print(text, flush=True)
 
 
-def _load(path: str):
-    from ..persistence import load_model
-
-    if not os.path.isfile(path):
-        raise ModelFileError(f"{path}: no such model file")
-    return load_model(path)
-
-
-def _same_axis_kind(source, motion: str, plant) -> None:
-    """Refuse a model or log of another kind of axis than the plant's (mm against deg)."""
-    if motion != plant.motion:
-        raise GreyboxError(f"{source}: a {motion} axis, the plant {plant.name} is a {plant.motion} one; feed-forward "
-                           "models, training logs and references must be of the plant's kind of axis")
-
-
 def _plant(args):
     from ..control.plants import ModelPlant, TwinPlant
+    from ..persistence import load_model
 
     key = args.plant.strip().lower()
     if key in TWIN_PLANTS:
@@ -121,7 +107,7 @@ def _plant(args):
     if not os.path.isfile(args.plant):
         raise GreyboxError(f"{args.plant}: no such model file; the plant is twin-X, twin-Y, twin-C or a gms/lugre "
                            "model file (--plant)")
-    model = _load(args.plant)  # its errors name the file already
+    model = load_model(args.plant)  # its errors name the file already
     try:
         return ModelPlant(model, name=Path(args.plant).stem)
     except GreyboxError as error:
@@ -143,52 +129,25 @@ def _fit_kinds(args) -> list[str]:
     return list(dict.fromkeys(kinds))
 
 
-def _training_runs(args, plant):
-    from ..control.plants import TwinPlant
-    from ..control.workflow import twin_training_runs
+def _models(args, plant) -> dict:
+    """The feed-forward models of --model-file and --model (:func:`greybox.control.workflow.feedforward_models`)."""
+    from ..control.workflow import check_axis_kind, feedforward_models, synthesises_training
+    from ._build import build_model
     from ._options import read_logs
 
-    if args.train:
+    kinds = _fit_kinds(args)
+    if not kinds and not args.model_files:
+        raise GreyboxError("no feed-forward model: give --model KIND... or --model-file FILE...")
+    if kinds and not args.train and not synthesises_training(plant):
+        raise GreyboxError("--model with a model plant needs training logs: give --train LOG ...")
+    runs = None
+    if kinds and args.train:
         runs = read_logs(args, args.train)
         for run in runs:
-            _same_axis_kind(run.source or "--train", run.motion, plant)
-        return runs
-    if not isinstance(plant, TwinPlant) or plant.axis is None:
-        raise GreyboxError("--model with a model plant needs training logs: give --train LOG ...")
-    _say(args, f"synthesising training data: axis {plant.axis}, datasets A and P, {args.train_duration:g} s each, "
-               f"seed {args.seed}")
-    return twin_training_runs(plant, seed=args.seed, duration_s=args.train_duration)
-
-
-def _models(args, plant) -> dict:
-    from ..registry import model_kind
-    from ._build import build_model
-
-    entries = []
-    for path in args.model_files:
-        model = _load(path)
-        _same_axis_kind(path, model.units_.name, plant)
-        entries.append((model_kind(model), Path(path).stem, model))
-    kinds = _fit_kinds(args)
-    if kinds:
-        runs = _training_runs(args, plant)
-        for kind in kinds:
-            started = time.perf_counter()
-            model = build_model(kind, args).fit(runs)
-            _say(args, f"fitted {kind} on {len(runs)} run(s) in {time.perf_counter() - started:.1f} s")
-            entries.append((kind, "fitted", model))
-    if not entries:
-        raise GreyboxError("no feed-forward model: give --model KIND... or --model-file FILE...")
-    counts = {}
-    for kind, _, _ in entries:
-        counts[kind] = counts.get(kind, 0) + 1
-    models = {}
-    for kind, origin, model in entries:
-        name = kind if counts[kind] == 1 else f"{kind} ({origin})"
-        if name in models:
-            raise GreyboxError(f"two feed-forward models are both named {name!r}; give distinct file names")
-        models[name] = model
-    return models
+            check_axis_kind(run.source or "--train", run.motion, plant)
+    return feedforward_models(plant, model_files=args.model_files, kinds=kinds,
+                              build=lambda kind: build_model(kind, args), train_runs=runs, seed=args.seed,
+                              train_duration_s=args.train_duration, progress=lambda text: _say(args, text))
 
 
 def _inertia(args):
@@ -203,6 +162,7 @@ def _inertia(args):
 
 
 def _references(args, plant) -> list:
+    from ..control.workflow import check_axis_kind
     from ._options import read_logs
 
     references = []
@@ -213,7 +173,7 @@ def _references(args, plant) -> list:
         if not os.path.isfile(value):
             raise GreyboxError(f"{value}: no such log; --reference takes low, high or log files")
         for run in read_logs(args, [value]):
-            _same_axis_kind(value, run.motion, plant)
+            check_axis_kind(value, run.motion, plant)
             references.append(run)
     return references
 

@@ -16,7 +16,7 @@ from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
 from ..models.effects import EFFECT_NAMES, effect
-from ..persistence import load_model, save_model
+from ..persistence import save_verified
 from ..registry import MODEL_CLASSES
 from ._build import CommandLineError, add_model_arguments, build_model
 from ._options import add_log_arguments, read_logs
@@ -183,10 +183,7 @@ def run(args: argparse.Namespace) -> int:
         for path in write_report(result, args.out, document):
             print(f"wrote {path}")
     if args.save_model:
-        save_model(result.model, args.save_model, overwrite=args.force)
-        reloaded = load_model(args.save_model)
-        if not np.array_equal(reloaded.predict(test), result.model.predict(test)):
-            raise ModelFileError(f"{args.save_model}: the saved model does not reproduce the fitted model")
+        save_verified(result.model, args.save_model, [test], overwrite=args.force)
         print(f"wrote {args.save_model}")
     startup = ", start-up included" if getattr(args, "startup_counted", False) else ""
     print(f"done in {time.perf_counter() - started:.1f} s wall{startup}")

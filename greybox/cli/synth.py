@@ -196,32 +196,21 @@ def _check_duration(args: argparse.Namespace, axes, datasets) -> None:
 
 def _run_plan(args: argparse.Namespace, cutting) -> int:
     """``synth --plan PROGRAM``: the twin axis the program moves runs it; one log."""
-    from ..data.io import write_log
-    from ..nc.gcode import read_program
-    from ..twin.axes import axis_geometry
-    from ..twin.datasets import make_dataset, stored
-    from ..twin.nc_run import program_trajectory
+    from ..twin.nc_run import synthesize_program
 
     given = [flag for flag, value in (("--family", args.family), ("--axis", args.axis), ("--duration", args.duration),
                                       ("--one-file", args.one_file)) if value is not None]
     if given:
         raise GreyboxError(f"--plan runs the program's own axis and motion; {', '.join(given)} does not apply")
-    program = read_program(args.plan)
-    geometry = axis_geometry(program.axis)
-    trajectory = program_trajectory(program, geometry)
-    out = Path(args.out) / f"{geometry.name}_{Path(args.plan).stem}.mcap"
-    if out.exists() and not args.force:
-        raise GreyboxError(f"{out}: file exists; pass --force to overwrite it")
     options = _effect_options(args)
     if cutting is not None:
         options["cutting"] = cutting
-    log = make_dataset(geometry.name, "N", args.seed, trajectory=trajectory,
-                       noise=CurrentNoise(std_A=args.noise_std), **options)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    write_log(stored(log, ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None), out)
-    lowered = trajectory.description["feeds_lowered"]
-    print(f"{Path(args.plan).name}: axis {geometry.name}, {len(program.blocks)} moves and dwells, "
-          f"{log.duration:.1f} s, {len(log)} samples -> {out}")
+    ran = synthesize_program(args.plan, args.seed, args.out, force=args.force,
+                             truth_channels=ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None,
+                             noise=CurrentNoise(std_A=args.noise_std), **options)
+    lowered = ran.trajectory.description["feeds_lowered"]
+    print(f"{Path(args.plan).name}: axis {ran.log.axis}, {len(ran.program.blocks)} moves and dwells, "
+          f"{ran.log.duration:.1f} s, {len(ran.log)} samples -> {ran.path}")
     if lowered:
         print(f"note: {Path(args.plan).name}: the twin's acceleration limit lowered the feeds of {len(lowered)} "
               f"stroke(s) (first at line {lowered[0]['line']}, to {100 * lowered[0]['factor']:.0f} %)",

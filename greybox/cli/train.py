@@ -17,7 +17,7 @@ from ..identify.intervals import METHODS as INTERVAL_METHODS
 from ..identify.intervals import attach_intervals
 from ..metrics import metrics_table
 from ..model_choice import DEFAULT_CANDIDATES
-from ..persistence import load_model, save_model
+from ..persistence import save_verified
 from ..registry import MODEL_CLASSES
 from ._advice import offset_note
 from ._build import add_model_arguments, build_model, takes_hyperparameter
@@ -223,7 +223,7 @@ def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
 
 
 def _run_machine(args: argparse.Namespace) -> int:
-    from ..machine_model import MachineModel, check_machine_output, load_machine, save_machine
+    from ..machine_model import MachineModel, check_machine_output, save_machine
 
     name, axes = _machine_axes(args)
     check_machine_output(args.out, [axis.name for axis in axes], overwrite=args.force)
@@ -239,11 +239,8 @@ def _run_machine(args: argparse.Namespace) -> int:
         records[axis.name] = record_training(args, list(args.train) + list(args.stage2 or ()), names, runs,
                                              predictions[axis.name][1])
         models[axis.name] = model
-    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force, records=records)
-    reloaded = load_machine(args.out)
-    for axis, (runs, expected) in predictions.items():
-        if not all(np.array_equal(reloaded.models[axis].predict(run), p) for run, p in zip(runs, expected)):
-            raise ModelFileError(f"{args.out}: the saved model of axis {axis} does not reproduce the fitted model")
+    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force, records=records,
+                           verify=predictions)
     for path in written:
         print(f"wrote {path}")
     return 0
@@ -332,18 +329,10 @@ def _run_auto(args: argparse.Namespace) -> int:
     names = [Path(group).name for group in groups]
     predictions = _report_fit(model, names, runs, time.perf_counter() - started,
                               f"{model.selection_['chosen']} (chosen by held-out runs)")
-    _save_checked(model, out, args.force, runs, predictions,
-                  record_training(args, list(args.train), names, runs, predictions))
-    return 0
-
-
-def _save_checked(model, out: Path, overwrite: bool, runs, predictions, records) -> None:
-    """Save the model with its records and check that the file predicts what the fitted model did."""
-    save_model(model, out, overwrite=overwrite, records=records)
-    reloaded = load_model(out)
-    if not all(np.array_equal(reloaded.predict(run), p) for run, p in zip(runs, predictions)):
-        raise ModelFileError(f"{out}: the saved model does not reproduce the fitted model's predictions")
+    save_verified(model, out, runs, predictions=predictions, overwrite=args.force,
+                  records=record_training(args, list(args.train), names, runs, predictions))
     print(f"wrote {out}")
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
@@ -375,5 +364,7 @@ def run(args: argparse.Namespace) -> int:
     names, runs = _fit(model, args, *data)
     _check_inertia(model, expected, source)
     predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
-    _save_checked(model, out, args.force, runs, predictions, record_training(args, inputs, names, runs, predictions))
+    save_verified(model, out, runs, predictions=predictions, overwrite=args.force,
+                  records=record_training(args, inputs, names, runs, predictions))
+    print(f"wrote {out}")
     return 0

@@ -7,12 +7,17 @@ or :class:`~greybox.control.plants.ModelPlant`) and fitted current models.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
 from ..data.log import AxisLog
 from ..data.prepare import prepare
 from ..errors import GreyboxError
+from ..persistence import load_model
+from ..registry import model_kind
 from ..twin import CurrentNoise, axis_geometry, make_dataset
 from .feedforward import InertiaFeedForward, ModelFeedForward
 from .loop import LoopResult, compare_feedforwards, controller_periods
@@ -21,7 +26,8 @@ from .plants import TwinPlant
 from .references import STROKES_MM, Reference, reference_from_log, stroke_reference
 from .tuning import default_bandwidth_hz, pole_placement_gains
 
-__all__ = ["DEFAULT_REFERENCE_STEP_S", "CompensationResult", "compensation_study", "twin_training_runs"]
+__all__ = ["DEFAULT_REFERENCE_STEP_S", "CompensationResult", "check_axis_kind", "compensation_study",
+           "feedforward_models", "synthesises_training", "twin_training_runs"]
 
 #: Step [s] of generated references when no feed-forward model says otherwise.
 DEFAULT_REFERENCE_STEP_S = 0.002
@@ -55,6 +61,22 @@ class CompensationResult:
     settings: dict
 
 
+def synthesises_training(plant) -> bool:
+    """Whether models for ``plant`` can be fitted without training logs (on its synthetic datasets).
+
+    Parameters
+    ----------
+    plant : TwinPlant or ModelPlant
+        The plant of the loop.
+
+    Returns
+    -------
+    bool
+        True for a twin plant of a named axis.
+    """
+    return isinstance(plant, TwinPlant) and plant.axis is not None
+
+
 def twin_training_runs(plant: TwinPlant, *, seed: int = 0, duration_s: float = 60.0) -> list[AxisLog]:
     """Prepared synthetic training runs (datasets A and P) of a twin plant's axis.
 
@@ -72,10 +94,112 @@ def twin_training_runs(plant: TwinPlant, *, seed: int = 0, duration_s: float = 6
     GreyboxError
         If the plant is not a twin of a named axis.
     """
-    if not isinstance(plant, TwinPlant) or plant.axis is None:
+    if not synthesises_training(plant):
         raise GreyboxError("feed-forward models for a model plant need training logs")
     return prepare([make_dataset(plant.axis, dataset, seed, duration_s=duration_s)
                     for dataset in TWIN_TRAINING_DATASETS])
+
+
+def check_axis_kind(source, motion: str, plant) -> None:
+    """Refuse a model, log or reference of another kind of axis than the plant's (mm against deg).
+
+    Parameters
+    ----------
+    source : str or path-like
+        What the message names: the file of the model or log.
+    motion : str
+        Its kind of axis: ``"linear"`` (mm) or ``"rotary"`` (deg).
+    plant : TwinPlant or ModelPlant
+        The plant of the loop.
+
+    Raises
+    ------
+    GreyboxError
+        If ``motion`` is not the plant's.
+    """
+    if motion != plant.motion:
+        raise GreyboxError(f"{source}: a {motion} axis, the plant {plant.name} is a {plant.motion} one; feed-forward "
+                           "models, training logs and references must be of the plant's kind of axis")
+
+
+def feedforward_models(plant, *, model_files: Sequence[str | PathLike] = (), kinds: Sequence[str] = (),
+                       build: Callable[[str], object] | None = None, train_runs: Sequence[AxisLog] | None = None,
+                       seed: int = 0, train_duration_s: float = 60.0,
+                       progress: Callable[[str], None] | None = None) -> dict:
+    """The feed-forward models of a compensation study by name: loaded from files and fitted by kind.
+
+    Parameters
+    ----------
+    plant : TwinPlant or ModelPlant
+        The plant of the loop; every model must be of its kind of axis.
+    model_files : sequence of str or path-like, default ()
+        Model files (``.gbm``) to load.
+    kinds : sequence of str, default ()
+        Model kinds to fit (:data:`greybox.registry.MODEL_CLASSES`), each once.
+    build : callable, optional
+        ``build(kind)`` returns an unfitted model of that kind (with the caller's hyperparameters);
+        required with ``kinds``.
+    train_runs : sequence of AxisLog, optional
+        Prepared training runs of the ``kinds``; without them, a twin plant's synthetic datasets A and P
+        (:func:`twin_training_runs`).
+    seed : int, default 0
+        Seed of the synthetic training data.
+    train_duration_s : float, default 60.0
+        Length [s] of each synthetic training dataset.
+    progress : callable, optional
+        Called with a line of text as the work advances.
+
+    Returns
+    -------
+    dict
+        ``{name: fitted model}``: named by kind, or ``"kind (origin)"`` (the file's stem, or ``fitted``) when
+        two models are of one kind.
+
+    Raises
+    ------
+    GreyboxError
+        If there is no model, a model or training run is of another kind of axis than the plant, a
+        model plant has no training runs, or two models end up with one name.
+    ModelFileError
+        If a model file does not load (the message names it).
+    """
+    say = progress or (lambda text: None)
+    entries = []
+    for path in model_files:
+        model = load_model(path)
+        check_axis_kind(path, model.units_.name, plant)
+        entries.append((model_kind(model), Path(path).stem, model))
+    kinds = list(dict.fromkeys(kinds))
+    if kinds:
+        if build is None:
+            raise GreyboxError("fitting models by kind needs build(kind), a builder of unfitted models")
+        if train_runs is not None:
+            for run in train_runs:
+                check_axis_kind(run.source or "training log", run.motion, plant)
+            runs = list(train_runs)
+        else:
+            if not synthesises_training(plant):
+                raise GreyboxError("feed-forward models for a model plant need training logs")
+            say(f"synthesising training data: axis {plant.axis}, datasets A and P, {train_duration_s:g} s each, "
+                f"seed {seed}")
+            runs = twin_training_runs(plant, seed=seed, duration_s=train_duration_s)
+        for kind in kinds:
+            started = time.perf_counter()
+            model = build(kind).fit(runs)
+            say(f"fitted {kind} on {len(runs)} run(s) in {time.perf_counter() - started:.1f} s")
+            entries.append((kind, "fitted", model))
+    if not entries:
+        raise GreyboxError("no feed-forward model: give model files or model kinds to fit")
+    counts = {}
+    for kind, _, _ in entries:
+        counts[kind] = counts.get(kind, 0) + 1
+    models = {}
+    for kind, origin, model in entries:
+        name = kind if counts[kind] == 1 else f"{kind} ({origin})"
+        if name in models:
+            raise GreyboxError(f"two feed-forward models are both named {name!r}; give distinct file names")
+        models[name] = model
+    return models
 
 
 def _feedforwards(plant, models: Mapping[str, object], inertia) -> list:

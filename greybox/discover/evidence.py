@@ -56,6 +56,7 @@ from threadpoolctl import threadpool_limits
 from ..base import LinearPart
 from ..data.log import AxisLog
 from ..identify.projection import Nuisance, PositionScan, added_squares
+from ..json_values import jsonable
 from ..models.effects import Effect, EffectContext, effect, scan_periods
 from .locate import structure_basis
 from .noise import ResidualNoise
@@ -113,9 +114,9 @@ class CandidateScore:
 
     def to_dict(self) -> dict:
         """JSON-able summary (without the scan curve)."""
-        out = {"explained_fraction": self.explained_fraction, "z": _finite(self.z), "p_value": self.p_value,
+        out = {"explained_fraction": self.explained_fraction, "z": jsonable(self.z), "p_value": self.p_value,
                "passes": self.passes, "absorbed": self.absorbed, "null_median": self.null_median,
-               "null_q95": self.null_q95, "threshold_fraction": _finite(self.threshold_fraction)}
+               "null_q95": self.null_q95, "threshold_fraction": jsonable(self.threshold_fraction)}
         if self.shape_name is not None:
             out[self.shape_name] = self.shape
         return out
@@ -164,16 +165,12 @@ class StepEvidence:
     def to_dict(self) -> dict:
         """JSON-able summary."""
         return {
-            "alpha": self.alpha, "threshold_z": _finite(self.threshold_z), "n_null": self.n_null,
+            "alpha": self.alpha, "threshold_z": jsonable(self.threshold_z), "n_null": self.n_null,
             "noise": self.noise, "winner": self.winner, "indistinguishable": list(self.indistinguishable),
             "comparisons": self.comparisons,
             "candidates": {name: score.to_dict() for name, score in self.candidates.items()},
             "structure": {**self.structure.to_dict(), "families": self.families},
         }
-
-
-def _finite(value: float):
-    return float(value) if np.isfinite(value) else None
 
 
 class _Candidate:

@@ -50,6 +50,7 @@ from ..data.quantities import MOTIONS
 from ..errors import GreyboxError
 from ..estimator import check_runs
 from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
+from ..json_values import jsonable
 from ..metrics import metrics_table
 from ..models.augmented import AugmentedModel
 from ..models.effects import EFFECT_NAMES, REFINEMENTS, VELOCITY_ONLY, effect
@@ -401,8 +402,7 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
         before, after = base_model.predict(test), model.predict(test)
         test_gap = _gap(test, before, after)
         residuals["test"] = _residuals(test, before, after)
-    settings = {"base": type(base).__name__, "base_params": {k: _jsonable(v) for k, v in
-                                                             base.get_params(deep=False).items()},
+    settings = {"base": type(base).__name__, "base_params": jsonable(base.get_params(deep=False), other=repr),
                 "candidates": names, "max_effects": max_effects, "alpha": alpha, "n_null": n_null, "seed": seed,
                 "refit_base": refit_base, "refine_base": refine_base, **held_out_settings,
                 "train_samples": n_samples, "test_samples": int(sum(len(run) for run in test))}
@@ -411,9 +411,4 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
                            seconds=time.perf_counter() - started, unit=train[0].effort_unit,
                            motion=train[0].motion, residuals=residuals, base_misfit=base_misfit)
 
-
-def _jsonable(value):
-    if value is None or isinstance(value, (bool, int, float, str)):
-        return value
-    return repr(value)
 

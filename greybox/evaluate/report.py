@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
 from ..atomic import write_text_atomic
+from ..json_values import jsonable
 from ..provenance import provenance, provenance_line
 from .html import write_html
 from .paper import PAPER_RE, PAPER_SOURCE
@@ -53,7 +54,6 @@ __all__ = [
     "RE_NOTE",
     "CSV_COLUMNS",
     "check_output_dir",
-    "json_ready",
     "records_json",
     "write_metrics",
     "experiment_table",
@@ -128,26 +128,6 @@ def check_output_dir(out_dir: str | os.PathLike, *, force: bool = False) -> Path
     return out_dir
 
 
-def json_ready(value):
-    """Replace non-finite floats by None, recursively (strict JSON has no NaN).
-
-    Parameters
-    ----------
-    value : object
-        A float, dict, list, tuple, NumPy scalar or anything else; dicts keep their keys, lists and
-        tuples become lists, NumPy scalars become Python numbers, other values pass through.
-    """
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_ready(v) for v in value]
-    if hasattr(value, "item"):  # NumPy scalars
-        return json_ready(value.item())
-    return value
-
-
 def records_json(records: Sequence[Mapping]) -> str:
     """Metric records as strict JSON text (non-finite numbers as null), one key per line.
 
@@ -156,7 +136,7 @@ def records_json(records: Sequence[Mapping]) -> str:
     records : sequence of dict
         Metric records.
     """
-    return json.dumps(json_ready(list(records)), indent=1, allow_nan=False) + "\n"
+    return json.dumps(jsonable(list(records)), indent=1, allow_nan=False) + "\n"
 
 
 def write_metrics(records: Sequence[Mapping], out_dir: str | os.PathLike) -> tuple[Path, Path]:
@@ -180,7 +160,7 @@ def write_metrics(records: Sequence[Mapping], out_dir: str | os.PathLike) -> tup
     writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore", lineterminator="\n")
     writer.writeheader()
     for record in records:
-        writer.writerow({k: ("" if v is None else v) for k, v in json_ready(dict(record)).items()})
+        writer.writerow({k: ("" if v is None else v) for k, v in jsonable(dict(record)).items()})
     csv_path = write_text_atomic(out_dir / "metrics.csv", buffer.getvalue())
     return json_path, csv_path
 

@@ -445,9 +445,6 @@ class GMSModel(CurrentModel):
         Unit of the effort the model was fitted on, "A" or "N".
     """
 
-    #: Names of format-1 model files: the slip rate and the viscous coefficient had names other models use.
-    renamed_attributes = {"C_": "slip_rate_", "mu_": "viscous_", "s0_": "s_0_"}
-
     def __init__(self, *, n_elements: int = 4, asymmetric: bool = False, fit_offset: bool = False,
                  method: str = "nelder-mead", n_starts: int = 4, random_state=0, max_iter: int = 400,
                  staged: bool = True, inertia=None):

@@ -36,6 +36,7 @@ import numpy as np
 from sklearn.base import clone
 
 from ..errors import GreyboxError, ParameterError
+from ..json_values import jsonable
 from ..metrics import relative_error, rmse
 
 __all__ = ["Fold", "CandidateScore", "held_out_folds", "score_candidates", "choose", "selection_record",
@@ -284,16 +285,13 @@ def selection_record(scores: Sequence[CandidateScore], folds: Sequence[Fold], ch
         object per candidate with ``label``, ``re``, ``re_se``, ``rmse``, ``n_params``, ``fold_re`` and
         ``error`` (None when scored).
     """
-    def number(value):
-        return float(value) if math.isfinite(value) else None
-
     return {
         "rule": RULE,
         "metric": "RE = RMSE / mean |effort| of the held-out runs [%], mean over the folds",
         "folds": [fold.name for fold in folds],
         "chosen": scores[chosen].label,
         "notes": [str(note) for note in notes],
-        "candidates": [{"label": s.label, "re": number(s.re), "re_se": number(s.re_se), "rmse": number(s.rmse),
+        "candidates": [{"label": s.label, "re": jsonable(s.re), "re_se": jsonable(s.re_se), "rmse": jsonable(s.rmse),
                         "n_params": int(s.n_params), "fold_re": [float(v) for v in s.fold_re], "error": s.error}
                        for s in scores],
     }

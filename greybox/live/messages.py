@@ -17,7 +17,6 @@ predict`` writes (:meth:`greybox.predict.process.ProcessResult.columns`) for the
 from __future__ import annotations
 
 import json
-import math
 from typing import Mapping
 
 import numpy as np
@@ -25,6 +24,7 @@ import numpy as np
 from ..data.log import AxisLog
 from ..data.units import log_from_columns
 from ..errors import GreyboxError, LogError
+from ..json_values import jsonable
 
 __all__ = ["MessageError", "SEQUENCE_KEY", "MAX_MESSAGE_SAMPLES", "MAX_MESSAGE_BYTES", "parse_json",
            "parse_csv_row", "csv_header", "Decoder", "message_log", "estimate_message"]
@@ -244,11 +244,6 @@ def message_log(columns: Mapping[str, np.ndarray], *, name: str, mapping: Mappin
     return log.replace(extras={}) if log.extras else log
 
 
-def _number(value: float):
-    """A float for JSON: None for a non-finite value (JSON has no NaN)."""
-    return value if math.isfinite(value) else None
-
-
 def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | None = None) -> str:
     """The JSON text of one output message: the estimate's columns as lists, and the sequence tag.
 
@@ -264,7 +259,7 @@ def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | No
     out: dict = {}
     for name, values in columns.items():
         values = np.asarray(values, dtype=np.float64)
-        out[name] = values.tolist() if np.isfinite(values).all() else [_number(v) for v in values.tolist()]
+        out[name] = values.tolist() if np.isfinite(values).all() else jsonable(values)
     if seq is not None:
         out[SEQUENCE_KEY] = seq
     if axis is not None:

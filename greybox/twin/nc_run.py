@@ -12,15 +12,22 @@ Rapid moves (G0) run at :data:`RAPID_FEED`.
 
 from __future__ import annotations
 
+from os import PathLike
+from pathlib import Path
+from typing import NamedTuple, Sequence
+
 import numpy as np
 
+from ..data.log import AxisLog
 from ..errors import GreyboxError
 from ..nc.blocks import Dwell, Move, Program
-from .axes import AxisGeometry
+from ..nc.gcode import read_program
+from .axes import AxisGeometry, axis_geometry
+from .datasets import make_dataset, stored
 from .motion import MotionLimits, MotionProfile
 from .trajectories import Trajectory
 
-__all__ = ["RAPID_FEED", "program_trajectory"]
+__all__ = ["RAPID_FEED", "ProgramRun", "program_trajectory", "synthesize_program"]
 
 #: Feed of rapid moves (G0) on the twin [mm/min or deg/min].
 RAPID_FEED = 10000.0
@@ -129,3 +136,70 @@ def program_trajectory(program: Program, geometry: AxisGeometry, limits: MotionL
         "max_acceleration_mm_s2": profile.limits.max_acceleration_mm_s2,
         "max_jerk_mm_s3": profile.limits.max_jerk_mm_s3,
     })
+
+
+class ProgramRun(NamedTuple):
+    """What :func:`synthesize_program` wrote.
+
+    Attributes
+    ----------
+    log : AxisLog
+        The simulated log (all its truth channels).
+    path : pathlib.Path
+        The file written, ``out_dir/<axis>_<program name>.mcap``.
+    program : Program
+        The program read.
+    trajectory : Trajectory
+        The motion the twin ran; ``trajectory.description["feeds_lowered"]`` lists the strokes whose feeds
+        the acceleration limit lowered.
+    """
+
+    log: AxisLog
+    path: Path
+    program: Program
+    trajectory: Trajectory
+
+
+def synthesize_program(program_path: str | PathLike, seed: int, out_dir: str | PathLike, *, force: bool = False,
+                       truth_channels: Sequence[str] | None = None, **options) -> ProgramRun:
+    """Run a one-axis NC program on the twin axis it moves and write the log as MCAP.
+
+    Parameters
+    ----------
+    program_path : str or path-like
+        G-code program file (:func:`greybox.nc.gcode.read_program`).
+    seed : int
+        Master seed (see :func:`~greybox.twin.datasets.make_dataset`).
+    out_dir : str or path-like
+        Output directory, created if missing; the log is ``out_dir/<axis>_<program name>.mcap``.
+    force : bool, default False
+        Overwrite an existing file; otherwise it is an error and nothing is written.
+    truth_channels : sequence of str, optional
+        Truth channels to keep in the file (default all), e.g.
+        :data:`~greybox.twin.datasets.ESSENTIAL_TRUTH_CHANNELS`.
+    **options
+        Passed to :func:`~greybox.twin.datasets.make_dataset` (effect, effect_strength, effect_params,
+        cutting, noise, ...).
+
+    Returns
+    -------
+    ProgramRun
+        The log, the file written, the program and the twin's trajectory.
+
+    Raises
+    ------
+    GreyboxError
+        For a program that cannot be read or run, or an existing file without ``force``.
+    """
+    from ..data.io import write_log
+
+    program = read_program(program_path)
+    geometry = axis_geometry(program.axis)
+    trajectory = program_trajectory(program, geometry)
+    out = Path(out_dir) / f"{geometry.name}_{Path(program_path).stem}.mcap"
+    if out.exists() and not force:
+        raise GreyboxError(f"{out}: file exists; pass --force to overwrite it")
+    log = make_dataset(geometry.name, "N", seed, trajectory=trajectory, **options)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    write_log(stored(log, truth_channels), out)
+    return ProgramRun(log, out, program, trajectory)
