@@ -39,6 +39,7 @@ def logs(tmp_path_factory):
     return paths
 
 
+@pytest.mark.slow  # a discovery run, > 5 s
 def test_discover_writes_findings_report_and_model(logs, tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(registry.MODEL_CLASSES, "augmented", AugmentedModel)
     out, model = tmp_path / "found.json", tmp_path / "model.gbm"
@@ -91,6 +92,7 @@ def test_a_null_too_small_for_alpha_is_refused_before_any_work(logs, tmp_path):
                  str(tmp_path / "a.json"), "--null-replicates", "9"])
 
 
+@pytest.mark.slow  # a discovery run, > 5 s
 def test_effects_option_restricts_the_library(logs, tmp_path):
     out = tmp_path / "a.json"
     run_cli(["--model", "coulomb", "--train", logs[0], "--test", logs[1], "--json", str(out), "--quiet",
@@ -101,6 +103,7 @@ def test_effects_option_restricts_the_library(logs, tmp_path):
     assert np.isfinite(document["test_rmse_before"])
 
 
+@pytest.mark.slow  # a discovery run, > 5 s
 def test_an_asymmetric_base_is_discovered_on(logs, tmp_path):
     model_path = tmp_path / "model.gbm"
     status = run_cli(["--model", "stribeck", "--asymmetric", "--train", logs[0], "--test", logs[1],

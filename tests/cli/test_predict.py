@@ -211,6 +211,7 @@ def test_negative_moving_mean_window_is_an_argparse_error(files, tmp_path, capsy
     assert not (tmp_path / "o.csv").exists()
 
 
+@pytest.mark.slow  # a discovery run, > 5 s
 def test_model_file_of_discover_predicts_in_chunks(files, tmp_path, capsys):
     """The augmented model files 'greybox discover --save-model' writes work in predict, across chunks."""
     from greybox.models.augmented import AugmentedModel

@@ -147,6 +147,7 @@ def sliding_comparison(feedforwards):
     return {name: value for (_, name), value in _compare(plant, feedforwards, ("high",)).items()}
 
 
+@pytest.mark.slow  # fits and closed loops, > 5 s
 def test_dynamic_friction_models_track_the_low_stroke_reference_best(comparison):
     """Small strokes live in pre-sliding, which only the dynamic models describe."""
     rms = {name: value for (reference, name), value in comparison.items() if reference == "low-stroke"}
@@ -155,6 +156,7 @@ def test_dynamic_friction_models_track_the_low_stroke_reference_best(comparison)
         assert rms[dynamic] < 0.5 * rms["coulomb"]
 
 
+@pytest.mark.slow  # fits and closed loops, > 5 s
 def test_friction_feedforward_helps_in_gross_sliding(comparison, sliding_comparison):
     """On the high stroke the axis mostly slides: even the Coulomb level removes much of the friction.
 

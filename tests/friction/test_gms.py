@@ -169,6 +169,7 @@ def test_predict_chunk_carries_the_state():
     np.testing.assert_allclose(np.concatenate(parts), model.predict(log), rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow  # an identification, > 5 s
 def test_identification_recovers_the_parameters_from_noise_free_data():
     log = synthetic_log(20.0, seed=1)
     model = GMSModel().fit(log)

@@ -134,6 +134,7 @@ def test_plant_law_takes_the_asymmetric_element_step():
     assert law.stable_step_s <= min(min(ASYMMETRIC["s_0"]), min(ASYMMETRIC["s_inf"])) / ASYMMETRIC["C"]
 
 
+@pytest.mark.slow  # an identification, > 5 s
 def test_identification_recovers_the_two_directions_levels():
     velocity = velocity_profile(30.0, seed=8)
     log = motion_log(velocity)

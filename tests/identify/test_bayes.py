@@ -56,6 +56,7 @@ def test_rejects_bad_bounds():
         minimize_log_uniform(bowl, {}, n_calls=3)
 
 
+@pytest.mark.slow  # a long search, > 5 s
 def test_a_minimum_in_a_corner_is_found_without_skopt_repeat_warnings():
     import warnings
 

@@ -146,6 +146,7 @@ def step_run(seed, n=4000, dt=0.002):
 
 
 @pytest.mark.filterwarnings("ignore:SVR hyperparameters:UserWarning")  # a pure step: the weight may reach its top
+@pytest.mark.slow  # a Bayesian search, > 5 s
 def test_a_searched_velocity_weight_narrows_the_kernel_across_the_coulomb_step():
     from greybox.models.svr import WEIGHT_BOUNDS
 

@@ -12,6 +12,10 @@ from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
 from studies.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
 
+#: A validation study's tests (runs of the study, its script, the real data sets): left out of the default
+#: run (`pytest -m slow` runs them, as .ci/run does).
+pytestmark = pytest.mark.slow
+
 
 def square_cut(n=4000, seed=0):
     """A process current switched on and off (unit strength) and a smooth error."""

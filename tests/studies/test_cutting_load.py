@@ -18,6 +18,10 @@ from greybox.twin.drive import AXIS_EFFICIENCIES
 from greybox.twin.family import AXIS_FILE, draw_member, member_dataset
 from studies.cutting_load import PASSES, TARGET_PCT, cutting_load_markdown, run_member, summarise
 
+#: A validation study's tests (runs of the study, its script, the real data sets): left out of the default
+#: run (`pytest -m slow` runs them, as .ci/run does).
+pytestmark = pytest.mark.slow
+
 CUT_BOTH_WAYS = CuttingSpec(strength_A=1.0, return_pass=-0.6)
 
 

@@ -13,6 +13,10 @@ import pytest
 from greybox.errors import GreyboxError
 from studies.cutting import cutting_validation
 
+#: A validation study's tests (runs of the study, its script, the real data sets): left out of the default
+#: run (`pytest -m slow` runs them, as .ci/run does).
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "cutting_validation.py"
 DATA = REPO / "data"

@@ -25,6 +25,10 @@ from greybox.model_choice import choose_model
 from studies import auto
 from studies import emps as bench
 
+#: A validation study's tests (runs of the study, its script, the real data sets): left out of the default
+#: run (`pytest -m slow` runs them, as .ci/run does).
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "emps_benchmark.py"
 

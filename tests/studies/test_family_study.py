@@ -9,6 +9,10 @@ from greybox.reproduce.experiments import QUICK_SETTINGS
 from studies import priors
 from studies.robustness import TARGETS, robustness_markdown, run_member, summarise
 
+#: A validation study's tests (runs of the study, its script, the real data sets): left out of the default
+#: run (`pytest -m slow` runs them, as .ci/run does).
+pytestmark = pytest.mark.slow
+
 
 def _row(index, law, ratios, process=30.0, mean=-2.0):
     return {"index": index, "law": law, "axis": "X", "noise_std_A": 0.08, "floor_re": 7.0, "cut_samples": 100,

@@ -12,6 +12,10 @@ from scipy.integrate import solve_ivp
 from greybox.data.prepare import prepare
 from studies import hysteresis_axis as ha
 
+#: A validation study's tests (runs of the study, its script, the real data sets): left out of the default
+#: run (`pytest -m slow` runs them, as .ci/run does).
+pytestmark = pytest.mark.slow
+
 SHORT_S = 10.0
 
 
