@@ -17,9 +17,9 @@ predict`` writes (:meth:`greybox.predict.process.ProcessResult.columns`) for the
 from __future__ import annotations
 
 import json
-import math
 from typing import Mapping
 
+import msgspec
 import numpy as np
 
 from ..data.log import AxisLog
@@ -84,8 +84,12 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
     """
     if len(text) > MAX_MESSAGE_BYTES:
         raise MessageError(f"the message holds {len(text)} bytes, more than {MAX_MESSAGE_BYTES}")
+    try:  # msgspec reads strict JSON a few times faster; json.loads takes what it refuses (NaN) or explains why
+        value = _DECODER.decode(text)
+    except msgspec.DecodeError:
+        value = None
     try:
-        value = json.loads(text)
+        value = json.loads(text) if value is None else value
     except (ValueError, UnicodeDecodeError) as exc:
         raise MessageError(f"not JSON ({exc})") from None
     seq = None
@@ -244,11 +248,6 @@ def message_log(columns: Mapping[str, np.ndarray], *, name: str, mapping: Mappin
     return log.replace(extras={}) if log.extras else log
 
 
-def _number(value: float):
-    """A float for JSON: None for a non-finite value (JSON has no NaN)."""
-    return value if math.isfinite(value) else None
-
-
 def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | None = None) -> str:
     """The JSON text of one output message: the estimate's columns as lists, and the sequence tag.
 
@@ -261,12 +260,14 @@ def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | No
     axis : str, optional
         The axis of a machine the estimates are of (key ``"axis"``).
     """
-    out: dict = {}
-    for name, values in columns.items():
-        values = np.asarray(values, dtype=np.float64)
-        out[name] = values.tolist() if np.isfinite(values).all() else [_number(v) for v in values.tolist()]
+    out: dict = {name: np.asarray(values, dtype=np.float64).tolist() for name, values in columns.items()}
     if seq is not None:
         out[SEQUENCE_KEY] = seq
     if axis is not None:
         out["axis"] = axis
-    return json.dumps(out, separators=(",", ":"))
+    # msgspec writes a float's shortest round-trip digits ten times faster than json, NaN and inf as null
+    return _ENCODER.encode(out).decode()
+
+
+#: One encoder for every output message, one decoder for every input message.
+_ENCODER, _DECODER = msgspec.json.Encoder(), msgspec.json.Decoder()
