@@ -19,12 +19,12 @@ from __future__ import annotations
 import json
 from typing import Mapping
 
+import msgspec
 import numpy as np
 
 from ..data.log import AxisLog
 from ..data.units import log_from_columns
 from ..errors import GreyboxError, LogError
-from ..json_values import jsonable
 
 __all__ = ["MessageError", "SEQUENCE_KEY", "MAX_MESSAGE_SAMPLES", "MAX_MESSAGE_BYTES", "parse_json",
            "parse_csv_row", "csv_header", "Decoder", "message_log", "estimate_message"]
@@ -84,8 +84,12 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
     """
     if len(text) > MAX_MESSAGE_BYTES:
         raise MessageError(f"the message holds {len(text)} bytes, more than {MAX_MESSAGE_BYTES}")
+    try:  # msgspec reads strict JSON a few times faster; json.loads takes what it refuses (NaN) or explains why
+        value = _DECODER.decode(text)
+    except msgspec.DecodeError:
+        value = None
     try:
-        value = json.loads(text)
+        value = json.loads(text) if value is None else value
     except (ValueError, UnicodeDecodeError) as exc:
         raise MessageError(f"not JSON ({exc})") from None
     seq = None
@@ -256,12 +260,14 @@ def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | No
     axis : str, optional
         The axis of a machine the estimates are of (key ``"axis"``).
     """
-    out: dict = {}
-    for name, values in columns.items():
-        values = np.asarray(values, dtype=np.float64)
-        out[name] = values.tolist() if np.isfinite(values).all() else jsonable(values)
+    out: dict = {name: np.asarray(values, dtype=np.float64).tolist() for name, values in columns.items()}
     if seq is not None:
         out[SEQUENCE_KEY] = seq
     if axis is not None:
         out["axis"] = axis
-    return json.dumps(out, separators=(",", ":"))
+    # msgspec writes a float's shortest round-trip digits ten times faster than json, NaN and inf as null
+    return _ENCODER.encode(out).decode()
+
+
+#: One encoder for every output message, one decoder for every input message.
+_ENCODER, _DECODER = msgspec.json.Encoder(), msgspec.json.Decoder()

@@ -321,18 +321,21 @@ class GMSSVRModel(KernelRegressionModel):
         inputs, end = self._inputs(run, state, sample_time)
         return self._friction_of(run, inputs), end
 
-    def _friction_of(self, run: AxisLog, inputs, frame=None) -> np.ndarray:
+    def _friction_of(self, run: AxisLog, inputs, expansion=None, weight=None) -> np.ndarray:
         """Friction [A] of a chunk whose SVR inputs are ``inputs``: the prediction less inertia and offset.
 
         Outside the box of the training inputs the prediction is handed over to the GMS stage's
-        (:mod:`greybox.models.handover`). ``frame``: the :meth:`kernel_frame` of a stream, built once.
+        (:mod:`greybox.models.handover`). ``expansion``, ``weight``: the kernel frame's
+        :meth:`~greybox.models.svr.KernelFrame.terms` of a stream, when at hand.
         """
-        frame = self.kernel_frame() if frame is None else frame
-        scaled = frame.coordinates(inputs)
-        current = frame.expansion(inputs, scaled)
+        if expansion is None:
+            frame = self.kernel_frame()
+            scaled = frame.coordinates(inputs)
+            expansion, weight = frame.expansion(inputs, scaled), frame.weight(inputs, scaled)
+        current = expansion
         if self.target == "residual":
             current = current + inputs[:, 1]
-        current = hand_over(inputs[:, 1], current, frame.weight(inputs, scaled))
+        current = hand_over(inputs[:, 1], current, weight)
         return current - self.J_ * run.acceleration - self.offset_
 
     def _stream_step(self, sample_time: float):
@@ -344,8 +347,9 @@ class GMSSVRModel(KernelRegressionModel):
 
         def step(run, state, region):
             inputs, end = self._inputs(run, state, sample_time, trajectory)
-            current = self.J_ * run.acceleration + self._friction_of(run, inputs, frame) + self.offset_
-            return current, end, self._flags(run, inputs, sample_time), end
+            expansion, weight, outside = frame.terms(inputs)
+            current = self.J_ * run.acceleration + self._friction_of(run, inputs, expansion, weight) + self.offset_
+            return current, end, self._flags(run, inputs, sample_time, outside), end
 
         return step
 

@@ -21,11 +21,14 @@ sample alone, so a run predicted in chunks gets the same weights as at once.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 from ..errors import ParameterError
 
-__all__ = ["HANDOVER_LENGTHS", "handover_width", "handover_weight", "hand_over"]
+__all__ = ["HANDOVER_LENGTHS", "handover_width", "handover_weight", "handover_rows", "hand_over"]
 
 #: Hand-over width in kernel length scales ``1/sqrt(gamma)``: within it the correction is handed over
 #: to the physical model. Beyond one length scale from its last support vectors an RBF expansion is
@@ -80,9 +83,33 @@ def handover_weight(X, low, high, width: float) -> np.ndarray:
             or not np.all(np.isfinite(high)) or np.any(low > high)):
         raise ParameterError(f"the training box of the hand-over must hold a finite (low, high) pair, low <= high, "
                              f"for each of the {X.shape[1]} inputs")
-    gap = np.maximum(np.maximum(low - X, X - high), 0.0)
-    t = np.minimum(np.sqrt(np.sum(gap * gap, axis=1)) / width, 1.0)
-    return 1.0 - t * t * (3.0 - 2.0 * t)
+    out = np.empty(X.shape[0])
+    handover_rows(np.ascontiguousarray(X), low, high, float(width), out)
+    return out
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def handover_rows(X, low, high, width, out):
+    """Compiled :func:`handover_weight` of checked arguments, written to ``out``, shape (n,).
+
+    Parameters
+    ----------
+    X : ndarray, shape (n, n_features)
+        Samples in the kernel's coordinates [standardised unit].
+    low, high : ndarray, shape (n_features,)
+        Corners of the box of the training inputs, ``low <= high``.
+    width : float
+        Hand-over width [standardised unit], positive.
+    out : ndarray, shape (n,)
+        Receives the weights.
+    """
+    for i in range(X.shape[0]):
+        squared = 0.0
+        for f in range(X.shape[1]):
+            gap = max(low[f] - X[i, f], X[i, f] - high[f], 0.0)
+            squared += gap * gap
+        t = min(math.sqrt(squared) / width, 1.0)
+        out[i] = 1.0 - t * t * (3.0 - 2.0 * t)
 
 
 def hand_over(physical, fitted, weight) -> np.ndarray:

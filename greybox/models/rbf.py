@@ -47,7 +47,8 @@ from numba import njit
 
 from ..threads import shared_pool
 
-__all__ = ["rbf_expansion", "DEFAULT_TOLERANCE", "BLOCK_SAMPLES", "EXP_RELATIVE_ERROR", "MAX_CUTOFF"]
+__all__ = ["rbf_expansion", "expansion_cutoff", "DEFAULT_TOLERANCE", "BLOCK_SAMPLES", "EXP_RELATIVE_ERROR",
+           "MAX_CUTOFF"]
 
 #: Default bound on the sum of the terms left out of one sample [unit of the output, e.g. A].
 DEFAULT_TOLERANCE = 1e-10
@@ -137,6 +138,36 @@ def _expansion_blocks(X, support_t, alpha, gamma, cutoff, block, first_block, st
             out[i] += total
 
 
+def expansion_cutoff(dual_coef, tolerance: float = DEFAULT_TOLERANCE) -> float | None:
+    """The largest ``gamma ||x - s||^2`` whose term :func:`rbf_expansion` keeps, for a bound ``tolerance``.
+
+    Parameters
+    ----------
+    dual_coef : ndarray, shape (n_support,)
+        Dual coefficients [unit of the output].
+    tolerance : float, default 1e-10
+        Bound on the sum of the terms left out of each sample's sum [unit of the output], > 0.
+
+    Returns
+    -------
+    float or None
+        ``log(sum(|dual_coef|) / tolerance)`` [1]; None when all the terms together stay within the tolerance.
+
+    Raises
+    ------
+    ValueError
+        For a cut-off beyond :data:`MAX_CUTOFF`.
+    """
+    weight = float(np.sum(np.abs(dual_coef)))
+    if weight <= tolerance:
+        return None
+    cutoff = math.log(weight / tolerance)
+    if cutoff > MAX_CUTOFF:
+        raise ValueError(f"tolerance {tolerance:g} is too small for dual coefficients summing to {weight:g} "
+                         f"(at least {weight * math.exp(-MAX_CUTOFF):.3g})")
+    return cutoff
+
+
 def rbf_expansion(
     X,
     support_vectors,
@@ -201,13 +232,9 @@ def rbf_expansion(
 
     n_samples = X.shape[0]
     out = np.full(n_samples, float(intercept))
-    weight = float(np.sum(np.abs(alpha)))
-    if n_samples == 0 or weight <= tolerance:
+    cutoff = None if n_samples == 0 else expansion_cutoff(alpha, tolerance)
+    if cutoff is None:
         return out  # every term together stays within the tolerance
-    cutoff = math.log(weight / tolerance)
-    if cutoff > MAX_CUTOFF:
-        raise ValueError(f"tolerance {tolerance:g} is too small for dual coefficients summing to {weight:g} "
-                         f"(at least {weight * math.exp(-MAX_CUTOFF):.3g})")
     support_t = np.ascontiguousarray(sv.T)
     n_blocks = -(-n_samples // BLOCK_SAMPLES)
     threads = min(threads, max(1, n_blocks // _MIN_BLOCKS_PER_THREAD))

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
+from numba import njit
 from sklearn.utils.validation import check_is_fitted
 
 from ..base import EFFORT, LENGTH, Parameter
@@ -45,8 +46,8 @@ from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_seed
 from ..identify.progress import ProgressEvent
 from .chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
-from .handover import hand_over, handover_weight, handover_width
-from .rbf import rbf_expansion
+from .handover import hand_over, handover_rows, handover_weight, handover_width
+from .rbf import BLOCK_SAMPLES, _expansion_blocks, expansion_cutoff, rbf_expansion
 from .subset import coverage_subset
 
 __all__ = ["KernelFrame",
@@ -494,11 +495,16 @@ class KernelRegressionModel(CurrentModel):
         X, state = self._inputs_chunk(log, state, sample_time)
         return self._flags(log, X, sample_time), state
 
-    def _flags(self, log: AxisLog, X, sample_time: float) -> dict[str, np.ndarray]:
-        """The training-region flags of a chunk whose SVR inputs are ``X``."""
+    def _flags(self, log: AxisLog, X, sample_time: float, outside=None) -> dict[str, np.ndarray]:
+        """The training-region flags of a chunk whose SVR inputs are ``X`` (``outside``: their ``"inputs"``
+        flag, from :meth:`KernelFrame.terms`, when at hand)."""
         out, _ = super()._region_flags(log, None, sample_time)
-        if getattr(self, "input_range_", None) is not None:
-            out["inputs"] = np.any((X < self.input_range_[0]) | (X > self.input_range_[1]), axis=1)
+        if outside is not None:
+            out["inputs"] = outside
+        elif getattr(self, "input_range_", None) is not None:
+            low, high = (np.ascontiguousarray(bound, dtype=np.float64) for bound in self.input_range_)
+            out["inputs"] = np.empty(len(X), dtype=np.bool_)
+            outside_rows(np.ascontiguousarray(X, dtype=np.float64), low, high, out["inputs"])
         return out
 
     def kernel_frame(self) -> "KernelFrame":
@@ -775,8 +781,58 @@ class KernelFrame:
             raise ParameterError(f"input_weights_ must hold one positive weight per input "
                                  f"({np.size(self.scale)}), got {weights!r}")
         self.root_weights = None if weights is None else np.sqrt(weights)
+        n_features = np.size(self.scale)
+        self._rows = tuple(np.ascontiguousarray(values, dtype=np.float64).reshape(n_features) for values in (
+            self.mean, self.scale, np.ones(n_features) if self.root_weights is None else self.root_weights))
         self.width = getattr(model, "handover_width_", None)
         self.box = None if self.width is None else self.coordinates(model.input_range_)
+        self._compiled = None
+
+    def _arguments(self):
+        """The arrays of :func:`frame_terms`, made contiguous once (support vectors column-wise)."""
+        if self._compiled is None:
+            m = self.model
+            n_features = np.size(self.scale)
+            alpha = np.ascontiguousarray(m.dual_coef_, dtype=np.float64).ravel()
+            cutoff = expansion_cutoff(alpha)
+            ranges = getattr(m, "input_range_", None)
+            box = (np.zeros((2, n_features)), 0.0) if self.width is None else (np.asarray(self.box), float(self.width))
+            as_row = lambda values: np.ascontiguousarray(values, dtype=np.float64).reshape(n_features)  # noqa: E731
+            self._compiled = (
+                *self._rows, np.ascontiguousarray(np.asarray(m.support_vectors_, dtype=np.float64).T), alpha,
+                float(m.intercept_), float(m.gamma_), -1.0 if cutoff is None else cutoff,
+                as_row(box[0][0]), as_row(box[0][1]), box[1],
+                as_row(np.zeros(n_features) if ranges is None else ranges[0]),
+                as_row(np.zeros(n_features) if ranges is None else ranges[1]),
+                self.width is not None, ranges is not None)
+        return self._compiled
+
+    def terms(self, X):
+        """Expansion, hand-over weight and input-range flags of raw inputs ``X`` in one compiled pass.
+
+        What :meth:`expansion`, :meth:`weight` and the model's ``"inputs"`` flag give, for the few samples of
+        a live message: the per-call checks and copies of :func:`~greybox.models.rbf.rbf_expansion` are done
+        once per frame.
+
+        Parameters
+        ----------
+        X : array_like, shape (n, n_features)
+            Raw SVR inputs (their units: mm, A, mm/s, ...).
+
+        Returns
+        -------
+        expansion : ndarray, shape (n,)
+            The fitted expansion [A].
+        weight : ndarray of shape (n,), or None
+            Weight of the correction; None for a model without the hand-over.
+        outside : ndarray of bool, shape (n,), or None
+            True where an input lies outside its training range; None for a file without the ranges.
+        """
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        arguments = self._arguments()
+        expansion, weight, outside = np.empty(len(X)), np.empty(len(X)), np.empty(len(X), dtype=np.bool_)
+        frame_terms(X, *arguments, expansion, weight, outside)
+        return expansion, (weight if arguments[-2] else None), (outside if arguments[-1] else None)
 
     def coordinates(self, X) -> np.ndarray:
         """Raw inputs ``X``, shape (n, n_features), in the kernel's coordinates: standardised, times sqrt(weight).
@@ -786,8 +842,10 @@ class KernelFrame:
         X : array_like, shape (n, n_features)
             Raw SVR inputs (their units: mm, A, mm/s, ...).
         """
-        scaled = (np.asarray(X, dtype=np.float64) - self.mean) / self.scale
-        return scaled if self.root_weights is None else scaled * self.root_weights
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        out = np.empty(X.shape)
+        coordinate_rows(X, *self._rows, out)
+        return out
 
     def expansion(self, X, scaled=None) -> np.ndarray:
         """The fitted expansion at raw inputs ``X`` [A].
@@ -817,3 +875,86 @@ class KernelFrame:
             return None
         return handover_weight(self.coordinates(X) if scaled is None else scaled, self.box[0], self.box[1],
                                self.width)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def outside_rows(X, low, high, out):
+    """True in ``out`` where any input of a row of ``X`` lies outside ``[low, high]``.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n, n_features)
+        Raw SVR inputs.
+    low, high : ndarray, shape (n_features,)
+        Lowest and highest value of each input over the training data.
+    out : ndarray of bool, shape (n,)
+        Receives the flags.
+    """
+    for i in range(X.shape[0]):
+        outside = False
+        for f in range(X.shape[1]):
+            outside = outside or X[i, f] < low[f] or X[i, f] > high[f]
+        out[i] = outside
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def frame_terms(X, mean, scale, root_weights, support_t, alpha, intercept, gamma, cutoff, box_low, box_high, width,
+                range_low, range_high, has_box, has_range, expansion, weight, outside):
+    """The kernel sum, the hand-over weight and the input-range flags of the rows of ``X``, in one call.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n, n_features)
+        Raw SVR inputs.
+    mean, scale, root_weights : ndarray, shape (n_features,)
+        The kernel's coordinates: ``(X - mean) / scale * root_weights``.
+    support_t : ndarray, shape (n_features, n_support)
+        Support vectors, column-wise, in those coordinates.
+    alpha : ndarray, shape (n_support,)
+        Dual coefficients [A].
+    intercept : float
+        Intercept [A].
+    gamma : float
+        Kernel parameter [1/(coordinate unit)^2].
+    cutoff : float
+        :func:`~greybox.models.rbf.expansion_cutoff`; negative: no term counts.
+    box_low, box_high : ndarray, shape (n_features,)
+        Hand-over box in the kernel's coordinates.
+    width : float
+        Hand-over width [coordinate unit].
+    range_low, range_high : ndarray, shape (n_features,)
+        Training range of the raw inputs.
+    has_box, has_range : bool
+        Whether ``weight`` and ``outside`` are to be filled.
+    expansion, weight : ndarray, shape (n,)
+        Receive the expansion [A] and the weight.
+    outside : ndarray of bool, shape (n,)
+        Receives the flags.
+    """
+    scaled = np.empty(X.shape)
+    coordinate_rows(X, mean, scale, root_weights, scaled)
+    expansion[:] = intercept
+    if cutoff >= 0.0:
+        _expansion_blocks(scaled, support_t, alpha, gamma, cutoff, BLOCK_SAMPLES, 0, 1, expansion)
+    if has_box:
+        handover_rows(scaled, box_low, box_high, width, weight)
+    if has_range:
+        outside_rows(X, range_low, range_high, outside)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def coordinate_rows(X, mean, scale, root_weights, out):
+    """Raw inputs in the kernel's coordinates, ``(X - mean) / scale * root_weights``, written to ``out``.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n, n_features)
+        Raw SVR inputs.
+    mean, scale, root_weights : ndarray, shape (n_features,)
+        Mean and scale of each input over the training data, square root of its kernel weight.
+    out : ndarray, shape (n, n_features)
+        Receives the coordinates.
+    """
+    for i in range(X.shape[0]):
+        for f in range(X.shape[1]):
+            out[i, f] = (X[i, f] - mean[f]) / scale[f] * root_weights[f]

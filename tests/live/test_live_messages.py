@@ -71,3 +71,25 @@ def test_non_finite_values_are_refused_naming_the_channel():
 def test_estimate_messages_are_json_with_the_sequence_tag():
     text = estimate_message({"time_s": np.array([0.0, 0.002]), "current_process_A": np.array([0.5, np.inf])}, seq=3)
     assert json.loads(text) == {"time_s": [0.0, 0.002], "current_process_A": [0.5, None], "seq": 3}
+
+
+def test_estimate_messages_carry_every_float_exactly():
+    rng = np.random.default_rng(5)
+    values = np.concatenate([rng.normal(size=200) * 10.0 ** rng.integers(-300, 300, 200), [-0.0, 5e-324, 1.5e308]])
+    text = estimate_message({"current_process_A": values}, seq="a", axis="X")
+    back = json.loads(text)
+    assert back["seq"] == "a" and back["axis"] == "X"
+    np.testing.assert_array_equal(np.array(back["current_process_A"]), values)
+
+
+def test_a_message_with_nan_reads_as_its_strict_part_does():
+    rng = np.random.default_rng(6)
+    message = {"time_s": (np.arange(10) * 0.002).tolist(), "position_mm": rng.normal(size=10).tolist(), "seq": 7}
+    strict, seq = parse_json(json.dumps(message))
+    nan_column = '"current_A": [' + ", ".join(["NaN"] * 10) + '], "seq"'
+    with_nan, _ = parse_json(json.dumps(message).replace('"seq"', nan_column))
+    assert seq == 7
+    for name in ("time_s", "position_mm"):
+        np.testing.assert_array_equal(strict[name], message[name])
+        np.testing.assert_array_equal(with_nan[name], message[name])
+    assert np.isnan(with_nan["current_A"]).all()

@@ -1,0 +1,86 @@
+"""The compiled kernels of a kernel model's frame (:class:`greybox.models.svr.KernelFrame`) against plain Python."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from greybox.models.svr import KernelFrame
+
+
+def _model(rng, *, weights=True, handover=True, ranges=True, n_support=40, n_features=3):
+    """A fitted kernel model's arrays, drawn at random (what KernelFrame reads of a model)."""
+    X = rng.normal(size=(200, n_features)) * [2.0, 5.0, 0.3][:n_features] + [1.0, -3.0, 0.0][:n_features]
+    model = SimpleNamespace(input_mean_=X.mean(axis=0), input_scale_=X.std(axis=0),
+                            input_weights_=rng.uniform(0.5, 2.0, n_features) if weights else None,
+                            handover_width_=0.8 if handover else None,
+                            input_range_=np.array([X.min(axis=0), X.max(axis=0)]) if ranges else None,
+                            support_vectors_=rng.normal(size=(n_support, n_features)),
+                            dual_coef_=rng.normal(size=n_support), intercept_=0.3, gamma_=0.7)
+    return model, X
+
+
+def reference_terms(model, X):
+    """Plain-Python expansion, hand-over weight and input-range flags of each row of raw inputs ``X``."""
+    n_features = X.shape[1]
+    weights = model.input_weights_ if model.input_weights_ is not None else [1.0] * n_features
+    expansion, weight, outside = [], [], []
+    if model.handover_width_ is not None:
+        box = [[(bound[f] - model.input_mean_[f]) / model.input_scale_[f] * math.sqrt(weights[f])
+                for f in range(n_features)] for bound in model.input_range_]
+    for row in X:
+        scaled = [(row[f] - model.input_mean_[f]) / model.input_scale_[f] * math.sqrt(weights[f])
+                  for f in range(n_features)]
+        total = model.intercept_
+        for sv, alpha in zip(model.support_vectors_, model.dual_coef_):
+            total += alpha * math.exp(-model.gamma_ * sum((a - b) ** 2 for a, b in zip(scaled, sv)))
+        expansion.append(total)
+        if model.handover_width_ is not None:
+            distance = math.sqrt(sum(max(lo - x, x - hi, 0.0) ** 2 for x, lo, hi in zip(scaled, *box)))
+            t = min(distance / model.handover_width_, 1.0)
+            weight.append(1.0 - 3.0 * t * t + 2.0 * t ** 3)
+        if model.input_range_ is not None:
+            outside.append(any(x < lo or x > hi for x, lo, hi in zip(row, *model.input_range_)))
+    return np.array(expansion), np.array(weight), np.array(outside, dtype=bool)
+
+
+@pytest.mark.parametrize("weights, handover, ranges", [(True, True, True), (False, True, True),
+                                                       (True, False, True), (True, False, False)])
+def test_terms_match_plain_python_and_the_offline_path(weights, handover, ranges):
+    rng = np.random.default_rng(7)
+    model, X = _model(rng, weights=weights, handover=handover, ranges=ranges)
+    X = np.concatenate([X[:70], X[:30] * 3.0])  # samples inside and far outside the training box
+    frame = KernelFrame(model)
+    expansion, weight, outside = frame.terms(X)
+    want_expansion, want_weight, want_outside = reference_terms(model, X)
+    np.testing.assert_allclose(expansion, want_expansion, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(expansion, frame.expansion(X), rtol=0, atol=1e-12)
+    if handover:
+        np.testing.assert_allclose(weight, want_weight, rtol=0, atol=1e-12)
+        np.testing.assert_array_equal(weight, frame.weight(X))
+        assert np.any(weight == 1.0) and np.any(weight < 1.0)
+    else:
+        assert weight is None
+    if ranges:
+        np.testing.assert_array_equal(outside, want_outside)
+        assert outside.any() and not outside.all()
+    else:
+        assert outside is None
+
+
+def test_coordinates_match_plain_python():
+    rng = np.random.default_rng(3)
+    model, X = _model(rng)
+    got = KernelFrame(model).coordinates(X[:20])
+    want = [[(x - m) / s * math.sqrt(w) for x, m, s, w in zip(row, model.input_mean_, model.input_scale_,
+                                                              model.input_weights_)] for row in X[:20]]
+    np.testing.assert_allclose(got, want, rtol=1e-15, atol=0)
+
+
+def test_terms_of_no_samples_are_empty():
+    model, _ = _model(np.random.default_rng(1))
+    expansion, weight, outside = KernelFrame(model).terms(np.empty((0, 3)))
+    assert expansion.shape == weight.shape == outside.shape == (0,)
