@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import importlib
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -31,23 +32,49 @@ from .log import AxisLog
 from .units import CANONICAL_NAMES, known_column
 from .validate import check_finite, check_increasing, check_time
 
-__all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS", "LOG_SUFFIXES"]
+__all__ = ["read_log", "write_log", "parse_column_mapping", "format_of", "FORMATS", "LOG_FORMATS", "LOG_SUFFIXES",
+           "LogFormat"]
+
+@dataclass(frozen=True)
+class LogFormat:
+    """How greybox reads (and writes) one log format: a line of :data:`LOG_FORMATS`.
+
+    Parameters
+    ----------
+    suffixes : tuple of str
+        The file extensions of the format, lower case with the dot.
+    module : str
+        The module of :mod:`greybox.data` that reads it (imported on first use).
+    reader : str
+        Its reading function: ``reader(path, **options)`` returns an :class:`~greybox.data.log.AxisLog`.
+    writer : str or None
+        Its writing function, ``writer(log, path)``; None for a format greybox only reads.
+    options : tuple of str
+        The reader options it takes of ``columns``, ``topic``, ``sample_time`` and ``axis``.
+    """
+
+    suffixes: tuple[str, ...]
+    module: str
+    reader: str
+    writer: str | None
+    options: tuple[str, ...]
+
+
+#: The log formats: a new format is its reading module and one line here.
+LOG_FORMATS = {
+    "csv": LogFormat((".csv",), "csv_io", "read_csv", "write_csv", ("columns", "sample_time", "axis")),
+    "parquet": LogFormat((".parquet", ".pq"), "parquet_io", "read_parquet", "write_parquet",
+                         ("columns", "sample_time", "axis")),
+    "mcap": LogFormat((".mcap",), "mcap_io", "read_mcap", "write_mcap", ("columns", "topic", "axis")),
+    "mat": LogFormat((".mat",), "matlab", "read_mat", None, ("columns", "sample_time", "axis")),
+    "tdms": LogFormat((".tdms",), "tdms_io", "read_tdms", None, ("columns", "topic", "sample_time", "axis")),
+}
 
 #: File extensions of each format.
-FORMATS = {"csv": (".csv",), "parquet": (".parquet", ".pq"), "mcap": (".mcap",), "mat": (".mat",), "tdms": (".tdms",)}
+FORMATS = {name: entry.suffixes for name, entry in LOG_FORMATS.items()}
 
 #: Every extension of a log file, in the order of :data:`FORMATS` (what a directory of logs is searched for).
 LOG_SUFFIXES = tuple(suffix for suffixes in FORMATS.values() for suffix in suffixes)
-
-# format -> (module, reader, writer or None, reader options)
-_HANDLERS = {
-    "csv": ("csv_io", "read_csv", "write_csv", ("columns", "sample_time", "axis")),
-    "parquet": ("parquet_io", "read_parquet", "write_parquet", ("columns", "sample_time", "axis")),
-    "mcap": ("mcap_io", "read_mcap", "write_mcap", ("columns", "topic", "axis")),
-    "mat": ("matlab", "read_mat", None, ("columns", "sample_time", "axis")),
-    "tdms": ("tdms_io", "read_tdms", None, ("columns", "topic", "sample_time", "axis")),
-}
-
 
 def format_of(path, fmt: str | None = None) -> str:
     """Return the format name of a file: ``fmt`` if given, else from the extension.
@@ -76,9 +103,11 @@ def format_of(path, fmt: str | None = None) -> str:
     raise LogError(path, f"unknown log file extension '{suffix}'; known: {known}")
 
 
-def _handler(fmt: str, index: int):
-    module = importlib.import_module(f"{__package__}.{_HANDLERS[fmt][0]}")
-    return getattr(module, _HANDLERS[fmt][index])
+def _handler(fmt: str, writer: bool = False):
+    """The reading (or writing) function of format ``fmt``, its module imported on first use."""
+    entry = LOG_FORMATS[fmt]
+    module = importlib.import_module(f"{__package__}.{entry.module}")
+    return getattr(module, entry.writer if writer else entry.reader)
 
 
 def read_log(
@@ -139,13 +168,13 @@ def read_log(
     if os.path.getsize(path) == 0:
         raise LogError(path, "empty file (0 bytes)")
     given = {"columns": columns, "topic": topic, "sample_time": sample_time, "axis": axis}
-    accepted = _HANDLERS[fmt][3]
+    accepted = LOG_FORMATS[fmt].options
     for option, value in given.items():
         if value is not None and option not in accepted:
             raise LogError(path, f"option '{option}' does not apply to {fmt} files")
     options = {option: given[option] for option in accepted}
     try:
-        log = _handler(fmt, 1)(path, **options)
+        log = _handler(fmt)(path, **options)
     except OSError as exc:
         raise LogError(path, f"cannot read the file ({exc.strerror or exc})") from None
     if time_tolerance is None:
@@ -182,7 +211,7 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
     """
     path = os.fspath(path)
     fmt = format_of(path, fmt)
-    if _HANDLERS[fmt][2] is None:
+    if LOG_FORMATS[fmt].writer is None:
         raise LogError(path, f"{fmt} files can be read but not written; write .csv, .parquet or .mcap")
     logs = [log] if isinstance(log, AxisLog) else list(log)
     if not logs:
@@ -190,7 +219,7 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
     for item in logs:
         if item.source and os.path.exists(path) and os.path.exists(item.source) and os.path.samefile(path, item.source):
             raise LogError(path, "refusing to overwrite the file the log was read from; choose another output path")
-    writer = _handler(fmt, 2)
+    writer = _handler(fmt, writer=True)
     if fmt == "csv":  # two files, each replaced in one step: the plain CSV and its metadata sidecar
         target = os.path.abspath(path)
         with atomic_output(target) as temporary, atomic_output(sidecar_path(target)) as side:
