@@ -54,7 +54,7 @@ CANDIDATES = {
 
 
 #: The candidate of the default of :class:`~greybox.models.gmssvr.GMSSVRModel` (the residual, searched over
-#: :func:`~greybox.models.svr.default_bounds`, gamma in [0.01, 1000]). Until this study first ran (seed 1,
+#: :func:`~greybox.models.kernel.default_bounds`, gamma in [0.01, 1000]). Until this study first ran (seed 1,
 #: members 0-11) the default was "residual, gamma >= 1"; the study chose this one (docs/svr.md).
 DEFAULT = "residual, gamma >= 0.01"
 

@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 KERNEL_TESTS = ("friction/test_kernels.py", "models/test_rbf.py", "twin/test_plant_laws.py",
                 "data/test_json_numbers.py", "data/test_mcap_io.py", "control/test_pid.py",
                 "control/test_plants.py", "twin/test_plant.py", "twin/test_family.py", "twin/test_ageing.py",
-                "live/test_zerophase.py", "models/test_svr_kernels.py")
+                "live/test_zerophase.py", "models/test_kernel.py")
 
 
 @pytest.mark.slow

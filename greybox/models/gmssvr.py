@@ -25,7 +25,7 @@ target); with ``handover=True`` (the default) the prediction is instead
 handed over to the GMS stage's alone, smoothly, within one kernel length
 scale of the box of the training inputs (:mod:`greybox.models.handover`),
 and is unchanged inside it. Both targets search the same
-intervals (:func:`greybox.models.svr.default_bounds`). The residual target
+intervals (:func:`greybox.models.kernel.default_bounds`). The residual target
 was chosen on the training runs of a development family of truth axes
 (``studies/priors.py`` in the repository): fitted on three quarters of dataset A and
 scored on the rest of A and on B, it is far better than the current target
@@ -88,7 +88,7 @@ class GMSSVRModel(KernelRegressionModel):
         SVR training samples, chosen to cover the (p, v) plane evenly.
     optimize : bool, default True
         Choose the hyperparameters left None by Bayesian optimisation over a
-        time-blocked cross-validation (see :func:`greybox.models.svr.fit_svr_expansion`).
+        time-blocked cross-validation (see :func:`greybox.models.kernel.fit_svr_expansion`).
     n_calls : int, default 25
         Evaluations of the Bayesian optimisation.
     cv_folds : int, default 3
@@ -97,7 +97,7 @@ class GMSSVRModel(KernelRegressionModel):
         Contiguous time blocks dealt to the folds (never spanning runs).
     bounds : dict, optional
         Search intervals ``{name: (low, high)}`` replacing those of
-        :func:`greybox.models.svr.default_bounds`.
+        :func:`greybox.models.kernel.default_bounds`.
     random_state : int, default 0
         Seed of subset choice and optimisation.
     handover : bool, default True
@@ -326,7 +326,7 @@ class GMSSVRModel(KernelRegressionModel):
 
         Outside the box of the training inputs the prediction is handed over to the GMS stage's
         (:mod:`greybox.models.handover`). ``expansion``, ``weight``: the kernel frame's
-        :meth:`~greybox.models.svr.KernelFrame.terms` of a stream, when at hand.
+        :meth:`~greybox.models.kernel.KernelFrame.terms` of a stream, when at hand.
         """
         if expansion is None:
             frame = self.kernel_frame()

@@ -114,16 +114,16 @@ def _lowest_corner(objective, intervals, n_calls, random_state, progress=None):
 
 def test_both_targets_search_the_default_intervals_and_ending_at_an_end_warns(fitted, monkeypatch):
     """No prior narrows the residual target's search (chosen on the family's training runs, docs/svr.md)."""
-    from greybox.models import svr
+    from greybox.models import kernel
 
-    monkeypatch.setattr(svr, "minimize_log_uniform", _lowest_corner)
+    monkeypatch.setattr(kernel, "minimize_log_uniform", _lowest_corner)
     model, train = fitted
     search = dict(C=3.0, epsilon=0.01, n_subset=200, n_calls=1, cv_folds=2, cv_blocks=4)
     for target in ("residual", "current"):
         fitted_model = GMSSVRModel(**search, target=target)
         with pytest.warns(UserWarning, match="gamma = 0.01 ended at the end"):
             fitted_model.fit_svr(train, gms=model.gms_)
-        assert fitted_model.gamma_ == svr.default_bounds(1.0)["gamma"][0] and fitted_model.at_bounds_ == ["gamma"]
+        assert fitted_model.gamma_ == kernel.default_bounds(1.0)["gamma"][0] and fitted_model.at_bounds_ == ["gamma"]
     narrowed = GMSSVRModel(**search, bounds={"gamma": (2.0, 50.0)})
     with pytest.warns(UserWarning, match="gamma = 2 ended at the end"):
         narrowed.fit_svr(train, gms=model.gms_)
