@@ -97,7 +97,7 @@ def main() -> None:
         root = Path(scratch)
         shifted = write_history(root, args.machines, args.axes, args.days, np.random.default_rng(0),
                                 args.write_compacted, args.append_days if args.write_compacted else 0)
-        files_before = sum(1 for _ in (root / "history").rglob("*.parquet"))
+        files_before = sum(1 for _ in (root / "history").glob("machine=*/axis=*/date=*/*.parquet"))
         names = ("compacted",) if args.only_compacted or args.write_compacted else ("history", "compacted")
         for name in names:
             if name == "compacted" and (args.append_days or not args.write_compacted):

@@ -122,7 +122,7 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
             connection.execute(f"""
                 CREATE TEMP TABLE rows AS
                 SELECT {needed}
-                FROM read_parquet({files}, hive_partitioning = false, union_by_name = true,
+                FROM read_parquet({files}, hive_partitioning = false, union_by_name = false,
                                   filename = {str(row_files).lower()})
                 {unique}""")
             versions = connection.execute("SELECT DISTINCT schema_version FROM rows").fetchall()

@@ -63,6 +63,9 @@ def test_bad_options_and_histories(tmp_path):
     pq.write_table(table.replace_schema_metadata({}).set_column(0, "schema_version", [[np.int32(1)]]), path)
     with pytest.raises(HistoryError, match="schema version"):
         changed_most(history)
+    pq.write_table(table.drop_columns(["backlash"]), path)  # a file of another layout among the others
+    with pytest.raises(HistoryError, match="not a readable"):
+        changed_most(history)
     path.write_bytes(b"not parquet")
     with pytest.raises(HistoryError, match="not a readable"):
         changed_most(history)
