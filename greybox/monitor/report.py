@@ -26,7 +26,7 @@ from .fingerprint import FEATURE_UNITS
 __all__ = ["axis_figure", "interactive_axis_html", "interactive_travel_html", "travel_map_figure", "write_report"]
 
 
-def axis_figure(trend, detector: ChangeDetector, path) -> Path:
+def axis_figure(trend, detector: ChangeDetector, path) -> Path | None:
     """Write the figure of one axis' features over the days as a PNG.
 
     Parameters
@@ -40,11 +40,13 @@ def axis_figure(trend, detector: ChangeDetector, path) -> Path:
 
     Returns
     -------
-    Path
-        ``path``.
+    Path or None
+        ``path``, or None when no feature of the axis is watched yet (fewer than two baseline days).
     """
-    plt = import_pyplot(path)
     features = list(trend.baseline)
+    if not features:
+        return None
+    plt = import_pyplot(path)
     figure, axes = plt.subplots(len(features), 1, figsize=(9, 1.7 * len(features) + 0.6), sharex=True,
                                 squeeze=False)
     dates = np.array(trend.dates, dtype="datetime64[D]")
@@ -149,13 +151,16 @@ def interactive_axis_html(trend, detector: ChangeDetector, div_id: str) -> str:
 
     Returns
     -------
-    str
-        The ``div`` and its inline call of plotly (plotly.js itself is included once per page).
+    str or None
+        The ``div`` and its inline call of plotly (plotly.js itself is included once per page), or None when
+        no feature of the axis is watched yet (fewer than two baseline days).
     """
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
 
     features = list(trend.baseline)
+    if not features:
+        return None
     dates = [d.isoformat() for d in trend.dates]
     figure = make_subplots(rows=len(features), cols=1, shared_xaxes=True, vertical_spacing=0.012,
                            subplot_titles=[f"{f} [{FEATURE_UNITS[f]}]" for f in features])
@@ -273,7 +278,8 @@ def write_report(detector: ChangeDetector, out_dir) -> Path:
         figures = []
         for i, trend in enumerate(detector.trends_):
             png = axis_figure(trend, detector, Path(scratch) / f"axis_{i}.png")
-            figures.append((f"{trend.machine} / {trend.axis} (severity {trend.severity:.2f})", png))
+            if png is not None:
+                figures.append((f"{trend.machine} / {trend.axis} (severity {trend.severity:.2f})", png))
             travel = travel_map_figure(trend, detector, Path(scratch) / f"travel_{i}.png")
             if travel is not None:
                 figures.append((f"{trend.machine} / {trend.axis}: friction along the travel", travel))
@@ -288,7 +294,9 @@ def write_report(detector: ChangeDetector, out_dir) -> Path:
 
     charts = []
     for i, trend in enumerate(detector.trends_):
-        charts.append(interactive_axis_html(trend, detector, f"axis-{i}"))
+        chart = interactive_axis_html(trend, detector, f"axis-{i}")
+        if chart is not None:
+            charts.append(chart)
         travel = interactive_travel_html(trend, detector, f"travel-{i}")
         if travel is not None:
             charts.append(travel)

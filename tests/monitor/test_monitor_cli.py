@@ -240,3 +240,10 @@ def test_monitor_compacts_the_history_it_appends_to(twin_days, tmp_path, capsys)
     assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
     assert "0 logs fingerprinted, 4 already in the history" in capsys.readouterr().out
     assert compacted.read_bytes() == before  # compacting again changes nothing
+
+
+def test_monitor_of_a_first_day_writes_the_page(twin_days, tmp_path, capsys):
+    first = sorted(str(p) for p in twin_days.iterdir())[0]  # one day: no feature has a baseline yet
+    assert main(["monitor", first, "--history", str(tmp_path / "h"), "--out", str(tmp_path / "r")]) == 0
+    assert "1 logs fingerprinted, 0 already in the history; 1 axes, 0 alarms" in capsys.readouterr().out
+    assert "Axes, most severe first" in (tmp_path / "r" / "index.html").read_text()
