@@ -6,7 +6,9 @@ Usage::
         [--kinds lubrication,preload,backlash,defect,none] [--json]
 
 For each seed (``--first-seed`` on: 2000 on are held out, used neither by the tests nor while the features
-and the detector were developed, which used seeds below 1000 and 1000-1014 for the first two kinds) and each
+and the detector were developed, which used seeds below 1000 and 1000-1014 for the first two kinds; run so
+far: 2000-2014 and 3000-3009 in round 1 of issue 34, 4000-4014, 3000-3009 again and 5000-5019 in round 2,
+see docs/monitor.md) and each
 drift kind at its documented rate (:data:`RATES`) from day ``--start`` (and none) the twin's X axis writes
 ``--days`` daily air-move logs
 (in memory, :func:`greybox.twin.ageing.aged_log`), each is fingerprinted

@@ -10,7 +10,9 @@ the history's own layout (one Parquet file per log: ``machine=/axis=/date=/<sha2
 temporary directory, then times :func:`greybox.monitor.query.changed_most` (the last 30 days against the first
 28) ``--repeat`` times after one warm-up, one DuckDB thread, on the history as written and after
 :func:`greybox.monitor.history.compact_history` (one file per machine and axis); ``--write-compacted`` writes
-the compacted files directly instead (the same files compaction writes). Printed: the files, the
+the compacted files directly instead (the same files compaction writes), and with ``--append-days N`` the
+last N days as row files, compacted (timed) before the query as ``greybox monitor`` does after filing a day's
+logs. Printed: the files, the
 median and largest wall time per query, and whether the shifted axes came first.
 """
 
@@ -34,7 +36,8 @@ from greybox.monitor.query import changed_most
 DAY0 = dt.date(2026, 1, 1)
 
 
-def write_history(root: Path, machines: int, axes: int, days: int, rng, compacted: bool = False) -> list:
+def write_history(root: Path, machines: int, axes: int, days: int, rng, compacted: bool = False,
+                  row_days: int = 0) -> list:
     shifted = []
     for m in range(machines):
         for a in range(axes):
@@ -51,8 +54,9 @@ def write_history(root: Path, machines: int, axes: int, days: int, rng, compacte
                     value = float(rng.normal(1.0, 0.01)) + (0.1 if shift and f == "sliding_pos" and day >= days - 20
                                                             else 0.0)
                     row[f], row[f"{f}_lo"], row[f"{f}_hi"] = value, value - 0.02, value + 0.02
-                rows.append(row)
-                if not compacted:
+                if compacted and day < days - row_days:
+                    rows.append(row)
+                else:
                     path = row_path(root / "history", row["machine"], row["axis"], date, row["log_sha256"])
                     path.parent.mkdir(parents=True, exist_ok=True)
                     pq.write_table(pa.Table.from_pylist([row], schema=SCHEMA), path)
@@ -83,17 +87,20 @@ def main() -> None:
                         help="time the query only after compaction (the history as written takes ms per file)")
     parser.add_argument("--write-compacted", action="store_true",
                         help="write the compacted files directly (a year of row files takes long to write)")
+    parser.add_argument("--append-days", type=int, default=0,
+                        help="with --write-compacted: the last days as row files, compacted as greybox monitor "
+                             "does after filing them (the compaction timed)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     results = {}
     with tempfile.TemporaryDirectory() as scratch:
         root = Path(scratch)
         shifted = write_history(root, args.machines, args.axes, args.days, np.random.default_rng(0),
-                                args.write_compacted)
-        files_before = sum(1 for _ in (root / "history").rglob("*.parquet"))
+                                args.write_compacted, args.append_days if args.write_compacted else 0)
+        files_before = sum(1 for _ in (root / "history").glob("machine=*/axis=*/date=*/*.parquet"))
         names = ("compacted",) if args.only_compacted or args.write_compacted else ("history", "compacted")
         for name in names:
-            if name == "compacted" and not args.write_compacted:
+            if name == "compacted" and (args.append_days or not args.write_compacted):
                 start = time.perf_counter()
                 compact_history(root / "history")
                 results["compaction_s"] = time.perf_counter() - start

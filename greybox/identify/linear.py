@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import lsq_linear
 
-__all__ = ["bounded_lstsq"]
+__all__ = ["bounded_lstsq", "bounded_normal_solve"]
 
 #: Relative floor of the eigenvalues of the scaled Gram matrix: a tiny ridge
 #: that keeps collinear regressors (e.g. GMS elements that never stick) solvable.
@@ -46,27 +46,52 @@ def bounded_lstsq(a: np.ndarray, b: np.ndarray, lower=None, upper=None) -> tuple
     copy of ``a`` is made. When the unconstrained solution violates a bound,
     the reduced problem is solved by bounded-variable least squares.
     """
-    p = a.shape[1]
+    x = bounded_normal_solve(a.T @ a, a.T @ b, lower=lower, upper=upper)
+    return x, a @ x - b
+
+
+def bounded_normal_solve(gram: np.ndarray, rhs: np.ndarray, lower=None, upper=None) -> np.ndarray:
+    """The solution of :func:`bounded_lstsq` from the normal equations ``a.T a`` and ``a.T b``.
+
+    Sums of these over groups of rows (e.g. the blocks of a block bootstrap) give the fit of the union of
+    the groups without touching the rows again.
+
+    Parameters
+    ----------
+    gram : ndarray, shape (p, p)
+        ``a.T @ a`` [unit of a squared].
+    rhs : ndarray, shape (p,)
+        ``a.T @ b`` [unit of a times unit of b].
+    lower, upper : array_like of shape (p,), optional
+        Bounds (``-inf``/``inf`` for none); unbounded if omitted.
+
+    Returns
+    -------
+    ndarray, shape (p,)
+        The solution. A column that is zero everywhere gets the coefficient nearest to 0 within its bounds.
+    """
+    gram_full = np.asarray(gram, dtype=float)
+    rhs = np.asarray(rhs, dtype=float)
+    p = gram_full.shape[0]
     lower = np.full(p, -np.inf) if lower is None else np.asarray(lower, dtype=float)
     upper = np.full(p, np.inf) if upper is None else np.asarray(upper, dtype=float)
-    gram_full = a.T @ a
-    norms = np.sqrt(np.diag(gram_full))
+    norms = np.sqrt(np.maximum(np.diag(gram_full), 0.0))
     active = norms > 0.0
     x = np.clip(0.0, lower, upper)
     if np.any(active):
         inv = 1.0 / norms[active]
-        gram = gram_full[np.ix_(active, active)] * inv[:, None] * inv[None, :]
-        rhs = (a.T @ b)[active] * inv
-        eigval, eigvec = np.linalg.eigh(gram)
+        scaled_gram = gram_full[np.ix_(active, active)] * inv[:, None] * inv[None, :]
+        scaled_rhs = rhs[active] * inv
+        eigval, eigvec = np.linalg.eigh(scaled_gram)
         eigval = np.maximum(eigval, _EIGEN_FLOOR * max(eigval[-1], 1.0))
-        x_scaled = eigvec @ ((eigvec.T @ rhs) / eigval)
+        x_scaled = eigvec @ ((eigvec.T @ scaled_rhs) / eigval)
         lo = lower[active] * norms[active]
         hi = upper[active] * norms[active]
         if np.any(x_scaled < lo) or np.any(x_scaled > hi):
             root = np.sqrt(eigval)
             r_mat = root[:, None] * eigvec.T
-            d_vec = (eigvec.T @ rhs) / root
+            d_vec = (eigvec.T @ scaled_rhs) / root
             x_scaled = lsq_linear(r_mat, d_vec, bounds=(lo, hi), method="bvls").x
         # bvls may end a rounding error outside a bound (e.g. -3e-13 for a stiffness bounded at 0)
         x[active] = np.clip(x_scaled * inv, lower[active], upper[active])
-    return x, a @ x - b
+    return x

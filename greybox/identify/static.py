@@ -31,10 +31,10 @@ from scipy.optimize import minimize_scalar
 from threadpoolctl import threadpool_limits
 
 from ..errors import ParameterError, Setting
-from .linear import bounded_lstsq
+from .linear import bounded_lstsq, bounded_normal_solve
 
-__all__ = ["check_direction_settings", "fit_coulomb", "fit_stribeck", "stribeck_curve", "stribeck_regressors",
-           "velocity_range"]
+__all__ = ["check_direction_settings", "coulomb_from_normal_equations", "coulomb_regressors", "fit_coulomb",
+           "fit_stribeck", "stribeck_curve", "stribeck_regressors", "velocity_range"]
 
 #: Number of log-spaced Stribeck velocities tried before the local refinement.
 _N_GRID = 40
@@ -149,7 +149,33 @@ def fit_coulomb(velocity, acceleration, effort, *, asymmetric: bool = False,
         then not separable from the two Coulomb levels).
     """
     check_direction_settings(asymmetric, fit_offset)
+    a = coulomb_regressors(velocity, acceleration, asymmetric=asymmetric, fit_offset=fit_offset)
+    effort = np.asarray(effort, dtype=float)
+    return coulomb_from_normal_equations(a.T @ a, a.T @ effort, asymmetric=asymmetric, fit_offset=fit_offset)
+
+
+def coulomb_regressors(velocity, acceleration, *, asymmetric: bool = False, fit_offset: bool = False) -> np.ndarray:
+    """Regressors of the Coulomb + viscous model of :func:`fit_coulomb`, one column per parameter.
+
+    Parameters
+    ----------
+    velocity : ndarray, shape (n,)
+        Velocity [mm/s].
+    acceleration : ndarray, shape (n,)
+        Acceleration [mm/s^2].
+    asymmetric : bool, default False
+        Separate Coulomb and viscous levels for positive and negative motion.
+    fit_offset : bool, default False
+        Append a constant column for an offset.
+
+    Returns
+    -------
+    ndarray, shape (n, p)
+        ``a, sgn(v), v`` (symmetric) or ``a, [v > 0], -[v < 0], v [v > 0], v [v < 0]`` (asymmetric), then
+        ``1`` with the offset; the parameters in the order of :func:`coulomb_from_normal_equations`.
+    """
     v = np.asarray(velocity, dtype=float)
+    acceleration = np.asarray(acceleration, dtype=float)
     positive = (v > 0.0).astype(float)
     negative = (v < 0.0).astype(float)
     if asymmetric:
@@ -158,11 +184,32 @@ def fit_coulomb(velocity, acceleration, effort, *, asymmetric: bool = False,
         columns = [acceleration, np.sign(v), v]
     if fit_offset:
         columns.append(np.ones_like(v))
-    a = np.column_stack(columns)
-    lower = np.full(a.shape[1], -np.inf)
+    return np.column_stack(columns)
+
+
+def coulomb_from_normal_equations(gram, rhs, *, asymmetric: bool = False, fit_offset: bool = False,
+                                  ) -> dict[str, float]:
+    """The fit of :func:`fit_coulomb` from the normal equations of :func:`coulomb_regressors`.
+
+    Parameters
+    ----------
+    gram : ndarray, shape (p, p)
+        ``R.T @ R`` of the regressors ``R`` [products of the regressors' units].
+    rhs : ndarray, shape (p,)
+        ``R.T @ y`` of the regressors and the effort [regressor unit times A].
+    asymmetric : bool, default False
+        The regressors have separate levels per direction of motion.
+    fit_offset : bool, default False
+        The regressors end with the offset's constant column.
+
+    Returns
+    -------
+    dict
+        As :func:`fit_coulomb`, the inertia held non-negative.
+    """
+    lower = np.full(np.shape(rhs)[0], -np.inf)
     lower[0] = 0.0
-    x, _ = bounded_lstsq(a, np.asarray(effort, dtype=float), lower=lower)
-    x = [float(value) for value in x]
+    x = [float(value) for value in bounded_normal_solve(gram, rhs, lower=lower)]
     if asymmetric:
         return {"J": x[0], "coulomb_pos": x[1], "coulomb_neg": x[2], "viscous_pos": x[3],
                 "viscous_neg": x[4], "offset": 0.0}

@@ -8,10 +8,16 @@ days,
 
     S+_t = max(0, S+_{t-1} + z_t - k),   S-_t = max(0, S-_{t-1} - z_t - k),
 
-and an alarm is raised on the first day either reaches ``h`` (``k = 0.5``: tuned to a shift of one standard
-deviation). The threshold ``h`` is calibrated by simulation (:func:`calibrated_threshold`): with the
-baseline estimated from only ``baseline_days`` days, the textbook ``h = 5`` (an in-control run length of
-about 900 days per sum when mean and deviation are known) raises several false alarms per axis and year,
+and an alarm is raised on the first day either reaches ``h``. The reference value ``k = 1`` is half the
+shift the detector is tuned to find quickly, two baseline standard deviations: the drifts watched for are
+ramps that leave the day-to-day spread within days, and a sum with a larger ``k`` (and its calibrated,
+lower ``h``) reaches its threshold on such a ramp sooner, at the cost of small sustained shifts (under one
+standard deviation) being found later. (Until round 2 of issue 34 it was ``k = 0.5``, tuned to a shift of
+one standard deviation; the change was chosen on development seeds, see docs/monitor.md.)
+
+The threshold ``h`` is calibrated by simulation (:func:`calibrated_threshold`): with the baseline
+estimated from only ``baseline_days`` days, the textbook ``h = 5`` of ``k = 0.5`` (an in-control run length
+of about 900 days per sum when mean and deviation are known) raises several false alarms per axis and year,
 because the estimated baseline is itself off by a fraction of a standard deviation. The calibration
 simulates stable axes (independent normal daily values), estimates their baseline as the detector does and
 sets ``h`` so that the expected number of false alarms is ``false_alarms_per_year`` per axis and year.
@@ -72,7 +78,7 @@ def cusum(z, *, k: float = 0.5, h: float = 5.0, clip: float = np.inf) -> tuple[n
 
 
 def calibrated_threshold(*, baseline_days: int, n_features: int, false_alarms_per_year: float = 1.0,
-                         k: float = 0.5, clip: float = 3.0, n_sim: int = 4000, seed: int = 0) -> float:
+                         k: float = 1.0, clip: float = 3.0, n_sim: int = 4000, seed: int = 0) -> float:
     """The CUSUM threshold that gives a set number of false alarms per axis and year on stable axes.
 
     Stable axes are simulated as independent standard normal daily values over ``baseline_days`` plus
@@ -90,7 +96,7 @@ def calibrated_threshold(*, baseline_days: int, n_features: int, false_alarms_pe
         Features watched per axis.
     false_alarms_per_year : float, default 1.0
         Expected false alarms per axis and year (365 days of daily values).
-    k : float, default 0.5
+    k : float, default 1.0
         CUSUM allowance [standard deviations].
     clip : float, default 3.0
         Standardised values are clipped to ``[-clip, clip]``.
@@ -278,8 +284,8 @@ class ChangeDetector:
     ----------
     baseline_days : int, default 28
         Number of first days (with a fingerprint) that set each feature's baseline; at least 3.
-    k : float, default 0.5
-        CUSUM allowance [baseline standard deviations].
+    k : float, default 1.0
+        CUSUM allowance [baseline standard deviations]: half the shift the detector is tuned to.
     h : float, optional
         CUSUM threshold [baseline standard deviations]; by default :func:`calibrated_threshold` for
         ``false_alarms_per_year``.
@@ -300,7 +306,7 @@ class ChangeDetector:
         Every alarm, most severe axis first, earliest first within an axis.
     """
 
-    def __init__(self, *, baseline_days: int = 28, k: float = 0.5, h: float | None = None,
+    def __init__(self, *, baseline_days: int = 28, k: float = 1.0, h: float | None = None,
                  false_alarms_per_year: float = 1.0, clip: float = 3.0, features=None):
         self.baseline_days = baseline_days
         self.k = k

@@ -31,10 +31,15 @@ On those samples, per direction of motion:
   and cannot pull the trend up to itself); and the amplitude of the periodic component, fitted with the
   trend without the stretch of the largest local excess.
 
-Intervals come from a moving-block bootstrap (the backlash width's from the reversals drawn with
-replacement): blocks of contiguous samples (default 0.2 s, much longer than the
-correlation of the current noise and of the friction memory) are drawn with replacement and everything is
-refitted on every replicate. The replicates are seeded, so the same log gives the same fingerprint.
+Intervals come from a block bootstrap (the backlash width's from the reversals drawn with replacement): the
+unloaded moving samples are cut into blocks of contiguous samples (default 0.2 s, much longer than the
+correlation of the current noise and of the friction memory), as many blocks as there are are drawn with
+replacement, and every feature is recomputed on each replicate. Every feature but the backlash is a
+least-squares fit or a mean, so it follows from sums over the samples (the normal equations of the sliding
+fit, the slow samples' sums, per bin of the travel the normal equations along the travel); these sums are
+taken once per block (per block and bin along the travel), and a replicate sums the blocks' sums weighted by
+how often each block was drawn: exactly the refit on the replicate's samples, at a cost per replicate that
+does not grow with the log. The replicates are seeded, so the same log gives the same fingerprint.
 """
 
 from __future__ import annotations
@@ -42,10 +47,11 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+from scipy import sparse
 
 from ..data.log import AxisLog, as_log_list
 from ..errors import LogError, ParameterError
-from ..identify.static import fit_coulomb
+from ..identify.static import coulomb_from_normal_equations, coulomb_regressors
 
 __all__ = ["FEATURES", "FEATURE_UNITS", "FrictionFingerprint", "reversal_widths", "spindle_idle_samples",
            "unloaded_samples"]
@@ -151,82 +157,138 @@ def spindle_idle_samples(load, *, threshold: float | None = None, pad: int = 100
     return cutting == 0.0
 
 
-def _block_indices(n: int, block: int, rng: np.random.Generator) -> np.ndarray:
-    """Row indices of one moving-block bootstrap replicate of ``n`` rows in blocks of ``block`` rows."""
-    block = min(block, n)
-    starts = rng.integers(0, n - block + 1, size=-(-n // block))
-    return (starts[:, None] + np.arange(block)[None, :]).ravel()[:n]
+def _block_counts(n_blocks: int, n_boot: int, rng: np.random.Generator) -> np.ndarray:
+    """How often each of ``n_blocks`` blocks is drawn in each of ``n_boot`` replicates of ``n_blocks`` draws."""
+    return rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=n_boot).astype(float)
 
 
-def _travel_design(x: np.ndarray, period_mm: float) -> np.ndarray:
-    """Columns of the fit along the travel: 1, u (the position scaled to [-1, 1]), sin, cos of the period."""
-    low, high = float(np.min(x)), float(np.max(x))
+def _travel_design(x: np.ndarray, low: float, high: float, period_mm: float) -> np.ndarray:
+    """Columns of the fit along the travel: 1, u (the position scaled from [low, high] to [-1, 1]), sin, cos of
+    the period."""
     u = (2.0 * x - low - high) / max(high - low, 1e-12)
     phase = 2.0 * np.pi * x / period_mm
     return np.column_stack([np.ones_like(x), u, np.sin(phase), np.cos(phase)])
 
 
-def _travel_features(x: np.ndarray, excess: np.ndarray, period_mm: float, bin_mm: float, min_count: int,
-                     ) -> tuple[float, float, np.ndarray, np.ndarray]:
-    """Periodic amplitude [A], local excess [A] and the map (bin centres [mm], mean excess [A]) of one sample set.
+def _row_products(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """Per row the outer product of ``left`` (n, p) and ``right`` (n, q), flattened to (n, p * q)."""
+    return (left[:, :, None] * right[:, None, :]).reshape(len(left), -1)
 
-    A linear trend and the periodic part are fitted to all samples; the local excess of a bin is its mean
-    residual under the trend refitted (the periodic part kept) to all samples but those of the bin and its
-    two neighbours (a deleted residual: a raised stretch cannot pull the trend up to itself), over the bins
-    at least two bins inside the travelled stretch (no extrapolation). The local excess is the largest of
-    them, and the periodic amplitude that of the fit of trend and periodic part without the stretch of the
-    largest one.
+
+class _Statistics:
+    """Sums over blocks of contiguous samples from which every feature but the backlash follows.
+
+    The features are least-squares fits and means, so each is a function of sums over the samples: of the
+    normal equations of the sliding fit, of the slow samples' effort and motion, and per bin of the travel
+    of the normal equations along the travel. A replicate of the block bootstrap is a weighted sum of the
+    blocks' sums (weight: how often the block is drawn), so nothing is refitted on the samples.
     """
-    if len(x) < 6:
-        return np.nan, np.nan, np.empty(0), np.empty(0)
-    design = _travel_design(x, period_mm)
-    bins = np.floor(x / bin_mm).astype(np.int64)
-    first = int(bins.min())
-    index = bins - first
-    n_bins = int(index.max()) + 1
-    counts = np.bincount(index, minlength=n_bins)
-    full = np.flatnonzero(counts >= min_count)
-    interior = full[(full - 2 >= full.min()) & (full + 2 <= full.max())]  # the fit is not extrapolated there
-    centres = (full + first + 0.5) * bin_mm
-    level = np.bincount(index, weights=excess, minlength=n_bins)[full] / np.maximum(counts[full], 1)
-    if not len(interior):
-        return np.nan, np.nan, centres, level
-    coef = np.linalg.lstsq(design, excess, rcond=None)[0]
-    trend = excess - design[:, 2:] @ coef[2:]  # the excess less its periodic part
-    local = np.full(n_bins, -np.inf)
-    for j in interior:
-        out = np.abs(index - j) <= 1
-        line = np.linalg.lstsq(design[~out, :2], trend[~out], rcond=None)[0]
-        inside = index == j
-        local[j] = float(np.mean(trend[inside] - design[inside, :2] @ line))
-    worst = int(np.argmax(local))
-    kept = np.abs(index - worst) > 1
-    refit = np.linalg.lstsq(design[kept], excess[kept], rcond=None)[0]
-    return float(np.hypot(refit[2], refit[3])), float(local[worst]), centres, level
 
+    def __init__(self, x, v, a, y, block: int, sliding_speed: float, breakaway_speed: float, period_mm: float,
+                 bin_mm: float):
+        n = len(y)
+        self.n_blocks = -(-n // block)
+        blocks = np.arange(n) // block
+        fast = np.abs(v) >= sliding_speed
+        regressors = coulomb_regressors(v[fast], a[fast], asymmetric=True)
+        columns = [_row_products(regressors, regressors), regressors * y[fast, None], (y[fast] ** 2)[:, None],
+                   np.ones((int(fast.sum()), 1))]
+        self.fast = self._sum(blocks[fast], np.hstack(columns), self.n_blocks)
+        slow = []
+        for sign in (1.0, -1.0):
+            chosen = (sign * v > 0.0) & (np.abs(v) < breakaway_speed)
+            values = np.column_stack([np.ones(int(chosen.sum())), y[chosen], a[chosen], v[chosen]])
+            slow.append(self._sum(blocks[chosen], values, self.n_blocks))
+        self.slow = np.hstack(slow)
+        # along the travel: the excess over the sliding level is linear in the sliding fit's parameters,
+        # excess = Z @ [1, -J, -viscous_pos, -viscous_neg, -coulomb_pos, -coulomb_neg]
+        xf, vf, af, yf = x[fast], v[fast], a[fast], y[fast]
+        sign = np.sign(vf)
+        positive, negative = (vf > 0.0).astype(float), (vf < 0.0).astype(float)
+        z = np.column_stack([sign * yf, sign * af, np.abs(vf) * positive, np.abs(vf) * negative, positive,
+                             negative])
+        low, high = (float(np.min(xf)), float(np.max(xf))) if len(xf) else (0.0, 1.0)
+        design = _travel_design(xf, low, high, period_mm)
+        bins = np.floor(xf / bin_mm).astype(np.int64)
+        self.first_bin = int(bins.min()) if len(bins) else 0
+        bin_index = bins - self.first_bin
+        self.n_bins = int(bin_index.max()) + 1 if len(bins) else 0
+        pairs, pair_index = np.unique(blocks[fast] * max(self.n_bins, 1) + bin_index, return_inverse=True)
+        self.pair_block = pairs // max(self.n_bins, 1)
+        self.pair_bin = pairs % max(self.n_bins, 1)
+        self.travel = self._sum(pair_index, np.hstack([_row_products(design, design), _row_products(design, z)]),
+                                len(pairs))
+        self.pair_to_bin = sparse.csr_matrix((np.ones(len(pairs)), (self.pair_bin, np.arange(len(pairs)))),
+                                             shape=(max(self.n_bins, 1), len(pairs)))
 
-def _features(x: np.ndarray, v: np.ndarray, a: np.ndarray, y: np.ndarray, sliding_speed: float,
-              breakaway_speed: float, period_mm: float, bin_mm: float, min_count: int,
-              ) -> tuple[np.ndarray, dict, tuple]:
-    """The features of :data:`FEATURES` but the backlash of the samples ``x, v, a, y`` [mm, mm/s, mm/s^2, A],
-    the fitted parameters of :func:`fit_coulomb` and the map along the travel."""
-    fast = np.abs(v) >= sliding_speed
-    params = fit_coulomb(v[fast], a[fast], y[fast], asymmetric=True)
-    viscous = np.where(v > 0.0, params["viscous_pos"], params["viscous_neg"])
-    residual = y[fast] - (params["J"] * a[fast] + np.where(v[fast] > 0.0, params["coulomb_pos"],
-                                                           -params["coulomb_neg"]) + viscous[fast] * v[fast])
-    friction = y - params["J"] * a - viscous * v
-    slow = np.abs(v) < breakaway_speed
-    slow_pos, slow_neg = friction[slow & (v > 0.0)], friction[slow & (v < 0.0)]
-    breakaway_pos = float(np.mean(slow_pos)) if len(slow_pos) else np.nan
-    breakaway_neg = -float(np.mean(slow_neg)) if len(slow_neg) else np.nan
-    sign = np.sign(v[fast])
-    excess = sign * friction[fast] - np.where(sign > 0.0, params["coulomb_pos"], params["coulomb_neg"])
-    periodic, local, centres, level = _travel_features(x[fast], excess, period_mm, bin_mm, min_count)
-    values = np.array([params["coulomb_pos"], params["coulomb_neg"], breakaway_pos, breakaway_neg,
-                       params["viscous_pos"], params["viscous_neg"], float(np.sqrt(np.mean(residual * residual))),
-                       np.nan, periodic, local])
-    return values, params, (centres, level)
+    @staticmethod
+    def _sum(groups: np.ndarray, values: np.ndarray, n_groups: int) -> np.ndarray:
+        """Column sums of ``values`` per group (the rows' ``groups``), shape (n_groups, columns)."""
+        return np.column_stack([np.bincount(groups, weights=column, minlength=n_groups) for column in values.T])
+
+    def features(self, weights: np.ndarray, settings: tuple) -> tuple[np.ndarray, dict, tuple]:
+        """The features of :data:`FEATURES` (the backlash NaN), the sliding fit and the travel map of the
+        samples with the blocks weighted by ``weights`` (n_blocks,)."""
+        min_count = settings[-1]
+        fast = weights @ self.fast
+        gram, rhs, yy, count = fast[:25].reshape(5, 5), fast[25:30], fast[30], fast[31]
+        params = coulomb_from_normal_equations(gram, rhs, asymmetric=True)
+        theta = np.array([params["J"], params["coulomb_pos"], params["coulomb_neg"], params["viscous_pos"],
+                          params["viscous_neg"]])
+        rss = yy - 2.0 * theta @ rhs + theta @ gram @ theta
+        noise = float(np.sqrt(max(rss, 0.0) / count)) if count else np.nan
+        slow = weights @ self.slow
+        breakaway = []
+        for offset, viscous, sign in ((0, params["viscous_pos"], 1.0), (4, params["viscous_neg"], -1.0)):
+            n_slow, sum_y, sum_a, sum_v = slow[offset:offset + 4]
+            breakaway.append(sign * (sum_y - params["J"] * sum_a - viscous * sum_v) / n_slow if n_slow else np.nan)
+        excess_coef = np.array([1.0, -params["J"], -params["viscous_pos"], -params["viscous_neg"],
+                                -params["coulomb_pos"], -params["coulomb_neg"]])
+        periodic, local, centres, level = self._travel_features(weights, excess_coef, settings[2], settings[3],
+                                                                min_count)
+        values = np.array([params["coulomb_pos"], params["coulomb_neg"], breakaway[0], breakaway[1],
+                           params["viscous_pos"], params["viscous_neg"], noise, np.nan, periodic, local])
+        return values, params, (centres, level)
+
+    def _travel_features(self, weights, excess_coef, period_mm, bin_mm, min_count):
+        """Periodic amplitude [A], local excess [A] and the map (bin centres [mm], mean excess [A]).
+
+        A linear trend and the periodic part are fitted to all samples; the local excess of a bin is its mean
+        residual under the trend refitted (the periodic part kept) to all samples but those of the bin and its
+        two neighbours (a deleted residual: a raised stretch cannot pull the trend up to itself), over the
+        bins at least two bins inside the travelled stretch (no extrapolation). The local excess is the
+        largest of them, and the periodic amplitude that of the fit of trend and periodic part without the
+        stretch of the largest one.
+        """
+        per_bin = self.pair_to_bin @ (self.travel * weights[self.pair_block][:, None])
+        gram_bin = per_bin[:, :16].reshape(-1, 4, 4)
+        rhs_bin = per_bin[:, 16:].reshape(-1, 4, 6) @ excess_coef  # design.T @ excess per bin
+        counts = gram_bin[:, 0, 0]
+        full = np.flatnonzero(counts >= min_count - 1e-9)
+        if counts.sum() < 6 or not len(full):
+            return np.nan, np.nan, np.empty(0), np.empty(0)
+        interior = full[(full - 2 >= full.min()) & (full + 2 <= full.max())]  # the fit is not extrapolated there
+        centres = (full + self.first_bin + 0.5) * bin_mm
+        level = rhs_bin[full, 0] / counts[full]
+        if not len(interior):
+            return np.nan, np.nan, centres, level
+        gram, rhs = gram_bin.sum(axis=0), rhs_bin.sum(axis=0)
+        coef = np.linalg.lstsq(gram, rhs, rcond=None)[0]
+        # design.T @ trend per bin, the trend being the excess less its periodic part
+        trend_bin = rhs_bin - gram_bin[:, :, 2:] @ coef[2:]
+        padded_gram = np.pad(gram_bin, ((1, 1), (0, 0), (0, 0)))
+        padded_trend = np.pad(trend_bin, ((1, 1), (0, 0)))
+        window_gram = padded_gram[interior] + padded_gram[interior + 1] + padded_gram[interior + 2]
+        window_trend = padded_trend[interior] + padded_trend[interior + 1] + padded_trend[interior + 2]
+        line_gram = (gram - window_gram)[:, :2, :2]
+        line_rhs = (trend_bin.sum(axis=0) - window_trend)[:, :2]
+        line = np.linalg.solve(line_gram, line_rhs[:, :, None])[:, :, 0]
+        local = (trend_bin[interior, 0] - np.einsum("ij,ij->i", gram_bin[interior, 0, :2], line)) / counts[interior]
+        worst = int(interior[np.argmax(local)])
+        stretch = slice(max(worst - 1, 0), worst + 2)
+        refit = np.linalg.lstsq(gram - gram_bin[stretch].sum(axis=0), rhs - rhs_bin[stretch].sum(axis=0),
+                                rcond=None)[0]
+        return float(np.hypot(refit[2], refit[3])), float(np.max(local)), centres, level
 
 
 def reversal_widths(position, velocity, friction, level_pos: float, level_neg: float, *, keep=None,
@@ -296,7 +358,7 @@ class FrictionFingerprint:
     breakaway_speed : float, default 2.0
         Moving samples slower than this [mm/s] give the break-away levels.
     n_boot : int, default 200
-        Number of moving-block bootstrap replicates for the intervals.
+        Number of block bootstrap replicates for the intervals.
     block_s : float, default 0.2
         Length [s] of a bootstrap block of contiguous samples.
     confidence : float, default 0.95
@@ -410,7 +472,9 @@ class FrictionFingerprint:
                                f"or faster and {slow} below {self.breakaway_speed:g} mm/s; a fingerprint needs at "
                                f"least {MIN_SAMPLES_PER_DIRECTION} and 1 in each direction")
         settings = (self.sliding_speed, self.breakaway_speed, self.period_mm, self.map_bin_mm, self.map_min_samples)
-        point, params, (centres, level) = _features(x, v, a, y, *settings)
+        block = max(1, int(round(self.block_s / sample_time)))
+        stats = _Statistics(x, v, a, y, block, *settings[:4])
+        point, params, (centres, level) = stats.features(np.ones(stats.n_blocks), settings)
         widths = np.concatenate([np.empty(0)] + [
             reversal_widths(run.position, run.velocity,
                             run.effort - params["J"] * run.acceleration
@@ -420,13 +484,13 @@ class FrictionFingerprint:
         backlash = FEATURES.index("backlash")
         point[backlash] = float(np.median(widths)) if len(widths) else np.nan
         rng = np.random.default_rng(self.seed)
-        block = max(1, int(round(self.block_s / sample_time)))
+        counts = _block_counts(stats.n_blocks, self.n_boot, rng)
         replicates = np.empty((self.n_boot, len(FEATURES)))
-        for b in range(self.n_boot):
-            rows = _block_indices(len(y), block, rng)
-            replicates[b] = _features(x[rows], v[rows], a[rows], y[rows], *settings)[0]
-            if len(widths):
-                replicates[b, backlash] = np.median(widths[rng.integers(0, len(widths), len(widths))])
+        with np.errstate(all="ignore"):
+            for b in range(self.n_boot):
+                replicates[b] = stats.features(counts[b], settings)[0]
+                if len(widths):
+                    replicates[b, backlash] = np.median(widths[rng.integers(0, len(widths), len(widths))])
         tail = 50.0 * (1.0 - self.confidence)
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # a feature without any value: NaN ends

@@ -9,7 +9,8 @@ bytes, so fingerprinting the same log again rewrites the same file with the same
 idempotent) and a log already in the history need not be fitted again. The partition columns are also
 stored in the row, so every file can be read on its own. Files are written atomically.
 
-Many small files are slow to query; :func:`compact_history` merges the row files of each machine and axis
+Many small files are slow to query; :func:`compact_history` (which ``greybox monitor`` runs after filing
+its logs) merges the row files of each machine and axis
 into one file ``DIR/machine=<machine>/axis=<axis>/compacted.parquet`` (same schema, one row per log) and
 removes them. The logs in it stay known (:func:`find_log`); a log filed again after compaction gets a row
 file of its own, which wins over its row in the compacted file when the history is read.
@@ -144,7 +145,7 @@ def find_log(history, sha256: str) -> tuple[str, str, dt.date, Path] | None:
                 dt.date.fromisoformat(found.parts[-2][len("date="):]), found)
     root = Path(history)
     for path in sorted(root.glob(f"machine=*/axis=*/{COMPACTED_NAME}")) if root.is_dir() else []:
-        table = _read_row_file(path)
+        table = _read_row_file(path, columns=("machine", "axis", "date", "log_sha256"))
         hits = [i for i, key in enumerate(table.column("log_sha256").to_pylist()) if key == sha256]
         if hits:
             return (table.column("machine")[hits[0]].as_py(), table.column("axis")[hits[0]].as_py(),
@@ -200,19 +201,22 @@ def append_fingerprint(history, *, machine: str, axis: str, date: dt.date, sha25
     return path
 
 
-def _read_row_file(path: Path) -> pa.Table:
+def _read_row_file(path: Path, columns=None) -> pa.Table:
+    """The rows of one history file (only ``columns``, in the schema's order, if given), checked."""
+    names = SCHEMA.names if columns is None else [name for name in SCHEMA.names if name in columns]
     try:
-        table = pq.read_table(path)
+        file_schema = pq.read_schema(path)
+        missing = [name for name in SCHEMA.names if name not in file_schema.names]
+        table = pq.read_table(path, columns=[name for name in names if name not in missing])
     except (pa.ArrowException, OSError) as error:
         raise HistoryError(f"{path}: not a readable Parquet file of the fingerprint history ({error})") from None
-    version = table.schema.metadata and table.schema.metadata.get(b"greybox.monitor.schema_version")
+    version = file_schema.metadata and file_schema.metadata.get(b"greybox.monitor.schema_version")
     if version != str(SCHEMA_VERSION).encode():
         found = version.decode() if version else "none"
         raise HistoryError(f"{path}: history schema version {found}; this greybox reads version {SCHEMA_VERSION}")
-    missing = [name for name in SCHEMA.names if name not in table.column_names]
     if missing:
         raise HistoryError(f"{path}: history file lacks the columns {', '.join(missing)}")
-    return table.select(SCHEMA.names).cast(SCHEMA)
+    return table.select(names).cast(pa.schema([SCHEMA.field(name) for name in names], metadata=SCHEMA.metadata))
 
 
 def read_history(history, *, machine: str | None = None, axis: str | None = None,

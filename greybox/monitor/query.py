@@ -6,7 +6,8 @@ of the last ``days`` days (up to the history's latest day, or ``until``) against
 detector takes it), in baseline standard deviations; per axis the feature with the largest absolute change.
 Every Parquet file of the history is read (row files and compacted files, a log's row file winning over its
 row in a compacted file, as :func:`~greybox.monitor.history.read_history` does); a history of one file per
-log is slow to read (milliseconds per file): :func:`~greybox.monitor.history.compact_history` first.
+log is slow to read (milliseconds per file): ``greybox monitor`` compacts the history
+(:func:`~greybox.monitor.history.compact_history`) after filing its logs.
 """
 
 from __future__ import annotations
@@ -112,13 +113,18 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
     needed = ", ".join(["schema_version", "machine", "axis", "date", "log_sha256", *(f'"{f}"' for f in chosen)])
     with duckdb.connect() as connection:
         connection.execute("SET threads TO 1")
-        try:  # the files are read once, only the columns needed; a log's row file wins over a compacted row
+        # the files are read once, only the columns needed; a log's row file wins over a compacted row (a
+        # history of compacted files only, as greybox monitor leaves it, holds every log once)
+        row_files = next(root.glob("machine=*/axis=*/date=*/*.parquet"), None) is not None
+        unique = (f"QUALIFY row_number() OVER (PARTITION BY log_sha256 ORDER BY filename LIKE '%{COMPACTED_NAME}', "
+                  f"filename) = 1") if row_files else ""
+        try:
             connection.execute(f"""
                 CREATE TEMP TABLE rows AS
                 SELECT {needed}
-                FROM read_parquet({files}, hive_partitioning = false, union_by_name = true, filename = true)
-                QUALIFY row_number() OVER (PARTITION BY log_sha256
-                                           ORDER BY filename LIKE '%{COMPACTED_NAME}', filename) = 1""")
+                FROM read_parquet({files}, hive_partitioning = false, union_by_name = false,
+                                  filename = {str(row_files).lower()})
+                {unique}""")
             versions = connection.execute("SELECT DISTINCT schema_version FROM rows").fetchall()
             if sorted(v for (v,) in versions) != [SCHEMA_VERSION]:
                 found = ", ".join(str(v) for (v,) in versions)

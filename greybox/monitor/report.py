@@ -23,10 +23,10 @@ from ..evaluate.table import Table
 from .detect import ChangeDetector
 from .fingerprint import FEATURE_UNITS
 
-__all__ = ["axis_figure", "interactive_axis_html", "travel_map_figure", "write_report"]
+__all__ = ["axis_figure", "interactive_axis_html", "interactive_travel_html", "travel_map_figure", "write_report"]
 
 
-def axis_figure(trend, detector: ChangeDetector, path) -> Path:
+def axis_figure(trend, detector: ChangeDetector, path) -> Path | None:
     """Write the figure of one axis' features over the days as a PNG.
 
     Parameters
@@ -40,11 +40,13 @@ def axis_figure(trend, detector: ChangeDetector, path) -> Path:
 
     Returns
     -------
-    Path
-        ``path``.
+    Path or None
+        ``path``, or None when no feature of the axis is watched yet (fewer than two baseline days).
     """
-    plt = import_pyplot(path)
     features = list(trend.baseline)
+    if not features:
+        return None
+    plt = import_pyplot(path)
     figure, axes = plt.subplots(len(features), 1, figsize=(9, 1.7 * len(features) + 0.6), sharex=True,
                                 squeeze=False)
     dates = np.array(trend.dates, dtype="datetime64[D]")
@@ -75,6 +77,19 @@ def axis_figure(trend, detector: ChangeDetector, path) -> Path:
     return saved
 
 
+def _travel_departure(trend, detector: ChangeDetector) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """Bin centres [mm], the daily map's departure [A] (days x bins) from its mean over the baseline days, and
+    the number of baseline days; None without a map."""
+    centres, daily = trend.travel_map
+    if len(centres) == 0 or not np.any(np.isfinite(daily)):
+        return None
+    n_base = min(detector.baseline_days, len(trend.dates))
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        departure = daily - np.nanmean(daily[:n_base], axis=0)
+    return np.asarray(centres), departure, n_base
+
+
 def travel_map_figure(trend, detector: ChangeDetector, path) -> Path | None:
     """Write the friction-along-travel map of one axis: the departure from the baseline per day and position.
 
@@ -92,13 +107,10 @@ def travel_map_figure(trend, detector: ChangeDetector, path) -> Path | None:
     Path or None
         ``path``, or None when the axis has no map.
     """
-    centres, daily = trend.travel_map
-    if len(centres) == 0 or not np.any(np.isfinite(daily)):
+    found = _travel_departure(trend, detector)
+    if found is None:
         return None
-    n_base = min(detector.baseline_days, len(trend.dates))
-    with np.errstate(invalid="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        departure = daily - np.nanmean(daily[:n_base], axis=0)
+    centres, departure, n_base = found
     plt = import_pyplot(path)
     figure, ax = plt.subplots(figsize=(9, 2.8))
     limit = float(np.nanmax(np.abs(departure))) or 1e-3
@@ -139,13 +151,16 @@ def interactive_axis_html(trend, detector: ChangeDetector, div_id: str) -> str:
 
     Returns
     -------
-    str
-        The ``div`` and its inline call of plotly (plotly.js itself is included once per page).
+    str or None
+        The ``div`` and its inline call of plotly (plotly.js itself is included once per page), or None when
+        no feature of the axis is watched yet (fewer than two baseline days).
     """
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
 
     features = list(trend.baseline)
+    if not features:
+        return None
     dates = [d.isoformat() for d in trend.dates]
     figure = make_subplots(rows=len(features), cols=1, shared_xaxes=True, vertical_spacing=0.012,
                            subplot_titles=[f"{f} [{FEATURE_UNITS[f]}]" for f in features])
@@ -173,6 +188,53 @@ def interactive_axis_html(trend, detector: ChangeDetector, div_id: str) -> str:
                          title={"text": f"{trend.machine} / {trend.axis}: drag to zoom, double-click to reset",
                                 "font": {"size": 13}}, template="simple_white")
     figure.update_annotations(font_size=10)
+    return figure.to_html(full_html=False, include_plotlyjs=False, div_id=div_id)
+
+
+def interactive_travel_html(trend, detector: ChangeDetector, div_id: str) -> str | None:
+    """The friction-along-travel map of one axis as an interactive plotly heat map (an HTML ``div``, no script).
+
+    The same content as :func:`travel_map_figure`: per day and position bin the friction's departure from
+    its mean over the baseline days, a star where an alarm found the largest departure; zoomable, the
+    departure of a cell shown on hover.
+
+    Parameters
+    ----------
+    trend : AxisTrend
+        The axis (:attr:`ChangeDetector.trends_`), with its daily map.
+    detector : ChangeDetector
+        The fitted detector (its baseline length).
+    div_id : str
+        HTML id of the chart's ``div``.
+
+    Returns
+    -------
+    str or None
+        The ``div`` and its inline call of plotly (plotly.js itself is included once per page), or None when
+        the axis has no map.
+    """
+    import plotly.graph_objects as go
+
+    found = _travel_departure(trend, detector)
+    if found is None:
+        return None
+    centres, departure, n_base = found
+    limit = float(np.nanmax(np.abs(departure))) or 1e-3
+    dates = [d.isoformat() for d in trend.dates]
+    cells = np.where(np.isfinite(departure.T), departure.T, None).tolist()  # JSON null: an empty cell
+    figure = go.Figure(go.Heatmap(x=dates, y=centres.tolist(), z=cells, colorscale="RdBu", reversescale=True,
+                                  zmin=-limit, zmax=limit, colorbar={"title": {"text": "vs baseline [A]"}},
+                                  hovertemplate="%{x}<br>%{y:.1f} mm<br>%{z:+.4f} A<extra></extra>"))
+    stars = [alarm for alarm in trend.alarms if np.isfinite(alarm.position_mm)]
+    if stars:
+        figure.add_trace(go.Scatter(x=[a.detected.isoformat() for a in stars], y=[a.position_mm for a in stars],
+                                    mode="markers", marker={"symbol": "star", "size": 12, "color": "black"},
+                                    text=[a.feature for a in stars], name="alarm", showlegend=False,
+                                    hovertemplate="alarm: %{text}<br>%{x}<br>%{y:.1f} mm<extra></extra>"))
+    figure.update_layout(height=360, margin={"l": 60, "r": 20, "t": 40, "b": 40}, template="simple_white",
+                         yaxis_title="position [mm]",
+                         title={"text": f"{trend.machine} / {trend.axis}: friction along the travel, departure from "
+                                        f"the first {n_base} days (drag to zoom)", "font": {"size": 13}})
     return figure.to_html(full_html=False, include_plotlyjs=False, div_id=div_id)
 
 
@@ -216,7 +278,8 @@ def write_report(detector: ChangeDetector, out_dir) -> Path:
         figures = []
         for i, trend in enumerate(detector.trends_):
             png = axis_figure(trend, detector, Path(scratch) / f"axis_{i}.png")
-            figures.append((f"{trend.machine} / {trend.axis} (severity {trend.severity:.2f})", png))
+            if png is not None:
+                figures.append((f"{trend.machine} / {trend.axis} (severity {trend.severity:.2f})", png))
             travel = travel_map_figure(trend, detector, Path(scratch) / f"travel_{i}.png")
             if travel is not None:
                 figures.append((f"{trend.machine} / {trend.axis}: friction along the travel", travel))
@@ -229,7 +292,14 @@ def write_report(detector: ChangeDetector, out_dir) -> Path:
                                 "friction along the travel against its baseline.")
     from plotly.offline import get_plotlyjs
 
-    charts = [interactive_axis_html(trend, detector, f"axis-{i}") for i, trend in enumerate(detector.trends_)]
+    charts = []
+    for i, trend in enumerate(detector.trends_):
+        chart = interactive_axis_html(trend, detector, f"axis-{i}")
+        if chart is not None:
+            charts.append(chart)
+        travel = interactive_travel_html(trend, detector, f"travel-{i}")
+        if travel is not None:
+            charts.append(travel)
     interactive = ('<h2 id="interactive">Interactive charts</h2>\n<script type="text/javascript">'
                    + get_plotlyjs() + "</script>\n" + "\n".join(charts) + "\n")
     page = page.replace("</body></html>", interactive + "</body></html>")

@@ -15,7 +15,7 @@ from ..data.prepare import prepare
 from ..errors import GreyboxError, LogError
 from .detect import ChangeDetector
 from .fingerprint import FrictionFingerprint, spindle_idle_samples, unloaded_samples
-from .history import append_fingerprint, file_sha256, find_log, read_history, row_path
+from .history import append_fingerprint, compact_history, file_sha256, find_log, read_history, row_path
 from .report import write_report
 
 __all__ = ["FingerprintJob", "MonitorResult", "fingerprint_file", "fingerprint_job", "log_date", "run_monitor"]
@@ -232,7 +232,11 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
                 model_path=None, spindle_column: str | None = None, baseline_days: int = 28,
                 scheduler: str | None = None, workers: int | None = None,
                 progress: Callable[[str], None] | None = None) -> MonitorResult:
-    """Fingerprint ``logs`` into ``history``, detect changes over the whole history, write the dashboard.
+    """Fingerprint ``logs`` into ``history``, compact it, detect changes over the whole history, write the dashboard.
+
+    The history is compacted (:func:`~greybox.monitor.history.compact_history`) after the logs are filed:
+    every machine and axis keeps one file, which its query (:func:`~greybox.monitor.query.changed_most`)
+    reads quickly. Compacting is atomic per axis and idempotent.
 
     Parameters
     ----------
@@ -288,6 +292,8 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         fitted, known = fitted + new, known + (not new)
         if progress is not None:
             progress(f"{path}: {'fingerprinted' if new else 'already in the history'} -> {row}")
+    if Path(history).is_dir():
+        compact_history(history)  # one file per machine and axis: the history stays quick to query
     table = read_history(history)
     if table.num_rows == 0:
         raise GreyboxError(f"{history}: the history holds no fingerprints; give logs to fingerprint")

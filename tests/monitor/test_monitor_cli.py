@@ -44,12 +44,13 @@ def test_monitor_fingerprints_once_and_writes_the_page(twin_days, tmp_path, caps
     assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
     out = capsys.readouterr().out
     assert "4 logs fingerprinted, 0 already in the history; 1 axes" in out
-    files = sorted(history.rglob("*.parquet"))
-    assert [f.parent.name for f in files] == [f"date=2026-05-0{d}" for d in range(1, 5)]
-    assert all(f.parts[-4] == "machine=mill7" and f.parts[-3] == "axis=X" for f in files)
+    files = sorted(history.rglob("*.parquet"))  # compacted after filing: one file of the axis
+    assert [f.relative_to(history).as_posix() for f in files] == ["machine=mill7/axis=X/compacted.parquet"]
+    assert [d.isoformat() for d in pq.read_table(files[0]).column("date").to_pylist()] == [
+        f"2026-05-0{d}" for d in range(1, 5)]
     page = (report / "index.html").read_text()
     assert "Axes, most severe first" in page and "mill7" in page and "data:image/png;base64," in page
-    row = pq.read_table(files[0])
+    row = pq.read_table(files[0]).slice(0, 1)
     assert row.num_rows == 1 and all(np.isfinite(row.column(name)[0].as_py()) for name in FEATURES)
     assert all(row.column(name)[0].as_py() > 0 for name in FEATURES if name != "local_excess")  # may be < 0
     assert len(row.column("map_position_mm")[0]) == len(row.column("map_excess_A")[0]) > 3
@@ -224,3 +225,25 @@ def test_fleet_run_matches_the_sequential_one(twin_days, tmp_path, capsys):
     err = capsys.readouterr().err  # (Dask may note a busy dashboard port before it on a shared machine)
     assert "Traceback" not in err and "1 of 1 logs failed" in err.strip().splitlines()[-1]
     assert "at least 2 are needed" in err.strip().splitlines()[-1]
+
+
+def test_monitor_compacts_the_history_it_appends_to(twin_days, tmp_path, capsys):
+    history, report = tmp_path / "history", tmp_path / "report"
+    logs = sorted(str(p) for p in twin_days.iterdir())
+    assert main(["monitor", *logs[:3], "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
+    assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
+    assert "1 logs fingerprinted, 3 already in the history" in capsys.readouterr().out
+    compacted = history / "machine=mill7" / "axis=X" / "compacted.parquet"
+    assert sorted(history.rglob("*.parquet")) == [compacted]  # the new row files merged, none left
+    before = compacted.read_bytes()
+    assert pq.read_table(compacted).num_rows == 4 and read_history(history).num_rows == 4
+    assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
+    assert "0 logs fingerprinted, 4 already in the history" in capsys.readouterr().out
+    assert compacted.read_bytes() == before  # compacting again changes nothing
+
+
+def test_monitor_of_a_first_day_writes_the_page(twin_days, tmp_path, capsys):
+    first = sorted(str(p) for p in twin_days.iterdir())[0]  # one day: no feature has a baseline yet
+    assert main(["monitor", first, "--history", str(tmp_path / "h"), "--out", str(tmp_path / "r")]) == 0
+    assert "1 logs fingerprinted, 0 already in the history; 1 axes, 0 alarms" in capsys.readouterr().out
+    assert "Axes, most severe first" in (tmp_path / "r" / "index.html").read_text()

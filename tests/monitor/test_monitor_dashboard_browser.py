@@ -36,6 +36,9 @@ def test_dashboard_renders_in_chromium(tmp_path):
         assert text in dom.stdout
     # plotly drew the interactive chart offline (its script is inline): the div holds its SVG, titled per feature
     assert 'id="axis-0"' in dom.stdout and 'class="main-svg"' in dom.stdout and "local_excess [A]" in dom.stdout
+    # and the friction-along-travel map as a heat map: plotly drew its cells (an image layer) and its colour bar
+    travel = dom.stdout[dom.stdout.index('id="travel-0"'):]
+    assert "friction along the travel" in travel and 'class="hm"' in travel and "colorbar" in travel
     shot = tmp_path / "shot.png"
     run = _chromium(tmp_path, "--window-size=1200,2400", f"--screenshot={shot}", page)
     assert run.returncode == 0 and shot.is_file()

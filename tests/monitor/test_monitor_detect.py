@@ -57,7 +57,8 @@ def _alternating(n):
 def test_step_rise_named_with_its_start_and_day_of_detection():
     x = _alternating(40)
     x[26:] += 0.03  # +2.9 sd from day 26 (day 25 is a low day: the upper sum is 0 there)
-    detector = ChangeDetector(baseline_days=14, h=5.0).fit(_table({"sliding_neg": x}, default=_alternating(40)))
+    detector = ChangeDetector(baseline_days=14, k=0.5, h=5.0).fit(_table({"sliding_neg": x},
+                                                                          default=_alternating(40)))
     (alarm,) = detector.alarms_
     assert (alarm.feature, alarm.direction, alarm.axis) == ("sliding_neg", "rises", "X")
     assert alarm.start == DAY0 + dt.timedelta(days=26)
@@ -93,15 +94,16 @@ def test_calibrated_threshold_holds_its_false_alarm_rate():
         calibrated_threshold(baseline_days=28, n_features=len(FEATURES)))
     per_axis_year = len(detector.alarms_) / 60
     assert 0.4 < per_axis_year < 1.8  # 1 asked; 60 axis-years leave a Monte-Carlo spread of about +-0.3
-    textbook = ChangeDetector(baseline_days=28, h=5.0).fit(pa.concat_tables(axes))
+    textbook = ChangeDetector(baseline_days=28, k=0.5, h=5.0).fit(pa.concat_tables(axes))
     assert len(textbook.alarms_) / 60 > 2.0 * per_axis_year  # why h is calibrated
 
 
 def test_threshold_rises_with_a_shorter_baseline_and_fewer_alarms():
-    short = calibrated_threshold(baseline_days=14, n_features=7)
-    long = calibrated_threshold(baseline_days=56, n_features=7)
-    rare = calibrated_threshold(baseline_days=56, n_features=7, false_alarms_per_year=0.1)
-    assert short > long and rare > long > 5.0
+    short = calibrated_threshold(baseline_days=14, n_features=7, k=0.5)
+    long = calibrated_threshold(baseline_days=56, n_features=7, k=0.5)
+    rare = calibrated_threshold(baseline_days=56, n_features=7, false_alarms_per_year=0.1, k=0.5)
+    assert short > long and rare > long > 5.0  # above the textbook h = 5 of k = 0.5
+    assert calibrated_threshold(baseline_days=56, n_features=7) < long  # the default k = 1: a lower h
 
 
 def test_too_few_days_no_alarm_and_bad_settings():

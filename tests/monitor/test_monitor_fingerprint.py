@@ -204,3 +204,71 @@ def test_production_day_fingerprint_by_its_spindle_load():
     assert abs(by_spindle.values_["sliding_neg"] - air.values_["sliding_neg"]) < abs(
         whole.values_["sliding_neg"] - air.values_["sliding_neg"])
     assert by_spindle.values_["sliding_pos"] == pytest.approx(air.values_["sliding_pos"], abs=0.01)
+
+
+def _reference_travel(x, excess, period_mm, bin_mm, min_count):
+    """Plain reference of the travel features: every leave-three-bins-out trend refitted on the samples."""
+    u = (2.0 * x - x.min() - x.max()) / (x.max() - x.min())
+    design = np.column_stack([np.ones_like(x), u, np.sin(2 * np.pi * x / period_mm), np.cos(2 * np.pi * x / period_mm)])
+    index = np.floor(x / bin_mm).astype(int)
+    first = index.min()
+    index -= first
+    counts = np.bincount(index)
+    full = np.flatnonzero(counts >= min_count)
+    interior = full[(full - 2 >= full.min()) & (full + 2 <= full.max())]
+    level = np.array([excess[index == j].mean() for j in full])
+    coef = np.linalg.lstsq(design, excess, rcond=None)[0]
+    trend = excess - design[:, 2:] @ coef[2:]
+    local = {}
+    for j in interior:
+        out = np.abs(index - j) <= 1
+        line = np.linalg.lstsq(design[~out, :2], trend[~out], rcond=None)[0]
+        local[j] = np.mean(trend[index == j] - design[index == j, :2] @ line)
+    worst = max(local, key=local.get)
+    kept = np.abs(index - worst) > 1
+    refit = np.linalg.lstsq(design[kept], excess[kept], rcond=None)[0]
+    return np.hypot(refit[2], refit[3]), local[worst], (full + first + 0.5) * bin_mm, level
+
+
+def _reference_features(x, v, a, y, fingerprint):
+    """Plain reference of the features but the backlash: the sliding fit and the means on the samples."""
+    from greybox.identify.static import fit_coulomb
+
+    fast = np.abs(v) >= fingerprint.sliding_speed
+    p = fit_coulomb(v[fast], a[fast], y[fast], asymmetric=True)
+    viscous = np.where(v > 0.0, p["viscous_pos"], p["viscous_neg"])
+    friction = y - p["J"] * a - viscous * v
+    level = np.where(v > 0.0, p["coulomb_pos"], -p["coulomb_neg"])
+    noise = np.sqrt(np.mean((friction - level)[fast] ** 2))
+    slow = np.abs(v) < fingerprint.breakaway_speed
+    sign = np.sign(v[fast])
+    excess = sign * friction[fast] - np.where(sign > 0.0, p["coulomb_pos"], p["coulomb_neg"])
+    periodic, local, centres, level_map = _reference_travel(x[fast], excess, fingerprint.period_mm,
+                                                            fingerprint.map_bin_mm, fingerprint.map_min_samples)
+    values = [p["coulomb_pos"], p["coulomb_neg"], friction[slow & (v > 0)].mean(), -friction[slow & (v < 0)].mean(),
+              p["viscous_pos"], p["viscous_neg"], noise, np.nan, periodic, local]
+    return np.array(values), centres, level_map
+
+
+def test_block_sums_give_the_features_of_the_drawn_samples():
+    """A bootstrap replicate from the blocks' sums equals the features refitted on the replicate's samples."""
+    from greybox.monitor.fingerprint import _block_counts, _Statistics
+
+    run = prepare(aged_log("X", 2, 9, [Drift("defect", 0, 0.05)]))[0]
+    keep = run.velocity != 0.0
+    x, v, a, y = run.position[keep], run.velocity[keep], run.acceleration[keep], run.effort[keep]
+    fingerprint = FrictionFingerprint()
+    settings = (fingerprint.sliding_speed, fingerprint.breakaway_speed, fingerprint.period_mm,
+                fingerprint.map_bin_mm, fingerprint.map_min_samples)
+    block = 100
+    stats = _Statistics(x, v, a, y, block, *settings[:4])
+    weights = np.vstack([np.ones(stats.n_blocks), _block_counts(stats.n_blocks, 2, np.random.default_rng(3))])
+    for w in weights:
+        rows = np.concatenate([np.arange(b * block, min((b + 1) * block, len(y)))
+                               for b in range(stats.n_blocks) for _ in range(int(w[b]))])
+        expected, centres, level = _reference_features(x[rows], v[rows], a[rows], y[rows], fingerprint)
+        values, _, (got_centres, got_level) = stats.features(w, settings)
+        np.testing.assert_allclose(values, expected, rtol=1e-7, atol=1e-9)
+        np.testing.assert_allclose(got_centres, centres)
+        np.testing.assert_allclose(got_level, level, rtol=1e-7, atol=1e-9)
+    assert not np.allclose(stats.features(weights[1], settings)[0][:7], stats.features(weights[0], settings)[0][:7])

@@ -63,6 +63,25 @@ def test_bad_options_and_histories(tmp_path):
     pq.write_table(table.replace_schema_metadata({}).set_column(0, "schema_version", [[np.int32(1)]]), path)
     with pytest.raises(HistoryError, match="schema version"):
         changed_most(history)
+    pq.write_table(table.drop_columns(["backlash"]), path)  # a file of another layout among the others
+    with pytest.raises(HistoryError, match="not a readable"):
+        changed_most(history)
     path.write_bytes(b"not parquet")
     with pytest.raises(HistoryError, match="not a readable"):
         changed_most(history)
+
+
+def test_a_row_file_wins_over_its_compacted_row(tmp_path):
+    history = _history(tmp_path, {})
+    compact_history(history)
+    first = changed_most(history, days=20).to_pylist()
+    # every day of the last 20 of m1/X filed again with its backlash raised: the row files win, no row twice
+    for day in range(40, 60):
+        sha = f"{hash(('m1', 'X', day)) & (2**64 - 1):064x}"
+        values = {f: 1.0 for f in FEATURES} | {"backlash": 1.5}
+        append_fingerprint(history, machine="m1", axis="X", date=DAY0 + dt.timedelta(days=day), sha256=sha,
+                           source="log", n_samples=1, values=values, lower=values, upper=values)
+    rows = changed_most(history, days=20).to_pylist()
+    assert (rows[0]["machine"], rows[0]["axis"], rows[0]["feature"]) == ("m1", "X", "backlash")
+    assert rows[0]["recent"] == pytest.approx(1.5) and rows[0]["recent_days"] == 20
+    assert first[0]["feature"] != "backlash" or abs(first[0]["change_sd"]) < 5
