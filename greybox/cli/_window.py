@@ -6,7 +6,7 @@ import argparse
 
 from ._types import FINITE
 
-__all__ = ["add_window_argument", "check_window"]
+__all__ = ["add_window_argument"]
 
 
 def add_window_argument(parser: argparse.ArgumentParser, flag: str = "--window") -> None:
@@ -28,21 +28,3 @@ def add_window_argument(parser: argparse.ArgumentParser, flag: str = "--window")
         "is drawn as its envelope, the minimum and maximum of each pixel column)",
     )
 
-
-def check_window(window, time, flag: str = "--window", name: str = "the log") -> tuple[float, float] | None:
-    """Return the window ``(start, end)`` [s], or None (:func:`greybox.evaluate.plots.check_window`).
-
-    Parameters
-    ----------
-    window : sequence of two floats or None
-        The option's value.
-    time : ndarray
-        The log's time [s].
-    flag : str, default "--window"
-        Option name, for the message.
-    name : str
-        The log, for the message.
-    """
-    from ..evaluate.plots import check_window as checked
-
-    return checked(window, time, flag, name)

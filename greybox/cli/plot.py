@@ -7,9 +7,9 @@ from pathlib import Path
 
 from ..atomic import check_output_path
 from ..errors import GreyboxError
-from ..evaluate.plots import plot_log
+from ..evaluate.plots import check_window, plot_log
 from ._options import add_log_arguments, read_logs
-from ._window import add_window_argument, check_window
+from ._window import add_window_argument
 
 
 def add_parser(subparsers) -> None:

@@ -13,8 +13,6 @@ from greybox.monitor.fingerprint import FEATURES
 from greybox.monitor.history import HistoryError, append_fingerprint, compact_history
 from greybox.monitor.query import changed_most
 
-pytest.importorskip("duckdb")
-
 DAY0 = dt.date(2026, 1, 1)
 
 
