@@ -36,7 +36,7 @@ from greybox.fleet import expand_logs
 from greybox.fleet_train import run_training, train_jobs
 from greybox.persistence import save_model
 from greybox.predict.fleet import fleet_jobs, run_fleet
-from greybox.registry import model_class
+from greybox.models.registry import model_class
 from greybox.twin import make_dataset
 
 

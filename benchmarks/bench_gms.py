@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_gms.py [--json] [--steps 2000000] [--repeats 5] [--elements 4]
 
-- ``ns_per_step``: numba kernel :func:`greybox.friction.kernels.gms_friction_kernel`,
+- ``ns_per_step``: numba kernel :func:`greybox.models.friction.kernels.gms_friction_kernel`,
   best of ``--repeats`` runs over ``--steps`` steps (compilation excluded),
   interleaved with the C runs;
 - ``python_ns_per_step``: the plain-Python reference of the tests
@@ -13,7 +13,7 @@ Usage::
   with ``cc -O2`` at run time, best of ``--repeats`` (timed inside the C program,
   file input and output excluded); ``null`` without a compiler.
   ``c_max_abs_diff`` is its largest difference to the numba friction [A];
-- ``fit_seconds``: :class:`greybox.friction.GMSModel` with default settings on a
+- ``fit_seconds``: :class:`greybox.models.friction.GMSModel` with default settings on a
   synthetic 500 Hz log of ``--fit-seconds-of-data`` seconds simulated by a GMS
   truth plus noise.
 """
@@ -36,9 +36,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the pl
 from friction_reference import gms_reference
 from friction_signals import STEP, motion_log, velocity_profile
 
-from greybox.friction import GMSModel
-from greybox.friction.gms import GMSState, simulate_gms
-from greybox.friction.kernels import direction_curves, gms_friction_kernel
+from greybox.models.friction import GMSModel
+from greybox.models.friction.gms import GMSState, simulate_gms
+from greybox.models.friction.kernels import direction_curves, gms_friction_kernel
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from greybox.data.io import read_log
 from greybox.data.prepare import prepare
-from greybox.friction.gms import GMSModel
+from greybox.models.friction.gms import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.twin import make_dataset
 

@@ -29,10 +29,10 @@ from greybox.cli._model_text import model_lines
 from greybox.data.io import read_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
-from greybox.friction import GMSModel
-from greybox.friction.gms import simulate_gms
 from greybox.identify.intervals import attach_intervals
-from greybox.registry import model_class
+from greybox.models.friction import GMSModel
+from greybox.models.friction.gms import simulate_gms
+from greybox.models.registry import model_class
 
 STEP = 0.002
 #: Truth of the coverage study: alpha, k [A/mm], C [mm/s], sigma, mu [A s/mm], s_0, s_inf [mm], v_s [mm/s],

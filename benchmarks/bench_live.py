@@ -62,7 +62,7 @@ def _model(path: str | None, folder: Path) -> Path:
         return Path(path)
     from greybox.data.io import read_log
     from greybox.data.prepare import prepare
-    from greybox.friction.gms import GMSModel
+    from greybox.models.friction.gms import GMSModel
     from greybox.models.gmssvr import GMSSVRModel
     from greybox.persistence import save_model
 

@@ -40,7 +40,7 @@ from greybox.fleet import expand_logs
 from greybox.monitor.workflow import run_monitor
 from greybox.persistence import save_model
 from greybox.predict.fleet import fleet_jobs, run_fleet
-from greybox.registry import model_class
+from greybox.models.registry import model_class
 from greybox.twin.ageing import SPINDLE_COLUMN, aged_log
 from greybox.twin.cutting import CuttingSpec
 

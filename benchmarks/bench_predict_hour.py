@@ -18,7 +18,7 @@ Steps, all on this machine in one run (its cores stated; ratios carry over, abso
    (both read, predicted and written block by block): wall time and peak resident memory (``VmHWM`` of
    that process), and the ratio GMS+SVR / GMS;
 4. the same GMS+SVR prediction on a Parquet log ``--long`` times as long: its peak memory against the hour's;
-5. the kernel sums of the hour's SVR inputs by :func:`greybox.models.rbf.rbf_expansion` (1 and all
+5. the kernel sums of the hour's SVR inputs by :func:`greybox.models.kernel.rbf.rbf_expansion` (1 and all
    threads) and by :func:`dense_expansion`, with the largest difference.
 """
 
@@ -40,11 +40,11 @@ import numpy as np
 from greybox.data import mcap_io
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
-from greybox.friction.gms import GMSModel
 from greybox.metrics import relative_error
 from greybox.models import svr as svr_module
+from greybox.models.friction.gms import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
-from greybox.models.rbf import rbf_expansion
+from greybox.models.kernel.rbf import rbf_expansion
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 

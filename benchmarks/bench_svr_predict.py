@@ -1,7 +1,7 @@
 """Time the compiled RBF expansion against scikit-learn's SVR.predict.
 
 The samples are drawn at random, not in time order as in a log, so that few terms are left out
-(:mod:`greybox.models.rbf`): the kernel's worst case. Prints one JSON line: n_samples, n_support,
+(:mod:`greybox.models.kernel.rbf`): the kernel's worst case. Prints one JSON line: n_samples, n_support,
 sklearn_s, compiled_s, speedup, max_abs_diff (largest |difference| of the two predictions) and
 max_abs_pred, plus threads (of the compiled expansion; libsvm uses one).
 
@@ -17,7 +17,7 @@ import time
 import numpy as np
 from sklearn.svm import SVR
 
-from greybox.models.rbf import rbf_expansion
+from greybox.models.kernel.rbf import rbf_expansion
 
 
 def main() -> None:

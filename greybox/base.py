@@ -6,11 +6,11 @@ Callers (chunked prediction, the discovery workflow, the position loop, the
 command line, reports, model files) never ask a model what kind it is: the
 model class answers through the methods documented here, and a new kind of
 model is one new module that implements them plus one line in
-:mod:`greybox.registry`.
+:mod:`greybox.models.registry`.
 
 :class:`ModelProtocol` lists the methods with their contracts and the default
 answers of a model that has no state, no linear parameters and no plant law;
-:class:`greybox.estimator.CurrentModel` implements the shared parts (fitting
+:class:`greybox.models.estimator.CurrentModel` implements the shared parts (fitting
 template, validation of runs, prediction of one run or chunk) on top of it.
 This module imports nothing else of greybox, so that every part of the
 package may depend on it.

@@ -91,7 +91,7 @@ def train_jobs(logs: Sequence[Path], model, out_dir: str, *, axes: Sequence[str]
 
 def _hyperparameters(model) -> dict:
     """Kind and hyperparameters of a model as JSON values: a nested model likewise, other values as text."""
-    from .registry import model_kind
+    from .models.registry import model_kind
 
     def value(item):
         if hasattr(item, "get_params"):

@@ -1,7 +1,7 @@
 """``greybox train --model auto``: the candidate models, and the one that predicts unseen runs best.
 
 A candidate is written ``KIND[:OPTION,...]``: a registered model kind
-(:data:`greybox.registry.MODEL_CLASSES`) and options of the model or of its
+(:data:`greybox.models.registry.MODEL_CLASSES`) and options of the model or of its
 first stage (``gms:asymmetric``, ``gmssvr:asymmetric``), among them
 
 - ``asymmetric``: friction of its own per direction of motion;
@@ -29,10 +29,10 @@ from __future__ import annotations
 from typing import Callable, Sequence
 
 from .errors import GreyboxError
-from .friction.backlash import BacklashModel
 from .identify.inertia import SPRING_SHARE_LIMIT, spring_share
 from .identify.selection import choose, held_out_folds, score_candidates, selection_record
-from .registry import MODEL_CLASSES
+from .models.friction.backlash import BacklashModel
+from .models.registry import MODEL_CLASSES
 
 __all__ = ["DEFAULT_CANDIDATES", "GAP_CANDIDATES", "GAP_EVIDENCE", "build_candidate", "choose_model"]
 

@@ -35,7 +35,7 @@ stage, say). Floats are written with Python's shortest round-trip repr, and
 arrays byte for byte, so a loaded model predicts bit-identically.
 
 The class of a model is looked up by its ``kind`` in the explicit registry
-:data:`greybox.registry.MODEL_CLASSES`; nothing named in the file is ever
+:data:`greybox.models.registry.MODEL_CLASSES`; nothing named in the file is ever
 imported. A file of a newer format version, of an unknown kind, or with
 parameters the class does not take is refused with a
 :class:`~greybox.errors.ModelFileError` naming the file. Files are written
@@ -57,14 +57,14 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from . import registry
+from .models import registry
 from .atomic import atomic_output
 from .data.log import AxisLog
 from .data.quantities import MOTIONS
 from .errors import GreyboxError, ModelFileError, ParameterError
-from .estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
 from .identify.intervals import check_intervals
 from .identify.selection import check_selection_record
+from .models.estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
 from .provenance import TRAINING_RECORD, check_training_record
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RECORD_CHECKS", "RENAMED_ATTRIBUTES", "save_model", "save_verified",
@@ -197,7 +197,7 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
     Parameters
     ----------
     model : estimator
-        An instance of a class in :data:`greybox.registry.MODEL_CLASSES`.
+        An instance of a class in :data:`greybox.models.registry.MODEL_CLASSES`.
         Its ``get_params(deep=False)`` and every attribute whose name ends in
         ``_`` (the learned attributes) are saved; they may be numbers, strings,
         booleans, None, lists, tuples, dicts with string keys, NumPy arrays
@@ -257,7 +257,7 @@ def save_verified(model, path: str | PathLike, runs, *, predictions=None, overwr
     Parameters
     ----------
     model : estimator
-        A fitted instance of a class in :data:`greybox.registry.MODEL_CLASSES`.
+        A fitted instance of a class in :data:`greybox.models.registry.MODEL_CLASSES`.
     path : str or path-like
         File to write (``.gbm`` by convention).
     runs : sequence of AxisLog
@@ -526,13 +526,13 @@ def check_fitted(model) -> None:
     Parameters
     ----------
     model : CurrentModel
-        A fitted model (:class:`greybox.estimator.CurrentModel`).
+        A fitted model (:class:`greybox.models.estimator.CurrentModel`).
 
     Raises
     ------
     ParameterError
         Naming the missing or malformed learned attribute, a parameter that is not finite or
-        beyond :data:`~greybox.estimator.MAX_PARAMETER_MAGNITUDE`, the invalid hyperparameter, or the
+        beyond :data:`~greybox.models.estimator.MAX_PARAMETER_MAGNITUDE`, the invalid hyperparameter, or the
         error the probe prediction gave.
     """
     model._check_params()  # the model's own hyperparameter check, as fit runs it first

@@ -49,9 +49,9 @@ from greybox.atomic import check_output_path, write_text_atomic
 from greybox.data.log import AxisLog
 from greybox.errors import GreyboxError
 from greybox.evaluate.plots import import_pyplot, save_figure
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from greybox.friction.backlash import BacklashModel
 from greybox.metrics import metrics_table
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction.backlash import BacklashModel
 from greybox.provenance import provenance, provenance_line
 from studies.arts_data import read_arts
 from studies.auto import HeldOutChoice
@@ -154,7 +154,7 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None, *
     seed : int, default 0
         Seed of the multi-start identifications.
     progress : None, bool or callable, optional
-        Progress of every fit (see :meth:`greybox.estimator.CurrentModel.fit`).
+        Progress of every fit (see :meth:`greybox.models.estimator.CurrentModel.fit`).
     train, test : sequence of str, default :data:`TRAIN_FILES`, :data:`TEST_FILES`
         File names of the split (disjoint); smaller subsets give a quick run.
 
@@ -308,7 +308,7 @@ def arts_benchmark(data: str | os.PathLike, json_path: str | os.PathLike, *, mar
     seed : int, default 0
         Seed of the multi-start identifications.
     progress : None, bool or callable, optional
-        Progress of every fit (see :meth:`greybox.estimator.CurrentModel.fit`).
+        Progress of every fit (see :meth:`greybox.models.estimator.CurrentModel.fit`).
     force : bool, default False
         Overwrite existing output files (never the data files).
     train, test : sequence of str, default :data:`TRAIN_FILES`, :data:`TEST_FILES`

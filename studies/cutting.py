@@ -61,7 +61,7 @@ from greybox.metrics import rmse
 from greybox.models.chunked import predict_chunked
 from greybox.predict.process import predict_process
 from greybox.provenance import provenance, provenance_line
-from greybox.registry import MODEL_CLASSES
+from greybox.models.registry import MODEL_CLASSES
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
 from studies.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
@@ -126,7 +126,7 @@ def evaluate_model(kind: str, model, case: CuttingCase, config, detail_strength:
     Parameters
     ----------
     kind : str
-        Model kind (a key of :data:`greybox.registry.MODEL_CLASSES`), reported in the row.
+        Model kind (a key of :data:`greybox.models.registry.MODEL_CLASSES`), reported in the row.
     model : CurrentModel
         The model fitted on the air cuts.
     case : CuttingCase
@@ -327,7 +327,7 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
     seed : int, default 7
         Seed of the cutting logs (the shipped data use 2024).
     kinds : sequence of str, default :data:`KINDS`
-        Model kinds of :data:`greybox.registry.MODEL_CLASSES`, fitted with their defaults.
+        Model kinds of :data:`greybox.models.registry.MODEL_CLASSES`, fitted with their defaults.
     strengths : sequence of float, default :data:`DEFAULT_STRENGTHS`
         Cut strengths swept [A at 1000 mm/min, full engagement].
     strength : float

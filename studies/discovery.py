@@ -52,10 +52,10 @@ from greybox.data.prepare import prepare
 from greybox.discover.noise import ResidualNoise
 from greybox.discover.report import write_json
 from greybox.discover.workflow import discover
-from greybox.friction import CoulombModel, GMSModel
 from greybox.metrics import relerr, rmse
 from greybox.models.augmented import AugmentedModel
 from greybox.models.effects import EFFECT_NAMES, VELOCITY_ONLY, EffectContext, effect
+from greybox.models.friction import CoulombModel, GMSModel
 from greybox.twin import EFFECTS as TWIN_EFFECTS
 from greybox.twin import CurrentNoise, EffectInputs, axis_geometry, default_plant_parameters, make_dataset
 from greybox.twin import effect_current as twin_effect_current

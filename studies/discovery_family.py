@@ -39,10 +39,10 @@ from greybox.atomic import write_text_atomic
 from greybox.data.prepare import prepare
 from greybox.discover.report import write_json
 from greybox.discover.workflow import discover
-from greybox.friction import GMSModel
 from greybox.metrics import rmse
 from greybox.models.augmented import AugmentedModel
 from greybox.models.effects import REFINEMENTS
+from greybox.models.friction import GMSModel
 from studies.discovery import wilson_interval
 from studies.hysteresis_axis import HIDDEN_EFFECTS, FamilyCase, family_logs
 

@@ -55,9 +55,9 @@ from greybox.data.log import AxisLog
 from greybox.data.prepare import derive, trim
 from greybox.errors import GreyboxError
 from greybox.evaluate.plots import import_pyplot, save_figure
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from greybox.friction.backlash import BacklashModel
 from greybox.metrics import relerr
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction.backlash import BacklashModel
 from greybox.provenance import provenance, provenance_line
 from studies.auto import HeldOutChoice
 
@@ -256,7 +256,7 @@ def run_benchmark(data: Path, names=MODEL_NAMES, seed: int = 0, progress=None) -
     seed : int, default 0
         Seed of the multi-start identifications.
     progress : None, bool or callable, optional
-        Progress of every greybox fit (see :meth:`greybox.estimator.CurrentModel.fit`).
+        Progress of every greybox fit (see :meth:`greybox.models.estimator.CurrentModel.fit`).
 
     Returns
     -------
@@ -440,7 +440,7 @@ def emps_benchmark(data: str | os.PathLike, json_path: str | os.PathLike, *, mar
     seed : int, default 0
         Seed of the multi-start identifications.
     progress : None, bool or callable, optional
-        Progress of every greybox fit (see :meth:`greybox.estimator.CurrentModel.fit`).
+        Progress of every greybox fit (see :meth:`greybox.models.estimator.CurrentModel.fit`).
     force : bool, default False
         Overwrite existing output files (never the data files).
 

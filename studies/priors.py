@@ -33,8 +33,8 @@ import numpy as np
 from greybox.atomic import write_text_atomic
 from greybox.data.prepare import prepare, trim
 from greybox.evaluate.records import TRUTH_CHANNEL
-from greybox.friction.gms import GMSModel
 from greybox.metrics import relative_error
+from greybox.models.friction.gms import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.models.svr import SVRCurrentModel
 from greybox.reproduce.experiments import MODEL_SETTINGS
@@ -54,7 +54,7 @@ CANDIDATES = {
 
 
 #: The candidate of the default of :class:`~greybox.models.gmssvr.GMSSVRModel` (the residual, searched over
-#: :func:`~greybox.models.kernel.default_bounds`, gamma in [0.01, 1000]). Until this study first ran (seed 1,
+#: :func:`~greybox.models.kernel.expansion.default_bounds`, gamma in [0.01, 1000]). Until this study first ran (seed 1,
 #: members 0-11) the default was "residual, gamma >= 1"; the study chose this one (docs/svr.md).
 DEFAULT = "residual, gamma >= 0.01"
 

@@ -7,7 +7,7 @@ import numpy as np
 from multisine import multisine_motion
 
 from greybox.data.log import AxisLog
-from greybox.friction.gms import GMSModel, simulate_gms
+from greybox.models.friction.gms import GMSModel, simulate_gms
 
 J_TRUE = 2e-4  # A s^2/mm
 OFFSET_TRUE = 0.1  # A

@@ -16,8 +16,8 @@ from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.fleet import MANIFEST, expand_logs
 from greybox.fleet_train import train_jobs, train_model
-from greybox.friction import CoulombModel
 from greybox.metrics import metrics_table
+from greybox.models.friction import CoulombModel
 from greybox.persistence import load_model
 from greybox.twin import make_dataset
 

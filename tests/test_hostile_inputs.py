@@ -28,7 +28,7 @@ from greybox.data.io import read_log, write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError, ModelFileError
-from greybox.friction import GMSModel
+from greybox.models.friction import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import MAX_MEMBER_BYTES, check_fitted, load_model, save_model
 from greybox.twin import make_dataset

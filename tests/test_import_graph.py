@@ -13,9 +13,9 @@ rules (DESIGN.md, "Layout"):
   imports nothing of greybox;
 - ``greybox.base`` (the model protocol) and ``greybox.twin.laws.base`` (the
   truth laws' base class) import nothing of greybox, and the twin imports no
-  model (``greybox.friction``, ``greybox.models``): a truth plant built from
-  the models it tests would flatter them;
-- the physical and current models (``greybox.friction``, ``greybox.models``)
+  model (``greybox.models``): a truth plant built from the models it tests
+  would flatter them;
+- the model kinds (``greybox.models``: physical friction, kernel, augmented)
   import nothing of the layers above them: ``evaluate``, ``predict``,
   ``discover``, ``reproduce``, ``control``, ``cli``;
 - prediction (``greybox.predict``) sits above the models, the data and
@@ -23,7 +23,7 @@ rules (DESIGN.md, "Layout"):
   below its users, which it imports nothing of: ``live``, ``monitor``,
   ``discover``, ``control``, ``reproduce``, ``cli``;
 - the model layer as a whole (:data:`MODEL_LAYER`: the model kinds in
-  ``friction`` and ``models``, their registry and file format, the
+  ``models`` with their registry, the file format, the
   identification and data layers they stand on) imports nothing outside it:
   no import runs back up the layers (the registry of model kinds imports no
   workflow: the augmented kind of ``greybox discover`` lives in ``models``).
@@ -32,8 +32,8 @@ An import names a module (``import greybox.twin.plant``, ``from ..twin import
 plant``) or a package's ``__init__`` (``from ..twin import make_dataset``).
 Importing a submodule from outside its package also runs the package's
 ``__init__`` (and its parents'), so that is an edge too: ``identify.initial``
-importing ``friction.curves`` would run ``friction/__init__``, which imports
-the models, which import ``identify.initial`` — a cycle Python reports only
+importing ``models.friction.stribeck`` would run ``models/friction/__init__``,
+which imports the models, which import ``identify.initial`` — a cycle Python reports only
 at run time. From inside a package its own ``__init__`` is not an edge (it is
 already running or done).
 """
@@ -53,8 +53,8 @@ TWIN_USERS = ("greybox.control", "greybox.reproduce", "greybox.cli")
 #: Layers the models must not depend on.
 #: The model kinds and everything they stand on: importing nothing outside this set.
 MODEL_LAYER = ("greybox.base", "greybox.errors", "greybox.threads", "greybox.atomic", "greybox.json_values",
-               "greybox.provenance", "greybox.metrics", "greybox.data", "greybox.identify", "greybox.estimator",
-               "greybox.friction", "greybox.models", "greybox.registry", "greybox.persistence")
+               "greybox.provenance", "greybox.metrics", "greybox.data", "greybox.identify", "greybox.models",
+               "greybox.persistence")
 ABOVE_MODELS = ("greybox.evaluate", "greybox.predict", "greybox.discover", "greybox.reproduce", "greybox.control",
                 "greybox.cli")
 #: Layers prediction must not depend on (they use it, or stand beside it).
@@ -260,15 +260,15 @@ def test_the_truth_laws_base_imports_nothing_of_greybox_and_no_truth_law_uses_a_
     found = forbidden(graph, lambda m: m == "greybox.twin.laws.base", lambda t: True)
     assert not found, "greybox/twin/laws/base.py must import nothing of greybox:\n" + "\n".join(found)
     found = forbidden(graph, lambda m: _within(m, "greybox.twin"),
-                      lambda t: _within(t, "greybox.friction") or _within(t, "greybox.models"))
+                      lambda t: _within(t, "greybox.models"))
     assert not found, "the truth plants must not be built from the models they test:\n" + "\n".join(found)
 
 
 def test_the_models_import_nothing_of_the_layers_above_them(graph):
     found = forbidden(graph,
-                      lambda m: _within(m, "greybox.friction") or _within(m, "greybox.models"),
+                      lambda m: _within(m, "greybox.models"),
                       lambda t: any(_within(t, p) for p in ABOVE_MODELS))
-    assert not found, "friction/ and models/ depend on a layer above them:\n" + "\n".join(found)
+    assert not found, "models/ depends on a layer above it:\n" + "\n".join(found)
 
 
 def test_prediction_imports_nothing_of_its_users_and_evaluate_nothing_of_prediction(graph):
@@ -281,7 +281,7 @@ def test_prediction_imports_nothing_of_its_users_and_evaluate_nothing_of_predict
 
 
 def test_the_model_layer_imports_nothing_above_it(graph):
-    assert "greybox.registry" in graph and "greybox.models.augmented" in graph
+    assert "greybox.models.registry" in graph and "greybox.models.augmented" in graph
     found = forbidden(graph,
                       lambda m: any(_within(m, p) for p in MODEL_LAYER),
                       lambda t: t != "greybox" and not any(_within(t, p) for p in MODEL_LAYER))

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 from sklearn.base import BaseEstimator
 
-from greybox import atomic, persistence, registry
+from greybox import atomic, persistence
 from greybox.errors import ModelFileError, ParameterError
+from greybox.models import registry
 from greybox.persistence import FORMAT_VERSION, load_model, save_model
 
 
@@ -256,7 +257,7 @@ def _axis_run(seed: int, n: int = 1500, dt: float = 0.002):
 
 
 def _real_models():
-    from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+    from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 
     return [
         CoulombModel(fit_offset=True),
@@ -298,7 +299,7 @@ def test_symmetric_model_files_from_before_the_asymmetric_option_still_load(tmp_
 
 
 def test_registry_names_every_current_model():
-    from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+    from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
     from greybox.models.gmssvr import GMSSVRModel
     from greybox.models.svr import SVRCurrentModel
 
@@ -319,7 +320,7 @@ def test_discovered_models_are_files_but_not_trainable_kinds():
 
 @pytest.fixture(scope="module")
 def gms_file(tmp_path_factory):
-    from greybox.friction import GMSModel
+    from greybox.models.friction import GMSModel
 
     path = tmp_path_factory.mktemp("gms") / "gms.gbm"
     save_model(GMSModel(n_elements=3, n_starts=1, max_iter=40).fit([_axis_run(0)]), path)
@@ -399,7 +400,7 @@ def test_every_single_flipped_byte_is_one_model_file_error(tmp_path, gms_file):
 
 
 def test_save_verified_writes_a_file_that_predicts_what_the_model_did(tmp_path):
-    from greybox.friction import CoulombModel
+    from greybox.models.friction import CoulombModel
     from greybox.persistence import save_verified
 
     runs = [_axis_run(1), _axis_run(2)]
@@ -414,7 +415,7 @@ def test_save_verified_writes_a_file_that_predicts_what_the_model_did(tmp_path):
 
 def test_a_saved_model_that_predicts_otherwise_is_refused_naming_the_file(tmp_path):
     """The comparison is bit for bit: predictions off by one ulp on one run are refused."""
-    from greybox.friction import CoulombModel
+    from greybox.models.friction import CoulombModel
     from greybox.persistence import save_verified
 
     runs = [_axis_run(1), _axis_run(2)]

@@ -24,10 +24,10 @@ ROOT = Path(__file__).resolve().parents[1]
 #: records, the controller and the controlled plants, the twin's plant and the truth laws of the family of axes,
 #: the ageing twin's play, the live stream's zero-phase filter, the kernel models' frame (kernel sum, hand-over,
 #: input flags).
-KERNEL_TESTS = ("friction/test_kernels.py", "models/test_rbf.py", "twin/test_plant_laws.py",
+KERNEL_TESTS = ("models/friction/test_kernels.py", "models/kernel/test_rbf.py", "twin/test_plant_laws.py",
                 "data/test_json_numbers.py", "data/test_mcap_io.py", "control/test_pid.py",
                 "control/test_plants.py", "twin/test_plant.py", "twin/test_family.py", "twin/test_ageing.py",
-                "live/test_zerophase.py", "models/test_kernel.py")
+                "live/test_zerophase.py", "models/kernel/test_expansion.py")
 
 
 @pytest.mark.slow

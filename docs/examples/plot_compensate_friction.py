@@ -16,8 +16,8 @@ excitation) and the loop follows a 10 s low-stroke reference (the command: 60 s 
 from greybox.control import TwinPlant, plot_tracking_errors
 from greybox.control.report import comparison_rows
 from greybox.control.workflow import compensation_study, twin_training_runs
-from greybox.friction.gms import GMSModel
-from greybox.friction.stribeck import StribeckModel
+from greybox.models.friction.gms import GMSModel
+from greybox.models.friction.stribeck import StribeckModel
 
 # %%
 # The plant and the feed-forward models

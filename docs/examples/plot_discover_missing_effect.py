@@ -20,7 +20,7 @@ import numpy as np
 
 from greybox.data import prepare
 from greybox.discover.workflow import discover
-from greybox.friction.coulomb import CoulombModel
+from greybox.models.friction.coulomb import CoulombModel
 from greybox.twin import make_dataset
 
 # %%

@@ -22,7 +22,7 @@ import pyarrow.dataset
 from distributed import LocalCluster
 
 from greybox.data import prepare, read_log
-from greybox.friction.stribeck import StribeckModel
+from greybox.models.friction.stribeck import StribeckModel
 from greybox.persistence import save_model
 from greybox.predict import predict_logs
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from greybox.data import prepare, read_log
 from greybox.data.axis_config import read_axis_config
-from greybox.friction.lugre import LuGreModel
+from greybox.models.friction.lugre import LuGreModel
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 

@@ -17,9 +17,9 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 
 from greybox.data import prepare, read_log
-from greybox.friction.gms import GMSModel
-from greybox.friction.stribeck import StribeckModel
 from greybox.metrics import relative_error, rmse
+from greybox.models.friction.gms import GMSModel
+from greybox.models.friction.stribeck import StribeckModel
 
 data = Path("../../data")  # the data/ folder of the repository (the gallery runs from docs/examples)
 

@@ -6,8 +6,8 @@ import argparse
 import json
 
 from ..errors import GreyboxError
-from ..friction.backlash import BacklashModel
-from ..registry import model_class
+from ..models.friction.backlash import BacklashModel
+from ..models.registry import model_class
 from ._model_options import MODEL_OPTIONS, CommandLineError
 from ._types import NON_NEGATIVE, POSITIVE_INT, SEED
 
@@ -97,7 +97,7 @@ def build_model(kind: str, args: argparse.Namespace):
     Parameters
     ----------
     kind : str
-        Registered model kind (e.g. ``"gms"``, ``"svr"``, ``"gmssvr"``), as in :func:`greybox.registry.model_class`.
+        Registered model kind (e.g. ``"gms"``, ``"svr"``, ``"gmssvr"``), as in :func:`greybox.models.registry.model_class`.
     args : argparse.Namespace
         Parsed command-line arguments; the model options (``offset``, ``asymmetric``, ``elements``,
         ``model_seed``, ``set``, ``backlash``) are read from it, and those it lacks count as not given.

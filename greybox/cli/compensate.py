@@ -28,7 +28,7 @@ def add_parser(subparsers) -> None:
         The sub-command registry of the ``greybox`` parser (from ``add_subparsers``).
     """
     from ..control.references import STROKES_MM
-    from ..registry import MODEL_CLASSES
+    from ..models.registry import MODEL_CLASSES
 
     parser = subparsers.add_parser(
         "compensate",
@@ -115,7 +115,7 @@ def _plant(args):
 
 
 def _fit_kinds(args) -> list[str]:
-    from ..registry import MODEL_CLASSES
+    from ..models.registry import MODEL_CLASSES
 
     if not args.kinds:
         if args.train:

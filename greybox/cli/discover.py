@@ -17,7 +17,7 @@ from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
 from ..models.effects import EFFECT_NAMES, effect
 from ..persistence import save_verified
-from ..registry import MODEL_CLASSES
+from ..models.registry import MODEL_CLASSES
 from ._build import CommandLineError, add_model_arguments, build_model
 from ._options import add_log_arguments, read_logs
 from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED

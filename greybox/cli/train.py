@@ -18,7 +18,7 @@ from ..identify.intervals import attach_intervals
 from ..metrics import metrics_table
 from ..model_choice import DEFAULT_CANDIDATES
 from ..persistence import save_verified
-from ..registry import MODEL_CLASSES
+from ..models.registry import MODEL_CLASSES
 from ._advice import offset_note
 from ._build import add_model_arguments, build_model, takes_hyperparameter
 from ._model_text import model_lines

@@ -92,7 +92,7 @@ class ModelFeedForward:
     Parameters
     ----------
     model : CurrentModel
-        A fitted greybox model (``greybox.registry`` kinds).
+        A fitted greybox model (``greybox.models.registry`` kinds).
     inertia_A_s2_mm : float, optional
         ``J_ff`` [A s^2/mm]; default the model's own ``J_``. Giving every
         model the same (e.g. the plant's) inertia compares the friction
@@ -104,7 +104,7 @@ class ModelFeedForward:
     def __init__(self, model, inertia_A_s2_mm: float | None = None, name: str | None = None):
         from sklearn.utils.validation import check_is_fitted
 
-        from ..registry import model_kind
+        from ..models.registry import model_kind
 
         kind = model_kind(model)
         check_is_fitted(model)

@@ -51,7 +51,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..base import PlantLaw
 from ..errors import GreyboxError
-from ..registry import model_kind
+from ..models.registry import model_kind
 from ..twin.plant import PlantParameters, default_plant_parameters, twin_plant_law
 from .pid import ControllerSettings, measure, pid_step
 

@@ -17,7 +17,7 @@ from ..data.log import AxisLog
 from ..data.prepare import prepare
 from ..errors import GreyboxError
 from ..persistence import load_model
-from ..registry import model_kind
+from ..models.registry import model_kind
 from ..twin import CurrentNoise, axis_geometry, make_dataset
 from .feedforward import InertiaFeedForward, ModelFeedForward
 from .loop import LoopResult, compare_feedforwards, controller_periods
@@ -135,7 +135,7 @@ def feedforward_models(plant, *, model_files: Sequence[str | PathLike] = (), kin
     model_files : sequence of str or path-like, default ()
         Model files (``.gbm``) to load.
     kinds : sequence of str, default ()
-        Model kinds to fit (:data:`greybox.registry.MODEL_CLASSES`), each once.
+        Model kinds to fit (:data:`greybox.models.registry.MODEL_CLASSES`), each once.
     build : callable, optional
         ``build(kind)`` returns an unfitted model of that kind (with the caller's hyperparameters);
         required with ``kinds``.

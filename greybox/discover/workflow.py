@@ -48,12 +48,12 @@ from sklearn.base import clone
 from ..data.log import AxisLog
 from ..data.quantities import MOTIONS
 from ..errors import GreyboxError
-from ..estimator import check_runs
 from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
 from ..json_values import jsonable
 from ..metrics import metrics_table
 from ..models.augmented import AugmentedModel
 from ..models.effects import EFFECT_NAMES, REFINEMENTS, VELOCITY_ONLY, effect
+from ..models.estimator import check_runs
 from ..provenance import provenance
 from .evidence import StepEvidence, score_step
 from .heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN, HeldOutTest

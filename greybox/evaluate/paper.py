@@ -3,7 +3,7 @@
 Tables 3 (train on A, test on C) and 4 (train on A + B, test on C + D) of the
 paper, measured on the X and Y axes of a Mazak VARIAXIS i-600, as given in
 ``../shared/papers/README.md``. Keys are ``(experiment, axis, model)`` with
-the model names of :data:`greybox.registry` (``stribeck``, ``svr``, ``gms``,
+the model names of :data:`greybox.models.registry` (``stribeck``, ``svr``, ``gms``,
 ``gmssvr``); experiment 1 is Table 3, experiment 2 is Table 4.
 """
 

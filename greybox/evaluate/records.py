@@ -23,7 +23,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..metrics import metrics_table
-from ..registry import model_kind
+from ..models.registry import model_kind
 from .figures import effort_name, error_boxplot, residual_vs_position, time_comparison
 from .regimes import metrics_by_regime
 from .report import evaluation_table, per_log_table, regime_table, write_report

@@ -19,7 +19,7 @@ inertia ``J`` estimated jointly:
 
 :func:`stribeck_curve` is the one NumPy copy of the Stribeck curve that the
 models, these fits and the initial guesses evaluate (the compiled kernels
-evaluate the same curve per sample: :func:`greybox.friction.kernels.stribeck_at`).
+evaluate the same curve per sample: :func:`greybox.models.friction.kernels.stribeck_at`).
 """
 
 from __future__ import annotations

@@ -127,7 +127,7 @@ def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, re
     """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
     from ..data.axis_config import read_axis_config
     from ..persistence import load_model
-    from ..registry import model_kind
+    from ..models.registry import model_kind
 
     model = load_model(model_path)
     config = read_axis_config(axis_config_path) if axis_config_path else None
@@ -152,7 +152,7 @@ def _machine_session(model_path, machine_path, options: dict, *, record_dir, rec
 
     from ..data.machine_config import read_machine_config
     from ..machine_model import load_machine
-    from ..registry import model_kind
+    from ..models.registry import model_kind
 
     if columns:
         raise GreyboxError("--columns applies to one axis; give a machine's channel names in --machine TOML")

@@ -28,7 +28,7 @@ parameters, so that the solve stays one linear least-squares problem.
 The prediction is ``J a + base friction + sum of terms + offset``. A
 ``constant_offset`` term is reported in ``offset_`` and an
 ``inertia_mismatch`` term in ``J_``; every other term belongs to what
-:meth:`~greybox.estimator.CurrentModel.friction` returns (so does a
+:meth:`~greybox.models.estimator.CurrentModel.friction` returns (so does a
 cogging-like ``position_periodic_force``, which is not friction strictly).
 """
 
@@ -47,9 +47,6 @@ from threadpoolctl import threadpool_limits
 from ..base import EFFORT, LinearPart, Parameter
 from ..data.log import AxisLog
 from ..errors import GreyboxError, ParameterError
-from ..estimator import CurrentModel, check_runs
-from ..friction.directions import viscous_columns
-from ..friction.gms import GMSModel
 from ..identify.linear import bounded_lstsq
 from ..identify.progress import make_progress
 from ..identify.projection import Nuisance, PositionScan, added_squares
@@ -62,6 +59,9 @@ from .effects import (
     period_scan,
     presliding_states,
 )
+from .estimator import CurrentModel, check_runs
+from .friction.directions import viscous_columns
+from .friction.gms import GMSModel
 
 __all__ = ["AugmentedModel", "normalise_effects"]
 

@@ -6,7 +6,7 @@ element deflections and stick/slip modes), and the grey-box model builds an
 input matrix of ``2 + N`` columns per sample for its kernel expansion. Here a
 run is cut into consecutive chunks of ``chunk_s`` seconds; each chunk starts
 from the state the previous one ended in, so the result equals the one-shot
-:meth:`~greybox.estimator.CurrentModel.predict` of the whole run, while the
+:meth:`~greybox.models.estimator.CurrentModel.predict` of the whole run, while the
 model's working memory grows with the chunk length only.
 
 Every chunk is integrated at the step of the whole run (its median time step),
@@ -15,7 +15,7 @@ result even for a log with jittered time stamps.
 
 The state carried between chunks is the model's own
 (:meth:`~greybox.base.ModelProtocol.initial_state`,
-:meth:`~greybox.estimator.CurrentModel.predict_chunk`): none for the memoryless
+:meth:`~greybox.models.estimator.CurrentModel.predict_chunk`): none for the memoryless
 models, the bristle deflection of LuGre, the element states of GMS (also the
 frozen GMS stage of GMS+SVR), and for the models of ``greybox discover`` the
 state of their base plus the start time of the run.
@@ -29,7 +29,7 @@ import numpy as np
 
 from ..data.log import AxisLog
 from ..errors import ParameterError
-from ..estimator import check_runs
+from .estimator import check_runs
 
 __all__ = ["DEFAULT_CHUNK_S", "samples_per_chunk", "chunk_slices", "iter_chunks", "predict_chunked"]
 

@@ -50,7 +50,7 @@ import numpy as np
 
 from ..data.log import AxisLog
 from ..errors import GreyboxError
-from ..friction.kernels import play_operator_kernel
+from .friction.kernels import play_operator_kernel
 
 __all__ = ["BASE_FRICTION", "EffectContext", "Effect", "EFFECTS", "EFFECT_NAMES", "REFINEMENTS", "VELOCITY_ONLY",
            "VELOCITY_CURVE_SCALES", "PRESLIDING_WIDTHS_MM", "presliding_states",
@@ -606,7 +606,7 @@ def _presliding_parameters(coefficients, context, shape, unit):
 #:   velocity-only friction law the base model lacks projects onto (a Stribeck curve of another shape,
 #:   viscous friction that is not linear);
 #: - ``presliding_hysteresis``: friction held at rest and pre-sliding hysteresis of another shape than the
-#:   base's. With ``s_k`` the states of play operators (:func:`greybox.friction.kernels.play_operator_kernel`)
+#:   base's. With ``s_k`` the states of play operators (:func:`greybox.models.friction.kernels.play_operator_kernel`)
 #:   of break-away displacements :data:`PRESLIDING_WIDTHS_MM`, the first (1 um) being the direction of the
 #:   last motion ``h``: the columns ``h - d`` (friction held at rest beyond what the velocity curve gives
 #:   there; zero once moving) and ``s_k - h`` for the wider operators (pre-sliding transients over the first

@@ -2,7 +2,7 @@
 
 Two stages:
 
-1. a :class:`~greybox.friction.GMSModel` (inertia + Generalized Maxwell-Slip
+1. a :class:`~greybox.models.friction.GMSModel` (inertia + Generalized Maxwell-Slip
    friction) is identified, and its parameters are then frozen;
 2. an RBF support vector regression corrects it, with the position ``p``
    [mm], the frozen GMS model's current ``I_GMS`` [A] and its element
@@ -25,7 +25,7 @@ target); with ``handover=True`` (the default) the prediction is instead
 handed over to the GMS stage's alone, smoothly, within one kernel length
 scale of the box of the training inputs (:mod:`greybox.models.handover`),
 and is unchanged inside it. Both targets search the same
-intervals (:func:`greybox.models.kernel.default_bounds`). The residual target
+intervals (:func:`greybox.models.kernel.expansion.default_bounds`). The residual target
 was chosen on the training runs of a development family of truth axes
 (``studies/priors.py`` in the repository): fitted on three quarters of dataset A and
 scored on the rest of A and on B, it is far better than the current target
@@ -52,9 +52,9 @@ from sklearn.utils.validation import check_is_fitted
 from ..base import Parameter
 from ..data.log import AxisLog
 from ..errors import LogError, ParameterError, Setting
-from ..estimator import check_runs
-from ..friction.gms import GMSModel
 from ..identify.progress import make_progress
+from .estimator import check_runs
+from .friction.gms import GMSModel
 from .handover import hand_over
 from .svr import KernelRegressionModel
 
@@ -88,7 +88,7 @@ class GMSSVRModel(KernelRegressionModel):
         SVR training samples, chosen to cover the (p, v) plane evenly.
     optimize : bool, default True
         Choose the hyperparameters left None by Bayesian optimisation over a
-        time-blocked cross-validation (see :func:`greybox.models.kernel.fit_svr_expansion`).
+        time-blocked cross-validation (see :func:`greybox.models.kernel.expansion.fit_svr_expansion`).
     n_calls : int, default 25
         Evaluations of the Bayesian optimisation.
     cv_folds : int, default 3
@@ -97,7 +97,7 @@ class GMSSVRModel(KernelRegressionModel):
         Contiguous time blocks dealt to the folds (never spanning runs).
     bounds : dict, optional
         Search intervals ``{name: (low, high)}`` replacing those of
-        :func:`greybox.models.kernel.default_bounds`.
+        :func:`greybox.models.kernel.expansion.default_bounds`.
     random_state : int, default 0
         Seed of subset choice and optimisation.
     handover : bool, default True
@@ -174,7 +174,7 @@ class GMSSVRModel(KernelRegressionModel):
         logs : AxisLog or list of AxisLog
             Prepared runs (velocity [mm/s] and acceleration [mm/s^2] present).
         progress : None, bool or callable, optional
-            See :meth:`greybox.estimator.CurrentModel.fit`.
+            See :meth:`greybox.models.estimator.CurrentModel.fit`.
 
         Returns
         -------
@@ -199,7 +199,7 @@ class GMSSVRModel(KernelRegressionModel):
         stage2_logs : AxisLog or list of AxisLog, optional
             Prepared runs of the SVR stage; default ``logs``.
         progress : None, bool or callable, optional
-            See :meth:`greybox.estimator.CurrentModel.fit`.
+            See :meth:`greybox.models.estimator.CurrentModel.fit`.
         first_stage : GMSModel, optional
             A fitted GMS model to freeze instead of fitting one.
 
@@ -220,7 +220,7 @@ class GMSSVRModel(KernelRegressionModel):
         logs : AxisLog or list of AxisLog
             Prepared runs.
         progress : None, bool or callable, optional
-            See :meth:`greybox.estimator.CurrentModel.fit`.
+            See :meth:`greybox.models.estimator.CurrentModel.fit`.
 
         Returns
         -------
@@ -242,7 +242,7 @@ class GMSSVRModel(KernelRegressionModel):
         logs : AxisLog or list of AxisLog
             Prepared runs; may differ from the runs the GMS stage was fitted on.
         progress : None, bool or callable, optional
-            See :meth:`greybox.estimator.CurrentModel.fit`.
+            See :meth:`greybox.models.estimator.CurrentModel.fit`.
         gms : GMSModel, optional
             A fitted GMS model to freeze (a copy is kept as ``gms_``); by
             default the one from :meth:`fit_gms`.
@@ -298,7 +298,7 @@ class GMSSVRModel(KernelRegressionModel):
         """SVR inputs of one run or chunk: position [mm], GMS current [A], deflections [mm]; and the end state.
 
         One simulation of the GMS stage gives both its current and its element states (``trajectory``: the
-        stage's :meth:`~greybox.friction.GMSModel.trajectory_runner` of a stream, checked once).
+        stage's :meth:`~greybox.models.friction.GMSModel.trajectory_runner` of a stream, checked once).
         """
         if trajectory is None:
             gms_current, z, _, end = self.gms_.trajectory(run, state, sample_time=sample_time)
@@ -326,7 +326,7 @@ class GMSSVRModel(KernelRegressionModel):
 
         Outside the box of the training inputs the prediction is handed over to the GMS stage's
         (:mod:`greybox.models.handover`). ``expansion``, ``weight``: the kernel frame's
-        :meth:`~greybox.models.kernel.KernelFrame.terms` of a stream, when at hand.
+        :meth:`~greybox.models.kernel.expansion.KernelFrame.terms` of a stream, when at hand.
         """
         if expansion is None:
             frame = self.kernel_frame()
@@ -387,7 +387,7 @@ class GMSSVRModel(KernelRegressionModel):
         return self.gms_.predict(logs)
 
     def states(self, logs: AxisLog | Iterable[AxisLog]) -> tuple[np.ndarray, np.ndarray]:
-        """GMS element deflections and stick flags (see :meth:`greybox.friction.GMSModel.states`).
+        """GMS element deflections and stick flags (see :meth:`greybox.models.friction.GMSModel.states`).
 
         Parameters
         ----------

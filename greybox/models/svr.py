@@ -18,12 +18,12 @@ Coulomb, viscous and position-dependent parts. ``J a`` has to be taken out
 first because the kernel does not see the acceleration.
 
 The machinery shared with the grey-box model
-(:class:`greybox.models.gmssvr.GMSSVRModel`) is :func:`greybox.models.kernel.fit_svr_expansion`:
+(:class:`greybox.models.gmssvr.GMSSVRModel`) is :func:`greybox.models.kernel.expansion.fit_svr_expansion`:
 standardise the inputs, choose the hyperparameters (C, epsilon, gamma) by
 Bayesian optimisation over a time-blocked cross-validation, train on a
 subset that covers the (p, v) plane, and keep the kernel expansion as plain
 arrays (support vectors, dual coefficients, intercept), evaluated by
-:func:`greybox.models.rbf.rbf_expansion`.
+:func:`greybox.models.kernel.rbf.rbf_expansion`.
 """
 
 from __future__ import annotations
@@ -36,13 +36,13 @@ from sklearn.utils.validation import check_is_fitted
 from ..base import EFFORT, LENGTH, Parameter
 from ..data.log import AxisLog
 from ..errors import ParameterError, Setting
-from ..estimator import CurrentModel
 from ..identify.linear import bounded_lstsq
 from ..identify.optimize import check_seed
 from ..identify.progress import ProgressEvent
 from .chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
+from .estimator import CurrentModel
 from .handover import hand_over, handover_width
-from .kernel import HYPERPARAMETERS, KernelFrame, _check_bounds, fit_svr_expansion, outside_rows
+from .kernel.expansion import HYPERPARAMETERS, KernelFrame, _check_bounds, fit_svr_expansion, outside_rows
 
 __all__ = ["KernelRegressionModel", "SVRCurrentModel", "coulomb_viscous_proxy", "BOUNDED"]
 
@@ -100,12 +100,12 @@ class KernelRegressionModel(CurrentModel):
     The subclass stores the SVR settings ``C``, ``epsilon``, ``gamma``,
     ``n_subset``, ``optimize``, ``n_calls``, ``cv_folds``, ``cv_blocks``,
     ``bounds``, ``random_state`` and ``handover`` (see :class:`SVRCurrentModel`); this class
-    checks them, fits the expansion (:func:`~greybox.models.kernel.fit_svr_expansion`) into the
+    checks them, fits the expansion (:func:`~greybox.models.kernel.expansion.fit_svr_expansion`) into the
     learned attributes ``input_mean_``, ``input_scale_``, ``support_vectors_``,
     ``dual_coef_``, ``intercept_``, ``epsilon_``, ``C_``, ``gamma_``,
     ``optimised_``, ``cv_rmse_``, ``search_history_``, ``at_bounds_``,
     ``n_train_``, ``input_weights_`` (the kernel's weight of each input, see
-    :class:`~greybox.models.kernel.SVRExpansion`), ``input_range_`` (the lowest and highest value of each
+    :class:`~greybox.models.kernel.expansion.SVRExpansion`), ``input_range_`` (the lowest and highest value of each
     input over the training data, shape (2, n_features)) and ``handover_width_`` (see
     :mod:`greybox.models.handover`; None without the hand-over), and evaluates it.
     The subclass weighs its correction by :meth:`_handover` and says what it hands over to.
@@ -137,7 +137,7 @@ class KernelRegressionModel(CurrentModel):
     def _fit_kernel(self, X, y, coverage, run_lengths: Sequence[int],
                     progress: Callable[[ProgressEvent], None] | None, *,
                     stage: str = "SVR hyperparameters") -> None:
-        """Fit :func:`~greybox.models.kernel.fit_svr_expansion` with this model's SVR settings; keep it as learned
+        """Fit :func:`~.kernel.expansion.fit_svr_expansion` with this model's SVR settings; keep it as learned
         attributes."""
         fit = fit_svr_expansion(
             X, y, coverage, run_lengths,
@@ -167,7 +167,7 @@ class KernelRegressionModel(CurrentModel):
         raise NotImplementedError
 
     def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
-        """As :meth:`CurrentModel.outside_training <greybox.estimator.CurrentModel.outside_training>`, with
+        """As :meth:`CurrentModel.outside_training <greybox.models.estimator.CurrentModel.outside_training>`, with
         ``"inputs"``: True where any SVR input lies outside its range over the training data. Computed
         in chunks, so that the inputs of a long run need not be held at once.
 
@@ -191,7 +191,7 @@ class KernelRegressionModel(CurrentModel):
 
     def _flags(self, log: AxisLog, X, sample_time: float, outside=None) -> dict[str, np.ndarray]:
         """The training-region flags of a chunk whose SVR inputs are ``X`` (``outside``: their ``"inputs"``
-        flag, from :meth:`~greybox.models.kernel.KernelFrame.terms`, when at hand)."""
+        flag, from :meth:`~greybox.models.kernel.expansion.KernelFrame.terms`, when at hand)."""
         out, _ = super()._region_flags(log, None, sample_time)
         if outside is not None:
             out["inputs"] = outside
@@ -202,7 +202,7 @@ class KernelRegressionModel(CurrentModel):
         return out
 
     def kernel_frame(self) -> "KernelFrame":
-        """The kernel's coordinates and hand-over box, checked once (:class:`~greybox.models.kernel.KernelFrame`).
+        """The kernel's coordinates and hand-over box, checked once (:class:`~.kernel.expansion.KernelFrame`).
 
         Returns
         -------

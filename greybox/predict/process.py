@@ -67,7 +67,7 @@ from ..data.quantities import MOTIONS, Motion
 from ..data.units import MOTOR_TORQUE
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
-from ..registry import model_kind
+from ..models.registry import model_kind
 from .interval import ProcessInterval
 
 __all__ = ["EXTRAPOLATION_WARNING_SHARE", "ProcessResult", "ProcessTally", "check_process_inputs",
@@ -117,7 +117,7 @@ class ProcessResult:
         bounds converted like the current; None without calibration or without axis metadata.
     outside : ndarray of bool or None
         True where the log leaves the region the model's training runs covered
-        (:meth:`~greybox.estimator.CurrentModel.outside_training`); None for a model file that
+        (:meth:`~greybox.models.estimator.CurrentModel.outside_training`); None for a model file that
         predates the record of that region.
     effort_quantity : str, default ""
         What the effort is (:func:`~greybox.data.effort.effort_quantity`): ``"motor torque"`` for a servo
@@ -226,7 +226,7 @@ def extrapolation_summary(counts: dict, n_outside: int | None, n_samples: int) -
     ----------
     counts : dict of str to int
         Samples outside the training region per quantity (of
-        :meth:`~greybox.estimator.CurrentModel.outside_training`); empty for a model without the record.
+        :meth:`~greybox.models.estimator.CurrentModel.outside_training`); empty for a model without the record.
     n_outside : int or None
         Samples outside in any quantity (None without the record).
     n_samples : int
@@ -292,7 +292,7 @@ class ProcessTally:
             The block (or whole result) to count in.
         regions : dict of str to ndarray of bool, optional
             Per quantity, True at the samples of the block outside the training region
-            (:meth:`~greybox.estimator.CurrentModel.outside_training`); None or empty when the model
+            (:meth:`~greybox.models.estimator.CurrentModel.outside_training`); None or empty when the model
             carries no training region.
         """
         self.n_samples += len(result.time)

@@ -79,7 +79,7 @@ class ModelSpec:
     Parameters
     ----------
     kind : str
-        Model kind of :data:`greybox.registry.MODEL_CLASSES`.
+        Model kind of :data:`greybox.models.registry.MODEL_CLASSES`.
     train : tuple of str
         Datasets the model is fitted on (for ``gmssvr`` with ``stage2``: the
         datasets of the GMS stage only).
@@ -364,7 +364,7 @@ def _settings_for(spec: ModelSpec, settings: Mapping[str, Mapping]) -> dict:
     A hyperparameter named after a registered kind is a stage of that kind (the ``gms`` of ``gmssvr``):
     it is built from that kind's settings unless given as a model.
     """
-    from ..registry import MODEL_CLASSES, model_class
+    from ..models.registry import MODEL_CLASSES, model_class
 
     params = {**settings.get(spec.kind, {}), **spec.params}
     for name in model_class(spec.kind)().get_params(deep=False):
@@ -389,7 +389,7 @@ class _FitCache:
 
     def fit(self, spec: ModelSpec, settings, logs, model_progress) -> tuple[object, float, list[str]]:
         """The fitted model, the fit's wall time [s] (0 when shared) and the warnings it issued."""
-        from ..registry import model_class
+        from ..models.registry import model_class
 
         model = model_class(spec.kind)(**_settings_for(spec, settings))
         key = _key(model, spec.train, spec.stage2)
@@ -439,7 +439,7 @@ def run_experiments(
     progress : callable, optional
         Receives one line of text per step (model fitted, with its time).
     model_progress : None, bool or callable, optional
-        Passed to every model's ``fit`` (see :meth:`greybox.estimator.CurrentModel.fit`).
+        Passed to every model's ``fit`` (see :meth:`greybox.models.estimator.CurrentModel.fit`).
 
     Returns
     -------
@@ -717,7 +717,7 @@ def reproduce(
     progress : callable, optional
         Receives one line of text per step.
     model_progress : None, bool or callable, optional
-        Progress of every model fit (see :meth:`greybox.estimator.CurrentModel.fit`).
+        Progress of every model fit (see :meth:`greybox.models.estimator.CurrentModel.fit`).
     intro : str
         Text placed under the report's title (e.g. the command that made it).
 

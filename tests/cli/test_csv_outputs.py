@@ -23,7 +23,7 @@ from greybox.data.file_metadata import sidecar_path
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare, trim
 from greybox.evaluate.report import CSV_COLUMNS
-from greybox.friction import CoulombModel, GMSModel
+from greybox.models.friction import CoulombModel, GMSModel
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 

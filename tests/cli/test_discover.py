@@ -10,11 +10,11 @@ import time
 import numpy as np
 import pytest
 
-from greybox import registry
 from greybox.cli import build_parser
 from greybox.cli import discover as discover_cli
 from greybox.data.io import write_log
 from greybox.errors import GreyboxError
+from greybox.models import registry
 from greybox.models.augmented import AugmentedModel
 from greybox.persistence import load_model
 from studies.discovery import StudyCase, case_logs

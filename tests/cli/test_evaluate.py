@@ -13,8 +13,8 @@ from greybox.data.io import write_log
 from greybox.data.prepare import prepare, trim
 from greybox.evaluate.regimes import REGIME_NAMES
 from greybox.evaluate.report import CSV_COLUMNS
-from greybox.friction import GMSModel, StribeckModel
 from greybox.metrics import rmse
+from greybox.models.friction import GMSModel, StribeckModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 

@@ -13,7 +13,7 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
-from greybox.friction import GMSModel
+from greybox.models.friction import GMSModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 

@@ -127,7 +127,7 @@ def test_every_model_option_of_the_commands_is_in_the_one_table():
 
 
 def test_a_refused_combination_names_both_settings_in_python_and_both_options_on_the_command_line():
-    from greybox.friction import CoulombModel
+    from greybox.models.friction import CoulombModel
 
     with pytest.raises(ParameterError) as caught:
         CoulombModel(asymmetric=True, fit_offset=True).fit([])

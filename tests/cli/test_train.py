@@ -9,8 +9,8 @@ import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
-from greybox.friction import CoulombModel
-from greybox.friction.backlash import BacklashModel
+from greybox.models.friction import CoulombModel
+from greybox.models.friction.backlash import BacklashModel
 from greybox.persistence import load_model
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;

@@ -118,7 +118,7 @@ def _force_log(dataset: str, seed: int, duration_s: float):
 def force_files(tmp_path_factory):
     """A Stribeck model fitted on a force log, two force test logs and one current log (MCAP)."""
     from greybox.data.prepare import prepare
-    from greybox.friction import StribeckModel
+    from greybox.models.friction import StribeckModel
     from greybox.persistence import save_model
 
     root = tmp_path_factory.mktemp("force")
@@ -288,7 +288,7 @@ def test_plot_window_option(short_log, tmp_path, capsys):
 def predict_files(tmp_path_factory):
     """A Stribeck model file and a 6 s cutting log of dataset C (MCAP)."""
     from greybox.data.prepare import prepare
-    from greybox.friction import StribeckModel
+    from greybox.models.friction import StribeckModel
     from greybox.persistence import save_model
 
     root = tmp_path_factory.mktemp("predict")

@@ -8,7 +8,7 @@ import pytest
 from greybox.control import InertiaFeedForward, ModelFeedForward, stroke_reference
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.twin import make_dataset
 

@@ -18,7 +18,7 @@ from greybox.control.loop import controller_periods
 from greybox.control.references import Reference
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.friction import CoulombModel, GMSModel, LuGreModel
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel
 from greybox.twin import CurrentNoise, default_plant_parameters, make_dataset
 
 WINDOW_CENTRE_MM = -250.0

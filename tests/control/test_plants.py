@@ -13,7 +13,7 @@ from greybox.control.plants import ModelPlant, TwinPlant, compiled_position_loop
 from greybox.control.references import Reference, filtered_random_reference
 from greybox.control.tuning import default_bandwidth_hz, pole_placement_gains
 from greybox.errors import GreyboxError
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 
 
 # ------------------------------------------------------------------ fixtures

@@ -7,7 +7,7 @@ import pytest
 from greybox.control.plants import ModelPlant, TwinPlant
 from greybox.control.workflow import feedforward_models, synthesises_training
 from greybox.errors import GreyboxError, ModelFileError
-from greybox.friction import CoulombModel
+from greybox.models.friction import CoulombModel
 from greybox.persistence import save_model
 
 
@@ -52,6 +52,6 @@ def test_a_model_plant_needs_training_runs_and_a_rotary_model_does_not_fit_a_lin
 
 
 def _gms(runs):
-    from greybox.friction import GMSModel
+    from greybox.models.friction import GMSModel
 
     return GMSModel(n_elements=2, n_starts=1, max_iter=30).fit(runs)

@@ -17,7 +17,7 @@ from greybox.data.io import read_log
 from greybox.data.prepare import prepare
 from greybox.data.units import MOTOR_TORQUE
 from greybox.errors import GreyboxError, LogError
-from greybox.friction import CoulombModel
+from greybox.models.friction import CoulombModel
 from greybox.predict.process import predict_process
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;

@@ -17,7 +17,7 @@ from greybox.data.mcap_io import McapLog
 from greybox.data.prepare import derivative_margin, prepare
 from greybox.data.stream import ParquetLog, median_step, open_stream, prepared_blocks
 from greybox.errors import LogError
-from greybox.friction import GMSModel
+from greybox.models.friction import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset

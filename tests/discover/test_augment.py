@@ -7,9 +7,9 @@ import pytest
 
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.friction import CoulombModel, StribeckModel
 from greybox.models.augmented import AugmentedModel
 from greybox.models.effects import effect
+from greybox.models.friction import CoulombModel, StribeckModel
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 

@@ -7,9 +7,9 @@ import pytest
 
 from greybox.data.log import AxisLog
 from greybox.discover.evidence import score_step
-from greybox.friction import CoulombModel
 from greybox.models.augmented import AugmentedModel
 from greybox.models.effects import EffectContext
+from greybox.models.friction import CoulombModel
 
 
 def sine_stroke(n=6000, step=0.002, seed=0):

@@ -15,9 +15,9 @@ import pytest
 from greybox.data.prepare import prepare
 from greybox.discover.heldout import HeldOutTest, _solve, block_labels
 from greybox.errors import GreyboxError
-from greybox.friction import CoulombModel, GMSModel
 from greybox.models.augmented import AugmentedModel
 from greybox.models.effects import effect
+from greybox.models.friction import CoulombModel, GMSModel
 from studies.discovery import StudyCase, case_logs
 from studies.hysteresis_axis import FamilyCase, family_logs
 

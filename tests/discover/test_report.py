@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 
 from greybox.discover.report import plot_evidence  # noqa: E402
 from greybox.discover.workflow import discover  # noqa: E402
-from greybox.friction import CoulombModel  # noqa: E402
+from greybox.models.friction import CoulombModel  # noqa: E402
 from studies.discovery import StudyCase, case_logs  # noqa: E402
 
 #: A discovery run takes several seconds.

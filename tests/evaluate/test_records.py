@@ -15,7 +15,7 @@ from greybox.data.log import AxisLog  # noqa: E402
 from greybox.data.prepare import prepare  # noqa: E402
 from greybox.evaluate.records import evaluate_models, write_evaluation_pdf  # noqa: E402
 from greybox.evaluate.table import Table  # noqa: E402
-from greybox.friction import CoulombModel  # noqa: E402
+from greybox.models.friction import CoulombModel  # noqa: E402
 
 
 def _log(seed: int) -> AxisLog:

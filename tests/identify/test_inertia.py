@@ -8,8 +8,8 @@ from friction_signals import motion_log, velocity_profile
 
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
-from greybox.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.identify.inertia import SPRING_SHARE_LIMIT, inertia_note, spring_share
+from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import load_model, save_model
 

@@ -7,8 +7,6 @@ import pytest
 from friction_signals import STEP, motion_log, velocity_profile
 from scipy.optimize import lsq_linear
 
-from greybox.friction import stribeck_curve
-from greybox.friction.gms import simulate_gms
 from greybox.identify.initial import (
     distance_since_reversal,
     motion_direction,
@@ -17,6 +15,8 @@ from greybox.identify.initial import (
     static_initial_guess,
 )
 from greybox.identify.linear import bounded_lstsq
+from greybox.models.friction import stribeck_curve
+from greybox.models.friction.gms import simulate_gms
 
 
 def test_motion_direction_carries_the_last_direction_over_standstill():

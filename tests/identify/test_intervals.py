@@ -12,17 +12,17 @@ import pytest
 from scipy.signal import lfilter
 
 import greybox.cli as cli
-from greybox import registry
 from greybox.base import Parameter
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.errors import ModelFileError
-from greybox.estimator import CurrentModel
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from greybox.friction.backlash import BacklashModel
 from greybox.identify.intervals import attach_intervals, cluster_covariance, cluster_labels, parameter_intervals
+from greybox.models import registry
 from greybox.models.augmented import AugmentedModel
+from greybox.models.estimator import CurrentModel
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction.backlash import BacklashModel
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 

@@ -10,8 +10,6 @@ from friction_signals import motion_log, velocity_profile
 from sklearn.base import BaseEstimator
 
 from greybox.errors import GreyboxError, ParameterError
-from greybox.friction import CoulombModel, GMSModel, StribeckModel
-from greybox.friction.backlash import BacklashModel
 from greybox.identify.selection import (
     CandidateScore,
     check_selection_record,
@@ -21,6 +19,8 @@ from greybox.identify.selection import (
     selection_record,
 )
 from greybox.model_choice import build_candidate, choose_model
+from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
+from greybox.models.friction.backlash import BacklashModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import load_model, save_model
 

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 import greybox.cli as cli
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from greybox.friction.backlash import BacklashModel
 from greybox.models.augmented import AugmentedModel
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction.backlash import BacklashModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.models.svr import SVRCurrentModel
 

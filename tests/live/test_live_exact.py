@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from live_helpers import EXAMPLE_AXIS, QUICK, joined, json_batches
 
-from greybox import registry
 from greybox.data.prepare import derivative_margin
 from greybox.live.run import run_live
+from greybox.models import registry
 
 #: Message sizes in turn: single samples, controller batches of 10, odd sizes.
 SIZES = (1, 10, 7, 1, 25, 3)

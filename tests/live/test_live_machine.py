@@ -12,7 +12,6 @@ from live_helpers import run_cli
 
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
-from greybox.friction import CoulombModel, GMSModel
 from greybox.live.estimator import LiveEstimator
 from greybox.live.machine import MachineSession
 from greybox.live.run import run_live
@@ -20,6 +19,7 @@ from greybox.live.session import LiveSession
 from greybox.live.sinks import LineSink
 from greybox.live.sources import Received
 from greybox.machine_model import MachineModel, save_machine
+from greybox.models.friction import CoulombModel, GMSModel
 from greybox.twin import make_dataset
 
 

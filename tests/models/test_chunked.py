@@ -7,9 +7,9 @@ import pytest
 
 from greybox.data.prepare import prepare
 from greybox.errors import LogError, ParameterError
-from greybox.friction import GMSModel, GMSState
 from greybox.models.chunked import chunk_slices, iter_chunks, predict_chunked, samples_per_chunk
-from greybox.registry import MODEL_CLASSES
+from greybox.models.friction import GMSModel, GMSState
+from greybox.models.registry import MODEL_CLASSES
 from greybox.twin import make_dataset
 
 #: Quick settings per kind (short searches, no Bayesian optimisation).

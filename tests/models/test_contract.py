@@ -18,16 +18,16 @@ import pytest
 from sklearn.base import clone
 from sklearn.model_selection import cross_val_score
 
-from greybox import registry
 from greybox.base import EFFORT, Parameter
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.estimator import CurrentModel
-from greybox.friction import CoulombModel, GMSModel, LuGreModel
-from greybox.friction.backlash import BacklashModel
+from greybox.models import registry
 from greybox.models.augmented import AugmentedModel
 from greybox.models.chunked import predict_chunked
+from greybox.models.estimator import CurrentModel
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel
+from greybox.models.friction.backlash import BacklashModel
 from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 

@@ -9,7 +9,7 @@ from sklearn.exceptions import NotFittedError
 from svr_runs import RIPPLE_A, SVR_FIXED, gms_run, quick_gms
 
 from greybox.errors import ParameterError
-from greybox.friction.gms import GMSModel
+from greybox.models.friction.gms import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
 
 
@@ -114,7 +114,7 @@ def _lowest_corner(objective, intervals, n_calls, random_state, progress=None):
 
 def test_both_targets_search_the_default_intervals_and_ending_at_an_end_warns(fitted, monkeypatch):
     """No prior narrows the residual target's search (chosen on the family's training runs, docs/svr.md)."""
-    from greybox.models import kernel
+    from greybox.models.kernel import expansion as kernel
 
     monkeypatch.setattr(kernel, "minimize_log_uniform", _lowest_corner)
     model, train = fitted

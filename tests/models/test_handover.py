@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from svr_runs import FIXED, sweep_run
 
-from greybox import persistence, registry
+from greybox import persistence
 from greybox.errors import ParameterError
+from greybox.models import registry
 from greybox.models.handover import HANDOVER_LENGTHS, hand_over, handover_weight, handover_width
 from greybox.models.svr import SVRCurrentModel
 

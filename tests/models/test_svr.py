@@ -10,7 +10,7 @@ from svr_runs import FIXED, J_TRUE, OFFSET_TRUE, sweep_run
 
 from greybox.data.log import AxisLog
 from greybox.errors import LogError
-from greybox.models.kernel import default_bounds
+from greybox.models.kernel.expansion import default_bounds
 from greybox.models.svr import SVRCurrentModel, coulomb_viscous_proxy
 
 
@@ -90,7 +90,7 @@ def test_unprepared_log_is_refused():
 
 
 def test_an_optimum_at_the_end_of_its_interval_is_reported():
-    from greybox.models.kernel import _near_bound
+    from greybox.models.kernel.expansion import _near_bound
 
     assert _near_bound(1.0, (1.0, 100.0)) and _near_bound(99.0, (1.0, 100.0))
     assert not _near_bound(10.0, (1.0, 100.0))
@@ -149,7 +149,7 @@ def step_run(seed, n=4000, dt=0.002):
 @pytest.mark.filterwarnings("ignore:SVR hyperparameters:UserWarning")  # a pure step: the weight may reach its top
 @pytest.mark.slow  # a Bayesian search, > 5 s
 def test_a_searched_velocity_weight_narrows_the_kernel_across_the_coulomb_step():
-    from greybox.models.kernel import WEIGHT_BOUNDS
+    from greybox.models.kernel.expansion import WEIGHT_BOUNDS
 
     train = [step_run(1), step_run(2)]
     settings = dict(n_subset=600, n_calls=12, cv_folds=2, cv_blocks=8)

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from svr_runs import FIXED, sweep_run
 
-from greybox import persistence, registry
+from greybox import persistence
+from greybox.models import registry
 from greybox.models.svr import SVRCurrentModel
 
 
@@ -26,7 +27,7 @@ def test_saved_and_loaded_model_predicts_identically(tmp_path, monkeypatch):
 def test_grey_box_model_with_nested_gms_stage_round_trips(tmp_path, monkeypatch, target):
     from svr_runs import SVR_FIXED, gms_run, quick_gms
 
-    from greybox.friction.gms import GMSModel
+    from greybox.models.friction.gms import GMSModel
     from greybox.models.gmssvr import GMSSVRModel
 
     monkeypatch.setitem(registry.MODEL_CLASSES, "gms", GMSModel)

@@ -160,7 +160,7 @@ def test_reference_model_leaves_out_a_process_load(twin_days, tmp_path, capsys):
     """With --model, a process current added to part of a log is left out: the levels stay those of the air cut."""
     from greybox.data.io import write_log
     from greybox.data.prepare import prepare
-    from greybox.friction import CoulombModel
+    from greybox.models.friction import CoulombModel
     from greybox.persistence import save_model
 
     source = sorted(twin_days.iterdir())[0]

@@ -12,7 +12,7 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
-from greybox.friction import GMSModel, StribeckModel
+from greybox.models.friction import GMSModel, StribeckModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import load_model, save_model
 from greybox.predict.process import EXTRAPOLATION_WARNING_SHARE, predict_process

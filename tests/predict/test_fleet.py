@@ -16,7 +16,7 @@ from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
 from greybox.fleet import MANIFEST, expand_logs
-from greybox.friction import StribeckModel
+from greybox.models.friction import StribeckModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 

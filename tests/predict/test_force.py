@@ -11,7 +11,7 @@ import pytest
 from greybox.data.axis_config import AxisConfig, parse_axis_config, read_axis_config
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.friction import CoulombModel
+from greybox.models.friction import CoulombModel
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 

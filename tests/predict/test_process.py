@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from greybox.data.prepare import prepare
-from greybox.friction import GMSModel
+from greybox.models.friction import GMSModel
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 

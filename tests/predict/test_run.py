@@ -14,8 +14,8 @@ from greybox.data.io import FORMATS, LOG_SUFFIXES, read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
 from greybox.fleet import MANIFEST, MODELS_FORMAT, expand_logs, machine_of
-from greybox.friction import CoulombModel
 from greybox.machine_model import MachineModel, save_machine
+from greybox.models.friction import CoulombModel
 from greybox.persistence import save_model
 from greybox.predict import ChunkProgress, Prediction, predict_logs
 from greybox.predict.output import write_process

@@ -11,8 +11,8 @@ import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
-from greybox.estimator import STANDSTILL_SHARE
-from greybox.friction import GMSModel, StribeckModel
+from greybox.models.estimator import STANDSTILL_SHARE
+from greybox.models.friction import GMSModel, StribeckModel
 from greybox.persistence import save_model
 from greybox.predict.process import predict_process
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from greybox.data.prepare import prepare
-from greybox.friction.coulomb import CoulombModel
+from greybox.models.friction.coulomb import CoulombModel
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec

@@ -16,8 +16,8 @@ import pytest
 from greybox.discover.report import write_json
 from greybox.discover.workflow import VERDICTS, discover
 from greybox.errors import GreyboxError
-from greybox.friction import CoulombModel
 from greybox.models.effects import EFFECT_NAMES, VELOCITY_ONLY
+from greybox.models.friction import CoulombModel
 from greybox.twin import CurrentNoise
 from studies.discovery import ABSORBED, StudyCase, case_logs, run_case, run_null, summarise
 

@@ -12,8 +12,8 @@ from friction_reference import lugre_step_reference, stribeck_reference
 from friction_signals import STEP, velocity_profile
 
 from greybox.base import PlantLaw
-from greybox.friction import CoulombModel, GMSModel, LuGreModel
-from greybox.friction.kernels import (
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel
+from greybox.models.friction.kernels import (
     direction_curves,
     gms_trajectory_kernel,
     lugre_decay_rate,
@@ -21,7 +21,7 @@ from greybox.friction.kernels import (
     lugre_trajectory_kernel,
     stribeck_at,
 )
-from greybox.friction.plant_laws import MAX_STEP_RATIO, gms_plant_law, lugre_plant_law, stable_step
+from greybox.models.friction.plant_laws import MAX_STEP_RATIO, gms_plant_law, lugre_plant_law, stable_step
 from greybox.twin.plant import (
     default_plant_parameters,
     lag_decay,

@@ -1,4 +1,4 @@
-"""The compiled kernels of a kernel model's frame (:class:`greybox.models.kernel.KernelFrame`) against plain Python."""
+"""The compiled kernels of a kernel model's frame (`KernelFrame`) against plain Python."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from greybox.models.kernel import KernelFrame
+from greybox.models.kernel.expansion import KernelFrame
 
 
 def _model(rng, *, weights=True, handover=True, ranges=True, n_support=40, n_features=3):

@@ -15,7 +15,7 @@ GMS element modes (``int8``): ``0`` sticking, ``+1`` slipping in the positive
 direction, ``-1`` slipping in the negative direction.
 
 Each formula is written once, as a compiled step that the run kernels here
-and the plant laws of the position loop (:mod:`greybox.friction.plant_laws`)
+and the plant laws of the position loop (:mod:`greybox.models.friction.plant_laws`)
 call: the Stribeck curve :func:`stribeck_at`, the GMS element step
 :func:`gms_element_step` (with :func:`gms_sample`), the LuGre exact step
 :func:`lugre_exact_step` (with :func:`lugre_decay_rate`).

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from greybox.models.subset import coverage_subset, grid_cells
+from greybox.models.kernel.subset import coverage_subset, grid_cells
 
 
 def skewed_log(n=20000, seed=0):
@@ -66,7 +66,7 @@ def test_small_input_returned_whole_and_bad_input_rejected():
 
 def test_accuracy_vs_subset_size_reports_each_size():
     from greybox.data.log import AxisLog
-    from greybox.models.subset import accuracy_vs_subset_size
+    from greybox.models.kernel.subset import accuracy_vs_subset_size
     from greybox.models.svr import SVRCurrentModel
 
     def run(seed, n=8000):

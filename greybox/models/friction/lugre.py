@@ -4,19 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import EFFORT, LENGTH, LinearPart, Parameter
-from ..errors import LogError, ParameterError
-from ..estimator import CurrentModel
-from ..identify.initial import (
+from ...base import EFFORT, LENGTH, LinearPart, Parameter
+from ...errors import LogError, ParameterError
+from ...identify.initial import (
     DEFAULT_DEFLECTION_MM,
     check_motion,
     presliding_deflection,
     sliding_mask,
     static_initial_guess,
 )
-from ..identify.linear import bounded_lstsq
-from ..identify.optimize import check_search_settings, local_search, multistart
-from ..identify.static import check_direction_settings, fit_stribeck, velocity_range
+from ...identify.linear import bounded_lstsq
+from ...identify.optimize import check_search_settings, local_search, multistart
+from ...identify.static import check_direction_settings, fit_stribeck, velocity_range
+from ..estimator import CurrentModel
 from .directions import direction_pair, viscous_columns
 from .kernels import direction_curves, lugre_trajectory_kernel
 from .plant_laws import lugre_plant_law
@@ -375,7 +375,7 @@ class LuGreModel(CurrentModel):
                                       Parameter(f"{name}_neg", value_neg, unit, f"{text}, negative motion"))]
 
     def plant_law(self):
-        """The fitted LuGre law as the plant of a position loop (:func:`greybox.friction.plant_laws.lugre_plant_law`).
+        """The fitted LuGre law as the plant of a position loop (:func:`~.plant_laws.lugre_plant_law`).
 
         Returns
         -------

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import EFFORT, LENGTH, LinearPart, Parameter
-from ..errors import ParameterError, Setting
+from ...base import EFFORT, LENGTH, LinearPart, Parameter
+from ...errors import ParameterError, Setting
+from ...identify.initial import check_motion, samples_at_speed
+from ...identify.static import check_direction_settings, fit_stribeck, stribeck_curve, stribeck_regressors
 from ..estimator import CurrentModel
-from ..identify.initial import check_motion, samples_at_speed
-from ..identify.static import check_direction_settings, fit_stribeck, stribeck_curve, stribeck_regressors
 
 __all__ = ["StribeckModel", "stribeck_curve"]
 

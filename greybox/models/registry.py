@@ -7,11 +7,11 @@ a file cannot make greybox run code other than these classes' constructors.
 
 from __future__ import annotations
 
+from .augmented import AugmentedModel
 from .friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from .friction.backlash import BacklashModel
-from .models.augmented import AugmentedModel
-from .models.gmssvr import GMSSVRModel
-from .models.svr import SVRCurrentModel
+from .gmssvr import GMSSVRModel
+from .svr import SVRCurrentModel
 
 __all__ = ["MODEL_CLASSES", "DERIVED_MODEL_CLASSES", "model_class", "model_kind"]
 
@@ -74,4 +74,4 @@ def model_kind(model) -> str:
     for kind, cls in _file_kinds().items():
         if type(model) is cls:
             return kind
-    raise KeyError(f"model class {type(model).__name__} is not registered in greybox.registry")
+    raise KeyError(f"model class {type(model).__name__} is not registered in greybox.models.registry")

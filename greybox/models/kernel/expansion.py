@@ -18,11 +18,11 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 from numba import njit
 
-from ..errors import ParameterError, Setting, SettingWarning
-from ..identify.bayes import minimize_log_uniform
-from ..identify.cv import blocked_folds
-from ..identify.progress import ProgressEvent
-from .handover import handover_rows, handover_weight
+from ...errors import ParameterError, Setting, SettingWarning
+from ...identify.bayes import minimize_log_uniform
+from ...identify.cv import blocked_folds
+from ...identify.progress import ProgressEvent
+from ..handover import handover_rows, handover_weight
 from .rbf import BLOCK_SAMPLES, _expansion_blocks, expansion_cutoff, rbf_expansion
 from .subset import coverage_subset
 
@@ -159,7 +159,7 @@ def fit_svr_expansion(
         Target [A].
     coverage : ndarray, shape (n_samples, k)
         Features whose plane the training subset must cover (position and
-        velocity), see :func:`greybox.models.subset.coverage_subset`.
+        velocity), see :func:`greybox.models.kernel.subset.coverage_subset`.
     run_lengths : sequence of int
         Samples per run, so that cross-validation blocks never span runs.
     fixed : dict
@@ -377,7 +377,7 @@ class KernelFrame:
         """Expansion, hand-over weight and input-range flags of raw inputs ``X`` in one compiled pass.
 
         What :meth:`expansion`, :meth:`weight` and the model's ``"inputs"`` flag give, for the few samples of
-        a live message: the per-call checks and copies of :func:`~greybox.models.rbf.rbf_expansion` are done
+        a live message: the per-call checks and copies of :func:`~greybox.models.kernel.rbf.rbf_expansion` are done
         once per frame.
 
         Parameters
@@ -483,7 +483,7 @@ def frame_terms(X, mean, scale, root_weights, support_t, alpha, intercept, gamma
     gamma : float
         Kernel parameter [1/(coordinate unit)^2].
     cutoff : float
-        :func:`~greybox.models.rbf.expansion_cutoff`; negative: no term counts.
+        :func:`~greybox.models.kernel.rbf.expansion_cutoff`; negative: no term counts.
     box_low, box_high : ndarray, shape (n_features,)
         Hand-over box in the kernel's coordinates.
     width : float

@@ -11,20 +11,20 @@ through compiled functions it receives as arguments:
 
 ``parameters`` and ``state`` are float64 arrays in the layout of each law
 (below). The element and bristle steps are the ones the models' run kernels
-use (:mod:`greybox.friction.kernels`), so a plant follows its model's law,
+use (:mod:`greybox.models.friction.kernels`), so a plant follows its model's law,
 now at the fine step ``h`` instead of the log's sample time. The friction
 is explicit: it reads the deflections and the rate of the previous step.
 
 GMS (``N`` elements)
     ``parameters = (mu+, mu-, sigma, C, curves, alpha_1..N, k_1..N)`` with ``curves`` the six
     numbers ``s_inf, s_0 - s_inf, 1 / v_s`` of positive, then of negative motion
-    (:func:`greybox.friction.kernels.direction_curves`),
+    (:func:`greybox.models.friction.kernels.direction_curves`),
     ``state = (sum_i alpha_i dz_i/dt, z_1..N, mode_1..N)``;
     ``F = mu(v) v + sigma sum_i alpha_i dz_i/dt + sum_i k_i z_i``.
 LuGre
     ``parameters = (sigma0, sigma1, sigma2+, sigma2-, curves)`` with ``curves`` the six
     numbers ``F_c, F_s - F_c, 1 / v_s`` of positive, then of negative motion
-    (:func:`greybox.friction.kernels.direction_curves` of ``F_s, F_c, v_s``; levels are magnitudes),
+    (:func:`greybox.models.friction.kernels.direction_curves` of ``F_s, F_c, v_s``; levels are magnitudes),
     ``state = (z, dz/dt)``; ``F = sigma0 z + sigma1 dz/dt + sigma2(v) v``.
 """
 
@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..base import PlantLaw
+from ...base import PlantLaw
 from .directions import direction_pair
 from .kernels import direction_curves, gms_element_step, gms_sample, lugre_decay_rate, lugre_exact_step, viscous_at
 
@@ -111,7 +111,7 @@ def gms_plant_friction(parameters, state, position_mm, velocity_mm_s):
 def gms_plant_advance(parameters, state, velocity_mm_s, step_s):
     """Move the GMS elements over one internal step ``step_s`` [s] at ``velocity_mm_s`` [mm/s] (in place).
 
-    Every element takes :func:`greybox.friction.kernels.gms_element_step`;
+    Every element takes :func:`greybox.models.friction.kernels.gms_element_step`;
     ``state[0]`` receives ``sum_i alpha_i dz_i/dt`` over the step [mm/s].
 
     Parameters
@@ -205,7 +205,7 @@ def lugre_plant_friction(parameters, state, position_mm, velocity_mm_s):
 def lugre_plant_advance(parameters, state, velocity_mm_s, step_s):
     """Move the bristles over one internal step ``step_s`` [s] at ``velocity_mm_s`` [mm/s] (in place).
 
-    The exact step :func:`greybox.friction.kernels.lugre_exact_step`;
+    The exact step :func:`greybox.models.friction.kernels.lugre_exact_step`;
     ``state[1]`` receives ``dz/dt`` over the step [mm/s].
 
     Parameters

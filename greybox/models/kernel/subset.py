@@ -17,7 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..metrics import metrics_table
+from ...metrics import metrics_table
 
 __all__ = ["coverage_subset", "grid_cells", "accuracy_vs_subset_size"]
 
@@ -146,7 +146,7 @@ def accuracy_vs_subset_size(model, train_logs, test_logs, sizes: Sequence[int]) 
     """
     from sklearn.base import clone
 
-    from ..data.log import as_log_list
+    from ...data.log import as_log_list
 
     test_runs = as_log_list(test_logs)
     measured = np.concatenate([run.current for run in test_runs])

@@ -45,7 +45,7 @@ import numba
 import numpy as np
 from numba import njit
 
-from ..threads import shared_pool
+from ...threads import shared_pool
 
 __all__ = ["rbf_expansion", "expansion_cutoff", "DEFAULT_TOLERANCE", "BLOCK_SAMPLES", "EXP_RELATIVE_ERROR",
            "MAX_CUTOFF"]

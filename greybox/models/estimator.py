@@ -19,14 +19,14 @@ from typing import Iterable
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from .base import EFFORT, LENGTH, ModelProtocol, Parameter
-from .data.log import AxisLog, as_log_list
-from .data.quantities import MOTIONS, Motion
-from .errors import LogError, ParameterError, Setting
-from .identify.inertia import axis_inertia_note, inertia_note
-from .identify.intervals import with_intervals
-from .identify.progress import make_progress
-from .metrics import rmse
+from ..base import EFFORT, LENGTH, ModelProtocol, Parameter
+from ..data.log import AxisLog, as_log_list
+from ..data.quantities import MOTIONS, Motion
+from ..errors import LogError, ParameterError, Setting
+from ..identify.inertia import axis_inertia_note, inertia_note
+from ..identify.intervals import with_intervals
+from ..identify.progress import make_progress
+from ..metrics import rmse
 
 __all__ = ["CurrentModel", "StreamView", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
 

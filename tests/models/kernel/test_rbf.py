@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from sklearn.svm import SVR
 
-from greybox.models import rbf
-from greybox.models.rbf import EXP_RELATIVE_ERROR, MAX_CUTOFF, rbf_expansion
+from greybox.models.kernel import rbf
+from greybox.models.kernel.rbf import EXP_RELATIVE_ERROR, MAX_CUTOFF, rbf_expansion
 
 
 def reference_expansion(X, sv, alpha, intercept, gamma):

@@ -7,16 +7,16 @@ import pytest
 from friction_reference import gms_reference, lugre_reference, play_operator_reference
 from friction_signals import STEP, velocity_profile
 
-from greybox.friction.directions import direction_pair
-from greybox.friction.gms import GMSState, gms_trajectory, simulate_gms
-from greybox.friction.kernels import (
+from greybox.models.friction.directions import direction_pair
+from greybox.models.friction.gms import GMSState, gms_trajectory, simulate_gms
+from greybox.models.friction.kernels import (
     direction_curves,
     gms_friction_kernel,
     gms_trajectory_kernel,
     lugre_trajectory_kernel,
     play_operator_kernel,
 )
-from greybox.friction.lugre import simulate_lugre
+from greybox.models.friction.lugre import simulate_lugre
 
 
 def gms_parameters(n_elements, seed=0):

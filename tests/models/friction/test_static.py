@@ -13,9 +13,9 @@ from friction_signals import motion_log, velocity_profile
 
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
-from greybox.friction import CoulombModel, StribeckModel, stribeck_curve
-from greybox.friction.coulomb import coulomb_friction
 from greybox.identify.static import fit_stribeck
+from greybox.models.friction import CoulombModel, StribeckModel, stribeck_curve
+from greybox.models.friction.coulomb import coulomb_friction
 from greybox.persistence import load_model, save_model
 
 

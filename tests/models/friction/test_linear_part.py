@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from greybox.data.prepare import prepare
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.twin import make_dataset
 
 MODELS = [CoulombModel(), CoulombModel(asymmetric=True), CoulombModel(fit_offset=True),

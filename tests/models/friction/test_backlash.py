@@ -8,9 +8,9 @@ from friction_reference import backlash_gap_reference
 from friction_signals import STEP, motion_log, velocity_profile
 
 from greybox.errors import ParameterError
-from greybox.friction import CoulombModel, GMSModel
-from greybox.friction.backlash import BacklashModel, BacklashState, gaps_of
-from greybox.friction.gms import simulate_gms
+from greybox.models.friction import CoulombModel, GMSModel
+from greybox.models.friction.backlash import BacklashModel, BacklashState, gaps_of
+from greybox.models.friction.gms import simulate_gms
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.

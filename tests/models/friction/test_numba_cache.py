@@ -14,7 +14,7 @@ def test_numba_cache_is_kept_out_of_the_package_directory(tmp_path):
     package = Path(greybox.__file__).resolve().parent
     env = {key: value for key, value in os.environ.items() if key != "NUMBA_CACHE_DIR"}
     env["XDG_CACHE_HOME"] = str(tmp_path)
-    script = ("import greybox, numba.core.config as c, greybox.friction.kernels; print(c.CACHE_DIR)")
+    script = ("import greybox, numba.core.config as c, greybox.models.friction.kernels; print(c.CACHE_DIR)")
     printed = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
     cache = Path(printed.stdout.strip())
     assert cache == tmp_path / "greybox" / "numba"

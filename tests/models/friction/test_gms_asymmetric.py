@@ -8,9 +8,9 @@ from friction_reference import gms_reference
 from friction_signals import STEP, motion_log, velocity_profile
 
 from greybox.errors import ParameterError
-from greybox.friction import GMSModel, stribeck_curve
-from greybox.friction.gms import gms_trajectory, simulate_gms
-from greybox.friction.plant_laws import gms_plant_law
+from greybox.models.friction import GMSModel, stribeck_curve
+from greybox.models.friction.gms import gms_trajectory, simulate_gms
+from greybox.models.friction.plant_laws import gms_plant_law
 
 #: Shared elements, and a break-away curve and viscous coefficient per direction (positive, negative motion).
 ASYMMETRIC = {"alpha": np.array([0.15, 0.25, 0.6]), "k": np.array([40.0, 60.0, 30.0]), "sigma": 0.002, "C": 2.0,

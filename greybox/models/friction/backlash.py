@@ -15,7 +15,7 @@ motion of the motor outside the gaps and standstill inside them:
 - when its friction changes sign after a load of at least ``threshold_``,
   the gap opens at the present motor position ``x``: it spans ``[x - b, x]``
   after a positive load, ``[x, x + b]`` after a negative one
-  (:func:`greybox.friction.kernels.backlash_gap_kernel`);
+  (:func:`greybox.models.friction.kernels.backlash_gap_kernel`);
 - the motor leaving the span closes the contact, on either face;
 - a run starts in the middle of a gap (the load's position in the gap is not logged).
 
@@ -38,11 +38,11 @@ from scipy.optimize import minimize_scalar
 from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 
-from ..base import EFFORT, LENGTH, Parameter
-from ..data.log import AxisLog
-from ..errors import ParameterError
+from ...base import EFFORT, LENGTH, Parameter
+from ...data.log import AxisLog
+from ...errors import ParameterError
+from ...identify.progress import ProgressEvent
 from ..estimator import CurrentModel
-from ..identify.progress import ProgressEvent
 from .gms import GMSModel
 from .kernels import backlash_gap_kernel
 

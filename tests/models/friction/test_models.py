@@ -8,8 +8,8 @@ from friction_signals import STEP, motion_log, velocity_profile
 from sklearn.base import clone
 
 from greybox.errors import LogError, ParameterError
-from greybox.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
-from greybox.friction.gms import simulate_gms
+from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
+from greybox.models.friction.gms import simulate_gms
 
 QUICK = {
     "coulomb": lambda: CoulombModel(),

@@ -1,9 +1,9 @@
 """Physical friction models: Coulomb, Stribeck, LuGre and GMS.
 
 Each model is a current model (inertia + friction, see
-:class:`greybox.estimator.CurrentModel`) with scikit-learn estimator
+:class:`greybox.models.estimator.CurrentModel`) with scikit-learn estimator
 conventions; the dynamic ones (LuGre, GMS) run compiled kernels from
-:mod:`greybox.friction.kernels`.
+:mod:`greybox.models.friction.kernels`.
 """
 
 from .coulomb import CoulombModel

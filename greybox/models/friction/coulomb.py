@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import EFFORT, LENGTH, LinearPart, Parameter
-from ..errors import ParameterError, Setting
+from ...base import EFFORT, LENGTH, LinearPart, Parameter
+from ...errors import ParameterError, Setting
+from ...identify.initial import check_motion, samples_at_speed
+from ...identify.static import check_direction_settings, fit_coulomb
 from ..estimator import CurrentModel
-from ..identify.initial import check_motion, samples_at_speed
-from ..identify.static import check_direction_settings, fit_coulomb
 
 __all__ = ["CoulombModel", "coulomb_friction"]
 

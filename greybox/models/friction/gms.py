@@ -24,19 +24,19 @@ from typing import NamedTuple
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from ..base import EFFORT, LENGTH, LinearPart, Parameter
-from ..errors import ParameterError, Setting
-from ..estimator import CurrentModel
-from ..identify.initial import (
+from ...base import EFFORT, LENGTH, LinearPart, Parameter
+from ...errors import ParameterError, Setting
+from ...identify.initial import (
     DEFAULT_DEFLECTION_MM,
     check_motion,
     direction_level_ratio,
     presliding_deflection,
     static_initial_guess,
 )
-from ..identify.linear import bounded_lstsq
-from ..identify.optimize import check_search_settings, fixed_design, local_search, multistart, multistart_results
-from ..identify.static import check_direction_settings, velocity_range
+from ...identify.linear import bounded_lstsq
+from ...identify.optimize import check_search_settings, fixed_design, local_search, multistart, multistart_results
+from ...identify.static import check_direction_settings, velocity_range
+from ..estimator import CurrentModel
 from .directions import direction_pair, viscous_columns
 from .kernels import direction_curves, gms_friction_kernel, gms_trajectory_kernel
 from .plant_laws import gms_plant_law
@@ -731,7 +731,7 @@ class GMSModel(CurrentModel):
         return np.vstack([p[1] for p in parts]), np.vstack([p[2] for p in parts])
 
     def plant_law(self):
-        """The fitted GMS law as the plant of a position loop (:func:`greybox.friction.plant_laws.gms_plant_law`).
+        """The fitted GMS law as the plant of a position loop (:func:`~.plant_laws.gms_plant_law`).
 
         Returns
         -------

@@ -8,8 +8,8 @@ from friction_reference import gms_reference
 from friction_signals import STEP, motion_log, velocity_profile
 
 from greybox.errors import ParameterError
-from greybox.friction import GMSModel, stribeck_curve
-from greybox.friction.gms import (
+from greybox.models.friction import GMSModel, stribeck_curve
+from greybox.models.friction.gms import (
     _COST_TIE,
     _SLOW_SLIP_RATIOS,
     PRUNE_SHARE,
