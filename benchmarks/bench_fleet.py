@@ -34,9 +34,9 @@ from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.fleet import expand_logs
 from greybox.fleet_train import run_training, train_jobs
+from greybox.models.registry import model_class
 from greybox.persistence import save_model
 from greybox.predict.fleet import fleet_jobs, run_fleet
-from greybox.models.registry import model_class
 from greybox.twin import make_dataset
 
 

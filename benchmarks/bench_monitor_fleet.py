@@ -37,10 +37,10 @@ from greybox.data.blocks import concatenate
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.fleet import expand_logs
+from greybox.models.registry import model_class
 from greybox.monitor.workflow import run_monitor
 from greybox.persistence import save_model
 from greybox.predict.fleet import fleet_jobs, run_fleet
-from greybox.models.registry import model_class
 from greybox.twin.ageing import SPINDLE_COLUMN, aged_log
 from greybox.twin.cutting import CuttingSpec
 

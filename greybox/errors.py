@@ -126,6 +126,9 @@ class SettingWarning(UserWarning):
         self.parts = tuple(parts)
         super().__init__(_text(parts))
 
+    def __reduce__(self):
+        return (type(self), self.parts)  # a worker process's warning keeps the settings it names
+
 
 class LogError(GreyboxError, ValueError):
     """An axis log cannot be read or fails validation.

@@ -22,7 +22,7 @@ from typing import Callable, Iterator, Mapping, Sequence
 
 from .atomic import write_text_atomic
 from .data.io import LOG_SUFFIXES
-from .errors import GreyboxError
+from .errors import GreyboxError, Setting
 
 __all__ = ["LOG_SUFFIXES", "MANIFEST", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_out_dir", "expand_logs",
            "fleet_summary", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared",
@@ -388,7 +388,8 @@ def check_out_dir(out: str | os.PathLike, inputs=()) -> Path:
     if path.exists() and not path.is_dir():
         raise GreyboxError(f"{path}: exists and is not a directory; the output of a fleet run is a directory")
     if any(path.resolve() == Path(item).resolve() for item in inputs):
-        raise GreyboxError(f"--out {path}: is one of the inputs; choose another output directory")
+        raise GreyboxError(Setting("out", assign=False), f" {path}: is one of the inputs; choose another output "
+                           "directory")
     return path.resolve()
 
 
@@ -431,7 +432,8 @@ def _client(scheduler: str | None, workers: int | None) -> Iterator:
         try:
             client = Client(scheduler, timeout="5s")
         except (OSError, TimeoutError) as error:
-            raise GreyboxError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({error})") from None
+            raise GreyboxError(Setting("scheduler", assign=False), f" {scheduler}: cannot reach the Dask scheduler "
+                                   f"({error})") from None
         cluster = None
     else:
         # one thread per worker process, compiled kernels included: the processes share out the cores

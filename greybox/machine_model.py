@@ -29,8 +29,8 @@ from typing import Mapping
 
 from .atomic import write_text_atomic
 from .errors import ModelFileError
-from .persistence import check_reproduces, load_model, save_model
 from .models.registry import model_kind
+from .persistence import check_reproduces, load_model, save_model
 
 __all__ = ["MACHINE_FORMAT", "MACHINE_FORMAT_VERSION", "MANIFEST", "MachineModel", "is_machine_model",
            "check_machine_output", "save_machine", "load_machine"]

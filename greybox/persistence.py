@@ -57,13 +57,13 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from .models import registry
 from .atomic import atomic_output
 from .data.log import AxisLog
 from .data.quantities import MOTIONS
 from .errors import GreyboxError, ModelFileError, ParameterError
 from .identify.intervals import check_intervals
 from .identify.selection import check_selection_record
+from .models import registry
 from .models.estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
 from .provenance import TRAINING_RECORD, check_training_record
 

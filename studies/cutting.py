@@ -59,9 +59,9 @@ from greybox.evaluate.plots import finish_figure, import_pyplot
 from greybox.evaluate.report import MODEL_LABELS as LABELS
 from greybox.metrics import rmse
 from greybox.models.chunked import predict_chunked
+from greybox.models.registry import MODEL_CLASSES
 from greybox.predict.process import predict_process
 from greybox.provenance import provenance, provenance_line
-from greybox.models.registry import MODEL_CLASSES
 from greybox.twin import make_dataset
 from greybox.twin.cutting import CuttingSpec
 from studies.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation

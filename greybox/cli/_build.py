@@ -97,7 +97,8 @@ def build_model(kind: str, args: argparse.Namespace):
     Parameters
     ----------
     kind : str
-        Registered model kind (e.g. ``"gms"``, ``"svr"``, ``"gmssvr"``), as in :func:`greybox.models.registry.model_class`.
+        Registered model kind (e.g. ``"gms"``, ``"svr"``, ``"gmssvr"``), as in
+        :func:`~greybox.models.registry.model_class`.
     args : argparse.Namespace
         Parsed command-line arguments; the model options (``offset``, ``asymmetric``, ``elements``,
         ``model_seed``, ``set``, ``backlash``) are read from it, and those it lacks count as not given.

@@ -23,7 +23,7 @@ from typing import Iterator
 from ..errors import Setting
 from ._model_options import MODEL_OPTIONS
 
-__all__ = ["OPTIONS", "Option", "command_notes", "error_message", "spelt"]
+__all__ = ["OPTIONS", "Option", "command_notes", "error_message", "spelt", "message_text"]
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,8 @@ _FLAGS = {"fit_offset", "asymmetric"}
 _MODEL_METAVARS = {"n_elements": "N", "random_state": "N", "inertia": "J"}
 
 #: Setting -> the option that sets it: the model options of train, discover and compensate
-#: (``greybox.cli._model_options``) and the log readers' options (``greybox.cli._options.add_log_arguments``).
+#: (``greybox.cli._model_options``), the log readers' options (``greybox.cli._options.add_log_arguments``) and
+#: those of ``greybox predict`` and ``greybox plot``.
 OPTIONS: dict[str, Option] = {
     **{name: Option(flag, None if name in _FLAGS else _MODEL_METAVARS.get(name, "VALUE"))
        for flag, _, name in MODEL_OPTIONS},
@@ -58,6 +59,17 @@ OPTIONS: dict[str, Option] = {
     "sample_time": Option("--sample-time", "S"),
     "topic": Option("--topic", "TOPIC"),
     "axis": Option("--axis", "NAME"),
+    # greybox predict (greybox.predict.predict_logs); the windows of plot and predict
+    "out": Option("--out", "OUT"),
+    "axis_config": Option("--axis-config", "TOML"),
+    "machine": Option("--machine", "TOML"),
+    "calibration": Option("--calibration", "AIRCUT..."),
+    "coverage": Option("--interval", "C"),
+    "plot": Option("--plot", "PNG"),
+    "plot_window": Option("--plot-window", "START END"),
+    "window": Option("--window", "START END"),
+    "scheduler": Option("--scheduler", "ADDRESS"),
+    "workers": Option("--workers", "N"),
 }
 
 
@@ -138,8 +150,16 @@ def spelt(parts, *, settable: bool = True) -> str:
     return " ".join(text.split())
 
 
-def _message(thing, settable: bool) -> str:
-    """An error's or a warning's text in command-line words (its parts, if it has them)."""
+def message_text(thing: BaseException, *, settable: bool) -> str:
+    """An error's or a warning's text in command-line words (its parts, if it has them), on one line.
+
+    Parameters
+    ----------
+    thing : BaseException
+        The error, or the warning's message (a :class:`Warning`).
+    settable : bool
+        Whether the command offers ``--set NAME=VALUE``.
+    """
     parts = getattr(thing, "parts", None)
     return spelt(parts if parts is not None else [str(thing)], settable=settable)
 
@@ -154,7 +174,7 @@ def error_message(error: BaseException, args: argparse.Namespace) -> str:
     args : argparse.Namespace
         The parsed command line (whether it offers ``--set``).
     """
-    return _message(error, hasattr(args, "set"))
+    return message_text(error, settable=hasattr(args, "set"))
 
 
 @contextlib.contextmanager
@@ -181,7 +201,7 @@ def command_notes(args: argparse.Namespace, stream=None) -> Iterator[list[str]]:
     settable = hasattr(args, "set")
 
     def show(message, category, filename, lineno, file=None, line=None) -> None:
-        note = "note: " + _message(message, settable)
+        note = "note: " + message_text(message, settable=settable)
         if note in printed:
             return
         printed.append(note)

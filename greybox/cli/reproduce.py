@@ -12,6 +12,7 @@ from ..errors import GreyboxError
 from ..evaluate.pattern import paper_pattern, sole_svr_beside_paper
 from ..evaluate.report import check_output_dir
 from ..reproduce.experiments import EXPERIMENTS, find_log, reproduce
+from ._spelling import message_text
 from ._types import POSITIVE_INT
 
 
@@ -52,12 +53,13 @@ def add_parser(subparsers) -> None:
 
 
 class _Elapsed:
-    """Progress lines on stderr, prefixed with the time since the start."""
+    """Progress lines on stderr, prefixed with the time since the start; a fit's warning as a note."""
 
     def __init__(self):
         self.started = time.perf_counter()
 
-    def __call__(self, line: str) -> None:
+    def __call__(self, item: str | Warning) -> None:
+        line = item if isinstance(item, str) else "  note: " + message_text(item, settable=False)
         print(f"[{time.perf_counter() - self.started:6.1f} s] {line}", file=sys.stderr, flush=True)
 
 

@@ -17,8 +17,8 @@ from ..identify.intervals import METHODS as INTERVAL_METHODS
 from ..identify.intervals import attach_intervals
 from ..metrics import metrics_table
 from ..model_choice import DEFAULT_CANDIDATES
-from ..persistence import save_verified
 from ..models.registry import MODEL_CLASSES
+from ..persistence import save_verified
 from ._advice import offset_note
 from ._build import add_model_arguments, build_model, takes_hyperparameter
 from ._model_text import model_lines

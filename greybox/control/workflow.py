@@ -16,8 +16,8 @@ from typing import Callable, Mapping, Sequence
 from ..data.log import AxisLog
 from ..data.prepare import prepare
 from ..errors import GreyboxError
-from ..persistence import load_model
 from ..models.registry import model_kind
+from ..persistence import load_model
 from ..twin import CurrentNoise, axis_geometry, make_dataset
 from .feedforward import InertiaFeedForward, ModelFeedForward
 from .loop import LoopResult, compare_feedforwards, controller_periods

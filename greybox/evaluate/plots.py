@@ -18,7 +18,7 @@ import numpy as np
 
 from ..atomic import atomic_output
 from ..data.log import AxisLog
-from ..errors import GreyboxError
+from ..errors import GreyboxError, Setting
 
 __all__ = ["ENVELOPE_POINTS", "check_window", "envelope", "envelope_indices", "plot_log", "save_figure",
            "import_pyplot", "legend_outside", "finish_figure", "window_title"]
@@ -113,7 +113,7 @@ def envelope(time, values, max_points: int = ENVELOPE_POINTS) -> tuple[np.ndarra
     return time[index], values[index]
 
 
-def check_window(window, time, flag: str = "--window", name: str = "the log") -> tuple[float, float] | None:
+def check_window(window, time, setting: str = "window", name: str = "the log") -> tuple[float, float] | None:
     """Return the window ``(start, end)`` [s], or None; refuse one that is empty, reversed or off the log.
 
     Parameters
@@ -122,8 +122,8 @@ def check_window(window, time, flag: str = "--window", name: str = "the log") ->
         The option's value.
     time : ndarray
         The log's time [s].
-    flag : str, default "--window"
-        Option name, for the message.
+    setting : str, default "window"
+        The setting that gave the window, named in the message (the command line spells its option).
     name : str
         The log, for the message.
 
@@ -135,12 +135,12 @@ def check_window(window, time, flag: str = "--window", name: str = "the log") ->
     if window is None:
         return None
     start, end = (float(v) for v in window)
-    text = f"{flag} {start:g} {end:g}"
+    text = (Setting(setting, assign=False), f" {start:g} {end:g}")
     if not (math.isfinite(start) and math.isfinite(end)) or start >= end:
-        raise GreyboxError(f"{text}: give START < END, both finite, in seconds of log time")
+        raise GreyboxError(*text, ": give START < END, both finite, in seconds of log time")
     first, last = float(time[0]), float(time[-1])
     if not ((time >= start) & (time <= end)).any():
-        raise GreyboxError(f"{text}: no sample in the window; {name} runs from {first:g} to {last:g} s")
+        raise GreyboxError(*text, f": no sample in the window; {name} runs from {first:g} to {last:g} s")
     return start, end
 
 

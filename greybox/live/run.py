@@ -126,8 +126,8 @@ def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, re
                   axis, source, say):
     """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
     from ..data.axis_config import read_axis_config
-    from ..persistence import load_model
     from ..models.registry import model_kind
+    from ..persistence import load_model
 
     model = load_model(model_path)
     config = read_axis_config(axis_config_path) if axis_config_path else None

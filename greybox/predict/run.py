@@ -29,7 +29,7 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..errors import GreyboxError
+from ..errors import GreyboxError, Setting
 from ..fleet import check_out_dir, fleet_summary, read_prepared
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from ..provenance import model_quantity, preparation_warning
@@ -190,16 +190,17 @@ class _Request:
             if plot.suffix.lower() not in PLOT_SUFFIXES:
                 raise GreyboxError(f"{plot}: unknown picture extension '{plot.suffix}'; use {', '.join(PLOT_SUFFIXES)}")
             if plot.resolve() == out.resolve():
-                raise GreyboxError(f"{plot}: --plot and --out name the same file")
+                raise GreyboxError(f"{plot}: ", _named("plot"), " and ", _named("out"), " name the same file")
             check_output_path(plot, overwrite=self.force, protect=inputs)
         elif self.plot_window is not None:
-            raise GreyboxError("--plot-window needs --plot PNG")
+            raise GreyboxError(_named("plot_window"), " needs ", Setting("plot"))
         if self.calibration is None and self.coverage is not None:
-            raise GreyboxError("--interval needs --calibration AIRCUT... (air-cut logs the model was not trained on)")
+            raise GreyboxError(_named("coverage"), " needs ", Setting("calibration"),
+                               " (air-cut logs the model was not trained on)")
         own = [path for path in self.calibration or () if Path(path).resolve() == Path(log).resolve()]
         if own:
-            raise GreyboxError(f"--calibration: {own[0]} is the cutting log itself; calibrate on air cuts the "
-                               "model was not trained on")
+            raise GreyboxError(_named("calibration"), f": {own[0]} is the cutting log itself; calibrate on air cuts "
+                               "the model was not trained on")
 
     def interval(self, model, read: Callable[[str], list]) -> ProcessInterval | None:
         """The calibrated interval of ``model`` from the calibration logs (``read(path)`` gives their runs)."""
@@ -251,12 +252,17 @@ class _Request:
         return Prediction(closing=lines, status=status, manifest=manifest)
 
 
+def _named(name: str) -> Setting:
+    """The setting ``name`` of :func:`predict_logs`, named in a message (the command line spells its option)."""
+    return Setting(name, assign=False)
+
+
 def _window(request: _Request, runs, log: str):
     """The picture's time window, checked against the log's time."""
     from ..evaluate.plots import check_window
 
     log_time = np.concatenate([run.time for run in runs])
-    return check_window(request.plot_window, log_time, "--plot-window", Path(log).name)
+    return check_window(request.plot_window, log_time, "plot_window", Path(log).name)
 
 
 class ModelFile:
@@ -282,8 +288,8 @@ class ModelFile:
         from ..persistence import load_model
 
         if request.machine:
-            raise GreyboxError("--machine applies to a machine model (a directory written by 'greybox train --axes'); "
-                               "give one axis's mechanics with --axis-config")
+            raise GreyboxError(_named("machine"), " applies to a machine model (a directory written by 'greybox train "
+                               "--axes'); give one axis's mechanics with ", _named("axis_config"))
         inputs = [self.path, log, *([request.axis_config] if request.axis_config else []), *(request.calibration or [])]
         request.check_outputs(log, inputs)
         config = read_axis_config(request.axis_config) if request.axis_config else None
@@ -424,7 +430,7 @@ class MachineDirectory:
     def predict_fleet(self, logs: Sequence[str], request: _Request) -> Prediction:
         """Refused: a fleet run takes one model file."""
         raise GreyboxError(f"{self.path}: a fleet run takes one model file; run one fleet per axis of the machine "
-                           "model with its file and --axis")
+                           "model with its file and ", _named("axis"))
 
     def predict_log(self, log: str, request: _Request) -> Prediction:
         """Predict every axis of one log (see :func:`predict_logs`)."""
@@ -435,11 +441,12 @@ class MachineDirectory:
         from .plot import plot_machine_process
 
         read = request.read
-        for option, value in (("--axis-config", request.axis_config), ("--columns", read.get("columns")),
-                              ("--axis", read.get("axis"))):
+        for setting, value in (("axis_config", request.axis_config), ("columns", read.get("columns")),
+                               ("axis", read.get("axis"))):
             if value:
-                raise GreyboxError(f"{option} does not apply to a machine model ({self.path}): it predicts every axis "
-                                   "of the log; give the axes' channels and mechanics with --machine TOML")
+                raise GreyboxError(_named(setting), f" does not apply to a machine model ({self.path}): it predicts "
+                                   "every axis of the log; give the axes' channels and mechanics with ",
+                                   Setting("machine"))
         inputs = [self.path, log] + ([request.machine] if request.machine else []) + list(request.calibration or [])
         request.check_outputs(log, inputs)
         machine = load_machine(self.path)
@@ -602,11 +609,13 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
                        progress=progress, fleet_progress=fleet_progress, notify=notify or (lambda line: None))
     source = open_model(model)
     if is_fleet(logs):
-        for option, value in (("--plot", plot), ("--plot-window", plot_window), ("--calibration", calibration),
-                              ("--interval", coverage), ("--machine", machine)):
+        for setting, value in (("plot", plot), ("plot_window", plot_window), ("calibration", calibration),
+                               ("coverage", coverage), ("machine", machine)):
             if value is not None:
-                raise GreyboxError(f"{option} applies to one log; a fleet run (several logs) writes the process tables")
+                raise GreyboxError(_named(setting), " applies to one log; a fleet run (several logs) writes the "
+                                   "process tables")
         return source.predict_fleet([str(item) for item in logs], request)
     if scheduler or workers:
-        raise GreyboxError("--scheduler and --workers apply to fleet runs (several logs, a directory or a pattern)")
+        raise GreyboxError(_named("scheduler"), " and ", _named("workers"),
+                           " apply to fleet runs (several logs, a directory or a pattern)")
     return source.predict_log(str(logs[0]), request)

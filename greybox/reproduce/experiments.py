@@ -387,8 +387,8 @@ class _FitCache:
     def __init__(self):
         self.models: dict[str, object] = {}
 
-    def fit(self, spec: ModelSpec, settings, logs, model_progress) -> tuple[object, float, list[str]]:
-        """The fitted model, the fit's wall time [s] (0 when shared) and the warnings it issued."""
+    def fit(self, spec: ModelSpec, settings, logs, model_progress) -> tuple[object, float, list[Warning]]:
+        """The fitted model, the fit's wall time [s] (0 when shared) and the warnings it issued (each once)."""
         from ..models.registry import model_class
 
         model = model_class(spec.kind)(**_settings_for(spec, settings))
@@ -403,7 +403,7 @@ class _FitCache:
             model.fit_staged([logs[d] for d in spec.train], [logs[d] for d in spec.stage2] if spec.stage2 else None,
                              progress=model_progress, first_stage=first)
         self.models[key] = model
-        notes = list(dict.fromkeys(str(w.message) for w in caught))
+        notes = list({str(w.message): w.message for w in caught}.values())
         return model, time.perf_counter() - started, notes
 
     def _stage(self, template, train, logs, model_progress):
@@ -420,7 +420,7 @@ def run_experiments(
     experiments: Sequence[Experiment] = EXPERIMENTS,
     *,
     settings: Mapping[str, Mapping] | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Callable[[str | Warning], None] | None = None,
     model_progress=None,
 ) -> AxisResults:
     """Fit and test every model of ``experiments`` on the prepared logs of one axis.
@@ -437,7 +437,9 @@ def run_experiments(
         ``gmssvr`` the entry ``"gms"`` (a dict, or an unfitted GMSModel) sets
         the GMS stage, by default the ``gms`` entry.
     progress : callable, optional
-        Receives one line of text per step (model fitted, with its time).
+        Receives one line of text per step (model fitted, with its time), and each warning a fit
+        issued (a :class:`Warning`; a :class:`~greybox.errors.SettingWarning` names the settings it
+        concerns), to be shown as a note.
     model_progress : None, bool or callable, optional
         Passed to every model's ``fit`` (see :meth:`greybox.models.estimator.CurrentModel.fit`).
 
@@ -459,7 +461,7 @@ def run_experiments(
             model, seconds, notes = cache.fit(spec, settings, logs, model_progress)
             train = {d: model.predict(logs[d]) for d in spec.fitted_on}
             test = {d: model.predict(logs[d]) for d in experiment.test}
-            result = ModelResult(spec, model, seconds, train, test, notes)
+            result = ModelResult(spec, model, seconds, train, test, [str(note) for note in notes])
             models.append(result)
             results.records += _model_records(experiment, axis, result, logs)
             if hasattr(model, "hyperparameters_table"):
@@ -470,7 +472,7 @@ def run_experiments(
             say(f"axis {axis}, experiment {experiment.number}: {spec.describe()}{shared}, "
                 f"test RE {test_re:.2f} %")
             for note in notes:
-                say(f"  note: {note}")
+                say(note)
         results.experiments[experiment.number] = models
         results.records += _noise_floor_records(experiment, axis, logs)
     results.seconds = time.perf_counter() - started
@@ -511,7 +513,7 @@ def run_axis(
     *,
     settings: Mapping[str, Mapping] | None = None,
     max_duration_s: float | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Callable[[str | Warning], None] | None = None,
     model_progress=None,
 ) -> AxisResults:
     """Read the logs of one axis from ``data_dir`` and run the experiments on them.
@@ -691,7 +693,7 @@ def reproduce(
     settings: Mapping[str, Mapping] | None = None,
     jobs: int = 1,
     save_models: bool = True,
-    progress: Callable[[str], None] | None = None,
+    progress: Callable[[str | Warning], None] | None = None,
     model_progress=None,
     intro: str = "",
 ) -> Reproduction:
@@ -715,7 +717,7 @@ def reproduce(
     save_models : bool, default True
         Write every fitted model to ``out_dir/models/exp<n>_<axis>_<model>.gbm``.
     progress : callable, optional
-        Receives one line of text per step.
+        Receives one line of text per step, and each warning a fit issued (see :func:`run_experiments`).
     model_progress : None, bool or callable, optional
         Progress of every model fit (see :meth:`greybox.models.estimator.CurrentModel.fit`).
     intro : str

@@ -12,7 +12,7 @@ import pytest
 
 from greybox.data.io import FORMATS, LOG_SUFFIXES, read_log, write_log
 from greybox.data.prepare import prepare
-from greybox.errors import GreyboxError
+from greybox.errors import GreyboxError, Setting
 from greybox.fleet import MANIFEST, MODELS_FORMAT, expand_logs, machine_of
 from greybox.machine_model import MachineModel, save_machine
 from greybox.models.friction import CoulombModel
@@ -89,15 +89,15 @@ def test_a_machine_model_predicts_every_axis_and_refuses_a_fleet(files, tmp_path
     assert {"X_current_process_A", "Y_current_process_A"} <= set(_table(tmp_path / "m.csv").columns)
     with pytest.raises(GreyboxError, match="a fleet run takes one model file"):
         predict_logs(files["machine"], [files["csv"], files["parquet"]], out=tmp_path / "fleet")
-    with pytest.raises(GreyboxError, match="--axis does not apply to a machine model"):
+    with pytest.raises(GreyboxError, match="^axis does not apply to a machine model"):
         predict_logs(files["machine"], files["csv"], out=tmp_path / "m2.csv", read={"axis": "X"})
     assert not (tmp_path / "fleet").exists() and not (tmp_path / "m2.csv").exists()
 
 
 @pytest.mark.parametrize("options, message", [
-    ({"plot": "p.png"}, "--plot applies to one log"),
-    ({"calibration": ["air.csv"]}, "--calibration applies to one log"),
-    ({"machine": "m.toml"}, "--machine applies to one log"),
+    ({"plot": "p.png"}, "^plot applies to one log"),
+    ({"calibration": ["air.csv"]}, "^calibration applies to one log"),
+    ({"machine": "m.toml"}, "^machine applies to one log"),
 ])
 def test_options_of_one_log_are_refused_for_a_fleet_before_any_work(files, tmp_path, options, message):
     with pytest.raises(GreyboxError, match=message):
@@ -106,10 +106,12 @@ def test_options_of_one_log_are_refused_for_a_fleet_before_any_work(files, tmp_p
 
 
 def test_cluster_options_are_refused_for_one_log_and_outputs_checked_before_work(files, tmp_path):
-    with pytest.raises(GreyboxError, match="--scheduler and --workers apply to fleet runs"):
+    with pytest.raises(GreyboxError, match="^scheduler and workers apply to fleet runs"):
         predict_logs(files["model_path"], files["csv"], out=tmp_path / "p.csv", workers=2)
-    with pytest.raises(GreyboxError, match="--interval needs --calibration"):
+    with pytest.raises(GreyboxError, match="^coverage needs calibration= ") as refused:
         predict_logs(files["model_path"], files["csv"], out=tmp_path / "p.csv", coverage=0.9)
+    # the message names the settings (the command line spells them as --interval and --calibration)
+    assert [part.name for part in refused.value.parts if isinstance(part, Setting)] == ["coverage", "calibration"]
     with pytest.raises(GreyboxError, match="is an input of this command"):
         predict_logs(files["model_path"], files["csv"], out=files["csv"], force=True)
     assert not (tmp_path / "p.csv").exists()

@@ -7,7 +7,7 @@ import pytest
 
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare, trim
-from greybox.errors import GreyboxError
+from greybox.errors import GreyboxError, Setting, SettingWarning
 from greybox.evaluate.records import NOISE_FLOOR
 from greybox.evaluate.report import svr_generalisation
 from greybox.metrics import rmse
@@ -147,6 +147,26 @@ def test_svr_generalisation_is_computed_from_the_runs_records(results):
         assert entry["loses_accuracy_on"] == [log for log, re in entry["test_re"].items() if re > train["re"]]
 
 
+def _lowest_corner(objective, intervals, **kwargs):
+    """Stand-in for the Bayesian optimisation that picks the lower end of every interval."""
+    point = {name: low for name, (low, _) in intervals.items()}
+    return point, [{**point, "objective": objective(point)}]
+
+
+def test_a_fits_warning_reaches_progress_with_the_settings_it_names(logs, monkeypatch):
+    from greybox.models.kernel import expansion
+
+    monkeypatch.setattr(expansion, "minimize_log_uniform", _lowest_corner)
+    one = (Experiment(1, "train on A, test on C", "Table 3", (ModelSpec("svr", ("A",)),), ("C",)),)
+    items = []
+    result = run_experiments({d: logs[d] for d in "AC"}, "X", one, progress=items.append,
+                             settings={"svr": {**FAST["svr"], "optimize": True, "n_calls": 1}})
+    (note,) = [item for item in items if isinstance(item, Warning)]
+    assert isinstance(note, SettingWarning) and "ended at the end of its search interval" in str(note)
+    assert [part.name for part in note.parts if isinstance(part, Setting)] == ["bounds"]
+    assert result.experiments[1][0].notes == [str(note)]  # the report keeps the text
+
+
 def test_missing_dataset_is_reported():
     logs = {d: None for d in "ABC"}
     with pytest.raises(GreyboxError, match="dataset.*D"):
@@ -167,7 +187,8 @@ def test_reproduce_writes_the_report_and_model_files(tmp_path):
     names = {p.name for p in out.iterdir()}
     assert {"metrics.json", "metrics.csv", "tables.md", "index.html", "models", "exp1_error_boxplot.png",
             "exp1_time_X.png", "exp1_time_Y.png", "exp1_residual_position_Y.png"} <= names
-    assert any(line.startswith("axis Y, experiment 1: gmssvr") for line in lines)  # from the worker process
+    assert any(isinstance(line, str) and line.startswith("axis Y, experiment 1: gmssvr")
+               for line in lines)  # from the worker process
     assert [(r["axis"], r["model"], r["dataset"]) for r in result.records] == [
         (axis, model, dataset) for axis in ("X", "Y") for model in ("stribeck", "gmssvr", NOISE_FLOOR)
         for dataset in ("train", "test")]
