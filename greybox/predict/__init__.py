@@ -6,7 +6,9 @@ table (and a picture). Its parts: :mod:`~greybox.predict.process` (the process c
 prepared runs), :mod:`~greybox.predict.stream` (block by block), :mod:`~greybox.predict.output` (the
 tables), :mod:`~greybox.predict.plot` (the picture), :mod:`~greybox.predict.machine` (every axis of a
 machine), :mod:`~greybox.predict.interval` (calibrated bounds), :mod:`~greybox.predict.fleet` (many
-logs on Dask) and :mod:`~greybox.predict.run` (the entry point).
+logs on Dask), :mod:`~greybox.predict.sources` (the model sources: file, machine model, per-machine
+models), :mod:`~greybox.predict.request` (a call's options and its result) and
+:mod:`~greybox.predict.run` (the entry point).
 
 The names below are loaded on first use, so that importing a part (the command line's option
 defaults, the live estimator's :mod:`~greybox.predict.process`) does not load every other.
@@ -18,9 +20,14 @@ __all__ = ["AxisFigures", "ChunkProgress", "Prediction", "predict_logs"]
 
 
 def __getattr__(name: str):
-    """:func:`predict_logs` and its result types, from :mod:`greybox.predict.run` on first use."""
-    if name in __all__:
-        from . import run
+    """:func:`predict_logs` (:mod:`greybox.predict.run`) and its result types (:mod:`greybox.predict.request`),
+    on first use."""
+    if name == "predict_logs":
+        from .run import predict_logs
 
-        return getattr(run, name)
+        return predict_logs
+    if name in __all__:
+        from . import request
+
+        return getattr(request, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -20,7 +20,8 @@ from greybox.persistence import save_model
 from greybox.predict import ChunkProgress, Prediction, predict_logs
 from greybox.predict.output import write_process
 from greybox.predict.process import predict_process
-from greybox.predict.run import MachineDirectory, ModelFile, ModelsDirectory, is_fleet, open_model
+from greybox.predict.run import is_fleet
+from greybox.predict.sources import MachineDirectory, ModelFile, ModelsDirectory, open_model
 from greybox.twin import make_dataset
 
 
