@@ -157,6 +157,11 @@ class LiveSession:
         """
         self.current_stats().write(path)
 
+    def warm_up(self) -> None:
+        """Load the compiled kernels before the stream starts, so that the first message is not kept waiting
+        (:meth:`LiveEstimator.warm_up`)."""
+        self.estimator.warm_up()
+
     def finish(self) -> None:
         """The end of the stream: the samples still waiting are estimated as the end of a log."""
         self._publish(self.estimator.finish(), None)
