@@ -111,6 +111,15 @@ class Recorder:
         if not self._parts:
             return None
         parts, self._parts, self._start_s = self._parts, [], None
+        live = {"file": self._files, "run": self._run}
+        path = self._next_path()
+        if self._writer is None:
+            self._writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="greybox-record")
+        self._writing.append((self._writer.submit(self._write, parts, path, live), path))
+        return path
+
+    def _write(self, parts: list, path: Path, live: dict) -> None:
+        """Write one file (in the writer thread): the parts joined into one block, the metadata with ``live``."""
         first = parts[0]
         # one block, one row group: a row group per message (thousands of a few rows each) took seconds to
         # write and read back, the stream waiting meanwhile
@@ -121,16 +130,11 @@ class Recorder:
                               motion=first.motion, effort_unit=first.effort_unit, tally=tally)
         attrs.pop("extrapolation", None)  # counted per file without the per-quantity flags: not comparable
         attrs.update(self.attrs)
-        attrs["live"] = {"file": self._files, "run": self._run, "start_s": float(first.time[0]),
-                         "stop_s": float(joined.time[-1]), "samples": len(joined.time)}
+        attrs["live"] = {**live, "start_s": float(first.time[0]), "stop_s": float(joined.time[-1]),
+                         "samples": len(joined.time)}
         metadata = {"axis": first.axis, "dataset": first.dataset or "", "effort_unit": first.effort_unit,
                     "attrs": attrs}
-        path = self._next_path()
-        if self._writer is None:
-            self._writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="greybox-record")
-        self._writing.append((self._writer.submit(write_process_blocks, [joined], path, metadata=lambda: metadata),
-                              path))
-        return path
+        write_process_blocks([joined], path, metadata=lambda: metadata)
 
     def _next_path(self) -> Path:
         index = self._files
