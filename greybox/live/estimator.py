@@ -193,21 +193,21 @@ class LiveEstimator:
         Returns
         -------
         bool
-            Whether the samples ran through (False when the model or the axis file refuses made-up samples of
-            the model's kind of axis; the stream's own messages then say why).
+            Whether the samples ran through (False when the model, the axis file or an option refuses made-up
+            samples of the model's kind of axis; the stream's own messages then say why).
         """
-        step = self.timeline.nominal or float(self.model.sample_time_)
-        trial = LiveEstimator(self.model, axis_config=self.axis_config, sample_time=step,
-                              tolerance=self.timeline.tolerance, cutoff_hz=self.cutoff_hz, chunk_s=self.chunk_s)
-        n = 2 * derivative_margin(step, cutoff_hz=self.cutoff_hz) + 32
-        time = step * np.arange(n)
-        log = AxisLog(time=time, position=np.sin(2.0 * np.pi * time), effort=np.zeros(n),
-                      effort_unit=self.model.effort_unit_, motion=self.model.motion_, source="warm-up")
         try:
+            step = self.timeline.nominal or float(self.model.sample_time_)
+            trial = LiveEstimator(self.model, axis_config=self.axis_config, sample_time=step,
+                                  tolerance=self.timeline.tolerance, cutoff_hz=self.cutoff_hz, chunk_s=self.chunk_s)
+            n = 2 * derivative_margin(step, cutoff_hz=self.cutoff_hz) + 32
+            time = step * np.arange(n)
+            log = AxisLog(time=time, position=np.sin(2.0 * np.pi * time), effort=np.zeros(n),
+                          effort_unit=self.model.effort_unit_, motion=self.model.motion_, source="warm-up")
             ran = trial.step(log.select(slice(0, n // 2))).results + trial.step(log.select(slice(n // 2, n))).results \
                 + trial.finish().results
-        except GreyboxError:
-            return False
+        except (GreyboxError, AttributeError, ValueError):  # a model file without its fit's record, an option
+            return False  # out of range: the stream's first message says what is wrong
         return bool(ran)
 
     def step(self, log: AxisLog) -> StepOutput:

@@ -34,3 +34,9 @@ def test_the_start_up_objects_are_frozen_while_the_stream_runs():
     with settled_memory():
         assert gc.get_freeze_count() > 0
     assert gc.get_freeze_count() == 0
+
+
+def test_a_warm_up_the_options_refuse_leaves_the_error_to_the_stream(model_file):
+    estimator = LiveEstimator(load_model(model_file("gms")), cutoff_hz=1e6)  # above the Nyquist frequency
+    assert estimator.warm_up() is False
+    assert estimator.runs == 0
