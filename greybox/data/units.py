@@ -43,6 +43,7 @@ __all__ = [
     "parse_column_name",
     "known_column",
     "resolve_columns",
+    "resolve_table",
     "axes_in_columns",
     "select_axis",
     "several_axes_table",
@@ -470,6 +471,56 @@ def _numeric(values) -> np.ndarray | None:
     return None
 
 
+def resolve_table(table: Mapping[str, object], *, source, columns: Mapping[str, str] | None = None,
+                  with_time: bool = True, effort_unit: str | None = None, select: str | None = None):
+    """The columns of a table under greybox's names, and the base channels among them.
+
+    The work on the names alone that :func:`log_from_columns` does before it reads any value: the axis
+    ``select`` taken (:func:`select_axis`), export headers renamed (:func:`~greybox.data.headers.canonical_table`),
+    unnamed columns left out, the channels found (:func:`resolve_columns`). A live stream does it once for
+    the column names its messages share.
+
+    Parameters
+    ----------
+    table : mapping of str to object
+        Columns under their names in the file (the values are passed through untouched).
+    source : str or path-like
+        File name for error messages.
+    columns : mapping of str to str, optional
+        Explicit ``{canonical_name: name_in_file}``; see :func:`resolve_columns`.
+    with_time : bool, default True
+        Look for a time column.
+    effort_unit : {"A", "N", "Nm"}, optional
+        Effort unit from the file's metadata.
+    select : str, optional
+        Axis to take from a several-axis table.
+
+    Returns
+    -------
+    table : dict of str to object
+        The columns under their new names, values as given.
+    names : list of str
+        The named columns, in order.
+    found : dict
+        ``{quantity: (column_name, factor_to_canonical_unit)}`` (:func:`resolve_columns`).
+    motion : {"linear", "rotary"}
+        The kind of axis.
+
+    Raises
+    ------
+    LogError
+        As :func:`select_axis`, :func:`~greybox.data.headers.canonical_table` and :func:`resolve_columns`.
+    """
+    if select is not None:
+        table = select_axis(table, select, source=source, columns=columns)
+    mapped = {parsed[0] for parsed in map(parse_column_name, columns or {}) if parsed is not None}
+    table = canonical_table(table, source=source, keep=(columns or {}).values(), mapped=mapped)
+    names = [n for n in table if n and not str(n).startswith("Unnamed: ")]
+    found, motion = resolve_columns(names, source=source, columns=columns, with_time=with_time,
+                                    effort_unit=effort_unit)
+    return table, names, found, motion
+
+
 def log_from_columns(
     table: Mapping[str, np.ndarray],
     *,
@@ -519,14 +570,9 @@ def log_from_columns(
         axis s, deg, deg/s, deg/s^2, A or Nm); every other numeric column, name
         unchanged, in ``extras``.
     """
-    if select is not None:
-        table, axis = select_axis(table, select, source=source, columns=columns), select
-    mapped = {parsed[0] for parsed in map(parse_column_name, columns or {}) if parsed is not None}
-    table = canonical_table(table, source=source, keep=(columns or {}).values(), mapped=mapped)
-    names = [n for n in table if n and not str(n).startswith("Unnamed: ")]
-    found, motion = resolve_columns(
-        names, source=source, columns=columns, with_time=time is None, effort_unit=effort_unit
-    )
+    table, names, found, motion = resolve_table(table, source=source, columns=columns, with_time=time is None,
+                                                effort_unit=effort_unit, select=select)
+    axis = select if select is not None else axis
     used = {column for column, _ in found.values()}
 
     def channel(quantity):

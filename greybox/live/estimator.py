@@ -17,9 +17,12 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Iterator
 
+import numpy as np
+
 from ..data.axis_config import AxisConfig
 from ..data.log import AxisLog
-from ..errors import LogError
+from ..data.prepare import derivative_margin
+from ..errors import GreyboxError, LogError
 from ..models.chunked import DEFAULT_CHUNK_S
 from ..predict.process import ProcessResult, ProcessTally, check_process_inputs, process_blocks
 from .lookahead import Lookahead
@@ -178,6 +181,34 @@ class LiveEstimator:
     def waiting(self) -> int:
         """Samples received and kept, not yet estimated."""
         return 0 if self._run is None else self._run.lookahead.waiting
+
+    def warm_up(self) -> bool:
+        """Run the model and the derivatives once over made-up samples, before the stream starts.
+
+        The first estimate of a stream would otherwise wait while the compiled kernels (the derivative
+        filter's, the model's) are loaded: tens of milliseconds, and on a busy machine more than a hundred,
+        during which the messages behind it queue up. Nothing of the made-up stream is kept: it runs in an
+        estimator of its own.
+
+        Returns
+        -------
+        bool
+            Whether the samples ran through (False when the model, the axis file or an option refuses made-up
+            samples of the model's kind of axis; the stream's own messages then say why).
+        """
+        try:
+            step = self.timeline.nominal or float(self.model.sample_time_)
+            trial = LiveEstimator(self.model, axis_config=self.axis_config, sample_time=step,
+                                  tolerance=self.timeline.tolerance, cutoff_hz=self.cutoff_hz, chunk_s=self.chunk_s)
+            n = 2 * derivative_margin(step, cutoff_hz=self.cutoff_hz) + 32
+            time = step * np.arange(n)
+            log = AxisLog(time=time, position=np.sin(2.0 * np.pi * time), effort=np.zeros(n),
+                          effort_unit=self.model.effort_unit_, motion=self.model.motion_, source="warm-up")
+            ran = trial.step(log.select(slice(0, n // 2))).results + trial.step(log.select(slice(n // 2, n))).results \
+                + trial.finish().results
+        except (GreyboxError, AttributeError, ValueError):  # a model file without its fit's record, an option
+            return False  # out of range: the stream's first message says what is wrong
+        return bool(ran)
 
     def step(self, log: AxisLog) -> StepOutput:
         """Take the samples of one message; return the estimates now complete and what happened.

@@ -54,7 +54,7 @@ class Lookahead:
         self._first: AxisLog | None = None  # the run's first samples: names, units, attrs
         self._filter: ZeroPhaseStream | None = None
         self._attrs: dict = {}
-        self._pending: dict[str, list] = {}
+        self._pending: dict[str, np.ndarray] = {}  # per channel a buffer; its first _n_pending values wait
         self._n_pending = 0
         self._given = 0  # samples of the run given out
 
@@ -73,9 +73,12 @@ class Lookahead:
         """
         if self._needs is None:
             self._start(log)
-        for name in self._pending:
-            self._pending[name].append(getattr(log, name) if name in _CHANNELS else log.extras[name])
-        self._n_pending += len(log)
+        n, stop = self._n_pending, self._n_pending + len(log)
+        for name, buffer in self._pending.items():
+            if stop > buffer.size:  # room for twice as many: the buffers settle at twice the look-ahead
+                buffer = self._pending[name] = np.concatenate((buffer[:n], np.empty(max(stop, 2 * n))))
+            buffer[n:stop] = getattr(log, name) if name in _CHANNELS else log.extras[name]
+        self._n_pending = stop
         if self._filter is not None:
             self._filter.push(log.position if log.velocity is None else log.velocity)
             if not self._filter.started:
@@ -95,7 +98,6 @@ class Lookahead:
             return None
         if self._filter is not None and not self._filter.started:
             n = self._filter.received
-            self._pending = {name: [] for name in self._pending}
             self._n_pending = 0
             raise LogError(self._first.source or None, f"the log has {n} samples; the 4th-order filter needs at "
                                                        f"least {self._filter.needed}")
@@ -105,7 +107,7 @@ class Lookahead:
         self._needs = not log.is_prepared
         self._first = log
         present = [name for name in _CHANNELS if getattr(log, name) is not None]
-        self._pending = {name: [] for name in [*present, *log.extras]}
+        self._pending = {name: np.empty(0) for name in [*present, *log.extras]}
         self._attrs = dict(log.attrs)
         if not self._needs:
             return
@@ -118,11 +120,10 @@ class Lookahead:
 
     def _give(self, ready: int, *, final: bool) -> AxisLog:
         columns = {}
-        for name, parts in self._pending.items():
-            joined = parts[0] if len(parts) == 1 else np.concatenate(parts)
-            columns[name] = joined[:ready]
-            rest = joined[ready:]
-            self._pending[name] = [rest] if len(rest) else []
+        waiting = self._n_pending
+        for name, buffer in self._pending.items():
+            columns[name] = buffer[:ready].copy()
+            buffer[:waiting - ready] = buffer[ready:waiting]  # the rest to the front (numpy copies overlaps safely)
         self._n_pending -= ready
         if self._filter is not None:
             derivatives = self._filter.derivatives(self._given, self._given + ready, final=final)

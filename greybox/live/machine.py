@@ -85,6 +85,11 @@ class MachineSession:
         for axis in axes:
             self.sessions[axis].take(columns, seq, name=item.name)
 
+    def warm_up(self) -> None:
+        """Load every axis's compiled kernels before the stream starts (:meth:`LiveSession.warm_up`)."""
+        for session in self.sessions.values():
+            session.warm_up()
+
     def finish(self) -> None:
         """The end of the stream, for every axis."""
         for session in self.sessions.values():

@@ -17,17 +17,18 @@ predict`` writes (:meth:`greybox.predict.process.ProcessResult.columns`) for the
 from __future__ import annotations
 
 import json
-from typing import Mapping
+import math
+from typing import Mapping, Union
 
 import msgspec
 import numpy as np
 
 from ..data.log import AxisLog
-from ..data.units import log_from_columns
+from ..data.units import EFFORT_QUANTITIES, log_from_columns, resolve_table
 from ..errors import GreyboxError, LogError
 
 __all__ = ["MessageError", "SEQUENCE_KEY", "MAX_MESSAGE_SAMPLES", "MAX_MESSAGE_BYTES", "parse_json",
-           "parse_csv_row", "csv_header", "Decoder", "message_log", "estimate_message"]
+           "parse_csv_row", "csv_header", "Decoder", "message_log", "MessageLogs", "estimate_message"]
 
 #: Key of a message's sequence tag, echoed in the estimates it completes.
 SEQUENCE_KEY = "seq"
@@ -84,6 +85,10 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
     """
     if len(text) > MAX_MESSAGE_BYTES:
         raise MessageError(f"the message holds {len(text)} bytes, more than {MAX_MESSAGE_BYTES}")
+    decoded = _typed_columns(text)
+    if decoded is not None:
+        columns, seq = decoded
+        return _checked(columns), seq
     try:  # msgspec reads strict JSON a few times faster; json.loads takes what it refuses (NaN) or explains why
         value = _DECODER.decode(text)
     except msgspec.DecodeError:
@@ -108,6 +113,36 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
         columns = {name: _column(name, column) for name, column in value.items() if name != SEQUENCE_KEY}
     else:
         raise MessageError("a message must be a JSON object (one sample, or columns of a batch) or a list of objects")
+    return _checked(columns), seq
+
+
+def _typed_columns(text: str | bytes) -> tuple[dict[str, np.ndarray], object] | None:
+    """The columns and sequence tag of a JSON object of number columns (or of one sample's numbers), or None.
+
+    The usual message, read in one pass: msgspec checks every value is a number as it reads it
+    (:data:`_COLUMNS`), and each column becomes a float array at once. Any other message (rows, text or
+    booleans in a column, NaN, nested lists, not JSON) gives None and goes to the general reader, which
+    names the problem.
+    """
+    try:
+        value = _COLUMNS.decode(text)
+    except msgspec.DecodeError:
+        return None
+    seq = value.pop(SEQUENCE_KEY, None)
+    columns = {}
+    for name, column in value.items():
+        kind = type(column)
+        if kind is list:
+            columns[name] = np.array(column, dtype=np.float64)
+        elif kind is float or kind is int:
+            columns[name] = np.array([column], dtype=np.float64)
+        else:  # text or null where numbers belong
+            return None
+    return columns, seq
+
+
+def _checked(columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The columns of a message, refused when empty, of different lengths or too long."""
     lengths = {len(column) for column in columns.values()}
     if not columns or lengths == {0}:
         raise MessageError("the message holds no samples")
@@ -115,7 +150,7 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
         raise MessageError(f"the columns have different lengths ({', '.join(map(str, sorted(lengths)))})")
     if max(lengths) > MAX_MESSAGE_SAMPLES:
         raise MessageError(f"the message holds {max(lengths)} samples, more than {MAX_MESSAGE_SAMPLES}")
-    return columns, seq
+    return columns
 
 
 def csv_header(line: str) -> list[str]:
@@ -241,11 +276,111 @@ def message_log(columns: Mapping[str, np.ndarray], *, name: str, mapping: Mappin
         log = log_from_columns(columns, source=name, columns=mapping or None, select=axis)
     except LogError as exc:
         raise MessageError(exc.problem) from None
-    for channel, values in log.named_channels(time=True):
+    _check_finite(log)
+    return log.replace(extras={}) if log.extras else log
+
+
+def _check_finite(log: AxisLog) -> None:
+    """Refuse a message whose channels hold NaN or infinity, naming the first such value."""
+    channels = log.named_channels(time=True)
+    if math.isfinite(sum(float(np.add.reduce(values)) for _, values in channels)):
+        return  # a sum of finite values overflowing to infinity gets the check below, which finds nothing
+    for channel, values in channels:
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise MessageError(f"channel '{channel}' holds {values[bad[0]]} at sample {bad[0]} of the message")
-    return log.replace(extras={}) if log.extras else log
+
+
+class MessageLogs:
+    """The samples of a stream's messages as axis logs (:func:`message_log`), the column names resolved once.
+
+    A stream's messages carry the same columns one after another. For the first message with a set of
+    column names, :func:`message_log` reads it and says what is wrong with it; the names' meaning (which
+    column is which channel, in which unit, the kind of axis) is kept, and the following messages with
+    the same names are read through it: each channel the column times its unit's factor, checked finite.
+    A plan that does not give the first message's log exactly is not used (nor is one of a rotary axis,
+    whose angle is unwrapped message by message): then every message goes through :func:`message_log`.
+
+    Parameters
+    ----------
+    mapping : mapping of str to str, optional
+        ``{canonical_name: column}`` for columns not named by the convention.
+    """
+
+    def __init__(self, *, mapping: Mapping[str, str] | None = None):
+        self.mapping = dict(mapping) if mapping else None
+        self._key: tuple | None = None
+        self._plan: _ColumnPlan | None = None
+
+    def log(self, columns: Mapping[str, np.ndarray], *, name: str, axis: str | None = None) -> AxisLog:
+        """The samples of one message, as :func:`message_log` gives them.
+
+        Parameters
+        ----------
+        columns : mapping of str to ndarray
+            The message's columns (:func:`parse_json`, :func:`parse_csv_row`).
+        name : str
+            How the message is named in errors.
+        axis : str, optional
+            Axis to take from a message holding several.
+
+        Raises
+        ------
+        MessageError
+            As :func:`message_log`.
+        """
+        key = (*columns, axis)
+        if key == self._key:
+            if self._plan is not None:
+                return self._plan.log(columns, name)
+            return message_log(columns, name=name, mapping=self.mapping, axis=axis)
+        log = message_log(columns, name=name, mapping=self.mapping, axis=axis)
+        self._key, self._plan = key, _ColumnPlan.of(columns, log, mapping=self.mapping, axis=axis, name=name)
+        return log
+
+
+class _ColumnPlan:
+    """Which column of a message is which channel, and the factor to its canonical unit."""
+
+    def __init__(self, channels: dict, log: AxisLog):
+        self.channels = channels  # {field: (column, factor)}
+        self.effort_unit, self.motion, self.axis, self.attrs = log.effort_unit, log.motion, log.axis, log.attrs
+
+    @classmethod
+    def of(cls, columns, log: AxisLog, *, mapping, axis, name) -> "_ColumnPlan | None":
+        """The plan of the column names of ``columns``, whose log is ``log``; None where it would not give it."""
+        if log.motion != "linear":
+            return None
+        try:
+            table, _, found, _ = resolve_table({column: column for column in columns}, source=name,
+                                               columns=mapping or None, select=axis)
+        except LogError:
+            return None
+        effort = next(quantity for quantity in EFFORT_QUANTITIES if quantity in found)
+        fields = {"time": "time", "position": "position", effort: "effort", "velocity": "velocity",
+                  "acceleration": "acceleration"}
+        channels = {field: (table[found[quantity][0]], found[quantity][1])
+                    for quantity, field in fields.items() if quantity in found}
+        plan = cls(channels, log)
+        try:
+            again = plan.log(columns, name)
+        except MessageError:
+            return None
+        same = all((a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
+                   for a, b in ((getattr(log, field), getattr(again, field)) for field in fields.values()))
+        same = same and (again.effort_unit, again.motion, again.axis, again.attrs) == \
+            (log.effort_unit, log.motion, log.axis, log.attrs)
+        return plan if same else None
+
+    def log(self, columns, name: str) -> AxisLog:
+        """The samples of a message with the plan's column names."""
+        values = {}
+        for field, (column, factor) in self.channels.items():
+            values[field] = columns[column] * factor if factor != 1.0 else columns[column]
+        log = AxisLog(**values, effort_unit=self.effort_unit, motion=self.motion, axis=self.axis, source=name,
+                      attrs=self.attrs)
+        _check_finite(log)
+        return log
 
 
 def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | None = None) -> str:
@@ -271,3 +406,6 @@ def estimate_message(columns: Mapping[str, np.ndarray], seq=None, axis: str | No
 
 #: One encoder for every output message, one decoder for every input message.
 _ENCODER, _DECODER = msgspec.json.Encoder(), msgspec.json.Decoder()
+
+#: The decoder of the usual message: an object of number columns (or of one sample's numbers) and a tag.
+_COLUMNS = msgspec.json.Decoder(dict[str, Union[list[float], float, int, str, None]])

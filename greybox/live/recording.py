@@ -1,21 +1,24 @@
 """Recordings of a live stream: rolling Parquet files of the table ``greybox predict`` writes.
 
 The estimates go to ``DIR/live-<start>-<n>.parquet``, a new file every ``every_s`` seconds of log time
-and at the start of every run (after a gap), each written at once when it is complete through
+and at the start of every run (after a gap). A file complete is written through
 :func:`greybox.predict.output.write_process_blocks` (atomically: a file is there whole or not at all;
-no file is overwritten). Its columns and metadata are those of ``greybox predict``'s Parquet output, with
-the file's place in the stream under ``attrs["live"]``. Memory holds one file's estimates at most.
+no file is overwritten) by a writer thread of its own, so that the stream does not wait for it (a minute
+of estimates takes a tenth of a second or more to write); closing the recorder waits for every file. Its
+columns and metadata are those of ``greybox predict``'s Parquet output, with the file's place in the stream
+under ``attrs["live"]``. Memory holds the estimates of the file being filled and of the one being written.
 """
 
 from __future__ import annotations
 
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 from ..data.axis_config import AxisConfig
 from ..errors import GreyboxError
 from ..predict.output import write_process_blocks
-from ..predict.process import ProcessResult, ProcessTally, process_attrs
+from ..predict.process import ProcessResult, ProcessTally, join_results, process_attrs
 
 __all__ = ["DEFAULT_RECORD_S", "Recorder"]
 
@@ -44,7 +47,7 @@ class Recorder:
     Attributes
     ----------
     written : list of pathlib.Path
-        Files written so far.
+        Files written so far (all of them once :meth:`close` returned).
 
     Raises
     ------
@@ -71,6 +74,9 @@ class Recorder:
         self._parts: list[ProcessResult] = []
         self._start_s: float | None = None
         self._run = 0
+        self._files = 0  # files handed to the writer
+        self._writer: ThreadPoolExecutor | None = None
+        self._writing: list[tuple[Future, Path]] = []
 
     def add(self, result: ProcessResult) -> None:
         """Take the estimates of consecutive samples; write the file once it spans ``every_s``.
@@ -94,35 +100,70 @@ class Recorder:
         self._run += 1
 
     def close_file(self) -> Path | None:
-        """Write the estimates held into the next file; None when none are held."""
+        """Hand the estimates held to the writer thread as the next file; None when none are held.
+
+        Raises
+        ------
+        GreyboxError
+            When an earlier file could not be written.
+        """
+        self._collect(wait=False)
         if not self._parts:
             return None
         parts, self._parts, self._start_s = self._parts, [], None
+        live = {"file": self._files, "run": self._run}
+        path = self._next_path()
+        if self._writer is None:
+            self._writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="greybox-record")
+        self._writing.append((self._writer.submit(self._write, parts, path, live), path))
+        return path
+
+    def _write(self, parts: list, path: Path, live: dict) -> None:
+        """Write one file (in the writer thread): the parts joined into one block, the metadata with ``live``."""
         first = parts[0]
+        # one block, one row group: a row group per message (thousands of a few rows each) took seconds to
+        # write and read back, the stream waiting meanwhile
+        joined = join_results(parts, {}) if len(parts) > 1 else parts[0]
         tally = ProcessTally()
-        for part in parts:
-            tally.add(part)
+        tally.add(joined)
         attrs = process_attrs(self.model, axis_config=self.axis_config, interval=None, chunk_s=self.chunk_s,
                               motion=first.motion, effort_unit=first.effort_unit, tally=tally)
         attrs.pop("extrapolation", None)  # counted per file without the per-quantity flags: not comparable
         attrs.update(self.attrs)
-        attrs["live"] = {"file": len(self.written), "run": self._run, "start_s": float(first.time[0]),
-                         "stop_s": float(parts[-1].time[-1]), "samples": int(sum(len(p.time) for p in parts))}
+        attrs["live"] = {**live, "start_s": float(first.time[0]), "stop_s": float(joined.time[-1]),
+                         "samples": len(joined.time)}
         metadata = {"axis": first.axis, "dataset": first.dataset or "", "effort_unit": first.effort_unit,
                     "attrs": attrs}
-        path = self._next_path()
-        write_process_blocks(parts, path, metadata=lambda: metadata)
-        self.written.append(path)
-        return path
+        write_process_blocks([joined], path, metadata=lambda: metadata)
 
     def _next_path(self) -> Path:
-        index = len(self.written)
+        index = self._files
         while True:
             path = self.directory / f"live-{self._stamp}-{index:05d}.parquet"
-            if not path.exists():
-                return path
             index += 1
+            if not path.exists():
+                self._files = index
+                return path
+
+    def _collect(self, *, wait: bool) -> None:
+        """Count the files the writer finished (all of them with ``wait``); raise the error of one that failed."""
+        while self._writing and (wait or self._writing[0][0].done()):
+            future, path = self._writing.pop(0)
+            future.result()
+            self.written.append(path)
 
     def close(self) -> None:
-        """Write the estimates still held."""
-        self.close_file()
+        """Write the estimates still held, and wait until every file is written.
+
+        Raises
+        ------
+        GreyboxError
+            When a file could not be written.
+        """
+        try:
+            self.close_file()
+            self._collect(wait=True)
+        finally:
+            if self._writer is not None:
+                self._writer.shutdown(wait=True)
+                self._writer = None

@@ -9,6 +9,7 @@ line, which exits with 143 (130 for Ctrl-C).
 from __future__ import annotations
 
 import contextlib
+import gc
 import signal
 import sys
 import threading
@@ -28,7 +29,7 @@ from .sinks import LineSink, MqttSink
 from .sources import LineSource, MqttSource
 from .stats import LiveStats
 
-__all__ = ["ALARM_STATUS", "LiveOutcome", "run_live"]
+__all__ = ["ALARM_STATUS", "LiveOutcome", "run_live", "settled_memory"]
 
 #: Exit status of ``greybox live --exit-on-alarm`` after an alarm.
 ALARM_STATUS = 3
@@ -104,6 +105,24 @@ class _Deferred:
         if self._pending is not None:
             pending, self._pending = self._pending, None
             self._forward(*pending)
+
+
+@contextlib.contextmanager
+def settled_memory():
+    """Leave the objects of the start-up out of the garbage collector's passes while the stream runs.
+
+    The modules, the model and the sessions are hundreds of thousands of objects that live as long as the
+    command; a full pass of the collector over them takes half a second (more on a busy machine), and one
+    falls due now and then as a long stream allocates. Frozen (:func:`gc.freeze`), they are not scanned
+    while the block runs; the collector still runs over what the stream allocates. They are given back to
+    the collector after the block.
+    """
+    gc.collect()
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
 
 
 def _source(spec: str, stdin: TextIO, connect_timeout: float):
@@ -269,13 +288,14 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         if out is not None:
             out.close()
         raise
-    say(f"greybox live: {kind} model {model_path}, reading "
-        f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
     status, stopped = 0, True
-    last_stats = time.monotonic()
     deferred = _Deferred()
     try:
-        with deferred:
+        session.warm_up()
+        with deferred, settled_memory():
+            say(f"greybox live: {kind} model {model_path}, reading "
+                f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
+            last_stats = time.monotonic()
             for item in stream:
                 with deferred.held():
                     session.handle(item)

@@ -16,7 +16,7 @@ import numpy as np
 from ..data.log import AxisLog
 from .estimator import LiveEstimator, Lost, RunStart, StepOutput
 from .limits import LimitWatch
-from .messages import Decoder, MessageError, estimate_message, message_log
+from .messages import Decoder, MessageError, MessageLogs, estimate_message
 from .recording import Recorder
 from .sources import ConnectionChange, Received
 from .stats import LiveStats
@@ -80,6 +80,7 @@ class LiveSession:
         self.stats = LiveStats()
         self.alarmed = False
         self._decoder = Decoder()
+        self._logs = MessageLogs(mapping=self.mapping)
         self._signature: tuple | None = None
         self._offline_since: float | None = None
         self._run = 0  # run of the last estimates
@@ -122,7 +123,7 @@ class LiveSession:
             message of this axis alone (its own topic).
         """
         try:
-            log = message_log(columns, name=name, mapping=self.mapping, axis=self.axis if select else None)
+            log = self._logs.log(columns, name=name, axis=self.axis if select else None)
             signature = _signature(log)
             if self._signature is None:
                 self._signature = signature
@@ -155,6 +156,11 @@ class LiveSession:
             The stats file.
         """
         self.current_stats().write(path)
+
+    def warm_up(self) -> None:
+        """Load the compiled kernels before the stream starts, so that the first message is not kept waiting
+        (:meth:`LiveEstimator.warm_up`)."""
+        self.estimator.warm_up()
 
     def finish(self) -> None:
         """The end of the stream: the samples still waiting are estimated as the end of a log."""

@@ -449,12 +449,14 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
         predicted = np.empty(len(block))
         parts = []
         for samples in chunk_slices(len(block), samples_per_chunk(sample_time, chunk_s)):
+            chunk = block if samples.stop - samples.start == len(block) else block.select(samples)
             predicted[samples], state, flags, region = model.predict_flag_chunk(
-                block.select(samples), state, region, sample_time=sample_time)
+                chunk, state, region, sample_time=sample_time)
             parts.append(flags)
             if progress is not None:
                 progress(float(block.time[samples.stop - 1]))
-        regions = {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
+        regions = parts[0] if len(parts) == 1 else \
+            {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
         result = _block_result(block, predicted, regions, axis_config, interval)
         if tally is not None:
             tally.add(result, regions)

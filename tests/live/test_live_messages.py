@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from greybox.live.messages import Decoder, MessageError, estimate_message, message_log, parse_json
+from greybox.live.messages import Decoder, MessageError, MessageLogs, estimate_message, message_log, parse_json
 
 ROWS = [{"time_s": 0.0, "position_mm": 1.0, "velocity_mm_s": 0.5, "current_A": 0.1},
         {"time_s": 0.002, "position_mm": 1.001, "velocity_mm_s": 0.5, "current_A": 0.2}]
@@ -93,3 +93,66 @@ def test_a_message_with_nan_reads_as_its_strict_part_does():
         np.testing.assert_array_equal(strict[name], message[name])
         np.testing.assert_array_equal(with_nan[name], message[name])
     assert np.isnan(with_nan["current_A"]).all()
+
+
+def _same_log(got, expected):
+    assert (got.effort_unit, got.motion, got.axis, got.source, got.attrs, got.extras) == \
+        (expected.effort_unit, expected.motion, expected.axis, expected.source, expected.attrs, expected.extras)
+    channels, wanted_channels = got.named_channels(time=True), expected.named_channels(time=True)
+    assert [name for name, _ in channels] == [name for name, _ in wanted_channels]
+    for (name, values), (_, wanted) in zip(channels, wanted_channels):
+        np.testing.assert_array_equal(values, wanted, err_msg=name)
+
+
+LAYOUTS = {  # columns of a stream's messages, mapping, axis; whether the names are resolved once
+    "canonical": (["time_s", "position_mm", "velocity_mm_s", "current_A"], None, None, True),
+    "other units": (["time_ms", "position_m", "current_mA"], None, None, True),
+    "one axis of two": (["time_s", "X_position_mm", "X_current_A", "Y_position_mm", "Y_current_A"], None, "Y", True),
+    "mapped": (["time_s", "pos", "I", "spare"], {"position_um": "pos", "current_A": "I"}, None, True),
+    "motor torque": (["time_s", "position_mm", "torque_Nm"], None, None, True),
+    "rotary": (["time_s", "position_deg", "torque_Nm"], None, None, False),
+}
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_the_stream_reader_gives_what_message_log_gives(layout):
+    names, mapping, axis, planned = LAYOUTS[layout]
+    reader = MessageLogs(mapping=mapping)
+    rng = np.random.default_rng(8)
+    for k in range(3):
+        columns = {name: rng.normal(size=5) for name in names}
+        columns[names[0]] = (k * 5 + np.arange(5)) * (2.0 if names[0] == "time_ms" else 0.002)
+        got = reader.log(columns, name=f"message {k}", axis=axis)
+        _same_log(got, message_log(columns, name=f"message {k}", mapping=mapping, axis=axis))
+    assert (reader._plan is not None) == planned  # names resolved once where the plan gives the same log
+
+
+def test_the_stream_reader_refuses_a_later_message_as_message_log_does():
+    reader = MessageLogs()
+    good = {"time_s": np.array([0.0, 0.002]), "position_mm": np.array([1.0, 2.0]), "current_A": np.array([0.0, 1.0])}
+    reader.log(good, name="message 1")
+    bad = {**good, "current_A": np.array([0.5, np.inf])}
+    with pytest.raises(MessageError) as expected:
+        message_log(bad, name="message 2")
+    with pytest.raises(MessageError) as got:
+        reader.log(bad, name="message 2")
+    assert str(got.value) == str(expected.value) and "current_A" in str(got.value)
+    other = {"time_s": good["time_s"], "position_mm": good["position_mm"]}  # new names: read and refused afresh
+    with pytest.raises(MessageError, match="current_A"):
+        reader.log(other, name="message 3")
+
+
+def test_number_columns_read_as_the_general_reader_reads_them():
+    rng = np.random.default_rng(9)
+    message = {"time_s": (np.arange(6) * 0.002).tolist(), "position_mm": [1, 2, 3, 4, 5, 6],
+               "current_A": rng.normal(size=6).tolist(), "seq": "a7"}
+    columns, seq = parse_json(json.dumps(message))
+    assert seq == "a7" and list(columns) == ["time_s", "position_mm", "current_A"]
+    for name in columns:
+        assert columns[name].dtype == np.float64
+        np.testing.assert_array_equal(columns[name], np.array(message[name], dtype=float))
+    single, seq = parse_json('{"time_s": 1, "position_mm": 2.5, "current_A": -3, "seq": 4}')
+    assert seq == 4 and {name: values.tolist() for name, values in single.items()} == \
+        {"time_s": [1.0], "position_mm": [2.5], "current_A": [-3.0]}
+    with pytest.raises(MessageError, match="column 'current_A' holds 'x', not a number"):
+        parse_json('{"time_s": 1, "position_mm": 2.5, "current_A": "x"}')

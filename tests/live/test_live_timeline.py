@@ -55,3 +55,16 @@ def test_a_short_stream_is_flushed_at_its_own_step():
     assert timeline.push(samples([0.0, 0.01, 0.02])) == []
     events = timeline.flush()
     assert timeline.nominal == 0.01 and len(kept(events)) == 3
+
+
+def test_a_message_within_the_tolerance_is_passed_on_whole_and_one_after_a_gap_is_split():
+    timeline = Timeline(sample_time=0.002, tolerance=0.25)
+    timeline.push(samples([0.0, 0.002]))
+    message = samples([0.0041, 0.006, 0.0079])
+    events = timeline.push(message)
+    assert len(events) == 1 and events[0] is message
+    events = timeline.push(samples([0.020, 0.022]))  # the gap before the message's first sample
+    assert [type(event).__name__ for event in events] == ["Gap", "AxisLog"]
+    events = timeline.push(samples([0.024, 0.0245, 0.026]))  # too soon inside the message
+    assert [type(event).__name__ for event in events] == ["AxisLog", "Dropped", "AxisLog"]
+    np.testing.assert_array_equal(kept(events), [0.024, 0.026])

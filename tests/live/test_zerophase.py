@@ -163,3 +163,20 @@ def test_lookahead_refuses_a_run_too_short_for_the_filter():
     with pytest.raises(LogError, match="needs at least 16"):
         lookahead.finish()
     assert lookahead.waiting == 0
+
+
+def test_lookahead_gives_the_derived_log_from_messages_of_any_size():
+    log = _log(900, velocity=False)
+    lookahead = Lookahead(sample_time=STEP)
+    out, k = [], 0
+    for size in [1, 3, 250, 2, 1, 400, 7, 236]:  # long after short: the buffers grow while samples wait
+        ready = lookahead.push(log.select(slice(k, k + size)))
+        k += size
+        if ready is not None:
+            out.append(ready)
+    out.append(lookahead.finish())
+    whole = derive(log, sample_time=STEP)
+    for name in ("time", "position", "effort", "velocity", "acceleration"):
+        expected = getattr(whole, name)
+        np.testing.assert_allclose(np.concatenate([getattr(part, name) for part in out]), expected, rtol=0,
+                                   atol=1e-9 * max(1.0, np.abs(expected).max()), err_msg=name)
