@@ -24,7 +24,7 @@ import scipy.io
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
-from greybox.data.io import read_log, write_log
+from greybox.data.io import LOG_FORMATS, read_log, write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError, ModelFileError
@@ -33,7 +33,8 @@ from greybox.models.gmssvr import GMSSVRModel
 from greybox.persistence import MAX_MEMBER_BYTES, check_fitted, load_model, save_model
 from greybox.twin import make_dataset
 
-FORMATS = (".csv", ".parquet", ".mcap", ".mat", ".tdms")
+#: The first extension of every registered log format: a new format is fuzzed here without an edit.
+FORMATS = tuple(entry.suffixes[0] for entry in LOG_FORMATS.values())
 
 #: A damaged TDMS file makes npTDMS say what it recovered: greybox passes that on as a warning (a note).
 pytestmark = pytest.mark.filterwarnings("ignore:.*\\(npTDMS\\):UserWarning")

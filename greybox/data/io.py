@@ -212,7 +212,8 @@ def write_log(log: AxisLog | Sequence[AxisLog], path, *, fmt: str | None = None)
     path = os.fspath(path)
     fmt = format_of(path, fmt)
     if LOG_FORMATS[fmt].writer is None:
-        raise LogError(path, f"{fmt} files can be read but not written; write .csv, .parquet or .mcap")
+        writable = ", ".join(entry.suffixes[0] for entry in LOG_FORMATS.values() if entry.writer is not None)
+        raise LogError(path, f"{fmt} files can be read but not written; write {writable}")
     logs = [log] if isinstance(log, AxisLog) else list(log)
     if not logs:
         raise LogError(path, "no log to write")

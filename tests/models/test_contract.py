@@ -207,7 +207,7 @@ def test_a_new_kind_is_one_class_and_one_registry_line(monkeypatch, train_runs, 
     """Registered, the new kind saves, loads, predicts in chunks, trains from the command line and prints."""
     from greybox.cli import main
 
-    monkeypatch.setitem(registry.MODEL_CLASSES, "viscous", ViscousModel)
+    monkeypatch.setitem(registry.MODEL_CLASSES, "added_viscous", ViscousModel)
     model = ViscousModel(fit_offset=True).fit(train_runs)
     loaded = load_model(save_model(model, tmp_path / "v.gbm"))
     np.testing.assert_array_equal(loaded.predict(unseen_log), model.predict(unseen_log))
@@ -217,7 +217,7 @@ def test_a_new_kind_is_one_class_and_one_registry_line(monkeypatch, train_runs, 
     for run, path in zip(train_runs, logs):
         write_log(run, path)
     out = tmp_path / "cli.gbm"
-    assert main(["train", "--model", "viscous", "--offset", "--quiet", "--train", *map(str, logs),
+    assert main(["train", "--model", "added_viscous", "--offset", "--quiet", "--train", *map(str, logs),
                  "--out", str(out)]) == 0
     assert isinstance(load_model(out), ViscousModel)
 
