@@ -13,6 +13,7 @@ is done. Every file is written atomically. :func:`fleet_summary` is the report o
 from __future__ import annotations
 
 import contextlib
+import functools
 import glob
 import json
 import os
@@ -436,10 +437,14 @@ def _client(scheduler: str | None, workers: int | None) -> Iterator:
                                    f"({error})") from None
         cluster = None
     else:
-        # one thread per worker process, compiled kernels included: the processes share out the cores
+        # one thread per worker process, compiled kernels included (each task runs them on one thread:
+        # _on_one_thread): the processes share out the cores. NUMBA_NUM_THREADS is not set for the workers:
+        # Dask sets such variables in a worker after it started, and a worker that had imported numba before
+        # (a spawned worker imports the parent's main script) and launched its threads under the old value
+        # failed at its next compilation ("Cannot set NUMBA_NUM_THREADS to a different value once the
+        # threads have been launched"), depending on what numba's cache held
         cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR,
-                               env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
+                               dashboard_address=None, silence_logs=logging.ERROR, env={"OMP_NUM_THREADS": "1"})
         client = Client(cluster)
     try:
         yield client
@@ -447,6 +452,14 @@ def _client(scheduler: str | None, workers: int | None) -> Iterator:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _on_one_thread(task: Callable, job):
+    """``task(job)`` with the compiled kernels of this thread on one thread (numba's setting, not its variable)."""
+    import numba
+
+    numba.set_num_threads(1)
+    return task(job)
 
 
 def _run_on_cluster(task: Callable, todo: list, scheduler: str | None, workers: int | None,
@@ -458,7 +471,9 @@ def _run_on_cluster(task: Callable, todo: list, scheduler: str | None, workers: 
 
     with _client(scheduler, workers) as client:
         info = {"scheduler": scheduler or "local", "workers": len(client.scheduler_info().get("workers", {}))}
-        futures = client.map(task, [job for _, job in todo], pure=False)
+        # on a local cluster the kernels of a task run on one thread (the processes share out the cores)
+        run = task if scheduler is not None else functools.partial(_on_one_thread, task)
+        futures = client.map(run, [job for _, job in todo], pure=False)
         index = {future.key: position for future, (position, _) in zip(futures, todo)}
         for future in as_completed(futures):
             error = future.exception() if future.status == "error" else None

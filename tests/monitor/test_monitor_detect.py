@@ -9,7 +9,7 @@ import pyarrow as pa
 import pytest
 
 from greybox.errors import ParameterError
-from greybox.monitor.detect import ChangeDetector, calibrated_threshold, cusum
+from greybox.monitor.detect import ChangeDetector, calibrated_threshold, cusum, stable_shapes
 from greybox.monitor.fingerprint import FEATURES
 from greybox.monitor.history import SCHEMA, SCHEMA_VERSION
 
@@ -89,13 +89,69 @@ def test_one_odd_day_is_no_alarm():
 def test_calibrated_threshold_holds_its_false_alarm_rate():
     rng = np.random.default_rng(2024)  # stable axes drawn apart from the calibration's own seed
     axes = [_table({name: rng.normal(1.0, 0.02, 28 + 365) for name in FEATURES}, axis=f"A{i}") for i in range(60)]
-    detector = ChangeDetector(baseline_days=28, false_alarms_per_year=1.0).fit(pa.concat_tables(axes))
+    detector = ChangeDetector(baseline_days=28, false_alarms_per_year=1.0, shapes="normal").fit(pa.concat_tables(axes))
     assert detector.threshold_ == pytest.approx(
-        calibrated_threshold(baseline_days=28, n_features=len(FEATURES)))
+        calibrated_threshold(baseline_days=28, n_features=len(FEATURES), false_alarms_per_year=1.0))
     per_axis_year = len(detector.alarms_) / 60
     assert 0.4 < per_axis_year < 1.8  # 1 asked; 60 axis-years leave a Monte-Carlo spread of about +-0.3
     textbook = ChangeDetector(baseline_days=28, k=0.5, h=5.0).fit(pa.concat_tables(axes))
     assert len(textbook.alarms_) / 60 > 2.0 * per_axis_year  # why h is calibrated
+
+
+def _skewed_shapes(n_features):
+    """Quantiles of a standardised log-normal (sigma 0.5): a magnitude skewed to high values, like a maximum."""
+    sample = np.random.default_rng(77).lognormal(0.0, 0.5, 400_000)
+    z = (sample - np.exp(0.125)) / np.sqrt((np.exp(0.25) - 1.0) * np.exp(0.25))
+    return np.tile(np.quantile(z, np.linspace(0.0, 1.0, 201)), (n_features, 1))
+
+
+def _false_alarms_per_axis_year(x, h, n_features, baseline_days=28, k=1.0, clip=3.0):
+    """Stable series (one per row) watched as the detector does: the expected alarms of n_features such sums."""
+    base = x[:, :baseline_days]
+    z = np.clip((x - base.mean(axis=1, keepdims=True)) / base.std(axis=1, ddof=1, keepdims=True), -clip, clip)
+    up, low = np.zeros(len(x)), np.zeros(len(x))
+    crossed_up, crossed_low = np.zeros(len(x), bool), np.zeros(len(x), bool)
+    for day in range(x.shape[1]):
+        up = np.maximum(0.0, up + z[:, day] - k)
+        low = np.maximum(0.0, low - z[:, day] - k)
+        crossed_up |= up >= h
+        crossed_low |= low >= h
+    return n_features * (crossed_up.mean() + crossed_low.mean())
+
+
+def test_calibration_on_skewed_days_holds_the_rate_the_normal_one_misses():
+    # stable days skewed to high values (not normal); the baselines estimated from 28 of them; drawn apart
+    # from the calibration's seed
+    x = np.random.default_rng(31).lognormal(0.0, 0.5, (20_000, 28 + 365))
+    skewed = calibrated_threshold(baseline_days=28, n_features=10, false_alarms_per_year=1.0,
+                                  shapes=_skewed_shapes(10))
+    normal = calibrated_threshold(baseline_days=28, n_features=10, false_alarms_per_year=1.0)
+    assert skewed > normal  # the upper sums of skewed days reach high more often
+    # 1 asked; 20,000 series: a Monte-Carlo spread of about +-0.03 (sd) on top of the calibration's own
+    assert abs(_false_alarms_per_axis_year(x, skewed, 10) - 1.0) < 0.12
+    assert _false_alarms_per_axis_year(x, normal, 10) > 1.4  # the calibration on normal days under-states it
+    # the same check on normal days holds the normal calibration
+    y = np.random.default_rng(32).standard_normal((20_000, 28 + 365))
+    assert abs(_false_alarms_per_axis_year(y, normal, 10) - 1.0) < 0.12
+
+
+def test_twin_shapes_are_standardised_quantiles_and_set_the_default_threshold():
+    shapes = stable_shapes()
+    assert shapes.shape[0] == len(FEATURES) and np.all(np.diff(shapes, axis=1) >= 0.0)
+    draws = np.array([np.interp(np.linspace(0.0, 1.0, 20001), np.linspace(0.0, 1.0, shapes.shape[1]), row)
+                      for row in shapes])
+    assert np.all(np.abs(draws.mean(axis=1)) < 0.05) and np.all(np.abs(draws.std(axis=1) - 1.0) < 0.05)
+    local = draws[FEATURES.index("local_excess")]
+    assert np.mean((local - local.mean()) ** 3) > 0.3  # a largest value along the travel: skewed to high values
+    detector = ChangeDetector().fit(_table({}, default=np.random.default_rng(4).normal(1.0, 0.01, 40)))
+    assert detector.threshold_ == pytest.approx(calibrated_threshold(
+        baseline_days=28, n_features=len(FEATURES), false_alarms_per_year=0.5, shapes=shapes))
+    assert detector.threshold_ > calibrated_threshold(baseline_days=28, n_features=len(FEATURES),
+                                                      false_alarms_per_year=1.0, shapes=shapes)
+    with pytest.raises(ParameterError, match="shapes"):
+        ChangeDetector(shapes="gamma").fit(_table({}, default=np.ones(40)))
+    with pytest.raises(ParameterError, match="ascending quantiles"):
+        calibrated_threshold(baseline_days=28, n_features=2, shapes=shapes[:2, ::-1])
 
 
 def test_threshold_rises_with_a_shorter_baseline_and_fewer_alarms():
