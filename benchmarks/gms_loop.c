@@ -1,7 +1,7 @@
 /*
  * Plain C reference loop of the GMS friction recursion, for benchmarks/bench_gms.py.
  *
- * The same forward-Euler recursion as greybox.friction.kernels.gms_friction_kernel
+ * The same forward-Euler recursion as greybox.models.friction.kernels.gms_friction_kernel
  * (see docs/friction-models.md): N Maxwell-slip elements sharing the Stribeck
  * curve s(v) = s_inf + (s_0 - s_inf) exp(-|v|/v_s), stick z += v T until the
  * deflection reaches alpha_i s(v) in the direction of motion, slip
