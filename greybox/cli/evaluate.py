@@ -9,7 +9,7 @@ from ..atomic import check_output_path, write_text_atomic
 from ..data.effort import EFFORT_UNITS, check_one_effort
 from ..errors import GreyboxError
 from ..evaluate.records import evaluate_models, write_evaluation_pdf, write_evaluation_report
-from ..evaluate.regimes import REGIME_NAMES
+from ..evaluate.regimes import REGIME_NAMES, TRAINING_REGION_NAMES
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json
 from ..persistence import load_model
 from ..provenance import model_quantity
@@ -64,10 +64,11 @@ def _row(name: str, label: str, width: int, m) -> str:
 
 
 def _print_records(records, unit: str, run_names) -> None:
-    """Per model: one row per test log (when there are several), then the pooled rows per regime."""
+    """Per model: one row per test log (when there are several), then the pooled rows per regime, then those inside
+    and outside the model's training region (a model whose file records it)."""
     per_log = len(run_names) > 1
     labels = [f"log {name}" for name in run_names] if per_log else []
-    width = max([14, *map(len, labels)])
+    width = max([14, *map(len, labels), *(len(name) for record in records for name in record["regimes"])])
     rows = "log / regime" if per_log else "regime"
     print(f"  {'model':<24} {rows:<{width}} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7} {'NMSE %':>8}")
     for record in records:
@@ -76,7 +77,7 @@ def _print_records(records, unit: str, run_names) -> None:
             for label, log in zip(labels, run_names):
                 print(_row(name, label, width, record["per_log"][log]))
                 name = ""
-        for regime in REGIME_NAMES:
+        for regime in REGIME_NAMES + tuple(name for name in TRAINING_REGION_NAMES if name in record["regimes"]):
             label = "all (pooled)" if per_log and regime == "all" else regime
             print(_row(name, label, width, record["regimes"][regime]))
             name = ""

@@ -158,6 +158,8 @@ def _done_line(args: argparse.Namespace, started: float, elapsed: float) -> str:
 
 def _report_extrapolation(summary: dict, log_name: str) -> None:
     """One line on the share of samples outside the training region; a note on stderr above the limit."""
+    from ..models.estimator import extrapolates
+
     if summary["share"] is None:
         print(f"  outside the training region: not known ({summary['reason']})")
         return
@@ -168,8 +170,7 @@ def _report_extrapolation(summary: dict, log_name: str) -> None:
         print(f"note: {log_name}: {100 * standstill:.1f} % of the samples are at standstill, where a memoryless "
               "model cannot know the friction the drive holds (flagged in the column standstill and left out of "
               "the process force figures); gms, lugre and gmssvr carry it from the last motion", file=sys.stderr)
-    beyond = max([share for name, share in summary["by"].items() if name != "standstill"] or [0.0])
-    if summary["share"] > summary["warn_above"] and beyond > 0.0:
+    if extrapolates(summary["by"], summary["share"]):
         print(f"note: {log_name}: {100 * summary['share']:.1f} % of the samples lie outside the positions, speeds "
               f"or inputs the model was trained on (more than {100 * summary['warn_above']:g} %): the model "
               "extrapolates there (column outside_training); train on air cuts that cover the cutting programme, "

@@ -17,18 +17,21 @@ from __future__ import annotations
 
 import os
 import textwrap
+import warnings
 from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
 
 from ..metrics import metrics_table
+from ..models.estimator import EXTRAPOLATION_WARNING_SHARE, extrapolates, outside_any
 from ..models.registry import model_kind
 from .figures import effort_name, error_boxplot, residual_vs_position, time_comparison
 from .regimes import metrics_by_regime
-from .report import evaluation_table, per_log_table, regime_table, write_report
+from .report import evaluation_table, per_log_table, regime_table, training_region_table, write_report
 
-__all__ = ["NOISE_FLOOR", "TRUTH_CHANNEL", "metric_record", "evaluate_models", "write_evaluation_report"]
+__all__ = ["NOISE_FLOOR", "TRUTH_CHANNEL", "metric_record", "evaluate_models", "training_region",
+           "write_evaluation_report"]
 
 #: Model name of the records that compare the noise-free current with the measured one.
 NOISE_FLOOR = "noise_floor"
@@ -92,10 +95,13 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
     -------
     records : list of dict
         One ``test`` record per model (see
-        :func:`metric_record`) with ``kind``, ``regimes`` and
+        :func:`metric_record`) with ``kind``, ``regimes``,
+        ``training_region`` (:func:`training_region`) and
         ``effort_unit`` (the unit of RMSE and largest error: "A", or "N"
         for force logs) added, plus a ``noise_floor`` record when every run
-        carries the noise-free current.
+        carries the noise-free current. The ``regimes`` of a model that
+        records its training region add ``inside_training`` and
+        ``outside_training`` (:data:`~greybox.evaluate.regimes.TRAINING_REGION_NAMES`).
     predictions : dict
         ``{name: predicted current [A] (or force [N]), runs concatenated}``.
 
@@ -103,6 +109,14 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
     ------
     ValueError
         If the runs carry different effort units.
+
+    Warns
+    -----
+    UserWarning
+        Per model and test run where more than
+        :data:`~greybox.models.estimator.EXTRAPOLATION_WARNING_SHARE` of the samples lie outside the
+        model's training region (with the RMSE there and inside); once per model whose file has no
+        record of that region.
     """
     _, unit = effort_name(runs)
     axis = "/".join(dict.fromkeys(run.axis for run in runs if run.axis))
@@ -116,10 +130,83 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
         per_log = {n: (run.effort, p) for n, run, p in zip(run_names, runs, parts)}
         record = metric_record(None, axis, name, "test", measured, prediction, run_names, per_log)
         record["kind"] = model_kind(models[name]) if name in models else NOISE_FLOOR
-        record["regimes"] = metrics_by_regime(runs, prediction)
+        flags = [models[name].outside_training(run) for run in runs] if name in models else None
+        outside = None if not flags or not all(flags) else [outside_any(f) for f in flags]
+        record["regimes"] = metrics_by_regime(runs, prediction, outside=outside)
         record["effort_unit"] = unit
+        if flags is not None:
+            record["training_region"] = training_region(name, runs, run_names, parts, flags)
         records.append(record)
     return records, predictions
+
+
+#: Words for the quantities of ``outside_training`` in the notes of :func:`training_region`.
+_REGION_WORDS = {"position": "positions", "velocity": "speeds", "inputs": "kernel inputs"}
+
+
+def _log_label(run, name: str) -> str:
+    """The test log as a note names it: its file name, or the run's name when the file was split or has none."""
+    source = Path(run.source) if run.source else None
+    return source.name if source is not None and source.stem == name else name
+
+
+def training_region(model: str, runs, run_names: Sequence[str], predictions: Sequence[np.ndarray],
+                    flags: Sequence[dict]) -> dict:
+    """The errors of one model inside and outside its training region, per test run; warns where it extrapolates.
+
+    Parameters
+    ----------
+    model : str
+        Model name, as the notes name it.
+    runs : list of AxisLog
+        Prepared test runs; ``effort`` is the measured value [A or N].
+    run_names : sequence of str
+        Their names in the records.
+    predictions : sequence of ndarray
+        The model's prediction of each run, same unit.
+    flags : sequence of dict
+        :meth:`~greybox.models.estimator.CurrentModel.outside_training` of each run (empty dicts for a
+        model file without the record).
+
+    Returns
+    -------
+    dict
+        ``{"share": None, "reason": str}`` without the record, else ``{"share": float, "warn_above": float,
+        "per_log": {name: {"share", "by", "inside", "outside"}}}``: the share of all samples outside [-],
+        and per run that share, the share per quantity (``{"position": ...}``) and the metrics
+        (``n``, ``rmse``, ``re``, ``nmse``) inside and outside.
+
+    Warns
+    -----
+    UserWarning
+        As :func:`evaluate_models`.
+    """
+    if not all(flags):
+        warnings.warn(f"{model}: the model file has no record of its training region (written before greybox "
+                      "kept one), so there are no inside_training and outside_training rows; retrain it to get "
+                      "them", UserWarning, stacklevel=3)
+        return {"share": None, "reason": "the model file has no record of its training region"}
+    per_log, n_outside = {}, 0
+    for run, name, predicted, flagged in zip(runs, run_names, predictions, flags):
+        beyond = outside_any(flagged)
+        n_outside += int(np.count_nonzero(beyond))
+        share = float(np.mean(beyond))
+        by = {quantity: float(np.mean(f)) for quantity, f in flagged.items()}
+        parts = {side: metrics_table(run.effort[mask], predicted[mask]) for side, mask in
+                 (("inside", ~beyond), ("outside", beyond))}
+        per_log[name] = {"share": share, "by": by, **{side: {key: table[key] for key in ("n", "rmse", "re", "nmse")}
+                                                      for side, table in parts.items()}}
+        if extrapolates(by, share):
+            words = ", ".join(f"{_REGION_WORDS.get(q, q)} {100 * value:.1f} %" for q, value in by.items() if value)
+            unit = effort_name([run])[1]
+            inside = parts["inside"]["rmse"]
+            against = f"{inside:.3g} {unit} inside" if parts["inside"]["n"] else "no sample inside"
+            warnings.warn(f"{_log_label(run, name)}: {100 * share:.1f} % of the samples lie outside what model "
+                          f"{model} was trained on ({words}); RMSE there {parts['outside']['rmse']:.3g} {unit} "
+                          f"against {against}", UserWarning, stacklevel=3)
+    total = sum(len(run) for run in runs)
+    return {"share": n_outside / total if total else float("nan"), "warn_above": EXTRAPOLATION_WARNING_SHARE,
+            "per_log": per_log}
 
 
 def _report_parts(records, predictions, runs, run_names, out_dir: Path | None):
@@ -144,6 +231,8 @@ def _report_parts(records, predictions, runs, run_names, out_dir: Path | None):
     if len(runs) > 1:
         tables.append(per_log_table(records, unit=unit))
     tables.append(regime_table(records))
+    if any("training_region" in record for record in records):
+        tables.append(training_region_table(records, unit=unit))
     intro = f"Models tested on {tests}; the logs' effort is {noun} in {unit}."
     return figures, tables, "greybox: model evaluation", intro
 

@@ -28,6 +28,16 @@ Regimes (a sample may belong to several):
 ``acceleration``
     ``|a| > a_steady``: the acceleration and deceleration phases.
 
+Given the samples a model was not trained on (``outside`` of
+:func:`metrics_by_regime`: :func:`~greybox.models.estimator.outside_any` of
+:meth:`~greybox.models.estimator.CurrentModel.outside_training`), two more
+rows split the samples by that model's own training region:
+
+``inside_training`` / ``outside_training``
+    The samples inside / outside the positions, speeds (and, for kernel
+    models, inputs) the model's training runs covered; for a memoryless model
+    standstill counts as outside. Together they hold every sample once.
+
 Default thresholds (:meth:`RegimeThresholds.from_logs`) scale with the motion
 in the logs, using the 99th percentile of ``|v|`` and ``|a|`` as a robust
 maximum (insensitive to single spikes of a differentiated signal):
@@ -48,10 +58,12 @@ from ..data.log import AxisLog, as_log_list
 from ..errors import LogError
 from ..metrics import metrics_table
 
-__all__ = ["REGIME_NAMES", "RegimeThresholds", "regime_masks", "metrics_by_regime"]
+__all__ = ["REGIME_NAMES", "TRAINING_REGION_NAMES", "RegimeThresholds", "regime_masks", "metrics_by_regime"]
 
 #: Names of the regimes, in the order reports list them.
 REGIME_NAMES = ("all", "low_velocity", "high_velocity", "reversal", "constant_feed", "acceleration")
+#: Names of the rows that split the samples by a model's training region, after :data:`REGIME_NAMES`.
+TRAINING_REGION_NAMES = ("inside_training", "outside_training")
 
 
 @dataclass(frozen=True)
@@ -204,6 +216,8 @@ def metrics_by_regime(
     logs: AxisLog | Sequence[AxisLog],
     predictions,
     thresholds: RegimeThresholds | None = None,
+    *,
+    outside=None,
 ) -> dict[str, dict[str, float | int]]:
     """Metrics of modelled against measured effort, overall and per regime.
 
@@ -218,13 +232,18 @@ def metrics_by_regime(
     thresholds : RegimeThresholds, optional
         Defaults to :meth:`RegimeThresholds.from_logs` of all runs together,
         so that every run is split by the same thresholds.
+    outside : sequence of array_like of bool, optional
+        Per run, True at the samples outside the model's training region
+        (:func:`~greybox.models.estimator.outside_any`); adds the rows of
+        :data:`TRAINING_REGION_NAMES`.
 
     Returns
     -------
     dict
-        ``{regime: metrics_table(...)}`` for every name in :data:`REGIME_NAMES`;
-        the samples of all runs in a regime are pooled. A regime without
-        samples has ``n == 0`` and nan metrics.
+        ``{regime: metrics_table(...)}`` for every name in :data:`REGIME_NAMES`
+        (and :data:`TRAINING_REGION_NAMES` with ``outside``); the samples of
+        all runs in a regime are pooled. A regime without samples has
+        ``n == 0`` and nan metrics.
     """
     runs = as_log_list(logs)
     if isinstance(logs, AxisLog) or (isinstance(predictions, np.ndarray) and predictions.ndim == 1):
@@ -248,4 +267,12 @@ def metrics_by_regime(
     for name in REGIME_NAMES:
         selected = np.concatenate([m[name] for m in masks])
         result[name] = metrics_table(measured[selected], modelled[selected])
+    if outside is not None:
+        flags = [np.asarray(f, dtype=bool).ravel() for f in outside]
+        if [f.shape[0] for f in flags] != [len(run) for run in runs]:
+            raise ValueError(f"runs of {[len(run) for run in runs]} samples but training-region flags of "
+                             f"{[f.shape[0] for f in flags]}")
+        beyond = np.concatenate(flags) if flags else np.zeros(0, dtype=bool)
+        for name, selected in zip(TRAINING_REGION_NAMES, (~beyond, beyond)):
+            result[name] = metrics_table(measured[selected], modelled[selected])
     return result

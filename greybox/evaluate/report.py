@@ -66,6 +66,7 @@ __all__ = [
     "evaluation_table",
     "per_log_table",
     "regime_table",
+    "training_region_table",
     "report_tables",
     "tables_markdown",
     "write_report",
@@ -484,6 +485,45 @@ def regime_table(records: Sequence[Mapping], title: str = "RE per operating regi
              "reversal: a window around each change of direction; constant feed; acceleration phases. "
              "A sample may belong to several regimes; the header gives each regime's share of the samples.",
              RE_NOTE]
+    return Table(title, header, rows, notes)
+
+
+def training_region_table(records: Sequence[Mapping], unit: str = "A",
+                          title: str = "Errors inside and outside each model's training region") -> Table:
+    """Samples, RMSE and RE of each model inside and outside the region its training runs covered.
+
+    The rows are the ``inside_training`` and ``outside_training`` regimes of the records
+    (:data:`greybox.evaluate.regimes.TRAINING_REGION_NAMES`); a model whose file has no record of its
+    training region gets a row of dashes.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Metric records of :func:`greybox.evaluate.records.evaluate_models`; those without
+        ``training_region`` (the noise floor) are left out.
+    unit : str, default "A"
+        Unit of the RMSE (the logs' effort unit).
+    title : str, default "Errors inside and outside each model's training region"
+        Table title.
+    """
+    header = ["model", "samples outside [%]", "samples inside", f"RMSE inside [{unit}]", "RE inside [%]",
+              "samples outside", f"RMSE outside [{unit}]", "RE outside [%]"]
+    rows = []
+    for record in records:
+        if "training_region" not in record:
+            continue
+        regimes = record.get("regimes") or {}
+        if "outside_training" not in regimes:
+            rows.append([_label(record["model"])] + ["–"] * (len(header) - 1))
+            continue
+        inside, outside = regimes["inside_training"], regimes["outside_training"]
+        share = 100.0 * outside["n"] / (inside["n"] + outside["n"]) if inside["n"] + outside["n"] else float("nan")
+        rows.append([_label(record["model"]), _number(share, 1), str(inside["n"]), _number(inside["rmse"], 4),
+                     _number(inside["re"], 2), str(outside["n"]), _number(outside["rmse"], 4),
+                     _number(outside["re"], 2)])
+    notes = ["Outside: samples whose position, speed (kernel models: inputs) lies beyond what the model's training "
+             "runs covered, or, for a memoryless model, at standstill (the column outside_training of greybox "
+             "predict); inside: the others. A dash: the model file has no record of its training region.", RE_NOTE]
     return Table(title, header, rows, notes)
 
 

@@ -28,7 +28,8 @@ from ..identify.intervals import with_intervals
 from ..identify.progress import make_progress
 from ..metrics import rmse
 
-__all__ = ["CurrentModel", "StreamView", "check_inertia", "check_runs", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
+__all__ = ["CurrentModel", "StreamView", "check_inertia", "check_runs", "extrapolates", "outside_any",
+           "EXTRAPOLATION_WARNING_SHARE", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
 
 #: Largest magnitude of an identified parameter a model file may carry: currents of a feed axis are
 #: amperes, stiffnesses thousands of A/mm; 1e12 in any unit is a corrupt or hostile file.
@@ -40,6 +41,46 @@ _REGION_CHANNELS = {"position_range_mm_": "position", "velocity_range_mm_s_": "v
 #: Speed below which a memoryless model's sample counts as standstill, as a share of the largest training
 #: speed [-]: flagged ``"standstill"`` by :meth:`CurrentModel.outside_training`.
 STANDSTILL_SHARE = 0.01
+
+#: Share of a log's samples outside the training region above which ``greybox predict`` and
+#: ``greybox evaluate`` warn [-].
+EXTRAPOLATION_WARNING_SHARE = 0.05
+
+
+def outside_any(flags: dict) -> np.ndarray | None:
+    """The samples outside the training region in any quantity: what ``outside_training`` means.
+
+    Parameters
+    ----------
+    flags : dict of str to ndarray of bool
+        :meth:`CurrentModel.outside_training` (or ``outside_training_chunk``) of a run.
+
+    Returns
+    -------
+    ndarray of bool or None
+        True where any flag is set; None when ``flags`` is empty (a model file that predates the record).
+    """
+    return np.logical_or.reduce(list(flags.values())) if flags else None
+
+
+def extrapolates(shares: dict, share: float) -> bool:
+    """Whether a log lies outside the training region enough to warn about.
+
+    Parameters
+    ----------
+    shares : dict of str to float
+        Share of the samples flagged per quantity of :meth:`CurrentModel.outside_training` [-].
+    share : float
+        Share of the samples flagged in any quantity (:func:`outside_any`) [-].
+
+    Returns
+    -------
+    bool
+        True when ``share`` exceeds :data:`EXTRAPOLATION_WARNING_SHARE` and some quantity other than
+        ``"standstill"`` is flagged (standstill alone is not extrapolation: it has a note of its own).
+    """
+    beyond = max([value for name, value in shares.items() if name != "standstill"] or [0.0])
+    return share > EXTRAPOLATION_WARNING_SHARE and beyond > 0.0
 
 
 def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:

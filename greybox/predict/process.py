@@ -67,6 +67,7 @@ from ..data.quantities import MOTIONS, Motion
 from ..data.units import MOTOR_TORQUE
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
+from ..models.estimator import EXTRAPOLATION_WARNING_SHARE, outside_any
 from ..models.registry import model_kind
 from .interval import ProcessInterval
 
@@ -215,10 +216,6 @@ class ProcessResult:
         return pd.DataFrame(self.columns())
 
 
-#: Share of samples outside the training region above which ``greybox predict`` warns.
-EXTRAPOLATION_WARNING_SHARE = 0.05
-
-
 def extrapolation_summary(counts: dict, n_outside: int | None, n_samples: int) -> dict:
     """JSON-able shares of samples outside the training region, overall and per quantity.
 
@@ -314,7 +311,7 @@ class ProcessTally:
             self._regions = True
             for name, flags in regions.items():
                 self.outside_counts[name] = self.outside_counts.get(name, 0) + int(np.count_nonzero(flags))
-            self.n_outside += int(np.count_nonzero(np.logical_or.reduce(list(regions.values()))))
+            self.n_outside += int(np.count_nonzero(outside_any(regions)))
 
     def rms(self, name: str) -> float:
         """Root mean square of ``measured``, ``model``, ``process`` or ``load`` over the samples added.
@@ -480,7 +477,7 @@ def _block_result(block: AxisLog, predicted: np.ndarray, regions: dict, axis_con
         if factors is not None:
             load_bounds = (axis_config.process_load(process - half_width, block.velocity),
                            axis_config.process_load(process + half_width, block.velocity))
-    outside = np.logical_or.reduce(list(regions.values())) if regions else None
+    outside = outside_any(regions)
     return ProcessResult(time=block.time, position=block.position, velocity=block.velocity, measured=block.effort,
                          model=predicted, load=load, effort_unit=block.effort_unit, motion=block.motion,
                          load_constants=factors,

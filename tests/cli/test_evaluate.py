@@ -10,17 +10,18 @@ import pytest
 
 import greybox.cli as cli
 from greybox.data.io import write_log
+from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare, trim
-from greybox.evaluate.regimes import REGIME_NAMES
+from greybox.evaluate.regimes import REGIME_NAMES, TRAINING_REGION_NAMES
 from greybox.evaluate.report import CSV_COLUMNS
 from greybox.metrics import rmse
-from greybox.models.friction import GMSModel, StribeckModel
+from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
-#: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
+#: The tests on the twin's logs take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.
-pytestmark = pytest.mark.slow
+slow = pytest.mark.slow
 
 
 @pytest.fixture(autouse=True)
@@ -43,13 +44,14 @@ def files(tmp_path_factory):
     return paths
 
 
+@slow
 def test_evaluate_prints_regimes_and_writes_json_and_report(files, tmp_path, capsys):
     out, records_file = tmp_path / "report", tmp_path / "metrics.json"
     status = cli.main(["evaluate", str(files["stribeck"]), str(files["gms"]), "--test", str(files["C"]),
                        str(files["D"]), "--json", str(records_file), "--out", str(out)])
     assert status == 0
     printed = capsys.readouterr().out
-    for regime in REGIME_NAMES:
+    for regime in REGIME_NAMES + TRAINING_REGION_NAMES:
         assert regime in printed
     assert "stribeck" in printed and "gms" in printed and "noise_floor" in printed
     records = {r["model"]: r for r in json.loads(records_file.read_text())}
@@ -66,6 +68,8 @@ def test_evaluate_prints_regimes_and_writes_json_and_report(files, tmp_path, cap
         assert record["regimes"]["all"]["rmse"] == pytest.approx(record["rmse"])
         low, high = record["regimes"]["low_velocity"], record["regimes"]["high_velocity"]
         assert low["n"] + high["n"] == record["n"]  # the two envelopes split the samples
+        inside, outside = (record["regimes"][region] for region in TRAINING_REGION_NAMES)
+        assert inside["n"] + outside["n"] == record["n"]  # so does the model's training region
         pooled = (low["n"] * low["rmse"] ** 2 + high["n"] * high["rmse"] ** 2) / record["n"]
         assert np.sqrt(pooled) == pytest.approx(record["rmse"])
     assert {p.name for p in out.iterdir()} >= {"metrics.json", "metrics.csv", "tables.md", "index.html",
@@ -76,6 +80,7 @@ def test_evaluate_prints_regimes_and_writes_json_and_report(files, tmp_path, cap
     assert f"numpy {np.__version__}" in (out / "tables.md").read_text()
 
 
+@slow
 def test_evaluate_refuses_before_any_work(files, tmp_path, capsys):
     existing = tmp_path / "m.json"
     existing.write_text("{}")
@@ -96,6 +101,7 @@ def test_evaluate_refuses_before_any_work(files, tmp_path, capsys):
     assert "none.gbm" in err and "Traceback" not in err
 
 
+@slow
 def test_reproduce_refuses_a_non_empty_directory_and_missing_logs(files, tmp_path, capsys):
     full = tmp_path / "full"
     full.mkdir()
@@ -134,3 +140,57 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
     assert list(table.columns) == list(CSV_COLUMNS) and len(table) == len(records)
     assert list(table["model"]) == [r["model"] for r in records] and list(table["n"]) == [r["n"] for r in records]
     assert cli.main(["reproduce", "--out", str(out), "--data", str(data), "--axis", "Y"]) == 2  # not empty now
+
+
+def _sine_log(amplitude_mm: float, offset_mm: float = 0.0, seed: int = 3) -> AxisLog:
+    """A 1.5 s sine of ``amplitude_mm`` about ``offset_mm`` at 2 ms, the current of Coulomb + viscous friction."""
+    time = np.arange(750) * 0.002
+    position = offset_mm + amplitude_mm * np.sin(2.0 * np.pi * time)
+    velocity = np.gradient(position, time)
+    effort = 0.4 * np.tanh(velocity / 0.5) + 0.01 * velocity + np.random.default_rng(seed).normal(0, 0.02, time.size)
+    return AxisLog(time=time, position=position, effort=effort)
+
+
+@pytest.fixture(scope="module")
+def windows(tmp_path_factory):
+    """A Coulomb model trained on a 10 mm window, the same model saved without the record of its window, and logs
+    inside and beyond it."""
+    root = tmp_path_factory.mktemp("windows")
+    model = CoulombModel().fit(prepare([_sine_log(5.0)]))
+    paths = {"c": save_model(model, root / "c.gbm")}
+    del model.position_range_mm_, model.velocity_range_mm_s_  # as a file written before the record
+    paths["old"] = save_model(model, root / "old.gbm")
+    for name, offset in (("same", 0.0), ("shifted", 3.0)):
+        paths[name] = root / f"{name}.csv"
+        write_log(_sine_log(5.0, offset, seed=4), paths[name])
+    return paths
+
+
+def test_evaluate_says_where_a_model_leaves_its_training_region(windows, tmp_path, capsys):
+    out = tmp_path / "m.json"
+    status = cli.main(["evaluate", str(windows["c"]), "--test", str(windows["same"]), str(windows["shifted"]),
+                       "--json", str(out)])
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    record = json.loads(out.read_text())[0]
+    inside, outside = (record["regimes"][name] for name in TRAINING_REGION_NAMES)
+    for name, row in zip(TRAINING_REGION_NAMES, (inside, outside)):
+        assert any(line.split()[:2] == [name, str(row["n"])] for line in captured.out.splitlines())
+    assert inside["n"] + outside["n"] == record["n"] and outside["n"] > 0
+    notes = [line for line in captured.err.splitlines() if line.startswith("note:")]
+    shifted = record["training_region"]["per_log"]["shifted"]
+    assert len(notes) == 1  # none on the log inside the window
+    assert notes[0].startswith(f"note: shifted.csv: {100 * shifted['share']:.1f} % of the samples lie outside what "
+                               f"model c was trained on (positions {100 * shifted['by']['position']:.1f} %, ")
+    assert f"standstill {100 * shifted['by']['standstill']:.1f} %)" in notes[0]
+    assert notes[0].endswith(f"RMSE there {shifted['outside']['rmse']:.3g} A against {shifted['inside']['rmse']:.3g} "
+                             "A inside")
+
+
+def test_evaluate_of_a_model_file_without_its_training_region_says_so_once(windows, capsys):
+    status = cli.main(["evaluate", str(windows["old"]), "--test", str(windows["same"]), str(windows["shifted"])])
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    notes = [line for line in captured.err.splitlines() if line.startswith("note:")]
+    assert len(notes) == 1 and notes[0].startswith("note: old: the model file has no record of its training region")
+    assert "inside_training" not in captured.out and "outside_training" not in captured.out
