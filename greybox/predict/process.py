@@ -71,7 +71,7 @@ from ..models.estimator import EXTRAPOLATION_WARNING_SHARE, outside_any
 from ..models.registry import model_kind
 from .interval import ProcessInterval
 
-__all__ = ["EXTRAPOLATION_WARNING_SHARE", "ProcessResult", "ProcessTally", "check_process_inputs",
+__all__ = ["ProcessResult", "ProcessTally", "check_process_inputs",
            "extrapolation_summary", "join_results", "predict_process", "process_attrs", "process_blocks"]
 
 
