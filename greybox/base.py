@@ -249,6 +249,37 @@ class ModelProtocol(BaseEstimator):
         """
         return {}
 
+    def interval_value(self, name: str):
+        """Present value of a coordinate named by :meth:`interval_coordinates`.
+
+        Parameters
+        ----------
+        name : str
+            A key of :meth:`interval_coordinates`.
+
+        Returns
+        -------
+        float or ndarray
+            The learned attribute ``name`` by default, in its own unit.
+        """
+        return getattr(self, name)
+
+    def set_interval_value(self, name: str, value) -> None:
+        """Write a value of a coordinate named by :meth:`interval_coordinates` (in place).
+
+        The intervals move each coordinate by a small step and write the saved value back; a model whose
+        coordinates are not plain learned attributes, or that keeps quantities derived from them, overrides
+        this and :meth:`interval_value`.
+
+        Parameters
+        ----------
+        name : str
+            A key of :meth:`interval_coordinates`.
+        value : float or ndarray
+            The new value, in the coordinate's own unit (fractions summing to 1 for a simplex).
+        """
+        setattr(self, name, value)
+
     def interval_notes(self) -> dict[str, str]:
         """Rows of :meth:`parameter_table` that get no interval, with the reason in a few words.
 

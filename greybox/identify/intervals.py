@@ -182,7 +182,8 @@ class _Coordinates:
             if kind not in ("log", "simplex"):
                 raise ValueError(f"coordinate {name!r} of kind {kind!r}: expected 'log' or 'simplex'")
         self.shape_index = [(name, element) for name, kind in self.shapes.items()
-                            for element in (range(1, np.size(getattr(model, name))) if kind == "simplex" else [None])]
+                            for element in (range(1, np.size(model.interval_value(name))) if kind == "simplex"
+                                            else [None])]
 
     @property
     def n_linear(self) -> int:
@@ -213,12 +214,12 @@ class _Coordinates:
 
     def _set_shape(self, index: int, delta: float) -> None:
         name, element = self.shape_index[index]
-        value = np.array(getattr(self.model, name), dtype=float)
+        value = np.array(self.model.interval_value(name), dtype=float)
         if element is None:
-            setattr(self.model, name, float(value * np.exp(delta)))
+            self.model.set_interval_value(name, float(value * np.exp(delta)))
             return
         value[element] *= np.exp(delta)
-        setattr(self.model, name, value / value.sum())
+        self.model.set_interval_value(name, value / value.sum())
 
     def perturbed(self, function, j: int, delta: float):
         """``function()`` with coordinate ``j`` moved by ``delta`` (its own units; log for a shape), then restored."""
@@ -231,12 +232,12 @@ class _Coordinates:
             finally:
                 self.model.set_linear_coefficients(self.coefficients)
         name = self.shape_index[j - self.n_linear][0]
-        saved = getattr(self.model, name)
+        saved = self.model.interval_value(name)
         try:
             self._set_shape(j - self.n_linear, delta)
             return function()
         finally:
-            setattr(self.model, name, saved)
+            self.model.set_interval_value(name, saved)
 
     def step(self, j: int) -> float:
         return self._linear_step(j) if j < self.n_linear else LOG_STEP

@@ -70,6 +70,9 @@ _INERTIA_TERM = "inertia_mismatch"
 _OFFSET_TERM = "constant_offset"
 #: The base refinement whose play-operator states carry over from chunk to chunk.
 _PRESLIDING_TERM = "presliding_hysteresis"
+#: Names of the interval coordinates (:meth:`AugmentedModel.interval_coordinates`): the base's, a term's shape.
+_BASE_PREFIX = "base."
+_SHAPE_SUFFIX = ".shape"
 
 
 def normalise_effects(effects) -> list[tuple[str, float | None]]:
@@ -479,6 +482,66 @@ class AugmentedModel(CurrentModel):
                                              if e["name"] == _INERTIA_TERM)
         self.offset_ = float(self.base_.offset_) + sum(e["coefficients"][0] for e in self.effects_
                                                        if e["name"] == _OFFSET_TERM)
+
+    # ---------------------------------------------------------------- parameter intervals
+    def interval_coordinates(self) -> dict[str, str]:
+        """The base's nonlinear parameters (``"base.<attribute>"``) and, when ``refine_shapes``, every term's
+        shape parameter (``"<index>:<effect>.shape"``: period, time constant or Stribeck velocity, log scale).
+
+        With ``refine_shapes`` false a term's shape is given or picked from its grid, not identified: it is
+        not varied, and its row is flagged as held fixed.
+        """
+        check_is_fitted(self, "effects_")
+        base = {f"{_BASE_PREFIX}{name}": kind for name, kind in self.base_.interval_coordinates().items()}
+        terms = {f"{i + 1}:{e['name']}{_SHAPE_SUFFIX}": "log" for i, e in enumerate(self.effects_)
+                 if e["shape"] is not None and self.refine_shapes}
+        return {**base, **terms}
+
+    def interval_value(self, name: str):
+        """Present value of a coordinate of :meth:`interval_coordinates` (the base's attribute, or a term's shape).
+
+        Parameters
+        ----------
+        name : str
+            ``"base.<attribute>"`` or ``"<index>:<effect>.shape"``.
+        """
+        if name.startswith(_BASE_PREFIX):
+            return self.base_.interval_value(name[len(_BASE_PREFIX):])
+        return self.effects_[self._term_index(name)]["shape"]
+
+    def set_interval_value(self, name: str, value) -> None:
+        """Write a coordinate of :meth:`interval_coordinates`, with what is derived from it.
+
+        A base parameter moves both the base and the friction the friction terms scale
+        (``friction_shape_base_``: the base as identified, of the same shape); a term's shape moves
+        that term's physical parameters too. ``friction_level_`` (the terms' scale) stays.
+
+        Parameters
+        ----------
+        name : str
+            ``"base.<attribute>"`` or ``"<index>:<effect>.shape"``.
+        value : float or ndarray
+            The new value, in the parameter's own unit ([mm], [s], [mm/s], or fractions for a simplex).
+        """
+        if name.startswith(_BASE_PREFIX):
+            attribute = name[len(_BASE_PREFIX):]
+            self.base_.set_interval_value(attribute, value)
+            shape_base = getattr(self, "friction_shape_base_", None)
+            if shape_base is not None:
+                shape_base.set_interval_value(attribute, np.array(value) if np.ndim(value) else value)
+            return
+        entry = self.effects_[self._term_index(name)]
+        entry["shape"] = float(value)
+        entry["parameters"] = effect(entry["name"]).parameters(entry["coefficients"], self.context, entry["shape"],
+                                                               self.effort_unit_)
+
+    def _term_index(self, name: str) -> int:
+        """Index into ``effects_`` of a term coordinate ``"<index>:<effect>.shape"`` (1-based index)."""
+        index = int(name.split(":", 1)[0]) - 1
+        if not (name.endswith(_SHAPE_SUFFIX) and 0 <= index < len(self.effects_)
+                and name == f"{index + 1}:{self.effects_[index]['name']}{_SHAPE_SUFFIX}"):
+            raise ValueError(f"no interval coordinate {name!r} in this model")
+        return index
 
 
 def _apart(period, low, high, others, step) -> tuple[float, float]:
