@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from greybox.data.prepare import prepare
-from greybox.friction import CoulombModel, StribeckModel
 from greybox.identify.intervals import attach_intervals, parameter_intervals
 from greybox.models.augmented import AugmentedModel
 from greybox.models.effects import effect
+from greybox.models.friction import CoulombModel, StribeckModel
 from greybox.twin import make_dataset
 
 PERIOD, AMPLITUDE, PHASE = 2.5, 0.08, -0.7  # mm, A, rad: the hidden cogging-like force
