@@ -22,6 +22,16 @@ from .process import ProcessResult
 __all__ = ["envelope_indices", "moving_mean", "plot_machine_process", "plot_process"]
 
 
+
+def _shown(time: np.ndarray, window) -> slice:
+    """The samples of ``time`` [s] inside ``window`` (all without one); ValueError if none lies in it."""
+    if window is None:
+        return slice(None)
+    shown = slice(np.searchsorted(time, window[0], "left"), np.searchsorted(time, window[1], "right"))
+    if shown.start >= shown.stop:
+        raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
+    return shown
+
 def moving_mean(values, window: int) -> np.ndarray:
     """Centred moving mean over ``window`` samples, the window shortened at both ends of the signal.
 
@@ -94,13 +104,7 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
     ValueError
         If no sample lies in ``window``.
     """
-    shown = slice(None)
-    if window is not None:
-        first = np.searchsorted(result.time, window[0], "left")
-        stop = np.searchsorted(result.time, window[1], "right")
-        if first >= stop:
-            raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
-        shown = slice(first, stop)
+    shown = _shown(result.time, window)
     plt = import_pyplot(path)
     unit = result.shown_unit
     units = result.units
@@ -205,11 +209,7 @@ def plot_machine_process(result, path: str | os.PathLike | None = None, *,
         If no sample lies in ``window``.
     """
     time = result.time
-    shown = slice(None)
-    if window is not None:
-        shown = slice(np.searchsorted(time, window[0], "left"), np.searchsorted(time, window[1], "right"))
-        if shown.start >= shown.stop:
-            raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
+    shown = _shown(time, window)
     columns = result.columns()
     panels = []
     for axis, axis_result in result.results.items():
