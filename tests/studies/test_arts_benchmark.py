@@ -169,6 +169,12 @@ def test_subset_study_writes_its_files_and_reports_the_re_of_its_predictions(tmp
             assert entry["files"][f"{log.dataset}.npy"]["re"] == entry[role]["re"]  # one file per role
     assert f"| `stribeck` | Stribeck + viscous + offset | 6 | {results['models']['stribeck']['train']['re']:.2f} |" \
         in table
+    coulomb = results["models"]["coulomb"]
+    assert coulomb["test"]["bands"] == coulomb["files"]["test4.npy"]["bands"]  # one file per role
+    refit = CoulombModel(fit_offset=True).fit(train)
+    assert coulomb["test"]["bands"] == bench.band_split([test], [refit.predict(test)])
+    floors = (coulomb["train"]["bands"]["floor"], coulomb["test"]["bands"]["floor"], coulomb["fast"]["bands"]["floor"])
+    assert "| floor: the measured force above the band | " + " | ".join(f"{f:.2f}" for f in floors) + " |" in table
     assert md.read_text().startswith(table) and "Measured with greybox" in md.read_text()
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
