@@ -22,7 +22,6 @@ from .process import ProcessResult
 __all__ = ["envelope_indices", "moving_mean", "plot_machine_process", "plot_process"]
 
 
-
 def _shown(time: np.ndarray, window) -> slice:
     """The samples of ``time`` [s] inside ``window`` (all without one); ValueError if none lies in it."""
     if window is None:
@@ -31,6 +30,7 @@ def _shown(time: np.ndarray, window) -> slice:
     if shown.start >= shown.stop:
         raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
     return shown
+
 
 def moving_mean(values, window: int) -> np.ndarray:
     """Centred moving mean over ``window`` samples, the window shortened at both ends of the signal.
