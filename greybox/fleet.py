@@ -15,19 +15,22 @@ from __future__ import annotations
 import contextlib
 import functools
 import glob
+import hashlib
 import json
 import os
 import time
+import unicodedata
 from pathlib import Path
 from typing import Callable, Iterator, Mapping, Sequence
+from urllib.parse import quote, unquote
 
 from .atomic import write_text_atomic
 from .data.io import LOG_SUFFIXES
 from .errors import GreyboxError, Setting
 
-__all__ = ["LOG_SUFFIXES", "MANIFEST", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_out_dir", "expand_logs",
-           "fleet_summary", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared",
-           "run_tasks"]
+__all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_names",
+           "check_out_dir", "decode_name", "encode_name", "expand_logs", "file_sha256", "fleet_summary", "log_names",
+           "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared", "run_tasks"]
 
 #: Name of the manifest in the output directory (a leading "_": dataset readers skip it).
 MANIFEST = "_manifest.json"
@@ -39,10 +42,14 @@ MODELS_FORMAT = "greybox-fleet-models"
 #: for a re-run when a run is killed.
 SAVE_EVERY_S = 10.0
 
+#: Longest name of one directory level most file systems take [bytes]: a partition ``log=<name>`` longer than
+#: this cannot be written and is refused before a fleet run starts.
+MAX_NAME_BYTES = 255
+
 _GLOB_CHARACTERS = set("*?[")
 
 
-def expand_logs(items: Sequence[str]) -> list[Path]:
+def expand_logs(items: Sequence[str], *, exclude: Sequence[str | os.PathLike] = ()) -> list[Path]:
     """The log files named by files, directories (searched recursively) and glob patterns, each once.
 
     Directories and patterns yield the files with a log extension (:data:`LOG_SUFFIXES`), so that a CSV
@@ -63,17 +70,19 @@ def expand_logs(items: Sequence[str]) -> list[Path]:
     GreyboxError
         For an item that names nothing, or no log at all.
     """
+    excluded = [Path(path).resolve() for path in exclude]
     logs: list[Path] = []
     for item in items:
         if _GLOB_CHARACTERS & set(item):
             found = [Path(name) for name in sorted(glob.glob(item, recursive=True))
-                     if Path(name).is_file() and Path(name).suffix.lower() in LOG_SUFFIXES]
+                     if Path(name).is_file() and Path(name).suffix.lower() in LOG_SUFFIXES
+                     and not _in_output(Path(name), excluded)]
             if not found:
                 raise GreyboxError(f"{item}: the pattern matches no log file ({', '.join(LOG_SUFFIXES)})")
             logs += found
         elif os.path.isdir(item):
-            found = sorted(path for path in Path(item).rglob("*") if path.is_file()
-                           and path.suffix.lower() in LOG_SUFFIXES and not path.name.startswith("."))
+            found = sorted(path for path in _walk(Path(item), excluded) if path.suffix.lower() in LOG_SUFFIXES
+                           and not path.name.startswith("."))
             if not found:
                 raise GreyboxError(f"{item}: no log file ({', '.join(LOG_SUFFIXES)}) in the directory")
             logs += found
@@ -85,6 +94,114 @@ def expand_logs(items: Sequence[str]) -> list[Path]:
     if not unique:
         raise GreyboxError("no log given")
     return unique
+
+
+def _is_output(directory: Path, excluded: Sequence[Path]) -> bool:
+    """Whether ``directory`` is a fleet run's output: one of ``excluded``, or holding a :data:`MANIFEST`."""
+    return (directory / MANIFEST).is_file() or directory.resolve() in excluded
+
+
+def _in_output(path: Path, excluded: Sequence[Path]) -> bool:
+    """Whether the file ``path`` lies inside a fleet run's output directory (:func:`_is_output`)."""
+    return any(_is_output(folder, excluded) for folder in path.absolute().parents)
+
+
+def _walk(root: Path, excluded: Sequence[Path]) -> Iterator[Path]:
+    """The files under ``root``, recursively, leaving out fleet outputs (:func:`_is_output`)."""
+    if _in_output(root / "_", excluded):
+        return
+    for folder, subfolders, files in os.walk(root):
+        subfolders[:] = sorted(name for name in subfolders if not _is_output(Path(folder) / name, excluded))
+        for name in files:
+            if os.path.isfile(os.path.join(folder, name)):
+                yield Path(folder) / name
+
+
+def log_names(logs: Sequence[str | os.PathLike]) -> list[str]:
+    """Each log's path relative to the deepest folder holding them all (``/`` between folders), suffix kept.
+
+    Distinct files get distinct names; with :func:`encode_name` they name a fleet's outputs.
+
+    Parameters
+    ----------
+    logs : sequence of str or path-like
+        Absolute paths of distinct log files (:func:`expand_logs`).
+    """
+    if not logs:
+        return []
+    root = os.path.commonpath([os.path.dirname(os.fspath(log)) for log in logs])
+    return [Path(os.path.relpath(os.fspath(log), root)).as_posix() for log in logs]
+
+
+def encode_name(name: str) -> str:
+    """A name as a partition value, reversibly: every character but letters, digits and ``-_.~`` percent-encoded.
+
+    ``pyarrow.dataset`` decodes the value when it reads a hive-partitioned dataset; :func:`decode_name`
+    is the inverse. ``/`` becomes ``%2F``, so that a relative path is one directory level.
+
+    Parameters
+    ----------
+    name : str
+        Any name (a log's relative path, :func:`log_names`).
+    """
+    return quote(name, safe="")
+
+
+def decode_name(value: str) -> str:
+    """The name a partition value of :func:`encode_name` encodes.
+
+    Parameters
+    ----------
+    value : str
+        The value, as in the directory's name after ``log=``.
+    """
+    return unquote(value)
+
+
+def check_names(logs: Sequence[str], names: Sequence[str]) -> None:
+    """Refuse, before anything is written, output names a file system would merge or cannot hold.
+
+    Distinct logs have distinct names (:func:`log_names`); a file system that ignores case or Unicode
+    normalisation would still write two of them to one directory, and a name over :data:`MAX_NAME_BYTES`
+    cannot be written at all.
+
+    Parameters
+    ----------
+    logs : sequence of str
+        The logs.
+    names : sequence of str
+        Their encoded names (:func:`encode_name`), in the same order.
+
+    Raises
+    ------
+    GreyboxError
+        Naming the log(s).
+    """
+    seen: dict[str, str] = {}
+    for log, name in zip(logs, names):
+        if len(f"log={name}".encode()) > MAX_NAME_BYTES:
+            raise GreyboxError(f"{log}: its output name, the path relative to the folder of all logs, is longer "
+                               f"than {MAX_NAME_BYTES} bytes once encoded; give logs of fewer folder levels")
+        key = unicodedata.normalize("NFC", decode_name(name)).casefold()
+        if key in seen:
+            raise GreyboxError(f"{log}: its output would take the place of that of {seen[key]} on a file system "
+                               "that ignores case; rename one of them")
+        seen[key] = log
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes (hex), read block by block.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An existing file.
+    """
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def partition(value: str) -> str:

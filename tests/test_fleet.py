@@ -47,3 +47,69 @@ def test_a_worker_compiles_after_launching_its_threads_and_runs_them_on_one(tmp_
     result = ast.literal_eval(done.stdout.strip().splitlines()[-1])
     assert result["status"] == "ok", result
     assert result["value"] == 2 and result["threads"] == 1  # the task's kernels on one thread
+
+
+# -- output names of a fleet run (greybox.fleet.log_names, encode_name, check_names) --------------------------
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from greybox.errors import GreyboxError  # noqa: E402
+from greybox.fleet import (  # noqa: E402
+    MANIFEST,
+    MAX_NAME_BYTES,
+    check_names,
+    decode_name,
+    encode_name,
+    expand_logs,
+    log_names,
+)
+
+#: A folder or file name: any characters a POSIX file name may hold (no "/" or NUL), never "." or "..".
+_PART = st.text(st.characters(blacklist_characters="/\x00", blacklist_categories=("Cs",)), min_size=1,
+                max_size=12).filter(lambda name: name not in (".", ".."))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.lists(_PART, min_size=1, max_size=4).map(lambda parts: "/plant/" + "/".join(parts)),
+                min_size=1, max_size=12, unique=True))
+def test_no_two_distinct_logs_share_an_output_name_and_each_name_gives_its_path_back(paths):
+    # distinct files (a path that is a file is no other file's folder)
+    paths = [path for path in paths if not any(other.startswith(path + "/") for other in paths)]
+    names = [encode_name(name) for name in log_names(paths)]
+    assert len(set(names)) == len(paths)
+    for path, name in zip(paths, names):
+        assert "/" not in name and "\x00" not in name  # one directory level, "log=<name>"
+        assert path.endswith("/" + decode_name(name))  # reversible: the relative path, suffix kept
+
+
+def test_the_cases_that_collided_get_distinct_names():
+    # were all "log=log", "log=X", "log=run_1": six logs, three outputs
+    logs = ["/p/a/m2/log.mcap", "/p/b/m2/log.mcap", "/p/c/X.mcap", "/p/c/X.parquet", "/p/c/run 1.mcap",
+            "/p/c/run_1.mcap"]
+    names = [encode_name(name) for name in log_names(logs)]
+    assert names == ["a%2Fm2%2Flog.mcap", "b%2Fm2%2Flog.mcap", "c%2FX.mcap", "c%2FX.parquet", "c%2Frun%201.mcap",
+                     "c%2Frun_1.mcap"]
+    check_names(logs, names)
+
+
+def test_names_a_file_system_would_merge_or_cannot_hold_are_refused():
+    logs = ["/p/m/Log.mcap", "/p/m/log.mcap"]
+    with pytest.raises(GreyboxError, match="ignores case"):
+        check_names(logs, [encode_name(name) for name in log_names(logs)])
+    long = ["/p/m/" + "x" * MAX_NAME_BYTES + ".mcap", "/p/n/a.mcap"]
+    with pytest.raises(GreyboxError, match="longer than 255 bytes"):
+        check_names(long, [encode_name(name) for name in log_names(long)])
+
+
+def test_a_fleet_output_inside_the_input_tree_is_not_read_back_as_logs(tmp_path):
+    (tmp_path / "m1").mkdir()
+    (tmp_path / "m1" / "a.csv").write_text("t\n")
+    results = tmp_path / "results" / "machine=m1" / "axis=X" / "log=m1%2Fa.csv"
+    results.mkdir(parents=True)
+    (results / "part-0.parquet").write_bytes(b"")
+    assert expand_logs([str(tmp_path)], exclude=[tmp_path / "results"]) == [tmp_path / "m1" / "a.csv"]
+    # an earlier run's output (its manifest there) is left out also when not excluded by name
+    (tmp_path / "results" / MANIFEST).write_text("{}")
+    assert expand_logs([str(tmp_path)]) == [tmp_path / "m1" / "a.csv"]
+    assert expand_logs([str(tmp_path / "**" / "*.*")]) == [tmp_path / "m1" / "a.csv"]

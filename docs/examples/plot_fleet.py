@@ -4,7 +4,7 @@ Predict a fleet of logs
 
 With many logs, from many machines, the prediction runs one task per log on Dask and writes the
 process tables to one Parquet dataset partitioned like the plant
-(``machine=<folder of the log>/axis=<axis>/log=<file name>``), with a manifest of every log. The
+(``machine=<folder of the log>/axis=<axis>/log=<path relative to the logs' folder>``), with a manifest of every log. The
 command line does the same with::
 
     greybox predict x.gbm plant/ --out results --axis-config examples/axis_x.toml

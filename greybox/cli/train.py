@@ -266,7 +266,7 @@ def _run_per_machine(args: argparse.Namespace) -> int:
                                "its logs in --train (give the axes of logs of several with --axes)")
     axes = [axis.name for axis in _machine_axes(args)[1]] if args.axes is not None else None
     out = check_out_dir(args.out, args.train)
-    logs = expand_logs(args.train)
+    logs = expand_logs(args.train, exclude=[out])
     model = build_model(args.model, args)  # a bad option is one error before any cluster starts
     jobs = train_jobs(logs, model, str(out), axes=axes, read=read_options(args))
     manifest = run_training(jobs, scheduler=args.scheduler, workers=args.workers, force=args.force,

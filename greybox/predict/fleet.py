@@ -3,21 +3,25 @@
 :func:`run_fleet` predicts each log (:func:`predict_log`, on a worker of :func:`greybox.fleet.run_tasks`)
 and writes its process table to a Parquet dataset partitioned like the plant::
 
-    OUT/machine=<folder of the log>/axis=<axis>/log=<file stem>/part-0.parquet
+    OUT/machine=<folder of the log>/axis=<axis>/log=<name>/part-0.parquet
 
-(``pyarrow.dataset.dataset(OUT, partitioning="hive")`` reads it whole, with the partition columns).
+where ``<name>`` is the log's path relative to the deepest folder holding every log of the run, suffix
+kept, percent-encoded (:func:`greybox.fleet.encode_name`: ``mill1%2Fmonday.mcap``): two distinct logs
+never share an output, and ``pyarrow.dataset.dataset(OUT, partitioning="hive")`` reads the dataset whole
+with the partition columns, ``log`` decoded to the relative path. Names a file system would merge (logs
+whose paths differ only in case) or cannot hold (over 255 bytes) are refused before anything is written.
 The manifest records what ran: every log with its status (``ok``, ``skipped``, ``failed`` with its
-one-line error), output, samples, seconds and the worker's peak memory, its model file and the file's
-SHA-256, the versions of greybox and its libraries, the cluster and the wall time. A re-run skips every
-log whose output is complete: listed ``ok`` in the manifest for the same model file (hash) and the same
-log file (size and modification time), its output still there, also after a run that was killed. The
+one-line error), output name, output, samples, seconds and the worker's peak memory, the log's SHA-256,
+its model file and the file's SHA-256, the versions of greybox and its libraries, the cluster and the wall
+time. A re-run skips every log whose output is complete: listed ``ok`` in the manifest under the same
+output name for the same model file (hash) and the same log file (size and modification time), its output
+still there, also after a run that was killed. The
 model is one model file, or a directory of models written by ``greybox train --per-machine``, from which
 each log gets its machine's model (:func:`machine_models`).
 """
 
 from __future__ import annotations
 
-import hashlib
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +32,10 @@ from ..fleet import (
     MANIFEST,
     MODELS_FORMAT,
     attempt,
+    check_names,
+    encode_name,
+    file_sha256,
+    log_names,
     log_stamp,
     machine_of,
     out_dir_of,
@@ -57,6 +65,9 @@ class FleetJob:
         Model file.
     out_dir : str
         Root of the Parquet dataset.
+    name : str
+        The log's output name, its ``log=`` partition value (:func:`greybox.fleet.encode_name` of its
+        path relative to the folder of all the run's logs).
     axis_config : str, optional
         Axis file (force or torque).
     read : dict
@@ -69,6 +80,7 @@ class FleetJob:
     machine: str
     model: str
     out_dir: str
+    name: str
     axis_config: str | None = None
     read: dict = field(default_factory=dict)
     chunk_s: float = 60.0
@@ -142,7 +154,7 @@ def _model_for(log: Path, machine: str, models: dict[str, dict[str, str]], direc
 
 def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: str | None = None,
                read: dict | None = None, chunk_s: float = 60.0) -> list[FleetJob]:
-    """One job per log; the machine is the name of the log's folder.
+    """One job per log; the machine is the name of the log's folder, the output name its relative path.
 
     ``model`` is one model file for every log, or a directory written by ``greybox train --per-machine``:
     each log then gets its machine's model (of ``read["axis"]`` where the machine has several).
@@ -166,24 +178,19 @@ def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: s
     Raises
     ------
     GreyboxError
-        For a models directory without a model of a log's machine (or axis).
+        For a models directory without a model of a log's machine (or axis), or output names a file system
+        would merge or cannot hold (:func:`greybox.fleet.check_names`).
     """
     read = dict(read or {})
+    names = [encode_name(name) for name in log_names(logs)]
+    check_names([str(log) for log in logs], names)
     if os.path.isdir(model):
         models = machine_models(model)
         chosen = [_model_for(Path(log), machine_of(log), models, model, read.get("axis")) for log in logs]
     else:
         chosen = [str(model)] * len(logs)
-    return [FleetJob(str(log), machine_of(log), path, str(out_dir), axis_config, read, float(chunk_s))
-            for log, path in zip(logs, chosen)]
-
-
-def _file_hash(path: str) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
+    return [FleetJob(str(log), machine_of(log), path, str(out_dir), name, axis_config, read, float(chunk_s))
+            for log, path, name in zip(logs, chosen, names)]
 
 
 def predict_log(job: FleetJob) -> dict:
@@ -198,8 +205,8 @@ def predict_log(job: FleetJob) -> dict:
     -------
     dict
         ``log``, ``machine``, ``status`` (``ok`` or ``failed``), ``output``, ``axis``, ``samples``,
-        ``seconds``, ``peak_rss_mb`` (of the worker process so far), and for a failure its ``error``
-        (one line). Never raises for a bad log.
+        ``log_sha256``, ``seconds``, ``peak_rss_mb`` (of the worker process so far), and for a failure its
+        ``error`` (one line). Never raises for a bad log.
     """
     return {"log": job.log, "machine": job.machine, **attempt(job.log, lambda: _predict_and_write(job))}
 
@@ -214,21 +221,22 @@ def _predict_and_write(job: FleetJob) -> dict:
     config = read_axis_config(job.axis_config) if job.axis_config else None
     model = load_model(job.model)
     attrs = {"model_file": job.model, "log_file": job.log}
+    digest = file_sha256(job.log)
     streamed = _stream_and_write(job, model, config, attrs)
     if streamed is not None:
-        return streamed
+        return {**streamed, "log_sha256": digest}
     runs = read_prepared(job.log, job.read, columns=config.channels if config else None)
     result = predict_process(model, runs, axis_config=config, chunk_s=job.chunk_s)
     result.attrs.update(attrs)
     target, axis = _partition(job, result.axis)
     path = write_process(result, target, overwrite=True)  # the table `predict` writes
-    return {"output": str(path), "axis": axis, "samples": len(result.time)}
+    return {"output": str(path), "axis": axis, "samples": len(result.time), "log_sha256": digest}
 
 
 def _partition(job: FleetJob, axis: str) -> tuple[Path, str]:
     """The job's table in the dataset (its directory made), and the name of its axis partition."""
     name = partition(axis or "-")
-    target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={name}" / f"log={partition(Path(job.log).stem)}"
+    target = Path(job.out_dir) / f"machine={job.machine}" / f"axis={name}" / f"log={job.name}"
     target.mkdir(parents=True, exist_ok=True)
     return target / "part-0.parquet", name
 
@@ -279,11 +287,12 @@ def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers
     """
     out_dir = out_dir_of(jobs, "no log to predict")
     files = {job.model for job in jobs} | {job.axis_config for job in jobs if job.axis_config}
-    hashes = {path: _file_hash(path) for path in files}
-    fingerprints = [{"log": job.log, "model": job.model, "model_sha256": hashes[job.model], **log_stamp(job.log),
+    hashes = {path: file_sha256(path) for path in files}
+    fingerprints = [{"log": job.log, "name": job.name, "model": job.model, "model_sha256": hashes[job.model],
+                     **log_stamp(job.log),
                      "axis_config_sha256": hashes.get(job.axis_config), "read": job.read, "chunk_s": job.chunk_s}
                     for job in jobs]  # an option or axis file changed: the log is predicted again
-    header = {"format": PREDICT_FORMAT, "format_version": 2, "axis_config": jobs[0].axis_config,
+    header = {"format": PREDICT_FORMAT, "format_version": 3, "axis_config": jobs[0].axis_config,
               "read": jobs[0].read, "chunk_s": jobs[0].chunk_s}
     return run_tasks(predict_log, jobs, fingerprints, out_dir=out_dir, header=header, items="logs",
                      scheduler=scheduler, workers=workers, force=force, progress=progress)

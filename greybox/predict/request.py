@@ -310,7 +310,7 @@ class Request:
         from .fleet import fleet_jobs, run_fleet
 
         out = check_out_dir(self.out)
-        jobs = fleet_jobs(expand_logs(logs), str(Path(model).resolve()), str(out),
+        jobs = fleet_jobs(expand_logs(logs, exclude=[out]), str(Path(model).resolve()), str(out),
                           axis_config=str(Path(self.axis_config).resolve()) if self.axis_config else None,
                           read=self.read, chunk_s=self.chunk_s)
         for path in sorted({job.model for job in jobs}):
@@ -318,7 +318,10 @@ class Request:
         manifest = run_fleet(jobs, scheduler=self.scheduler, workers=self.workers, force=self.force,
                              progress=self.fleet_progress)
         lines, status = fleet_summary(manifest, "logs", "predicted", lambda entry: entry["error"])
-        lines.append(f"wrote {out / MANIFEST} and the dataset {out}/machine=*/axis=*/log=*/part-0.parquet")
+        if manifest["counts"]["ok"] + manifest["counts"]["skipped"]:
+            lines.append(f"wrote {out / MANIFEST} and the dataset {out}/machine=*/axis=*/log=*/part-0.parquet")
+        else:
+            lines.append(f"wrote {out / MANIFEST} (every log failed: no output)")
         return Prediction(closing=lines, status=status, manifest=manifest)
 
 

@@ -64,13 +64,13 @@ def test_a_fleet_run_writes_a_partitioned_dataset_and_a_manifest(plant, tmp_path
     assert manifest["counts"] == {"ok": 3, "skipped": 0, "failed": 1} and manifest["versions"]["distributed"]
     table = ds.dataset(out, format="parquet", partitioning="hive").to_table().to_pandas()
     assert set(table["machine"]) == {"mill1", "mill2"} and set(table["axis"]) == {"X"}
-    assert set(table["log"]) == {"monday", "tuesday"}
+    assert set(table["log"]) == {"mill1/monday.mcap", "mill1/tuesday.parquet", "mill2/monday.csv"}
     # a log's partition holds what greybox predict writes for that log alone
     single = tmp_path / "single.parquet"
     assert cli.main(["predict", str(plant / "x.gbm"), str(plant / "mill2" / "monday.csv"), "--out", str(single),
                      "--axis-config", str(EXAMPLE), "--quiet"]) == 0
     alone = pd.read_parquet(single)
-    part = pd.read_parquet(out / "machine=mill2" / "axis=X" / "log=monday" / "part-0.parquet")
+    part = pd.read_parquet(out / "machine=mill2" / "axis=X" / "log=mill2%2Fmonday.csv" / "part-0.parquet")
     pd.testing.assert_frame_equal(part, alone)
     assert np.any(np.abs(part["force_process_N"]) > 100.0)
 
@@ -118,3 +118,36 @@ def test_fleet_options_are_checked(plant, tmp_path, capsys):
     status = cli.main(["predict", str(plant / "x.gbm"), str(plant / "mill1" / "monday.mcap"), "--out",
                        str(tmp_path / "c.csv"), "--workers", "2"])
     assert status == 2 and "--scheduler and --workers apply to fleet runs" in capsys.readouterr().err
+
+
+def test_logs_of_one_name_in_other_places_or_formats_get_outputs_of_their_own(plant, tmp_path, capsys):
+    # were written to one file: "6 predicted, 0 failed", three files left, a re-run skipped both of a pair
+    root = tmp_path / "logs"
+    source = plant / "mill1" / "monday.mcap"
+    for relative in ("a/m2/log.mcap", "b/m2/log.mcap", "c/X.mcap", "c/run 1.mcap", "c/run_1.mcap"):
+        (root / relative).parent.mkdir(parents=True, exist_ok=True)
+        (root / relative).write_bytes(source.read_bytes())
+    write_log(make_dataset("X", "C", 12, duration_s=20, cutting=True), root / "c" / "X.parquet")
+    out = root / "results"  # inside the input tree: never read back as logs
+    argv = ["predict", str(plant / "x.gbm"), str(root), "--out", str(out), "--workers", "2", "--quiet"]
+    assert cli.main(argv) == 0
+    assert "6 predicted, 0 skipped (complete from an earlier run), 0 failed of 6 logs" in capsys.readouterr().out
+    manifest = json.loads((out / MANIFEST).read_text())
+    outputs = [entry["output"] for entry in manifest["logs"]]
+    assert len(set(outputs)) == 6 and all(Path(path).is_file() for path in outputs)
+    assert all(len(entry["log_sha256"]) == 64 for entry in manifest["logs"])
+    table = ds.dataset(out, format="parquet", partitioning="hive").to_table().to_pandas()
+    assert set(table["log"]) == {"a/m2/log.mcap", "b/m2/log.mcap", "c/X.mcap", "c/X.parquet", "c/run 1.mcap",
+                                 "c/run_1.mcap"}
+    assert cli.main(argv) == 0  # the output directory inside the tree is not read as logs on a re-run
+    assert "0 predicted, 6 skipped" in capsys.readouterr().out
+
+
+def test_a_run_where_every_log_failed_says_it_wrote_no_dataset(plant, tmp_path, capsys):
+    (tmp_path / "m").mkdir()
+    for name in ("a.csv", "b.csv"):
+        (tmp_path / "m" / name).write_text("not,a\nlog,x\n")
+    assert cli.main(["predict", str(plant / "x.gbm"), str(tmp_path / "m"), "--out", str(tmp_path / "none"),
+                     "--workers", "1", "--quiet"]) == 2
+    printed = capsys.readouterr().out
+    assert "0 predicted" in printed and "every log failed: no output" in printed and "the dataset" not in printed
