@@ -53,12 +53,16 @@ def expand_logs(items: Sequence[str], *, exclude: Sequence[str | os.PathLike] = 
     """The log files named by files, directories (searched recursively) and glob patterns, each once.
 
     Directories and patterns yield the files with a log extension (:data:`LOG_SUFFIXES`), so that a CSV
-    log's metadata sidecar or a manifest beside the logs is not taken for a log.
+    log's metadata sidecar or a manifest beside the logs is not taken for a log; they never yield a file
+    inside a fleet run's output (a directory holding a :data:`MANIFEST`, or one of ``exclude``), so that an
+    output directory inside the input tree is not read back as logs.
 
     Parameters
     ----------
     items : sequence of str
         Log files, directories and glob patterns (``**`` matches across directories).
+    exclude : sequence of path-like, default ()
+        Directories whose files are never logs (the run's own output directory).
 
     Returns
     -------
