@@ -19,7 +19,7 @@ import pyarrow as pa
 
 from ..errors import ParameterError
 from .fingerprint import FEATURES
-from .history import COMPACTED_NAME, SCHEMA_VERSION, HistoryError
+from .history import COMPACTED_NAME, SCHEMA_VERSION, HistoryError, check_history, history_lock
 
 __all__ = ["changed_most"]
 
@@ -61,7 +61,6 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
     HistoryError
         If the history is not a directory or holds no Parquet file.
     """
-    import duckdb
 
     chosen = tuple(FEATURES if features is None else features)
     unknown = [f for f in chosen if f not in FEATURES]
@@ -74,9 +73,18 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
     root = Path(history)
     if not root.is_dir():
         raise HistoryError(f"{root}: history is not a directory")
-    if next(root.rglob("*.parquet"), None) is None:
+    with history_lock(root, shared=True):  # no compaction meanwhile
+        return _query(root, check_history(root), chosen, days, until, baseline_days, limit)
+
+
+def _query(root: Path, paths: list, chosen: tuple, days: int, until: dt.date | None, baseline_days: int,
+           limit: int) -> pa.Table:
+    """:func:`changed_most` on the history's checked files ``paths``."""
+    import duckdb
+
+    if not paths:
         raise HistoryError(f"{root}: the history holds no fingerprints")
-    files = _sql_text(str(root / "**" / "*.parquet"))
+    files = "[" + ", ".join(_sql_text(str(path)) for path in paths) + "]"
     columns = ", ".join(f'avg("{f}") AS "{f}"' for f in chosen)
     names = ", ".join(f'"{f}"' for f in chosen)
     end = "(SELECT max(date) FROM daily)" if until is None else f"DATE {_sql_text(until.isoformat())}"
@@ -115,7 +123,7 @@ def changed_most(history, *, days: int = 30, until: dt.date | None = None, basel
         connection.execute("SET threads TO 1")
         # the files are read once, only the columns needed; a log's row file wins over a compacted row (a
         # history of compacted files only, as greybox monitor leaves it, holds every log once)
-        row_files = next(root.glob("machine=*/axis=*/date=*/*.parquet"), None) is not None
+        row_files = any(path.name != COMPACTED_NAME for path in paths)
         unique = (f"QUALIFY row_number() OVER (PARTITION BY log_sha256 ORDER BY filename LIKE '%{COMPACTED_NAME}', "
                   f"filename) = 1") if row_files else ""
         try:

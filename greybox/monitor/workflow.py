@@ -29,6 +29,9 @@ _DATE_IN_NAME = re.compile(r"(\d{4}-\d{2}-\d{2})")
 def log_date(log, path) -> dt.date:
     """The day of a log: its ``date`` attribute (ISO), else the first ``YYYY-MM-DD`` in its file name.
 
+    The attribute is a day (``YYYY-MM-DD``) or an ISO date and time, nothing after it; the day is no later
+    than the file was last written, nor than today (a day of slack for time zones).
+
     Parameters
     ----------
     log : AxisLog
@@ -39,7 +42,7 @@ def log_date(log, path) -> dt.date:
     Raises
     ------
     LogError
-        If neither gives a valid date.
+        If neither gives a valid date, or the day lies after the file was written or after today.
     """
     text = log.attrs.get("date") if isinstance(log.attrs, dict) else None
     found = _DATE_IN_NAME.search(Path(path).name)
@@ -47,9 +50,15 @@ def log_date(log, path) -> dt.date:
     if not text:
         raise LogError(path, "no date: the log has no 'date' attribute and its name no YYYY-MM-DD")
     try:
-        return dt.date.fromisoformat(str(text)[:10])
+        day = dt.datetime.fromisoformat(str(text).strip()).date()
     except ValueError:
-        raise LogError(path, f"date {text!r} is not a valid YYYY-MM-DD day") from None
+        raise LogError(path, f"date {text!r} is not a valid YYYY-MM-DD day (or ISO date and time)") from None
+    written = dt.datetime.fromtimestamp(Path(path).stat().st_mtime, dt.timezone.utc).date()
+    latest = min(written, dt.datetime.now(dt.timezone.utc).date()) + dt.timedelta(days=1)
+    if day > latest:
+        raise LogError(path, f"date {day.isoformat()} lies after the file was written ({written.isoformat()}) or "
+                             "after today; give the day the log was recorded")
+    return day
 
 
 def fingerprint_file(path, history, *, machine: str | None = None, axis: str | None = None, model=None,
