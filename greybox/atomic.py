@@ -4,7 +4,13 @@ Every file greybox writes (logs, model files, reports, figures) goes through
 :func:`atomic_output`: the content is written to a temporary file in the target
 directory, flushed, given the permissions a plain ``open`` would give, and
 renamed over the target in one step. If writing fails, the temporary file is
-removed and an existing file of that name is left untouched.
+removed and an existing file of that name is left untouched. The temporary file
+is hidden and named after the target and the writing process
+(``.<name>.<pid>-<random>.tmp``); one left by a process that was killed (SIGKILL
+runs no clean-up) is removed by the next write of the same target once that
+process is gone (:data:`STALE_AFTER_S`). An error of the operating system while
+writing (a full disk, a read-only file system) names the target, not the
+temporary file.
 """
 
 from __future__ import annotations
@@ -12,12 +18,20 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
+import stat
+import time
 from pathlib import Path
 from typing import Iterator
 
 from .errors import GreyboxError
 
-__all__ = ["atomic_output", "check_output_path", "write_text_atomic", "write_bytes_atomic"]
+__all__ = ["STALE_AFTER_S", "atomic_output", "check_output_path", "remove_stale_temporaries", "write_text_atomic",
+           "write_bytes_atomic"]
+
+#: Age [s] since its last change after which a temporary file of a process that is gone is removed; one of a
+#: process still running (on this host) is kept, unless unchanged for a day (a writer on another host).
+STALE_AFTER_S = 60.0
+_DAY_S = 86400.0
 
 
 def _default_mode() -> int:
@@ -50,24 +64,82 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
         raise FileNotFoundError(f"{path}: directory {directory} does not exist")
+    remove_stale_temporaries(path)
     temporary = None
     try:
         while temporary is None:
             # the name is known before the file exists: a Ctrl-C or SIGTERM (delivered to whichever thread,
             # so it cannot be held back) that stops the command from here on finds the file and removes it
-            temporary = directory / f".{path.name}.{secrets.token_hex(8)}.tmp"
+            temporary = directory / f".{path.name}.{os.getpid()}-{secrets.token_hex(8)}.tmp"
             try:
                 os.close(os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
             except FileExistsError:  # another file of that name (not ours): draw again
                 temporary = None
-        yield temporary
-        with open(temporary, "rb+") as stream:
-            os.fsync(stream.fileno())
-        os.chmod(temporary, _default_mode())
-        os.replace(temporary, path)
+        try:
+            yield temporary
+            with open(temporary, "rb+") as stream:
+                os.fsync(stream.fileno())
+            os.chmod(temporary, _default_mode())
+            os.replace(temporary, path)
+        except OSError as error:  # name the user's file, not our hidden one
+            if error.filename is not None and os.fspath(error.filename) == os.fspath(temporary) and error.errno:
+                raise OSError(error.errno, error.strerror, str(path)) from None
+            raise
     finally:
         if temporary is not None and os.path.exists(temporary):
             os.unlink(temporary)
+
+
+def _alive(pid: int) -> bool:
+    """Whether a process of this id runs on this host (True where it cannot be told)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError, ValueError, OverflowError):  # another user's, or no such call (Windows)
+        return True
+    return True
+
+
+def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files of ``path`` that killed writers left; the files removed.
+
+    A temporary file (``.<name>.<pid>-<random>.tmp`` beside ``path``) is stale when its process is gone and
+    it has not changed for :data:`STALE_AFTER_S`, or has not changed for a day. Regular files only.
+
+    Parameters
+    ----------
+    path : path-like
+        The target file whose temporary files are looked for.
+    """
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    prefix = f".{path.name}."
+    removed = []
+    try:
+        names = [name for name in os.listdir(directory) if name.startswith(prefix) and name.endswith(".tmp")]
+    except OSError:
+        return removed
+    now = time.time()
+    for name in names:
+        middle = name[len(prefix):-len(".tmp")]
+        pid = middle.split("-", 1)[0]
+        candidate = directory / name
+        try:
+            info = os.lstat(candidate)
+        except OSError:
+            continue
+        age = now - info.st_mtime
+        gone = pid.isdigit() and not _alive(int(pid))
+        if stat.S_ISREG(info.st_mode) and ((gone and age > STALE_AFTER_S) or age > _DAY_S):
+            try:
+                os.unlink(candidate)
+            except OSError:
+                continue
+            removed.append(candidate)
+    return removed
 
 
 def check_output_path(path: str | os.PathLike, *, overwrite: bool = False, protect=(),

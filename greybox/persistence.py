@@ -1,13 +1,13 @@
 """Saving and loading fitted models, without pickle.
 
-File format (format name ``greybox-model``, version 2)
+File format (format name ``greybox-model``, version 3)
 ------------------------------------------------------
 A model file is a ZIP archive (any file name; ``.gbm`` by convention) with
 
 ``model.json``
     A JSON object::
 
-        {"format": "greybox-model", "format_version": 2,
+        {"format": "greybox-model", "format_version": 3,
          "greybox_version": "0.1.0",
          "model": {"kind": "gms",
                    "params": {...},       # get_params(deep=False)
@@ -34,6 +34,16 @@ JSON has no non-finite numbers) and ``{"__estimator__": {"kind", "params",
 stage, say). Floats are written with Python's shortest round-trip repr, and
 arrays byte for byte, so a loaded model predicts bit-identically.
 
+``digest.json`` (since greybox 0.1 format version 3)
+    The SHA-256 of every other member, ``{"format": "greybox-digest", "algorithm": "sha256",
+    "members": {name: hex digest}}``, and, when the file was saved with the plant's key
+    (:func:`model_key`), ``"hmac_sha256"``: HMAC-SHA256 with that key over the canonical JSON of
+    ``members`` (keys sorted, no spaces). At load every member is hashed and compared: a member
+    changed, added or removed since the file was written is refused in one line naming it. With the
+    plant's key set, a file whose signature is missing or does not verify is refused; without it the
+    signature is not checked. A file without ``digest.json`` (written before it existed) loads with a
+    warning that changes to it cannot be detected, and is refused when the plant's key is set.
+
 The class of a model is looked up by its ``kind`` in the explicit registry
 :data:`greybox.models.registry.MODEL_CLASSES`; nothing named in the file is ever
 imported. A file of a newer format version, of an unknown kind, or with
@@ -45,10 +55,14 @@ with fixed ZIP timestamps, so the same model always gives the same bytes.
 
 from __future__ import annotations
 
+import hashlib
+import hmac
 import io
 import json
 import math
+import os
 import re
+import warnings
 import zipfile
 import zlib
 from os import PathLike
@@ -67,8 +81,9 @@ from .models import registry
 from .models.estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
 from .provenance import TRAINING_RECORD, check_training_record
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RECORD_CHECKS", "RENAMED_ATTRIBUTES", "save_model", "save_verified",
-           "load_model", "check_fitted", "check_reproduces"]
+__all__ = ["DIGEST_MEMBER", "FORMAT_NAME", "FORMAT_VERSION", "KEY_ENV", "KEY_FILE_ENV", "RECORD_CHECKS",
+           "RENAMED_ATTRIBUTES", "digest_document", "model_key", "save_model", "save_verified", "load_model",
+           "check_fitted", "check_reproduces"]
 
 #: Check of each record a model file may hold, by name: returns the record or raises ValueError.
 RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
@@ -76,8 +91,17 @@ RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
 #: Value of the ``format`` field of every model file.
 FORMAT_NAME = "greybox-model"
 #: Newest format version this greybox writes and reads. Version 2 renamed learned attributes
-#: (:data:`RENAMED_ATTRIBUTES`); version-1 files are read with the old names mapped.
-FORMAT_VERSION = 2
+#: (:data:`RENAMED_ATTRIBUTES`); version-1 files are read with the old names mapped. Version 3 added the
+#: member :data:`DIGEST_MEMBER` (an older greybox would refuse it as an unexpected member).
+FORMAT_VERSION = 3
+
+#: Member holding the SHA-256 of every other member (and the signature with the plant's key).
+DIGEST_MEMBER = "digest.json"
+
+#: Environment variable holding the plant's key for signing and checking model files (its text, UTF-8).
+KEY_ENV = "GREYBOX_MODEL_KEY"
+#: Environment variable naming a file that holds the plant's key (its bytes; a final newline is dropped).
+KEY_FILE_ENV = "GREYBOX_MODEL_KEY_FILE"
 
 #: Learned attributes that files of format version 1 hold under an older name, by model kind:
 #: ``{kind: {old name: new name}}`` (the GMS slip rate and viscous coefficient had names other models use).
@@ -170,6 +194,94 @@ def _write_member(archive: zipfile.ZipFile, name: str, data: bytes) -> None:
     archive.writestr(info, data)
 
 
+def model_key() -> bytes | None:
+    """The plant's key for model-file signatures: from :data:`KEY_FILE_ENV` (a file) or :data:`KEY_ENV`; None.
+
+    Raises
+    ------
+    ModelFileError
+        When the key file cannot be read, or the key is empty.
+    """
+    named = os.environ.get(KEY_FILE_ENV)
+    if named:
+        try:
+            key = Path(named).read_bytes()
+        except OSError as error:
+            raise ModelFileError(f"{named}: cannot read the model key file ({KEY_FILE_ENV}, --key-file): "
+                                 f"{error.strerror or error}") from None
+        key = key[:-1] if key.endswith(b"\n") else key
+        if not key:
+            raise ModelFileError(f"{named}: the model key file is empty")
+        return key
+    text = os.environ.get(KEY_ENV)
+    if text is None:
+        return None
+    if not text:
+        raise ModelFileError(f"{KEY_ENV} is set but empty; give the plant's key or unset it")
+    return text.encode("utf-8")
+
+
+def _canonical_members(members: dict) -> bytes:
+    return json.dumps(members, sort_keys=True, separators=(",", ":")).encode("utf-8")
+
+
+def digest_document(members: dict[str, bytes], key: bytes | None = None) -> bytes:
+    """The bytes of :data:`DIGEST_MEMBER` for a model file of these members: their SHA-256, signed with ``key``.
+
+    Parameters
+    ----------
+    members : dict of str to bytes
+        Every other member of the file by name, with its content.
+    key : bytes, optional
+        The plant's key: adds ``hmac_sha256`` (HMAC-SHA256 over the canonical JSON of the digests).
+    """
+    digests = {name: hashlib.sha256(data).hexdigest() for name, data in sorted(members.items())}
+    document = {"format": "greybox-digest", "algorithm": "sha256", "members": digests}
+    if key is not None:
+        document["hmac_sha256"] = hmac.new(key, _canonical_members(digests), hashlib.sha256).hexdigest()
+    return (json.dumps(document, indent=1, sort_keys=True) + "\n").encode("utf-8")
+
+
+def _check_digest(archive: zipfile.ZipFile, path: Path, key: bytes | None) -> None:
+    """Refuse a file whose members are not those its digest records, or whose signature does not verify."""
+    names = [name for name in archive.namelist() if name != DIGEST_MEMBER]
+    if DIGEST_MEMBER not in archive.namelist():
+        if key is not None:
+            raise ModelFileError(f"{path}: carries no digest or signature, and the plant's key is set ({KEY_ENV} "
+                                 "or --key-file): refused; save it again with the key")
+        warnings.warn(f"{path}: written before model files carried a digest: a change to it cannot be detected; "
+                      "save it again (greybox train) to add one", UserWarning, stacklevel=3)
+        return
+    try:
+        document = json.loads(_read_member(archive, DIGEST_MEMBER, 1 << 20).decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError):
+        raise ModelFileError(f"{path}: {DIGEST_MEMBER} is not valid JSON") from None
+    recorded = document.get("members") if isinstance(document, dict) else None
+    if document.get("algorithm") != "sha256" or not isinstance(recorded, dict) or not all(
+            isinstance(value, str) and re.fullmatch(r"[0-9a-f]{64}", value) for value in recorded.values()):
+        raise ModelFileError(f"{path}: {DIGEST_MEMBER} is not a digest of SHA-256 values by member")
+    for name in sorted(set(names) - set(recorded)):
+        raise ModelFileError(f"{path}: member {name} is not in the file's digest: added after the file was "
+                             "written; refused")
+    for name in sorted(set(recorded) - set(names)):
+        raise ModelFileError(f"{path}: member {name} of the file's digest is missing: removed after the file was "
+                             "written; refused")
+    for name in sorted(names):
+        limit = MAX_JSON_BYTES if name == _JSON_MEMBER else MAX_MEMBER_BYTES
+        if hashlib.sha256(_read_member(archive, name, limit)).hexdigest() != recorded[name]:
+            raise ModelFileError(f"{path}: member {name} was changed after the file was written (its SHA-256 is "
+                                 f"not the one {DIGEST_MEMBER} records); refused")
+    if key is not None:
+        signature = document.get("hmac_sha256")
+        if not isinstance(signature, str):
+            raise ModelFileError(f"{path}: not signed, and the plant's key is set ({KEY_ENV} or --key-file): "
+                                 "refused; save it again with the key")
+        expected = hmac.new(key, _canonical_members(recorded), hashlib.sha256).hexdigest()
+        if not hmac.compare_digest(signature, expected):
+            raise ModelFileError(f"{path}: its signature does not match the plant's key: changed after it was "
+                                 "signed, or signed with another key; refused")
+
+
 def _checked_records(records, path: Path, action: str) -> dict:
     """The records of a model file that this greybox knows, each checked; a malformed one is an error."""
     if records is None:
@@ -191,7 +303,8 @@ def _checked_records(records, path: Path, action: str) -> dict:
     return checked
 
 
-def save_model(model, path: str | PathLike, *, overwrite: bool = False, records: dict | None = None) -> Path:
+def save_model(model, path: str | PathLike, *, overwrite: bool = False, records: dict | None = None,
+               key: bytes | None = None) -> Path:
     """Save a (fitted or unfitted) model to one file, atomically.
 
     Parameters
@@ -208,6 +321,9 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
         Replace an existing file; otherwise an existing file is an error.
     records : dict, optional
         Records about the model by name (``{"training": ...}``), each checked by :data:`RECORD_CHECKS`.
+    key : bytes, optional
+        The plant's key the file is signed with (:data:`DIGEST_MEMBER`); default :func:`model_key`, none
+        when it is not set.
 
     Returns
     -------
@@ -242,11 +358,13 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
         raise ModelFileError(f"{path}: directory {directory} does not exist")
+    members = {_JSON_MEMBER: text.encode("utf-8"), **encoder.arrays}
+    signed_with = model_key() if key is None else key
     with atomic_output(path) as temporary:
         with zipfile.ZipFile(temporary, "w") as archive:
-            _write_member(archive, _JSON_MEMBER, text.encode("utf-8"))
-            for member, data in encoder.arrays.items():
+            for member, data in members.items():
                 _write_member(archive, member, data)
+            _write_member(archive, DIGEST_MEMBER, digest_document(members, signed_with))
     return path
 
 
@@ -412,7 +530,7 @@ def _check_members(archive: zipfile.ZipFile, path: Path) -> None:
         twice = sorted({name for name in names if names.count(name) > 1})
         raise ModelFileError(f"{path}: the member {twice[0]!r} is stored twice")
     for info in infos:
-        if info.filename != _JSON_MEMBER and not _ARRAY_MEMBER.match(info.filename):
+        if info.filename not in (_JSON_MEMBER, DIGEST_MEMBER) and not _ARRAY_MEMBER.match(info.filename):
             raise ModelFileError(f"{path}: unexpected member {info.filename!r} (a model file holds {_JSON_MEMBER} "
                                  f"and {_ARRAY_DIR}NNN_name.npy only)")
         limit = MAX_JSON_BYTES if info.filename == _JSON_MEMBER else MAX_MEMBER_BYTES
@@ -427,7 +545,7 @@ def _check_members(archive: zipfile.ZipFile, path: Path) -> None:
         raise ModelFileError(f"{path}: members of {total} bytes in all, more than {MAX_TOTAL_BYTES}")
 
 
-def load_model(path: str | PathLike, *, records: bool = False):
+def load_model(path: str | PathLike, *, records: bool = False, key: bytes | None = None):
     """Load a model saved by :func:`save_model`.
 
     Parameters
@@ -436,6 +554,9 @@ def load_model(path: str | PathLike, *, records: bool = False):
         Model file.
     records : bool, default False
         Also return the file's records (checked; ``{}`` for a file without any).
+    key : bytes, optional
+        The plant's key the file must be signed with; default :func:`model_key` (unset: the signature is
+        not checked, the digest is).
 
     Returns
     -------
@@ -448,7 +569,8 @@ def load_model(path: str | PathLike, *, records: bool = False):
     ------
     ModelFileError
         If the file is missing, not a greybox model file, of a newer format
-        version, of a model kind this greybox does not know, or damaged.
+        version, of a model kind this greybox does not know, damaged, changed
+        since it was written (:data:`DIGEST_MEMBER`) or not signed with the plant's key.
     """
     path = Path(path)
     if path.is_dir():
@@ -460,6 +582,7 @@ def load_model(path: str | PathLike, *, records: bool = False):
     try:
         with zipfile.ZipFile(path) as archive:
             _check_members(archive, path)
+            _check_digest(archive, path, model_key() if key is None else key)
             try:
                 document = json.loads(_read_member(archive, _JSON_MEMBER, MAX_JSON_BYTES).decode("utf-8"))
             except KeyError:
@@ -489,7 +612,7 @@ def load_model(path: str | PathLike, *, records: bool = False):
                 raise ModelFileError(f"{path}: values nested too deeply") from None
             except (TypeError, ValueError) as error:  # the class refused a parameter value
                 raise ModelFileError(f"{path}: a parameter of the model is malformed: {error}") from None
-            unused = sorted(set(archive.namelist()) - {_JSON_MEMBER} - decoder.referenced)
+            unused = sorted(set(archive.namelist()) - {_JSON_MEMBER, DIGEST_MEMBER} - decoder.referenced)
     except (zipfile.BadZipFile, zlib.error, EOFError, RuntimeError, NotImplementedError) as error:
         # a flipped bit in a ZIP header may also read as "encrypted" or "unsupported compression"
         if zipfile.is_zipfile(path):

@@ -23,6 +23,7 @@ import pytest
 import scipy.io
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
+from model_files import write_members
 
 from greybox.data.io import LOG_FORMATS, read_log, write_log
 from greybox.data.log import AxisLog
@@ -142,10 +143,7 @@ def _members(kind: str = "gms") -> dict[str, bytes]:
 
 
 def _write(path: Path, members, *, duplicates=()) -> Path:
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
-        for name, data in list(members.items()) + list(duplicates):
-            archive.writestr(name, data)
-    return path
+    return write_members(path, members, duplicates=duplicates, compression=zipfile.ZIP_DEFLATED)
 
 
 def _with_json(change) -> dict[str, bytes]:

@@ -10,6 +10,7 @@ import zipfile
 import numpy as np
 import pytest
 from export_logs import write_export_logs
+from model_files import write_members
 
 from greybox.cli import main
 from greybox.data.io import read_log
@@ -116,9 +117,7 @@ def _rewrite(path, target, change) -> None:
     document = json.loads(members["model.json"])
     change(document)
     members["model.json"] = json.dumps(document).encode()
-    with zipfile.ZipFile(target, "w") as archive:
-        for name, data in members.items():
-            archive.writestr(name, data)
+    write_members(target, members)
 
 
 @pytest.mark.parametrize("change, message", [

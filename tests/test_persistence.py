@@ -9,6 +9,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from model_files import write_members
 from sklearn.base import BaseEstimator
 
 from greybox import atomic, persistence
@@ -73,9 +74,7 @@ def _rewrite_json(path, change):
     document = json.loads(members["model.json"])
     change(document)
     members["model.json"] = json.dumps(document).encode()
-    with zipfile.ZipFile(path, "w") as archive:
-        for name, content in members.items():
-            archive.writestr(name, content)
+    write_members(path, members)
 
 
 def test_round_trip_predicts_bit_identically(tmp_path, data):
@@ -191,9 +190,7 @@ def test_pickled_array_member_is_refused(tmp_path, data):
     buffer = io.BytesIO()
     np.save(buffer, np.array([object()], dtype=object), allow_pickle=True)
     members[member] = buffer.getvalue()
-    with zipfile.ZipFile(path, "w") as archive:
-        for name, content in members.items():
-            archive.writestr(name, content)
+    write_members(path, members)
     with pytest.raises(ModelFileError, match=r"pickled\.gbm.*cannot be read"):
         load_model(path)
 
@@ -444,3 +441,77 @@ def test_check_fitted_refuses_an_implausible_parameter_and_a_state_that_streams_
     model.predict_chunk = drifting
     with pytest.raises(ParameterError, match="chunked and one-shot prediction of a probe run differ"):
         check_fitted(model)
+
+
+# -- the digest and the plant's signature (issue 41) -----------------------------------------------------------
+
+
+def _members_of(path) -> dict:
+    with zipfile.ZipFile(path) as archive:
+        return {name: archive.read(name) for name in archive.namelist()}
+
+
+def _write_raw(path, members) -> None:
+    """Write the members as they are (a stale digest kept): an edit by hand with a ZIP tool."""
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, content in members.items():
+            archive.writestr(name, content)
+
+
+def test_a_member_changed_added_or_removed_after_saving_is_refused_naming_it(tmp_path, data):
+    path = save_model(ToyModel().fit(*data), tmp_path / "m.gbm")
+    members = _members_of(path)
+    assert json.loads(members[persistence.DIGEST_MEMBER])["members"].keys() == set(members) - {
+        persistence.DIGEST_MEMBER}
+    edited = dict(members, **{"model.json": members["model.json"].replace(b'"gain": 1.5', b'"gain": 2.0')})
+    assert edited["model.json"] != members["model.json"]
+    _write_raw(path, edited)
+    with pytest.raises(ModelFileError, match=r"m\.gbm: member model\.json was changed after the file was written"):
+        load_model(path)
+    array = next(name for name in members if name.startswith("arrays/"))
+    _write_raw(path, {name: data for name, data in members.items() if name != array})
+    with pytest.raises(ModelFileError, match=rf"member {array} of the file's digest is missing"):
+        load_model(path)
+    _write_raw(path, {**members, "arrays/999_extra.npy": members[array]})
+    with pytest.raises(ModelFileError, match="member arrays/999_extra.npy is not in the file's digest"):
+        load_model(path)
+
+
+def test_a_file_without_a_digest_loads_with_a_warning(tmp_path, data):
+    path = save_model(ToyModel().fit(*data), tmp_path / "old.gbm")
+    _write_raw(path, {name: content for name, content in _members_of(path).items()
+                      if name != persistence.DIGEST_MEMBER})
+    with pytest.warns(UserWarning, match="written before model files carried a digest"):
+        load_model(path)
+
+
+def test_a_signed_file_is_checked_with_the_plants_key(tmp_path, data, monkeypatch):
+    model = ToyModel().fit(*data)
+    monkeypatch.delenv(persistence.KEY_ENV, raising=False)
+    monkeypatch.delenv(persistence.KEY_FILE_ENV, raising=False)
+    unsigned = save_model(model, tmp_path / "unsigned.gbm")
+    monkeypatch.setenv(persistence.KEY_ENV, "plant secret")
+    signed = save_model(model, tmp_path / "signed.gbm")
+    assert json.loads(_members_of(signed)[persistence.DIGEST_MEMBER])["hmac_sha256"]
+    load_model(signed)
+    with pytest.raises(ModelFileError, match="unsigned.gbm: not signed, and the plant's key is set"):
+        load_model(unsigned)
+    # a forger who edits a member and recomputes the digest cannot sign it without the key
+    members = _members_of(signed)
+    forged = dict(members, **{"model.json": members["model.json"].replace(b'"gain": 1.5', b'"gain": 2.0')})
+    write_members(signed, forged, key=b"another key")
+    with pytest.raises(ModelFileError, match="signature does not match the plant's key"):
+        load_model(signed)
+    write_members(signed, forged)
+    with pytest.raises(ModelFileError, match="not signed"):
+        load_model(signed)
+    monkeypatch.delenv(persistence.KEY_ENV)
+    assert load_model(signed).gain == 2.0  # without the key a consistent digest is all that is checked
+    key_file = tmp_path / "key"
+    key_file.write_bytes(b"plant secret\n")
+    monkeypatch.setenv(persistence.KEY_FILE_ENV, str(key_file))
+    write_members(signed, members, key=b"plant secret")  # the key file holds the same key
+    load_model(signed)
+    key_file.write_bytes(b"")
+    with pytest.raises(ModelFileError, match="the model key file is empty"):
+        load_model(signed)

@@ -7,21 +7,26 @@ the sub-commands with their one-line summaries; a sub-command's module is
 imported only when that sub-command runs (or shows its ``--help``), so that
 ``greybox --help`` loads no model, reader or plotting library. Errors caused by
 the user's input (:class:`greybox.errors.GreyboxError`) are printed as one line
-naming the file and the problem, with exit status 2 and no traceback. Warnings
-issued while a command runs are printed as one ``note:`` line each; in both, a
-model hyperparameter is named by the option that sets it
-(:mod:`greybox.cli._spelling`).
+naming the file and the problem, with exit status 2 and no traceback; so are
+errors of the operating system (a read-only file system, a full disk, a
+permission: :class:`OSError`, naming the path) and any unexpected error (a bug:
+one line naming it, its traceback only with ``greybox --debug``). Warnings
+issued while a command runs, or while its options are read, are printed as one
+``note:`` line each, never with a source line; in both, a model hyperparameter
+is named by the option that sets it (:mod:`greybox.cli._spelling`).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import os
 import signal
 import sys
 import threading
 import time
+import warnings
 
 from ..errors import GreyboxError
 from ._spelling import command_notes, error_message
@@ -82,17 +87,24 @@ def command_of(argv: list[str]) -> str | None:
     Parameters
     ----------
     argv : list of str
-        The arguments after the program name. The options of ``greybox`` itself (``--help``,
-        ``--version``) take no value, so the first other argument is the sub-command.
+        The arguments after the program name. Of the options of ``greybox`` itself only ``--key-file``
+        takes a value, so the first other argument is the sub-command.
 
     Returns
     -------
     str or None
         That argument if it names a sub-command, else None.
     """
+    skip = False
     for argument in argv:
+        if skip:
+            skip = False
+            continue
         if argument == "--":
             return None
+        if argument == "--key-file":
+            skip = True
+            continue
         if not argument.startswith("-"):
             return argument if argument in COMMANDS else None
     return None
@@ -115,6 +127,11 @@ def build_parser(commands=None) -> argparse.ArgumentParser:
         description="Grey-box motor-current models of machine-tool feed axes.",
     )
     parser.add_argument("--version", action="version", version=f"greybox {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="print the traceback of an unexpected error (default: one line)")
+    parser.add_argument("--key-file", metavar="FILE",
+                        help="file holding the plant's key: model files are signed with it when saved and must be "
+                        "signed with it when loaded (as the variable GREYBOX_MODEL_KEY_FILE)")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                        parser_class=OneLineParser)
     loaded = set(COMMANDS if commands is None else commands)
@@ -181,8 +198,53 @@ def main(argv: list[str] | None = None) -> int:
     name is kept, and the status is 143 (130 for Ctrl-C).
     """
     arguments = sys.argv[1:] if argv is None else argv
-    parser = build_parser([command] if (command := command_of(arguments)) else [])
-    args = parser.parse_args(arguments)
+    with warnings.catch_warnings():  # a warning while the modules load: one line, no source line
+        warnings.showwarning = _one_line_warning
+        parser = build_parser([command] if (command := command_of(arguments)) else [])
+        args = parser.parse_args(arguments)
+    with _key_file(args.key_file):
+        return _run(args, argv)
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one ``note:`` line on stderr (before a command's own display is set up)."""
+    print(f"note: {str(message).splitlines()[0] if str(message) else category.__name__}", file=sys.stderr)
+
+
+@contextlib.contextmanager
+def _key_file(path: str | None):
+    """``--key-file``: the plant's key file for the command (the variable GREYBOX_MODEL_KEY_FILE), then restored."""
+    if path is None:
+        yield
+        return
+    from ..persistence import KEY_FILE_ENV
+
+    before = os.environ.get(KEY_FILE_ENV)
+    os.environ[KEY_FILE_ENV] = path
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(KEY_FILE_ENV, None)
+        else:
+            os.environ[KEY_FILE_ENV] = before
+
+
+def os_error_line(error: OSError) -> str:
+    """One line for an error of the operating system: the path(s) it names and the problem.
+
+    Parameters
+    ----------
+    error : OSError
+        The error (``filename``, ``filename2`` and ``strerror`` where the operating system gave them).
+    """
+    problem = error.strerror or str(error) or type(error).__name__
+    paths = [str(name) for name in (error.filename, error.filename2) if name is not None]
+    return f"{' -> '.join(paths)}: {problem}" if paths else problem
+
+
+def _run(args: argparse.Namespace, argv: list[str] | None) -> int:
+    """Run the parsed command; every error one line on stderr (a traceback only with --debug)."""
     age = process_age_s() if argv is None else None  # a command of its own: its start-up counts too
     args.started_s = time.perf_counter() - (age or 0.0)
     args.startup_counted = age is not None
@@ -196,14 +258,30 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt as stop:  # Ctrl-C, or SIGTERM (Terminated)
         return _stopped(stop, args.command)
-    except SystemError as error:  # a signal handled inside a callback of compiled code comes out wrapped
-        stop = _signal_behind(error)
-        if stop is None:
-            raise
-        return _stopped(stop, args.command)
     except BrokenPipeError:  # the reader of the output went away (``greybox ... | head``): stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
+    except OSError as error:  # read-only file system, disk full, permission, ...
+        if args.debug:
+            raise
+        print(f"greybox {args.command}: error: {os_error_line(error)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        if args.debug:
+            raise
+        print(f"greybox {args.command}: error: out of memory; give fewer or shorter logs, or a machine with more "
+              "memory", file=sys.stderr)
+        return 2
+    except Exception as error:  # a bug (or a signal handled inside compiled code, wrapped in a SystemError)
+        stop = _signal_behind(error) if isinstance(error, SystemError) else None
+        if stop is not None:
+            return _stopped(stop, args.command)
+        if args.debug:
+            raise
+        text = str(error).splitlines()[0] if str(error) else ""
+        print(f"greybox {args.command}: internal error: {type(error).__name__}{': ' + text if text else ''} "
+              "(a bug: please report it with the output of 'greybox --debug ...')", file=sys.stderr)
+        return 2
     finally:
         if installed:
             signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)

@@ -9,6 +9,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from model_files import write_members
 from scipy.signal import lfilter
 
 import greybox.cli as cli
@@ -315,10 +316,7 @@ def _tampered(tmp_path, change) -> str:
     change(document["model"]["attributes"]["parameter_intervals_"]["rows"])
     members["model.json"] = json.dumps(document).encode()
     hostile = tmp_path / "hostile.gbm"
-    with zipfile.ZipFile(hostile, "w") as archive:
-        for name, data in members.items():
-            archive.writestr(name, data)
-    return hostile
+    return write_members(hostile, members)
 
 
 @pytest.mark.parametrize("change, message", [

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from model_files import write_members
 from svr_runs import FIXED, sweep_run
 
 from greybox import persistence
@@ -143,9 +144,7 @@ def test_the_hand_over_round_trips_and_a_file_from_before_it_predicts_as_fitted(
     del document["model"]["params"]["handover"]
     members["model.json"] = json.dumps(document).encode()
     path = tmp_path / "old.gbm"
-    with zipfile.ZipFile(path, "w") as archive:
-        for name, data in members.items():
-            archive.writestr(name, data)
+    write_members(path, members)
     loaded_old = persistence.load_model(path)
     assert loaded_old.handover  # the setting's default ...
     np.testing.assert_array_equal(loaded_old.predict(test), plain.predict(test))  # ... yet predicts as fitted

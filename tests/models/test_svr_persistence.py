@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from model_files import write_members
 from svr_runs import FIXED, sweep_run
 
 from greybox import persistence
@@ -61,9 +62,7 @@ def test_the_kernel_weights_round_trip_and_a_file_with_bad_ones_is_refused(tmp_p
         buffer = __import__("io").BytesIO()
         np.save(buffer, np.array(bad), allow_pickle=False)
         hostile = tmp_path / f"hostile_{len(bad)}_{bad[1]:g}.gbm"
-        with zipfile.ZipFile(hostile, "w") as archive:
-            for name, data in members.items():
-                archive.writestr(name, buffer.getvalue() if name == member else data)
+        write_members(hostile, {**members, member: buffer.getvalue()})
         with pytest.raises(ModelFileError, match="input_weights_ must hold one positive weight per input"):
             persistence.load_model(hostile)
 

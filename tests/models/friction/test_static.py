@@ -10,6 +10,7 @@ import pytest
 import scipy.io
 import scipy.signal
 from friction_signals import motion_log, velocity_profile
+from model_files import write_members
 
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
@@ -178,9 +179,7 @@ def test_symmetric_stribeck_file_without_the_asymmetric_flag_loads(asymmetric_lo
     assert not any(name.endswith("_neg_") for name in content["model"]["attributes"])
     members["model.json"] = json.dumps(content).encode()
     old = tmp_path / "old.gbm"
-    with zipfile.ZipFile(old, "w") as archive:
-        for name, data in members.items():
-            archive.writestr(name, data)
+    write_members(old, members)
     loaded = load_model(old)
     assert not loaded.asymmetric
     np.testing.assert_array_equal(loaded.predict(asymmetric_log), model.predict(asymmetric_log))
