@@ -20,7 +20,8 @@ from importlib import metadata
 from .data.effort import EFFORT_UNITS
 
 __all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "PREPARATION_KEYS", "file_identity",
-           "training_record", "check_training_record", "preparation_differences", "model_quantity"]
+           "axis_warning", "training_file_warning", "training_record", "check_training_record",
+           "preparation_differences", "model_quantity"]
 
 #: Libraries whose versions can move a figure or a timing.
 LIBRARIES = ("numpy", "scipy", "scikit-learn", "scikit-optimize", "pandas", "numba", "matplotlib", "pyarrow", "mcap")
@@ -111,7 +112,7 @@ def file_identity(path) -> dict:
     return {"name": os.path.basename(os.fspath(path)), "bytes": size, "sha256": digest.hexdigest()}
 
 
-def training_record(files, preparation: dict, runs, total: dict, ranges: dict) -> dict:
+def training_record(files, preparation: dict, runs, total: dict, ranges: dict, axis: str | None = None) -> dict:
     """The record of how a model was made, checked (:func:`check_training_record`), JSON-ready.
 
     Parameters
@@ -129,17 +130,22 @@ def training_record(files, preparation: dict, runs, total: dict, ranges: dict) -
         one of :data:`EFFORT_QUANTITY_NAMES`; optional, files written before it lack it).
     ranges : dict
         ``{channel: [low, high]}`` of the training runs (position, velocity, acceleration in the log's units).
+    axis : str, optional
+        The axis the training logs name (``"axis"``, left out when they name none).
 
     Returns
     -------
     dict
-        ``{"version", "greybox", "files", "preparation", "runs", "training_error", "ranges"}``: the same
+        ``{"version", "greybox", "files", "preparation", "runs", "training_error", "ranges"}`` and
+        ``"axis"`` where known: the same
         logs and options give the same record (no time stamps, no output name), so a model file stays
         reproducible byte for byte.
     """
     record = {"version": TRAINING_RECORD_VERSION, "greybox": _version("greybox"),
               "files": list(files), "preparation": dict(preparation), "runs": list(runs),
               "training_error": dict(total), "ranges": {name: list(pair) for name, pair in ranges.items()}}
+    if axis is not None:
+        record["axis"] = str(axis)
     return check_training_record(record)
 
 
@@ -180,8 +186,10 @@ def check_training_record(record) -> dict:
     if not isinstance(record, dict):
         raise ValueError("the record must be an object")
     expected = {"version", "greybox", "files", "preparation", "runs", "training_error", "ranges"}
-    if set(record) != expected:
-        raise ValueError(f"the record must hold exactly {', '.join(sorted(expected))}")
+    if set(record) - {"axis"} != expected:  # "axis": files since the axis was recorded
+        raise ValueError(f"the record must hold exactly {', '.join(sorted(expected))} (and axis)")
+    if "axis" in record:
+        _text(record["axis"], "axis", 256)
     if record["version"] != TRAINING_RECORD_VERSION:
         raise ValueError(f"version {record['version']!r} is not {TRAINING_RECORD_VERSION}")
     _text(record["greybox"], "greybox")
@@ -300,6 +308,49 @@ def preparation_of(runs, read) -> dict:
             "max_gap_steps": float(read.get("max_gap", MAX_GAP_STEPS)),
             "time_tolerance": float(read.get("time_tolerance", 0.25)),
             "derived": sorted({name for entry in filters for name in entry.get("derived", ())})}
+
+
+def axis_warning(records: dict, axis: str | None, log_name: str, model_name: str) -> str | None:
+    """The ``warning:`` line when a log names another axis than the model's training logs did, else None.
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records (a file without a training record, or one without its axis, warns of nothing).
+    axis : str or None
+        The axis the log names (None: it names none, nothing to compare).
+    log_name, model_name : str
+        Names for the message.
+    """
+    trained = (records.get(TRAINING_RECORD) or {}).get("axis")
+    if trained is None or not axis or str(axis) == trained:
+        return None
+    return (f"warning: {log_name} is of axis {axis}, but {model_name} was trained on axis {trained}: another axis's "
+            "friction and inertia; predict it with its own axis's model")
+
+
+def training_file_warning(records: dict, path, model_name: str) -> str | None:
+    """The ``warning:`` line when the file ``path`` is one of the model's training files (by SHA-256), else None.
+
+    Parameters
+    ----------
+    records : dict
+        The model file's records (a file without a training record warns of nothing).
+    path : str or path-like
+        A file given as held-out data (a calibration log).
+    model_name : str
+        Name of the model file, for the message.
+    """
+    record = records.get(TRAINING_RECORD)
+    if record is None:
+        return None
+    digest = file_identity(path)["sha256"]
+    trained = next((entry["name"] for entry in record["files"] if entry["sha256"] == digest), None)
+    if trained is None:
+        return None
+    return (f"warning: calibration log {os.path.basename(os.fspath(path))} is the training file {trained} of "
+            f"{model_name} (the same SHA-256): an interval calibrated on data the model was fitted to is too "
+            "narrow; calibrate on air cuts the model was not trained on")
 
 
 def preparation_warning(records: dict, read, runs, log_name: str, model_name: str) -> str | None:

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from ..data.effort import EFFORT_UNITS, check_one_effort
+from ..data.effort import EFFORT_UNITS, check_one_axis, check_one_effort
 from ..data.prepare import MAX_GAP_STEPS
 from ..json_values import jsonable
 from ..metrics import metrics_table
@@ -52,6 +52,7 @@ def record_training(args: argparse.Namespace, files, names, runs, predictions) -
         The prepared runs and the fitted model's effort for each [A, or N, Nm].
     """
     quantity = check_one_effort(runs)
+    axis = check_one_axis(runs)
     tables = [metrics_table(run.effort, prediction) for run, prediction in zip(runs, predictions)]
     total = metrics_table(np.concatenate([run.effort for run in runs]), np.concatenate(predictions))
 
@@ -66,7 +67,8 @@ def record_training(args: argparse.Namespace, files, names, runs, predictions) -
             ranges[channel] = [float(min(v.min() for v in values)), float(max(v.max() for v in values))]
     record = training_record([file_identity(path) for path in dict.fromkeys(files)], preparation_of(args, runs),
                              [{"name": str(name), **figures(table)} for name, table in zip(names, tables)],
-                             {**figures(total), "unit": EFFORT_UNITS[quantity], "quantity": quantity}, ranges)
+                             {**figures(total), "unit": EFFORT_UNITS[quantity], "quantity": quantity}, ranges,
+                             axis=axis)
     return {TRAINING_RECORD: record}
 
 
@@ -122,6 +124,7 @@ def record_lines(records: dict) -> list[str]:
              f"  preparation    = step {prep['sample_time_s'] * 1e3:g} ms, cut-off {cutoff}, {resample}, "
              f"max gap {prep['max_gap_steps']:g} steps, time tolerance {prep['time_tolerance']:g}, derived "
              f"{', '.join(prep['derived']) or 'nothing'}",
+             *([f"  axis           = {record['axis']}"] if "axis" in record else []),
              *([f"  effort         = {quantity} [{total['unit']}]"] if quantity else []),
              f"  training error = RMSE {total['rmse']:.4g} {total['unit']}{re} over {total['samples']} samples "
              f"({len(record['runs'])} run(s))"]

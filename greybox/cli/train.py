@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import check_output_path
-from ..data.effort import EFFORT_UNITS, check_one_effort, effort_quantity, effort_text
+from ..data.effort import EFFORT_UNITS, check_one_axis, check_one_effort, effort_quantity, effort_text
 from ..errors import GreyboxError, ModelFileError
 from ..identify.intervals import METHODS as INTERVAL_METHODS
 from ..identify.intervals import attach_intervals
@@ -120,6 +120,7 @@ def _read_all(args: argparse.Namespace, axis=None) -> tuple[list, list, list]:
     names, runs = _read(args, args.train, axis)
     second_names, second = _read(args, args.stage2, axis) if args.stage2 else ([], [])
     check_one_effort(runs + second)  # before any fit: a model of a current and a torque at once is neither
+    check_one_axis(runs + second)  # nor is a model of two axes
     return names + second_names, runs, second
 
 
@@ -315,6 +316,7 @@ def _run_auto(args: argparse.Namespace) -> int:
         runs += pieces
         groups += [str(path)] * len(pieces)
     check_one_effort(runs)
+    check_one_axis(runs)
     started = time.perf_counter()
     report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
     inertia, source = _read_axis_inertia(args, runs)

@@ -22,8 +22,8 @@ from pathlib import Path
 from ..errors import GreyboxError
 from .units import MOTOR_TORQUE
 
-__all__ = ["EFFORT_UNITS", "MOTOR_TORQUE_QUANTITY", "check_one_effort", "column_stem", "convert_effort",
-           "effort_quantity", "effort_text", "shown_unit"]
+__all__ = ["EFFORT_UNITS", "MOTOR_TORQUE_QUANTITY", "check_one_axis", "check_one_effort", "column_stem",
+           "convert_effort", "effort_quantity", "effort_text", "shown_unit"]
 
 #: The quantity of a linear axis's log whose effort is the motor torque read through ``k_t = 1``.
 MOTOR_TORQUE_QUANTITY = "motor torque"
@@ -89,6 +89,30 @@ def column_stem(quantity: str) -> str:
 
 def _name(run) -> str:
     return Path(run.source).name if run.source else "a log without a file name"
+
+
+def check_one_axis(runs) -> str | None:
+    """The one axis the ``runs`` name (None when none names one); an error naming the files when they name several.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        The training runs (their ``axis`` and ``source``).
+
+    Raises
+    ------
+    GreyboxError
+        When the runs are of different axes: one model is one axis's.
+    """
+    found: dict[str, list[str]] = {}
+    for run in runs:
+        if run.axis:
+            found.setdefault(str(run.axis), []).append(Path(run.source or "?").name)
+    if len(found) > 1:
+        listed = "; ".join(f"axis {axis}: {', '.join(dict.fromkeys(files))}" for axis, files in sorted(found.items()))
+        raise GreyboxError(f"the training logs are of different axes ({listed}); a model is one axis's: train each "
+                           "axis's logs apart, or give --axes to train a model per axis of logs that hold several")
+    return next(iter(found), None)
 
 
 def check_one_effort(runs, what: str = "the training logs",

@@ -16,6 +16,7 @@ from typing import Callable, Sequence
 
 from ..errors import GreyboxError, Setting
 from ..fleet import check_out_dir, fleet_summary
+from ..provenance import training_file_warning
 from .interval import DEFAULT_COVERAGE, ProcessInterval, calibrate_interval
 from .output import check_output_path, output_paths, write_process
 from .process import ProcessTally
@@ -237,8 +238,12 @@ class Request:
             raise GreyboxError(named("calibration"), f": {own[0]} is the cutting log itself; calibrate on air cuts "
                                "the model was not trained on")
 
-    def interval(self, model, read: Callable[[str], list]) -> ProcessInterval | None:
+    def interval(self, model, read: Callable[[str], list], records: dict | None = None,
+                 model_name: str = "the model") -> ProcessInterval | None:
         """The calibrated interval of ``model`` from the calibration logs, or None without them.
+
+        A calibration log that is one of the model's training files (by its SHA-256 in the training
+        record) gets a warning.
 
         Parameters
         ----------
@@ -246,9 +251,15 @@ class Request:
             The model whose process current the interval bounds.
         read : callable
             ``read(path)`` gives the prepared runs of a calibration log.
+        records : dict, optional
+            The model file's records (its training files).
+        model_name : str, default "the model"
+            Name of the model file, for the warning.
         """
         if not self.calibration:
             return None
+        for path in self.calibration:
+            self.warn(training_file_warning(records or {}, path, model_name))
         return calibrate_interval(model, [run for path in self.calibration for run in read(path)],
                                   coverage=DEFAULT_COVERAGE if self.coverage is None else self.coverage,
                                   chunk_s=self.chunk_s)

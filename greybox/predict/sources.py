@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import GreyboxError, Setting
 from ..fleet import read_prepared
 from ..models.chunked import chunk_slices, samples_per_chunk
-from ..provenance import model_quantity, preparation_warning
+from ..provenance import axis_warning, model_quantity, preparation_warning
 from .effort import align_effort
 from .interval import ProcessInterval
 from .output import output_paths
@@ -89,7 +89,7 @@ class ModelFile:
             if not calibrated:
                 calibrated.append(request.interval(model, lambda path: align_effort(
                     records, model, read_prepared(path, read, columns=columns, notify=request.notify), config,
-                    Path(path).name, names[1], request.notify)))
+                    Path(path).name, names[1], request.notify), records, names[1]))
             return calibrated[0]
 
         figures = {"axis_file": Path(request.axis_config).name if request.axis_config else None,
@@ -103,6 +103,7 @@ class ModelFile:
         if streamed is not None and _first_quantity(streamed) != model_quantity(records, model):
             streamed = None  # read whole, to convert its effort (align_effort)
         if streamed is not None:
+            request.warn(axis_warning(records, streamed.axis, *names))
             request.warn(preparation_warning(records, read, None, *names))
             done = self._stream(model, streamed, config, request, inputs, attrs, interval, figures)
             if done is not None:
@@ -110,6 +111,7 @@ class ModelFile:
         runs = align_effort(records, model, read_prepared(log, read, columns=columns, notify=request.notify), config,
                             *names, request.notify)
         if streamed is None:
+            request.warn(axis_warning(records, runs[0].axis if runs else None, *names))
             request.warn(preparation_warning(records, read, runs, *names))
         return self._whole(model, runs, log, config, request, inputs, attrs, interval, figures)
 
