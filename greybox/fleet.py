@@ -20,6 +20,7 @@ import json
 import os
 import time
 import unicodedata
+import warnings
 from pathlib import Path
 from typing import Callable, Iterator, Mapping, Sequence
 from urllib.parse import quote, unquote
@@ -294,17 +295,24 @@ def attempt(label: str, work: Callable[[], dict]) -> dict:
     dict
         ``status`` ``ok`` with what ``work`` returned, ``seconds`` and ``peak_rss_mb`` (of the worker
         process so far [MB]); or ``failed`` with ``error``, one line (a bug is named an internal
-        error of ``label``), and ``seconds``.
+        error of ``label``), and ``seconds``; ``notes``, the first line of each warning ``work`` issued
+        (once each), where it issued any: they are printed by :func:`fleet_summary`, not by the worker.
     """
     started = time.perf_counter()
-    try:
-        result = work()
-    except GreyboxError as error:
-        return {"status": "failed", "error": str(error), "seconds": time.perf_counter() - started}
-    except Exception as error:  # a bug, not bad input: reported in the manifest, the fleet goes on
-        return {"status": "failed", "error": f"{label}: internal error {type(error).__name__}: {error}",
-                "seconds": time.perf_counter() - started}
-    return {"status": "ok", **result, "seconds": time.perf_counter() - started, "peak_rss_mb": _peak_rss_mb()}
+    with warnings.catch_warnings(record=True) as caught:  # the worker's warnings go to the manifest, not its stderr
+        warnings.simplefilter("default")
+        try:
+            result = work()
+        except GreyboxError as error:
+            result = {"status": "failed", "error": str(error)}
+        except Exception as error:  # a bug, not bad input: reported in the manifest, the fleet goes on
+            result = {"status": "failed", "error": f"{label}: internal error {type(error).__name__}: {error}"}
+    notes = list(dict.fromkeys(str(item.message).splitlines()[0] for item in caught if str(item.message)))
+    extra = {"notes": notes} if notes else {}
+    if result.get("status") == "failed":
+        return {**result, **extra, "seconds": time.perf_counter() - started}
+    return {"status": "ok", **result, **extra, "seconds": time.perf_counter() - started,
+            "peak_rss_mb": _peak_rss_mb()}
 
 
 def _peak_rss_mb() -> float | None:
@@ -540,7 +548,16 @@ def fleet_summary(manifest: dict, items: str, verb: str, describe: Callable[[dic
     lines = [f"fleet: {counts['ok']} {verb}, {counts['skipped']} skipped (complete from an earlier run), "
              f"{counts['failed']} failed of {len(manifest[items])} {items} in {manifest['seconds']:.1f} s{where}"]
     lines += [f"  failed: {describe(entry)}" for entry in manifest[items] if entry["status"] == "failed"]
+    lines += [f"  note: {_entry_label(entry)}: {note}" for entry in manifest[items] if entry["status"] != "skipped"
+              for note in entry.get("notes", ())]
     return lines, 2 if counts["failed"] else 0
+
+
+def _entry_label(entry: dict) -> str:
+    """What a manifest entry is of: its log, or its machine (and axis)."""
+    if entry.get("log"):
+        return Path(entry["log"]).name
+    return "/".join(str(entry[name]) for name in ("machine", "axis") if entry.get(name)) or "?"
 
 
 @contextlib.contextmanager
@@ -596,8 +613,20 @@ def _run_on_cluster(task: Callable, todo: list, scheduler: str | None, workers: 
         run = task if scheduler is not None else functools.partial(_on_one_thread, task)
         futures = client.map(run, [job for _, job in todo], pure=False)
         index = {future.key: position for future, (position, _) in zip(futures, todo)}
+        jobs = {future.key: job for future, (_, job) in zip(futures, todo)}
         for future in as_completed(futures):
             error = future.exception() if future.status == "error" else None
             finish(index[future.key], future.result() if error is None else
-                   {"status": "failed", "error": f"lost on the cluster: {type(error).__name__}: {error}"})
+                   {"status": "failed", "error": f"{_job_label(jobs[future.key])}: lost on the cluster (the worker "
+                                                 f"running it died, e.g. out of memory or killed: "
+                                                 f"{type(error).__name__})"})
         return info
+
+
+def _job_label(job) -> str:
+    """What a fleet job works on, for a message: its log, its file or its machine."""
+    for name in ("log", "path", "machine"):
+        value = getattr(job, name, None)
+        if value:
+            return str(value)
+    return type(job).__name__

@@ -154,3 +154,18 @@ def test_a_killed_writers_temporary_file_is_removed_by_the_next_write(tmp_path):
     os.utime(alive, (os.path.getmtime(alive) - 3600,) * 2)
     atomic.write_text_atomic(target, "new")
     assert not dead.exists() and alive.exists() and target.read_text() == "new"
+
+
+@pytest.mark.parametrize("model", ["coulomb", "auto"])
+def test_an_all_zero_current_is_refused_in_one_line(tmp_path, capsys, model):
+    # before, with --model auto: a ValueError traceback from the choice ("min() arg is an empty sequence")
+    paths = []
+    for seed in (0, 1):
+        log = _log("X", seed)
+        paths.append(tmp_path / f"zero{seed}.csv")
+        write_log(AxisLog(time=log.time, position=log.position, effort=np.zeros_like(log.time), axis="X"), paths[-1])
+    status, _, err = _main(capsys, "train", "--model", model, "--train", *paths, "--out", tmp_path / "z.gbm",
+                           "--quiet")
+    assert status == 2 and err.strip().splitlines() == [
+        "greybox train: error: the effort of the training logs is zero throughout (zero0.csv, zero1.csv): nothing "
+        "to fit; check the effort column (--columns) or the drive's recording"]

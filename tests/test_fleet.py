@@ -113,3 +113,64 @@ def test_a_fleet_output_inside_the_input_tree_is_not_read_back_as_logs(tmp_path)
     (tmp_path / "results" / MANIFEST).write_text("{}")
     assert expand_logs([str(tmp_path)]) == [tmp_path / "m1" / "a.csv"]
     assert expand_logs([str(tmp_path / "**" / "*.*")]) == [tmp_path / "m1" / "a.csv"]
+
+
+#: A main script whose one job kills the worker running it (as the kernel's OOM killer would).
+DYING = '''
+import os
+from dataclasses import dataclass
+
+import dask
+
+from greybox.fleet import _run_on_cluster
+
+
+@dataclass(frozen=True)
+class Job:
+    log: str
+
+
+def task(job):
+    os._exit(9)
+
+
+if __name__ == "__main__":
+    results = {}
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        jobs = [(0, Job("/plant/mill1/monday.mcap"))]
+        _run_on_cluster(task, jobs, None, 1, lambda index, entry: results.update(entry))
+    print(repr(results))
+'''
+
+
+@pytest.mark.slow
+def test_a_job_whose_worker_died_is_reported_by_its_log(tmp_path):
+    # before: "lost on the cluster: KilledWorker: ('task-5f2c...', ...)", naming a Dask task, not the log
+    script = tmp_path / "dying_main.py"
+    script.write_text(DYING)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parents[1]),
+                                                        os.environ.get("PYTHONPATH", "")])}
+    done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    result = ast.literal_eval(done.stdout.strip().splitlines()[-1])
+    assert result["status"] == "failed"
+    assert result["error"].startswith("/plant/mill1/monday.mcap: lost on the cluster (the worker running it died")
+
+
+def test_a_workers_warnings_go_to_the_manifest_and_the_summary_as_note_lines():
+    import warnings
+
+    from greybox.fleet import attempt, fleet_summary
+
+    def work():
+        warnings.warn("the log's clock jumps\nsecond line", UserWarning, stacklevel=2)
+        warnings.warn("the log's clock jumps\nsecond line", UserWarning, stacklevel=2)
+        return {"output": "x"}
+
+    entry = {"log": "/plant/m1/a.mcap", **attempt("a.mcap", work)}
+    assert entry["status"] == "ok" and entry["notes"] == ["the log's clock jumps"]
+    manifest = {"counts": {"ok": 1, "skipped": 0, "failed": 0}, "cluster": {"workers": 1, "scheduler": "local"},
+                "seconds": 1.0, "logs": [entry]}
+    lines, status = fleet_summary(manifest, "logs", "predicted", lambda e: e["error"])
+    assert status == 0 and lines[-1] == "  note: a.mcap: the log's clock jumps"

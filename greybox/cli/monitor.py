@@ -38,6 +38,7 @@ def add_parser(subparsers) -> None:
                         help="fingerprint the logs on the Dask cluster of this scheduler (tcp://host:8786)")
     parser.add_argument("--baseline-days", type=NumberRange(int, low=3), default=28, metavar="N",
                         help="first days with a fingerprint that set each feature's baseline (default %(default)s)")
+    parser.add_argument("--force", action="store_true", help="replace the dashboard of an earlier run in --out")
     parser.set_defaults(run=run)
 
 
@@ -47,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     result = run_monitor(args.logs, args.history, args.out, machine=args.machine, axis=args.axis,
                          model_path=args.model, spindle_column=args.spindle_load,
                          baseline_days=args.baseline_days, scheduler=args.scheduler, workers=args.workers,
-                         progress=print)
+                         progress=print, force=args.force)
     trends = result.detector.trends_
     print(f"{result.fitted} logs fingerprinted, {result.known} already in the history; "
           f"{len(trends)} axes, {len(result.detector.alarms_)} alarms")

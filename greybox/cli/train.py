@@ -11,7 +11,14 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import check_output_path
-from ..data.effort import EFFORT_UNITS, check_one_axis, check_one_effort, effort_quantity, effort_text
+from ..data.effort import (
+    EFFORT_UNITS,
+    check_effort_measured,
+    check_one_axis,
+    check_one_effort,
+    effort_quantity,
+    effort_text,
+)
 from ..errors import GreyboxError, ModelFileError
 from ..identify.intervals import METHODS as INTERVAL_METHODS
 from ..identify.intervals import attach_intervals
@@ -121,6 +128,7 @@ def _read_all(args: argparse.Namespace, axis=None) -> tuple[list, list, list]:
     second_names, second = _read(args, args.stage2, axis) if args.stage2 else ([], [])
     check_one_effort(runs + second)  # before any fit: a model of a current and a torque at once is neither
     check_one_axis(runs + second)  # nor is a model of two axes
+    check_effort_measured(runs + second)
     return names + second_names, runs, second
 
 
@@ -317,6 +325,7 @@ def _run_auto(args: argparse.Namespace) -> int:
         groups += [str(path)] * len(pieces)
     check_one_effort(runs)
     check_one_axis(runs)
+    check_effort_measured(runs)  # the held-out relative errors the choice compares would be undefined
     started = time.perf_counter()
     report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
     inertia, source = _read_axis_inertia(args, runs)

@@ -22,8 +22,8 @@ from pathlib import Path
 from ..errors import GreyboxError
 from .units import MOTOR_TORQUE
 
-__all__ = ["EFFORT_UNITS", "MOTOR_TORQUE_QUANTITY", "check_one_axis", "check_one_effort", "column_stem",
-           "convert_effort", "effort_quantity", "effort_text", "shown_unit"]
+__all__ = ["EFFORT_UNITS", "MOTOR_TORQUE_QUANTITY", "check_effort_measured", "check_one_axis", "check_one_effort",
+           "column_stem", "convert_effort", "effort_quantity", "effort_text", "shown_unit"]
 
 #: The quantity of a linear axis's log whose effort is the motor torque read through ``k_t = 1``.
 MOTOR_TORQUE_QUANTITY = "motor torque"
@@ -113,6 +113,27 @@ def check_one_axis(runs) -> str | None:
         raise GreyboxError(f"the training logs are of different axes ({listed}); a model is one axis's: train each "
                            "axis's logs apart, or give --axes to train a model per axis of logs that hold several")
     return next(iter(found), None)
+
+
+def check_effort_measured(runs) -> None:
+    """Refuse training runs whose effort is zero throughout: nothing to fit, and no relative error to compare.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        The training runs (their ``source`` names the files in the message).
+
+    Raises
+    ------
+    GreyboxError
+        When every sample of every run has an effort of 0 (or none is finite).
+    """
+    import numpy as np
+
+    if runs and not any(np.any(np.isfinite(run.effort) & (run.effort != 0.0)) for run in runs):
+        files = ", ".join(dict.fromkeys(Path(run.source or "?").name for run in runs))
+        raise GreyboxError(f"the effort of the training logs is zero throughout ({files}): nothing to fit; check the "
+                           "effort column (--columns) or the drive's recording")
 
 
 def check_one_effort(runs, what: str = "the training logs",

@@ -240,7 +240,7 @@ class MonitorResult:
 def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
                 model_path=None, spindle_column: str | None = None, baseline_days: int = 28,
                 scheduler: str | None = None, workers: int | None = None,
-                progress: Callable[[str], None] | None = None) -> MonitorResult:
+                progress: Callable[[str], None] | None = None, force: bool = False) -> MonitorResult:
     """Fingerprint ``logs`` into ``history``, compact it, detect changes over the whole history, write the dashboard.
 
     The history is compacted (:func:`~greybox.monitor.history.compact_history`) after the logs are filed:
@@ -273,11 +273,16 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         ``_manifest.json`` in the history and skips the logs it lists as done, unchanged.
     progress : callable, optional
         Called with one line per log.
+    force : bool, default False
+        Replace the dashboard of an earlier run in ``out_dir``; otherwise it is an error, before any work.
 
     Returns
     -------
     MonitorResult
     """
+    page = Path(out_dir) / "index.html"
+    if page.exists() and not force:
+        raise GreyboxError(f"{page}: exists; give --force to replace the dashboard (or another --out)")
     detector = ChangeDetector(baseline_days=baseline_days)
     detector._check_params()  # refuse bad options before any work
     if Path(history).exists() and not Path(history).is_dir():

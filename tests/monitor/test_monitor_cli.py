@@ -217,11 +217,12 @@ def test_fleet_run_matches_the_sequential_one(twin_days, tmp_path, capsys):
     capsys.readouterr()
     assert read_history(fleet).equals(read_history(alone))  # the same rows, whoever fitted them
     assert main(["monitor", *logs, "--history", str(fleet), "--out", str(tmp_path / "r1"), "--baseline-days", "3",
-                 "--workers", "1"]) == 0
+                 "--workers", "1", "--force"]) == 0
     assert "0 logs fingerprinted, 3 already in the history" in capsys.readouterr().out
     bad = tmp_path / "bad_2026-05-09.csv"
     bad.write_text("time_s,position_mm,current_A\n0,0,nan\n")
-    assert main(["monitor", str(bad), "--history", str(fleet), "--out", str(tmp_path / "r1"), "--workers", "1"]) == 2
+    assert main(["monitor", str(bad), "--history", str(fleet), "--out", str(tmp_path / "r1"), "--workers", "1",
+                 "--force"]) == 2
     err = capsys.readouterr().err  # (Dask may note a busy dashboard port before it on a shared machine)
     assert "Traceback" not in err and "1 of 1 logs failed" in err.strip().splitlines()[-1]
     assert "at least 2 are needed" in err.strip().splitlines()[-1]
@@ -231,13 +232,21 @@ def test_monitor_compacts_the_history_it_appends_to(twin_days, tmp_path, capsys)
     history, report = tmp_path / "history", tmp_path / "report"
     logs = sorted(str(p) for p in twin_days.iterdir())
     assert main(["monitor", *logs[:3], "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
-    assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
+    page = (report / "index.html").read_bytes()
+    capsys.readouterr()
+    # before: the dashboard of the earlier run was replaced without --force
+    assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 2
+    assert "index.html: exists; give --force" in capsys.readouterr().err
+    assert (report / "index.html").read_bytes() == page and read_history(history).num_rows == 3  # nothing done
+    assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3",
+                 "--force"]) == 0
     assert "1 logs fingerprinted, 3 already in the history" in capsys.readouterr().out
     compacted = history / "machine=mill7" / "axis=X" / "compacted.parquet"
     assert sorted(history.rglob("*.parquet")) == [compacted]  # the new row files merged, none left
     before = compacted.read_bytes()
     assert pq.read_table(compacted).num_rows == 4 and read_history(history).num_rows == 4
-    assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3"]) == 0
+    assert main(["monitor", *logs, "--history", str(history), "--out", str(report), "--baseline-days", "3",
+                 "--force"]) == 0
     assert "0 logs fingerprinted, 4 already in the history" in capsys.readouterr().out
     assert compacted.read_bytes() == before  # compacting again changes nothing
 
