@@ -446,12 +446,12 @@ def _forget(root: Path, sha256: str, keep: Path) -> None:
             path.unlink()
             _remove_if_empty(path.parent)
     for _, _, compacted in _scan(root):
-        if compacted is None:
+        if compacted is None or sha256 not in _read_row_file(compacted, columns=("log_sha256",)).column(
+                "log_sha256").to_pylist():  # only the keys read; the whole file where the log is
             continue
         table = _read_row_file(compacted)
         keys = table.column("log_sha256").to_pylist()
-        if sha256 in keys:
-            _write(compacted, table.filter(pa.array([key != sha256 for key in keys])))
+        _write(compacted, table.filter(pa.array([key != sha256 for key in keys])))
 
 
 def _remove_if_empty(directory: Path) -> None:
