@@ -169,3 +169,28 @@ def test_an_all_zero_current_is_refused_in_one_line(tmp_path, capsys, model):
     assert status == 2 and err.strip().splitlines() == [
         "greybox train: error: the effort of the training logs is zero throughout (zero0.csv, zero1.csv): nothing "
         "to fit; check the effort column (--columns) or the drive's recording"]
+
+
+def test_the_staging_file_of_a_killed_parquet_writer_is_removed_by_the_next_write(tmp_path):
+    # before: ".blocks.XXXX.tmp" (uncompressed, megabytes) stayed for good after a SIGKILL
+    from greybox.errors import GreyboxError
+    from greybox.predict.output import write_process_blocks
+
+    target = tmp_path / "out.parquet"
+    seen = []
+
+    def blocks():  # looks at the directory while the writer runs, then stops it
+        seen.extend(path.name for path in tmp_path.iterdir())
+        raise GreyboxError("stop")
+        yield
+
+    with pytest.raises(GreyboxError, match="stop"):
+        write_process_blocks(blocks(), target, metadata=dict)
+    prefix = f".{target.name}.{os.getpid()}-"  # the writer's process, as remove_stale_temporaries reads it
+    assert any(name.startswith(prefix) and name.endswith(".blocks.tmp") for name in seen), seen
+    assert list(tmp_path.iterdir()) == []  # an error (not a kill) leaves nothing
+    staging = tmp_path / f".out.parquet.{2**22 + 12345}-0123456789abcdef.tmp.01234567.blocks.tmp"
+    staging.write_bytes(b"x" * 1000)
+    os.utime(staging, (1e9, 1e9))
+    atomic.write_text_atomic(target, "new")
+    assert not staging.exists()

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import secrets
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
 
@@ -140,8 +140,10 @@ def _write_parquet(results: Iterable[ProcessResult], path, metadata: Callable[[]
     """
     import pyarrow.parquet as pq
 
-    handle, staging = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(path)), prefix=".blocks.", suffix=".tmp")
-    os.close(handle)
+    # named after ``path`` (the hidden temporary of atomic_output, which names its process): a run killed by
+    # SIGKILL leaves it to be removed by the next write of the same output (atomic.remove_stale_temporaries)
+    staging = f"{os.path.abspath(path)}.{secrets.token_hex(4)}.blocks.tmp"
+    os.close(os.open(staging, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
     try:
         writer = None
         try:
