@@ -194,3 +194,17 @@ def test_the_staging_file_of_a_killed_parquet_writer_is_removed_by_the_next_writ
     os.utime(staging, (1e9, 1e9))
     atomic.write_text_atomic(target, "new")
     assert not staging.exists()
+
+
+def test_a_fleet_output_of_the_earlier_naming_is_refused_before_any_work(tmp_path):
+    # its outputs (log=<file stem>) would stay beside the new ones and be read twice as one dataset
+    from greybox.errors import GreyboxError
+    from greybox.predict.fleet import FleetJob, run_fleet
+
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "_manifest.json").write_text(json.dumps({"format": "greybox-fleet", "format_version": 2, "logs": []}))
+    job = FleetJob(str(tmp_path / "m1" / "a.csv"), "m1", str(tmp_path / "absent.gbm"), str(out), "a.csv")
+    with pytest.raises(GreyboxError, match="earlier greybox, whose outputs are named otherwise"):
+        run_fleet([job])
+    assert sorted(path.name for path in out.iterdir()) == ["_manifest.json"]

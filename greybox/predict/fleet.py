@@ -45,10 +45,15 @@ from ..fleet import (
     run_tasks,
 )
 
-__all__ = ["PREDICT_FORMAT", "FleetJob", "fleet_jobs", "machine_models", "model_of_log", "predict_log", "run_fleet"]
+__all__ = ["FORMAT_VERSION", "PREDICT_FORMAT", "FleetJob", "fleet_jobs", "machine_models", "model_of_log",
+           "predict_log", "run_fleet"]
 
 #: ``format`` of the manifest of a fleet prediction.
 PREDICT_FORMAT = "greybox-fleet"
+
+#: ``format_version`` of that manifest: 3 since the outputs are named by the log's relative path
+#: (:func:`greybox.fleet.log_names`); a directory of another version is refused.
+FORMAT_VERSION = 3
 
 
 @dataclass(frozen=True)
@@ -286,13 +291,18 @@ def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers
         When the scheduler cannot be reached or the jobs disagree on the output directory.
     """
     out_dir = out_dir_of(jobs, "no log to predict")
+    earlier = read_manifest(out_dir, PREDICT_FORMAT).get("format_version", FORMAT_VERSION)
+    if earlier != FORMAT_VERSION:  # its outputs are named otherwise: a re-run would leave them beside the new ones
+        raise GreyboxError(f"{out_dir}: holds the dataset of an earlier greybox, whose outputs are named "
+                           f"otherwise (manifest format version {earlier}, now {FORMAT_VERSION}); choose another "
+                           "output directory")
     files = {job.model for job in jobs} | {job.axis_config for job in jobs if job.axis_config}
     hashes = {path: file_sha256(path) for path in files}
     fingerprints = [{"log": job.log, "name": job.name, "model": job.model, "model_sha256": hashes[job.model],
                      **log_stamp(job.log),
                      "axis_config_sha256": hashes.get(job.axis_config), "read": job.read, "chunk_s": job.chunk_s}
                     for job in jobs]  # an option or axis file changed: the log is predicted again
-    header = {"format": PREDICT_FORMAT, "format_version": 3, "axis_config": jobs[0].axis_config,
+    header = {"format": PREDICT_FORMAT, "format_version": FORMAT_VERSION, "axis_config": jobs[0].axis_config,
               "read": jobs[0].read, "chunk_s": jobs[0].chunk_s}
     return run_tasks(predict_log, jobs, fingerprints, out_dir=out_dir, header=header, items="logs",
                      scheduler=scheduler, workers=workers, force=force, progress=progress)
