@@ -34,7 +34,7 @@ JSON has no non-finite numbers) and ``{"__estimator__": {"kind", "params",
 stage, say). Floats are written with Python's shortest round-trip repr, and
 arrays byte for byte, so a loaded model predicts bit-identically.
 
-``digest.json`` (since greybox 0.1 format version 3)
+``digest.json`` (format version 3)
     The SHA-256 of every other member, ``{"format": "greybox-digest", "algorithm": "sha256",
     "members": {name: hex digest}}``, and, when the file was saved with the plant's key
     (:func:`model_key`), ``"hmac_sha256"``: HMAC-SHA256 with that key over the canonical JSON of
