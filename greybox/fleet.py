@@ -29,9 +29,10 @@ from .atomic import write_text_atomic
 from .data.io import LOG_SUFFIXES
 from .errors import GreyboxError, Setting
 
-__all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_names",
-           "check_out_dir", "decode_name", "encode_name", "expand_logs", "file_sha256", "fleet_summary", "log_names",
-           "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared", "run_tasks"]
+__all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_machines",
+           "check_names", "check_out_dir", "decode_name", "encode_name", "expand_logs", "file_sha256", "fleet_summary",
+           "log_names", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared",
+           "run_tasks"]
 
 #: Name of the manifest in the output directory (a leading "_": dataset readers skip it).
 MANIFEST = "_manifest.json"
@@ -229,6 +230,31 @@ def machine_of(log: str | os.PathLike) -> str:
         Log file.
     """
     return partition(Path(log).parent.name)
+
+
+def check_machines(logs: Sequence[str | os.PathLike]) -> None:
+    """Refuse logs whose different folder names give one machine name (:func:`machine_of`: ``run 1``, ``run_1``).
+
+    Folders of one name in different places are one machine, by design; folders whose names differ only in
+    the characters a partition value cannot hold would be merged without a word.
+
+    Parameters
+    ----------
+    logs : sequence of str or path-like
+        The logs of a fleet run.
+
+    Raises
+    ------
+    GreyboxError
+        Naming the two folders.
+    """
+    seen: dict[str, str] = {}
+    for log in logs:
+        folder = Path(log).parent.name
+        name = machine_of(log)
+        if seen.setdefault(name, folder) != folder:
+            raise GreyboxError(f"{Path(log).parent}: the folders {seen[name]!r} and {folder!r} both give the machine "
+                               f"name {name}; rename one of them (a machine name holds letters, digits, '-', '_', '.')")
 
 
 def log_stamp(path: str | os.PathLike) -> dict:

@@ -31,7 +31,17 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .errors import GreyboxError
-from .fleet import MODELS_FORMAT, attempt, log_stamp, machine_of, out_dir_of, partition, read_prepared, run_tasks
+from .fleet import (
+    MODELS_FORMAT,
+    attempt,
+    check_machines,
+    log_stamp,
+    machine_of,
+    out_dir_of,
+    partition,
+    read_prepared,
+    run_tasks,
+)
 from .identify.intervals import attach_intervals
 
 __all__ = ["TrainJob", "run_training", "train_jobs", "train_model"]
@@ -81,6 +91,7 @@ def train_jobs(logs: Sequence[Path], model, out_dir: str, *, axes: Sequence[str]
         Options of reading and preparing the logs.
     """
     read = dict(read or {})
+    check_machines(logs)
     machines: dict[str, list[str]] = {}
     for log in logs:
         machines.setdefault(machine_of(log), []).append(str(log))

@@ -174,3 +174,11 @@ def test_a_workers_warnings_go_to_the_manifest_and_the_summary_as_note_lines():
                 "seconds": 1.0, "logs": [entry]}
     lines, status = fleet_summary(manifest, "logs", "predicted", lambda e: e["error"])
     assert status == 0 and lines[-1] == "  note: a.mcap: the log's clock jumps"
+
+
+def test_folders_whose_names_give_one_machine_name_are_refused():
+    from greybox.fleet import check_machines
+
+    check_machines(["/p/a/m2/log.mcap", "/p/b/m2/log.mcap"])  # one name in two places: one machine, by design
+    with pytest.raises(GreyboxError, match="the folders 'run 1' and 'run_1' both give the machine name run_1"):
+        check_machines(["/p/run 1/a.mcap", "/p/run_1/b.mcap"])

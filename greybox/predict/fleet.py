@@ -32,6 +32,7 @@ from ..fleet import (
     MANIFEST,
     MODELS_FORMAT,
     attempt,
+    check_machines,
     check_names,
     encode_name,
     file_sha256,
@@ -189,6 +190,7 @@ def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: s
     read = dict(read or {})
     names = [encode_name(name) for name in log_names(logs)]
     check_names([str(log) for log in logs], names)
+    check_machines(logs)
     if os.path.isdir(model):
         models = machine_models(model)
         chosen = [_model_for(Path(log), machine_of(log), models, model, read.get("axis")) for log in logs]
