@@ -118,7 +118,7 @@ def test_each_log_is_predicted_with_its_machines_model(plant, trained, tmp_path,
     single = tmp_path / "single.parquet"
     assert _main(capsys, ["predict", models / "mill2" / "X.gbm", plant / "mill2" / "a.csv", "--out", single,
                           "--quiet"])[0] == 0
-    part = pd.read_parquet(out / "machine=mill2" / "axis=X" / "log=a" / "part-0.parquet")
+    part = pd.read_parquet(out / "machine=mill2" / "axis=X" / "log=mill2%2Fa.csv" / "part-0.parquet")
     pd.testing.assert_frame_equal(part, pd.read_parquet(single))
     from_directory = tmp_path / "from_directory.parquet"  # one log, the models directory: its machine's model
     status, printed, _ = _main(capsys, ["predict", models, plant / "mill2" / "a.csv", "--out", from_directory,
