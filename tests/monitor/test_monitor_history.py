@@ -167,7 +167,7 @@ def _concurrent_writers(history: Path, workers: int, logs: int) -> None:
 
 def test_concurrent_writers_keep_every_row_exactly_once(tmp_path):
     # before: compaction listed the row files, merged and deleted them without a lock: rows were lost
-    _concurrent_writers(tmp_path, workers=2, logs=6)
+    _concurrent_writers(tmp_path, workers=2, logs=4)
 
 
 @pytest.mark.slow
