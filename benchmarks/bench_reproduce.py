@@ -11,7 +11,11 @@ stderr, then prints one JSON object:
 - ``noise_floor``: per experiment and axis, the GMS+SVR test RE, the noise-floor
   test RE (noise-free current against the measured one) and their ratio;
 - ``targets``: ``reproduce_under_600_s`` and ``gmssvr_within_1.5x_noise_floor``
-  (experiment 2, every axis), true or false.
+  (experiment 2, every axis), true or false;
+- ``metrics`` and ``hyperparameters`` with ``--records``: every metric record of the run (``metrics.json``
+  of the report) and the SVR settings found (the paper's Table 2), from which the record
+  ``docs/results/reproduce.json`` renders the pages' tables (``python scripts/record.py
+  reproduce``).
 
     python benchmarks/bench_reproduce.py --out /tmp/reproduce-bench
 """
@@ -28,6 +32,7 @@ import time
 from pathlib import Path
 
 from greybox.evaluate.report import noise_floor_ratios
+from greybox.json_values import jsonable
 from greybox.reproduce.experiments import reproduce
 
 #: Targets of GitHub issue 4.
@@ -48,6 +53,8 @@ def main() -> None:
     parser.add_argument("--axis", nargs="+", default=["X", "Y"], metavar="AXIS")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--records", action="store_true",
+                        help="print every metric record and the SVR settings found too")
     args = parser.parse_args()
 
     out = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="greybox-reproduce-"))
@@ -61,7 +68,7 @@ def main() -> None:
     seconds = time.perf_counter() - started
     ratios = noise_floor_ratios(result.records)
     second = [r for r in ratios if r["experiment"] == 2]
-    print(json.dumps({
+    figures = {
         "seconds": round(seconds, 1),
         "cpu_seconds": round(_cpu_seconds() - cpu, 1),
         "jobs": args.jobs,
@@ -74,7 +81,11 @@ def main() -> None:
             "reproduce_under_600_s": seconds < MAX_SECONDS,
             "gmssvr_within_1.5x_noise_floor": bool(second) and all(r["ratio"] <= MAX_RATIO for r in second),
         },
-    }, indent=1))
+    }
+    if args.records:
+        figures["metrics"] = jsonable(list(result.records))
+        figures["hyperparameters"] = jsonable(list(result.hyperparameters))
+    print(json.dumps(figures, indent=1))
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@ All functions take the measured effort ``y`` and the modelled effort ``y_hat``
 same length. Several runs may be compared at once by concatenating their
 samples: none of these metrics depends on the order of the samples.
 
-The names are the ones used in every greybox report (see ``DESIGN.md``):
+The names are the ones used in every greybox report:
 
 =========  ==============================================  =============
 name       definition                                      unit

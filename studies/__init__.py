@@ -18,7 +18,9 @@ on ``sys.path``); their tests are in ``tests/studies/`` (pytest's
   drive (``scripts/emps_benchmark.py``);
 - :mod:`studies.arts` and :mod:`studies.arts_data`: the friction models on the
   real ARTS-Lab dry-friction device with backlash (``scripts/arts_benchmark.py``);
-- :mod:`studies.auto`: the held-out model choice both benchmarks report.
+- :mod:`studies.auto`: the held-out model choice both benchmarks report;
+- :mod:`studies.records` and :mod:`studies.result_pages`: the measured records under ``docs/results/``
+  (``scripts/record.py``) and the pages' tables rendered from them (``scripts/render_results.py``).
 
 The paper's two experiments that ``greybox reproduce`` runs are in the
 package: :mod:`greybox.reproduce`. Nothing is imported here, so that importing

@@ -3,7 +3,7 @@ r"""An independent family of synthetic feed axes: Bouc-Wen hysteresis friction w
 The family checks the discovery workflow on a friction law it was not
 developed on. Nothing here comes from greybox's friction models or its
 synthetic twin: the friction law, the trajectories, the noise and the hidden
-effects are written apart (``tests/test_hysteresis_axis.py`` checks the
+effects are written apart (``tests/studies/test_hysteresis_axis.py`` checks the
 imports). The logs are returned raw (time, position, current), so a caller
 prepares them with :func:`greybox.data.prepare.prepare` exactly like a real
 log.

@@ -27,7 +27,7 @@ def gms_reference(velocity, sample_time, alpha, k, sigma, s_0, s_inf, v_s, c, mu
     ``s_0``, ``s_inf``, ``v_s`` and ``mu`` are numbers, or pairs (positive
     motion, negative motion) for the direction-dependent model; at rest the
     positive curve is used (no element moves there).
-    ``slip_law="design"`` is the slip law of DESIGN.md,
+    ``slip_law="design"`` is the slip law greybox implements (docs/friction-models.md),
     ``dz/dt = alpha_i C (sgn(v) - z / s_i)``. ``slip_law="sgn(1-z/s)"`` is
     the form ``sgn(v) alpha_i C (1 - z / s_i)`` found in several public
     implementations, which runs away for negative velocities.

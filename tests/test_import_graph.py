@@ -3,7 +3,7 @@
 Every ``import`` statement of every module counts, also those inside
 functions and under ``if TYPE_CHECKING:``: an import that only runs later is
 still a dependency, and hiding a cycle in a function does not remove it. The
-rules (DESIGN.md, "Layout"):
+rules (docs/layout.md, "Layer rules"):
 
 - no import cycle between modules;
 - only ``greybox.twin`` itself, ``greybox.control``, ``greybox.reproduce`` and

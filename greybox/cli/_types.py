@@ -6,7 +6,7 @@ error, one line naming the option, the allowed range and the value given, exit s
 
     greybox train: error: argument --time-tolerance: must be a fraction in (0, 1), got 6
 
-rather than in a ``ValueError`` deep in the library. ``tests/test_cli_option_ranges.py`` finds every
+rather than in a ``ValueError`` deep in the library. ``tests/cli/test_types.py`` finds every
 option of every sub-command and fails for one whose type is not a :class:`NumberRange`.
 """
 

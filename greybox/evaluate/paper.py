@@ -1,8 +1,8 @@
 """The published figures of Rüppel et al. (2024) that reports put beside greybox's.
 
 Tables 3 (train on A, test on C) and 4 (train on A + B, test on C + D) of the
-paper, measured on the X and Y axes of a Mazak VARIAXIS i-600, as given in
-``../shared/papers/README.md``. Keys are ``(experiment, axis, model)`` with
+paper (J. Machine Engineering 24(1), 2024), measured on the X and Y axes of a Mazak
+VARIAXIS i-600. Keys are ``(experiment, axis, model)`` with
 the model names of :data:`greybox.models.registry` (``stribeck``, ``svr``, ``gms``,
 ``gmssvr``); experiment 1 is Table 3, experiment 2 is Table 4.
 """

@@ -10,7 +10,7 @@ side (``train`` or ``test``), as made by
 
 with RMSE in A and RE in %. RE is ``RMSE / mean(|I|)``: the paper divides by
 the mean of the current, which is close to zero for an axis that moves both
-ways, so the mean *absolute* current is used (see ``DESIGN.md``).
+ways, so the mean *absolute* current is used (:mod:`greybox.metrics`).
 
 Files written by :func:`write_report`:
 

@@ -30,11 +30,14 @@ class Table:
     rows: list[list[str]]
     notes: list[str] = field(default_factory=list)
 
+    def pipe_lines(self) -> list[str]:
+        """The header and the rows as the lines of a Markdown pipe table, without title or notes."""
+        return ["| " + " | ".join(self.header) + " |", "|" + "|".join("---" for _ in self.header) + "|",
+                *("| " + " | ".join(row) + " |" for row in self.rows)]
+
     def to_markdown(self) -> str:
         """The table as a Markdown section (``###`` title, pipe table, notes)."""
-        lines = [f"### {self.title}", "", "| " + " | ".join(self.header) + " |",
-                 "|" + "|".join("---" for _ in self.header) + "|"]
-        lines += ["| " + " | ".join(row) + " |" for row in self.rows]
+        lines = [f"### {self.title}", "", *self.pipe_lines()]
         if self.notes:
             lines.append("")
             lines += [f"{note}  " if i < len(self.notes) - 1 else note for i, note in enumerate(self.notes)]

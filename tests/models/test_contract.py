@@ -22,6 +22,8 @@ from greybox.base import EFFORT, Parameter
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
+from greybox.evaluate.records import TRUTH_CHANNEL
+from greybox.metrics import relative_error
 from greybox.models import registry
 from greybox.models.augmented import AugmentedModel
 from greybox.models.chunked import predict_chunked
@@ -94,6 +96,37 @@ def unseen_log():
 
 
 @pytest.fixture(scope="module")
+def unseen_aircut():
+    return prepare([make_dataset("X", "C", seed=4, duration_s=8)])[0]
+
+
+#: Largest test RE of each kind on an unseen air cut, as a multiple of the noise floor's RE (the noise-free
+#: current against the measured one: the best any model can do), and why the kind cannot come closer. The
+#: kinds measured 83-90 % of their class's bound when the bounds were set (static 2.14-2.16, dynamic
+#: 1.37-1.62, augmented 1.77, SVR 3.96); a kind that loses its physics lands well above its bound.
+ACCURACY = {
+    "static": (2.6, "no pre-sliding and no memory: the current held at dwells and the pre-sliding ramps after "
+                    "each reversal are its error"),
+    "dynamic": (1.8, "pre-sliding and dwells represented; what is left is the motor's cogging (part of the "
+                     "noise-free current, no model here has it) and a short, quick search"),
+    "augmented": (2.1, "four effects fitted beside the GMS on 16 s of data, their shapes not refined: the thermal "
+                       "drift and the periodic force extrapolate into the unseen run"),
+    "svr": (4.5, "a function of position and velocity from 300 samples of a 50 mm window, not tuned: no "
+                 "pre-sliding, and the unseen run leaves the window"),
+}
+#: The accuracy class of each case.
+ACCURACY_CLASS = {"coulomb": "static", "stribeck": "static", "stribeck-asymmetric": "static",
+                  "augmented-coulomb": "static", "backlash-coulomb": "static", "svr": "svr",
+                  "augmented-gms": "augmented"}
+
+
+def test_every_case_has_an_accuracy_bound_with_a_reason():
+    classes = {ACCURACY_CLASS.get(case, "dynamic") for case in CASES}
+    assert classes <= set(ACCURACY) and all(len(reason) > 40 for _, reason in ACCURACY.values())
+    assert all(case in CASES for case in ACCURACY_CLASS)
+
+
+@pytest.fixture(scope="module")
 def fitted(train_runs):
     return {case: make().fit(train_runs) for case, make in CASES.items()}
 
@@ -144,6 +177,14 @@ def test_unseen_log_predicts_a_finite_current_close_to_the_measurement(case, fit
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
+def test_unseen_air_cut_is_predicted_within_the_kinds_bound_over_the_noise_floor(case, fitted, unseen_aircut):
+    floor = relative_error(unseen_aircut.effort, unseen_aircut.extras[TRUTH_CHANNEL])
+    bound, reason = ACCURACY[ACCURACY_CLASS.get(case, "dynamic")]
+    ratio = relative_error(unseen_aircut.effort, fitted[case].predict(unseen_aircut)) / floor
+    assert ratio <= bound, f"{case}: test RE {ratio:.2f} times the noise floor's, bound {bound} ({reason})"
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
 def test_parameter_table_lists_every_identified_parameter_with_a_unit(case, fitted):
     model = fitted[case]
     table = model.parameter_table()
@@ -166,7 +207,9 @@ def test_score_is_negative_rmse_and_model_selection_accepts_it(case, fitted, tra
     rmse = np.sqrt(np.mean((model.predict(unseen_log) - unseen_log.effort) ** 2))
     assert model.score(unseen_log) == pytest.approx(-rmse, rel=1e-12)
     scores = cross_val_score(CASES[case](), train_runs, cv=2)
-    assert scores.shape == (2,) and np.all(scores < 0)
+    folds = [(train_runs[1], train_runs[0]), (train_runs[0], train_runs[1])]  # KFold(2) on the two runs
+    held_out = [-np.sqrt(np.mean((CASES[case]().fit([fit]).predict(test) - test.effort) ** 2)) for fit, test in folds]
+    np.testing.assert_allclose(scores, held_out, rtol=1e-9)
 
 
 @pytest.mark.parametrize("case", sorted(CASES))

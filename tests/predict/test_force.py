@@ -164,7 +164,9 @@ def test_process_force_of_a_cutting_log_is_the_scaled_process_current():
     back = result.process * cut.velocity < 0
     assert back.any() and (~back).any()
     np.testing.assert_allclose(result.load, np.where(back, backdriven, driving) * result.process, rtol=1e-15)
-    assert result.load_constants == pytest.approx((763.4070148223198, 997.9176664344051))
+    # the axis file's data sheet: F = k_t I i 2 pi eta_d / h driving, k_t I i 2 pi / (eta_b h) back-driven (h in m)
+    per_ampere = 1.35 * 1.0 * 2 * np.pi / 0.010
+    assert result.load_constants == pytest.approx((per_ampere * 0.9, per_ampere / 0.85), rel=1e-12)
     columns = result.columns()
     assert list(columns)[:5] == ["time_s", "current_measured_A", "current_model_A", "current_process_A",
                                  "force_process_N"]

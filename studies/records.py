@@ -1,0 +1,255 @@
+"""Measured records: every figure a page publishes comes from one JSON file the code can re-make.
+
+A *record* (``docs/results/<name>.json``) holds the figures one measuring command printed, with where and
+when they were measured: the command, the git commit of the tree it ran on, the date, the cores, the load
+of the machine before and after, and the package versions (:func:`greybox.provenance.provenance`).
+:data:`SPECS` names every record: the command that re-makes it, and the repository paths whose change
+makes it stale. ``python scripts/record.py NAME`` measures one and writes it; the pages' tables are
+rendered from the records (:mod:`studies.result_pages`), never typed.
+
+A record is *stale* when a commit after the one it was measured on changed a path it depends on
+(:func:`stale_commits`), and it is refused outright when those paths held uncommitted changes while it was
+measured: its figures would belong to no commit.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+
+from greybox.atomic import write_text_atomic
+from greybox.errors import GreyboxError
+from greybox.provenance import provenance
+
+__all__ = ["MEASURING", "ROOT", "RESULTS", "RecordSpec", "SPECS", "measure", "write_record", "read_record",
+           "record_path", "stale_commits", "uncommitted"]
+
+#: Environment variable naming the record being measured, set for its command: the test of the records does
+#: not hold the record being re-made to its old figures (the default test run is itself a record).
+MEASURING = "GREYBOX_MEASURING_RECORD"
+#: The repository's root.
+ROOT = Path(__file__).resolve().parents[1]
+#: Where the records live.
+RESULTS = ROOT / "docs" / "results"
+
+#: What the paper's experiments depend on: the shipped data, the models and everything that fits, tests
+#: and reports them.
+_REPRODUCTION = ("data", "greybox/data", "greybox/identify", "greybox/models", "greybox/evaluate",
+                 "greybox/reproduce", "greybox/base.py", "greybox/metrics.py", "greybox/persistence.py",
+                 "greybox/threads.py", "greybox/provenance.py", "benchmarks/bench_reproduce.py")
+
+
+@dataclass(frozen=True)
+class RecordSpec:
+    """How one record is made.
+
+    Attributes
+    ----------
+    name : str
+        The record's name: ``docs/results/<name>.json``.
+    command : tuple of str
+        The command, run from the repository's root with this Python; it prints one JSON object (the
+        figures) as the last thing on its standard output.
+    depends_on : tuple of str
+        Repository paths (files or folders) whose change makes the record stale.
+    what : str
+        What is measured, one line.
+    """
+
+    name: str
+    command: tuple
+    depends_on: tuple
+    what: str
+
+
+#: Every record the pages cite.
+SPECS = {spec.name: spec for spec in (
+    RecordSpec("reproduce", ("benchmarks/bench_reproduce.py", "--records"), _REPRODUCTION,
+               "both experiments of the paper on the shipped twin (greybox reproduce), with its wall time"),
+    RecordSpec("default-tests", ("benchmarks/bench_test_run.py",),
+               ("greybox", "tests", "studies", "data", "pyproject.toml", "benchmarks/bench_test_run.py"),
+               "the default test run (pytest -q): tests passed, skipped, wall time"),
+)}
+
+
+def record_path(name: str) -> Path:
+    """The file of record ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`SPECS`.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    return RESULTS / f"{name}.json"
+
+
+def _git(*args: str, root: Path = ROOT) -> str:
+    result = subprocess.run(["git", *args], cwd=root, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise GreyboxError(f"git {' '.join(args)}: {result.stderr.strip() or 'failed'}")
+    return result.stdout
+
+
+def uncommitted(paths, *, root: Path = ROOT) -> list[str]:
+    """Paths under ``paths`` with changes not committed (``git status --porcelain``).
+
+    Parameters
+    ----------
+    paths : sequence of str
+        Repository paths.
+    root : path-like, default :data:`ROOT`
+        The repository.
+
+    Returns
+    -------
+    list of str
+        The changed files, as git names them.
+    """
+    lines = _git("status", "--porcelain", "--untracked-files=all", "--", *paths, root=root).splitlines()
+    return [line[3:] for line in lines if line.strip()]
+
+
+def stale_commits(record: dict, *, head: str = "HEAD", root: Path = ROOT) -> list[str]:
+    """Commits after the record's own that changed a path it depends on.
+
+    Parameters
+    ----------
+    record : dict
+        A record as :func:`read_record` returns it.
+    head : str, default "HEAD"
+        The commit the pages are checked at.
+    root : path-like, default :data:`ROOT`
+        The repository.
+
+    Returns
+    -------
+    list of str
+        ``"<short hash> <subject>"`` per commit, newest first; empty when the record is current. A record
+        whose commit is not an ancestor of ``head`` is stale as a whole (one entry saying so).
+    """
+    commit = record["commit"]
+    ancestor = subprocess.run(["git", "merge-base", "--is-ancestor", commit, head], cwd=root,
+                              capture_output=True).returncode == 0
+    if not ancestor:
+        return [f"{commit[:9]} is not in the history of {head}"]
+    return _git("log", "--format=%h %s", f"{commit}..{head}", "--", *record["depends_on"], root=root).splitlines()
+
+
+def _load() -> list[float]:
+    return [round(value, 2) for value in os.getloadavg()]
+
+
+def _last_json(text: str, command) -> dict:
+    start = text.rfind("\n{") + 1  # the last line that opens an object at its first column; 0: none or the first
+    try:
+        figures = json.loads(text[start:])
+    except json.JSONDecodeError:
+        figures = None
+    if not isinstance(figures, dict):
+        raise GreyboxError(f"{' '.join(command)}: printed no JSON object at the end of its output")
+    return figures
+
+
+def measure(spec: RecordSpec, *, allow_dirty: bool = False, root: Path = ROOT) -> dict:
+    """Run a record's command and return the record.
+
+    Parameters
+    ----------
+    spec : RecordSpec
+        The record to make.
+    allow_dirty : bool, default False
+        Measure although the paths the record depends on hold uncommitted changes (the record then says
+        so, and the pages' test refuses it: for trying a change, not for publishing).
+    root : path-like, default :data:`ROOT`
+        The repository the command runs in.
+
+    Returns
+    -------
+    dict
+        ``name``, ``what``, ``command``, ``commit``, ``uncommitted``, ``date`` (UTC, ISO 8601),
+        ``seconds`` (wall time of the command), ``cores``, ``load_before`` and ``load_after`` (1, 5 and 15
+        minute load averages), ``versions``, ``depends_on`` and ``figures``.
+
+    Raises
+    ------
+    GreyboxError
+        When the depended-on paths hold uncommitted changes (unless ``allow_dirty``), the command fails,
+        or it prints no JSON object.
+    """
+    changed = uncommitted(spec.depends_on, root=root)
+    if changed and not allow_dirty:
+        raise GreyboxError(f"record {spec.name}: uncommitted changes in what it measures "
+                           f"({', '.join(changed[:5])}{', ...' if len(changed) > 5 else ''}); commit them first")
+    command = [sys.executable, *spec.command]
+    load_before, started = _load(), time.perf_counter()
+    result = subprocess.run(command, cwd=root, stdout=subprocess.PIPE, text=True,
+                            env={**os.environ, MEASURING: spec.name})
+    seconds = time.perf_counter() - started
+    if result.returncode != 0:
+        raise GreyboxError(f"record {spec.name}: {' '.join(spec.command)} exited with status {result.returncode}")
+    versions = provenance()
+    return {
+        "name": spec.name,
+        "what": spec.what,
+        "command": "python " + " ".join(spec.command),
+        "commit": _git("rev-parse", "HEAD", root=root).strip(),
+        "uncommitted": changed,
+        "date": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "seconds": round(seconds, 1),
+        "cores": versions["cpu_count"],
+        "load_before": load_before,
+        "load_after": _load(),
+        "versions": versions,
+        "depends_on": list(spec.depends_on),
+        "figures": _last_json(result.stdout, spec.command),
+    }
+
+
+def write_record(record: dict) -> Path:
+    """Write a record atomically to ``docs/results/<name>.json``.
+
+    Parameters
+    ----------
+    record : dict
+        As :func:`measure` returns it.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+    """
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    return write_text_atomic(record_path(record["name"]), json.dumps(record, indent=1, sort_keys=True) + "\n")
+
+
+def read_record(name: str) -> dict:
+    """Read record ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`SPECS`.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    GreyboxError
+        When the record has not been made.
+    """
+    path = record_path(name)
+    if not path.is_file():
+        raise GreyboxError(f"{path.relative_to(ROOT)}: no such record; make it with python scripts/record.py {name}")
+    return json.loads(path.read_text(encoding="utf-8"))

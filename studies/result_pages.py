@@ -1,0 +1,246 @@
+"""The pages' result tables, rendered from the measured records (:mod:`studies.records`).
+
+A page marks each rendered stretch with two HTML comments, invisible on GitHub and in the built site::
+
+    <!-- record reproduce-exp1 -->
+    | model | X train RMSE [A] | ... |
+    <!-- end record -->
+
+``reproduce-exp1`` names a view (:data:`VIEWS`): the records it reads and how it renders them.
+:func:`render_text` replaces every marked stretch by its view of the records as they are now;
+``python scripts/render_results.py`` does so for the README and every page of ``docs/``, and
+``tests/studies/test_result_pages.py`` fails while a page differs from its rendering (a figure typed or
+changed by hand) or a record is stale.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from greybox.atomic import write_text_atomic
+from greybox.errors import GreyboxError
+from greybox.evaluate.pattern import paper_pattern, paper_pattern_table, sole_svr_table
+from greybox.evaluate.report import (
+    MODEL_LABELS,
+    experiment_table,
+    hyperparameter_table,
+    noise_floor_table,
+    svr_generalisation_table,
+)
+
+from .records import ROOT, read_record
+
+__all__ = ["BLOCK", "View", "VIEWS", "PAGES", "render_text", "render_pages", "cited_records"]
+
+#: A marked stretch of a page: the view's name, the rendered text.
+BLOCK = re.compile(r"(?P<open><!-- record (?P<view>[\w-]+) -->\n)(?P<body>.*?)(?P<close><!-- end record -->)", re.S)
+
+#: The pages rendered: the README and every Markdown page of the documentation.
+PAGES = (ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")))
+
+
+def _pipe(table) -> str:
+    return "\n".join(table.pipe_lines()) + "\n"
+
+
+def _metrics(record: dict) -> list[dict]:
+    return record["figures"]["metrics"]
+
+
+def _test_re(record: dict, experiment: int, axis: str, model: str) -> float:
+    for row in _metrics(record):
+        if (row["experiment"], row["axis"], row["model"], row["dataset"]) == (experiment, axis, model, "test"):
+            return row["re"]
+    raise GreyboxError(f"record {record['name']}: no test record of {model} on {axis} in experiment {experiment}")
+
+
+def _load(record: dict) -> str:
+    return f"load {record['load_before'][0]:.1f} before, {record['load_after'][0]:.1f} after"
+
+
+def _where(record: dict) -> str:
+    return f"{record['cores']} cores, {_load(record)}; commit {record['commit'][:9]}, {record['date'][:10]}"
+
+
+def _reproduce_run(record: dict) -> str:
+    figures = record["figures"]
+    return (f"`{record['command']}` (the experiments of `greybox reproduce --out DIR` with {figures['jobs']} jobs)"
+            f" took {figures['seconds']:.0f} s wall and {figures['cpu_seconds']:.0f} s of CPU time "
+            f"({_where(record)}).\n")
+
+
+def _reproduce_exp(experiment: int) -> Callable[[dict], str]:
+    return lambda record: _pipe(experiment_table(_metrics(record), experiment))
+
+
+def _reproduce_per_log(record: dict) -> str:
+    cells = {}
+    for row in _metrics(record):
+        if row["experiment"] == 2 and row["dataset"] == "test" and row["model"] != "noise_floor":
+            for log, figures in row.get("per_log", {}).items():
+                cells.setdefault(row["model"], {})[f"{row['axis']} on {log}"] = figures["re"]
+    columns = sorted({column for models in cells.values() for column in models})
+    lines = ["| model | " + " | ".join(columns) + " |", "|" + "---|" * (len(columns) + 1)]
+    lines += [f"| {MODEL_LABELS.get(model, model)} | " + " | ".join(f"{res[c]:.2f}" if c in res else "–"
+                                                                    for c in columns) + " |"
+              for model, res in cells.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _reproduce_summary(record: dict) -> str:
+    first, second = (experiment_table(_metrics(record), n) for n in (1, 2))
+    axes = [name.split()[0] for name in first.header[1:] if name.endswith("test RE [%]") and "paper" not in name]
+
+    def cells(table, label):
+        for row in table.rows:
+            if row[0] == label:
+                values = dict(zip(table.header, row))
+                ours = " / ".join(values[f"{axis} test RE [%]"] for axis in axes)
+                paper = " / ".join(values[f"{axis} paper test RE [%]"] for axis in axes)
+                return ours, "–" if set(paper.split(" / ")) == {"–"} else paper
+        return "–", "–"
+
+    labels = [row[0] for row in first.rows] + [row[0] for row in second.rows if row[0] not in
+                                               {r[0] for r in first.rows}]
+    floor = [label for label in labels if label.startswith("noise floor")]
+    lines = [f"| model | exp. 1 (train A, test C) {' / '.join(axes)} | paper | exp. 2 (train A + B, test C + D) "
+             f"{' / '.join(axes)} | paper |", "|---|---|---|---|---|"]
+    for label in [label for label in labels if label not in floor] + floor:
+        lines.append("| " + " | ".join([label, *cells(first, label), *cells(second, label)]) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _reproduce_table(table_of: Callable, key: str = "metrics") -> Callable[[dict], str]:
+    return lambda record: _pipe(table_of(record["figures"][key]))
+
+
+def _tests_run(record: dict) -> str:
+    figures = record["figures"]
+    skipped = f", {figures['skipped']} skipped" if figures["skipped"] else ""
+    return f"`pytest -q`: {figures['passed']} passed{skipped} in {figures['seconds']:.0f} s ({_where(record)}).\n"
+
+
+def _readme_table(reproduction: dict, tests: dict) -> str:
+    checks = paper_pattern(_metrics(reproduction))
+    met = sum(check["met"] for check in checks)
+    second = " / ".join(f"{_test_re(reproduction, 2, axis, 'gmssvr'):.2f}" for axis in ("X", "Y"))
+    figures = tests["figures"]
+    skipped = f", {figures['skipped']} skipped" if figures["skipped"] else ""
+    return ("| what | figure | page |\n|---|---|---|\n"
+            f"| the paper's experiments on the shipped twin (`greybox reproduce --out DIR`) | GMS+SVR test RE X / Y "
+            f"{second} % (experiment 2); the paper's pattern: {met} of {len(checks)} checks met; "
+            f"{reproduction['figures']['seconds']:.0f} s ({_where(reproduction)}) | [reproduce](docs/reproduce.md) |\n"
+            f"| the default test run (`pytest -q`) | {figures['passed']} passed{skipped} in {figures['seconds']:.0f} s "
+            f"({_where(tests)}) | [installation and tests](docs/install.md) |\n")
+
+
+@dataclass(frozen=True)
+class View:
+    """One rendered stretch: the records it reads, and the function of them that gives its text.
+
+    Attributes
+    ----------
+    records : tuple of str
+        Names of :data:`studies.records.SPECS`, in the order ``render`` takes them.
+    render : callable
+        ``render(*records) -> str``: the stretch's Markdown, ending in a newline.
+    """
+
+    records: tuple
+    render: Callable[..., str]
+
+
+#: The views the pages render, by name.
+VIEWS = {
+    "reproduce-run": View(("reproduce",), _reproduce_run),
+    "reproduce-exp1": View(("reproduce",), _reproduce_exp(1)),
+    "reproduce-exp2": View(("reproduce",), _reproduce_exp(2)),
+    "reproduce-exp2-per-log": View(("reproduce",), _reproduce_per_log),
+    "reproduce-pattern": View(("reproduce",), _reproduce_table(paper_pattern_table)),
+    "reproduce-sole-svr": View(("reproduce",), _reproduce_table(sole_svr_table)),
+    "reproduce-noise-floor": View(("reproduce",), _reproduce_table(noise_floor_table)),
+    "reproduce-svr-generalisation": View(("reproduce",), _reproduce_table(svr_generalisation_table)),
+    "reproduce-hyperparameters": View(("reproduce",), _reproduce_table(hyperparameter_table, "hyperparameters")),
+    "reproduce-summary": View(("reproduce",), _reproduce_summary),
+    "default-tests-run": View(("default-tests",), _tests_run),
+    "readme-measured": View(("reproduce", "default-tests"), _readme_table),
+}
+
+
+def render_text(text: str, *, read: Callable[[str], dict] = read_record, where: str = "page") -> str:
+    """``text`` with every marked stretch rendered anew from its record.
+
+    Parameters
+    ----------
+    text : str
+        A page.
+    read : callable, default :func:`studies.records.read_record`
+        Record name -> record.
+    where : str, default "page"
+        The page's name, for the error message.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    GreyboxError
+        Naming the page, for a view that does not exist or a record that has not been made.
+    """
+    records = {}
+
+    def render(match: re.Match) -> str:
+        view = VIEWS.get(match["view"])
+        if view is None:
+            raise GreyboxError(f"{where}: no view {match['view']!r}; views: {', '.join(VIEWS)}")
+        for name in view.records:
+            if name not in records:
+                records[name] = read(name)
+        return match["open"] + view.render(*(records[name] for name in view.records)) + match["close"]
+
+    return BLOCK.sub(render, text)
+
+
+def cited_records(text: str) -> set[str]:
+    """The names of the records a page renders.
+
+    Parameters
+    ----------
+    text : str
+        A page.
+
+    Returns
+    -------
+    set of str
+    """
+    return {name for match in BLOCK.finditer(text) if match["view"] in VIEWS for name in VIEWS[match["view"]].records}
+
+
+def render_pages(pages=PAGES, *, check: bool = False) -> list[Path]:
+    """Render every page's marked stretches from the records, writing the pages that change.
+
+    Parameters
+    ----------
+    pages : sequence of path-like, default :data:`PAGES`
+        The pages.
+    check : bool, default False
+        Only report the pages that would change; write nothing.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The pages that changed (or would change).
+    """
+    changed = []
+    for page in map(Path, pages):
+        text = page.read_text(encoding="utf-8")
+        rendered = render_text(text, where=str(page.relative_to(ROOT)))
+        if rendered != text:
+            changed.append(page)
+            if not check:
+                write_text_atomic(page, rendered)
+    return changed

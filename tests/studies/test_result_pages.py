@@ -1,0 +1,79 @@
+"""Every figure a page renders from a record equals its record, and every record it renders is current.
+
+A figure typed or changed by hand inside a marked stretch makes the page differ from its rendering; a
+commit to what a record measures, after the record was made, makes it stale. Either fails here, naming
+the page or the record and what to run.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import pytest
+
+from greybox.errors import GreyboxError
+from studies.records import MEASURING, RESULTS, SPECS, read_record, stale_commits
+from studies.result_pages import BLOCK, PAGES, VIEWS, cited_records, render_text
+
+TEXTS = {page: page.read_text(encoding="utf-8") for page in PAGES}
+CITED = sorted(set().union(*(cited_records(text) for text in TEXTS.values())))
+
+
+def _first_difference(text: str, rendered: str) -> str:
+    for line, (mine, theirs) in enumerate(zip(text.splitlines(), rendered.splitlines()), start=1):
+        if mine != theirs:
+            return f"line {line}: {mine!r}, its record gives {theirs!r}"
+    return "the pages differ in length"
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[page.name for page in PAGES])
+def test_every_page_equals_its_rendering_from_the_records(page):
+    text = TEXTS[page]
+    rendered = render_text(text, where=page.name)
+    assert rendered == text, (f"{page.name} differs from its records at {_first_difference(text, rendered)}; "
+                              "run python scripts/render_results.py (figures are never typed)")
+
+
+@pytest.mark.skipif(shutil.which("git") is None, reason="a record's age is read from the git history")
+@pytest.mark.parametrize("name", CITED)
+def test_every_record_a_page_renders_is_current_and_made_by_its_command(name):
+    record = read_record(name)
+    assert name in SPECS, f"record {name} has no command to re-make it in studies.records.SPECS"
+    assert record["depends_on"] == list(SPECS[name].depends_on), f"record {name} was made for other paths"
+    assert not record["uncommitted"], f"record {name} was measured on uncommitted code: {record['uncommitted']}"
+    if os.environ.get(MEASURING) == name:
+        return  # this run re-makes the record: its old figures are what is being replaced
+    stale = stale_commits(record)
+    assert not stale, (f"record {name} (commit {record['commit'][:9]}) is older than changes to what it measures: "
+                       f"{'; '.join(stale[:5])}; re-make it: python scripts/record.py {name}")
+
+
+def test_every_record_file_is_cited_and_has_a_command():
+    files = sorted(path.stem for path in RESULTS.glob("*.json"))
+    assert set(files) <= set(SPECS), f"records without a command: {set(files) - set(SPECS)}"
+    assert set(files) == set(CITED), f"records no page renders: {set(files) - set(CITED)}"
+
+
+def test_every_view_is_rendered_on_some_page():
+    used = {match["view"] for text in TEXTS.values() for match in BLOCK.finditer(text)}
+    assert set(VIEWS) == used, f"views no page renders: {sorted(set(VIEWS) - used)}"
+
+
+def test_a_figure_changed_by_hand_inside_a_stretch_is_put_back_and_one_outside_is_left():
+    page = next(page for page in PAGES if cited_records(TEXTS[page]))
+    text = TEXTS[page]
+    match = next(BLOCK.finditer(text))
+    body = match["body"]
+    digit = next(i for i, char in enumerate(body) if char.isdigit())
+    forged = body[:digit] + str((int(body[digit]) + 1) % 10) + body[digit + 1:]
+    changed = text[:match.start("body")] + forged + text[match.end("body"):]
+    assert changed != text and render_text(changed) == text
+    outside = "A typed figure: 1.234 %\n"
+    assert render_text(outside + text) == outside + text
+
+
+def test_an_unknown_view_names_the_page_and_the_views():
+    text = "<!-- record nothing -->\n| x |\n<!-- end record -->\n"
+    with pytest.raises(GreyboxError, match="page.md: no view 'nothing'; views: reproduce-run, "):
+        render_text(text, where="page.md", read=lambda name: {})
