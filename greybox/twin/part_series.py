@@ -3,6 +3,9 @@
 Every part runs the same one-axis program (by default :func:`part_program`: passes across a workpiece at
 several feeds, each with an air approach and exit at the cut's feed and an air return); before each part the
 axis waits at rest for the loading time plus a random delay (the small timing differences of real parts).
+Each part is simulated on its own: a short stroke in the direction of the program's last one
+(:data:`LEAD_IN_MM`), cut off the log, leaves the friction held that the previous part left, so that the
+parts joined into one long log are what a continuous run would log.
 
 **Warm-up law.** The machine's warmth ``theta`` in [0, 1] rises while it runs (parts and loading times) and
 falls during a pause, both first order::
@@ -340,9 +343,30 @@ class PartSeriesSpec:
         return CuttingSpec(strength_A=PART_STRENGTH_A, workpiece_mm=workpiece)
 
 
+#: Length [mm] of the stroke the twin runs before each part, in the direction of the program's last one, so
+#: that each part starts with the friction the previous part left held (the stroke is cut off the log).
+LEAD_IN_MM = 0.5
+
+
 def _waiting(program: Program, seconds: float) -> Program:
-    """The program with a dwell of ``seconds`` after its first move."""
-    return replace(program, blocks=(program.blocks[0], Dwell(seconds, 0), *program.blocks[1:]))
+    """The program with a dwell of ``seconds`` after its first move, and the lead-in stroke before it."""
+    moves = [block for block in program.blocks if isinstance(block, Move)]
+    last = next((b for a, b in zip(moves[-2::-1], moves[::-1]) if b.target != a.target), None)
+    if last is None:
+        return replace(program, blocks=(program.blocks[0], Dwell(seconds, 0), *program.blocks[1:]))
+    before = moves[[i for i, m in enumerate(moves) if m is last][-1] - 1]
+    sign = 1.0 if last.target > before.target else -1.0
+    start = program.blocks[0]
+    lead = Move(start.target - sign * LEAD_IN_MM, None, 0)
+    return replace(program, blocks=(lead, Move(start.target, last.feed, 0), Dwell(seconds, 0), *program.blocks[1:]))
+
+
+def _lead_in_end(velocity_mm_s) -> int:
+    """Index of the first sample at rest after the lead-in stroke (0 without motion)."""
+    moving = np.abs(np.asarray(velocity_mm_s)) > 0.0
+    first = int(np.argmax(moving)) if moving.any() else 0
+    after = np.flatnonzero(~moving[first:])
+    return first + int(after[0]) if moving.any() and after.size else 0
 
 
 def _part_seed(seed: int, part: int) -> int:
@@ -385,12 +409,17 @@ def make_part_series(spec: PartSeriesSpec, seed: int) -> tuple[list[AxisLog], di
         trajectory = program_trajectory(_waiting(program, spec.loading_s + float(waits[index])), geometry)
         n = int(np.floor(trajectory.duration_s / SAMPLE_TIME_S + 1e-9)) + 1
         time = np.round(np.arange(n) * SAMPLE_TIME_S, 9)
+        start = _lead_in_end(trajectory.motion.evaluate(time)[1])
+        time = np.round(time - time[start], 9)
         scale = spec.events.scale(part, time)
         log = make_dataset(geometry.name, "S", _part_seed(seed, part), trajectory=trajectory, cutting=cutting,
                            cutting_scale=scale, plant=WarmPlant(plant, spec.warm_up, warmth), noise=spec.noise)
         force_name = next(name for name in log.extras
                           if name.startswith("truth_process_") and name != "truth_process_A")
-        cuts = cutting_current(cutting, time, log.position, log.velocity) != 0.0  # where an intact tool cuts
+        cuts = cutting_current(cutting, time, log.position, log.velocity)[start:] != 0.0  # where an intact tool cuts
+        log = log.select(slice(start, None))
+        log = log.replace(time=np.round(log.time - log.time[0], 9))
+        n = len(log)
         log = log.replace(extras={**log.extras, PART_COLUMN: np.full(n, float(part))},
                           attrs={**log.attrs, "part": {"number": part, "series_start_s": clock}})
         logs.append(log)

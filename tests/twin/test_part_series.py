@@ -69,7 +69,7 @@ def test_series_follows_the_warm_up_and_the_tool_events_and_writes_their_truth()
     broken = logs[3].time >= 4.0
     assert cut[3][~broken].max() > 0.1 and cut[3][broken].max() == 0.0 and cut[4].max() == 0.0
     assert {e["kind"] for e in truth["events"]} == {"breakage", "missing blank", "oversized blank", "pause"}
-    assert parts[3]["mean_cut_force"] < parts[0]["mean_cut_force"]
+    assert parts[3]["mean_cut_force"] < 0.9 * 1.3 * parts[0]["mean_cut_force"]  # worn 30 %, broken part-way
     # the waits differ from part to part within the jitter
     waits = np.array([p["wait_s"] for p in parts])
     assert np.all((waits >= 1.0) & (waits <= 1.3)) and np.ptp(waits) > 0.01
