@@ -25,8 +25,9 @@ friction the axis holds):
 
 - the band: a position is outside when ``|y_i - c_i| > k_b s_i``; with ``m = L / w`` nearly independent
   smoothed values per part of ``L`` samples (``w`` samples per smoothing length) and Gaussian deviations,
-  ``k_b = z(alpha / (4 m)) sqrt(1 + 1/n)`` for ``n`` teach-in parts (``z(p)`` the upper ``p`` quantile of the
-  standard normal, two-sided);
+  ``k_b = t_nu(alpha / (4 m)) sqrt(1 + 1/n)`` for ``n`` teach-in parts (``t_nu(p)`` the upper ``p`` quantile
+  of Student's t, two-sided, with ``nu = 5 (n - 1)`` degrees of freedom: the spread is pooled over five
+  smoothing lengths of ``n`` parts);
 - the part's mean load deviation over the cut samples, ``D = mean_cut(d_i (y_i - c_i))``: outside when
   ``|D| > k_m sd(D)``, ``sd(D)`` over the teach-in parts and ``k_m = t_{n-1}(alpha / 4) sqrt(1 + 1/n)``
   (Student's t, two-sided). A worn tool raises ``D`` long before single positions leave the band.
@@ -44,7 +45,6 @@ from os import PathLike
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import norm
 from scipy.stats import t as student
 
 from ..atomic import write_text_atomic
@@ -259,7 +259,8 @@ class Envelope:
         self.spread_ = np.maximum(pooled, 0.5 * float(np.nanmedian(pooled)))
         n = len(parts)
         independent = max(1.0, length / self.width_)
-        self.band_factor_ = float(norm.isf(self.false_alarm_rate / (4.0 * independent)) * math.sqrt(1.0 + 1.0 / n))
+        self.band_factor_ = float(student.isf(self.false_alarm_rate / (4.0 * independent), (n - 1) * SPREAD_POOL)
+                                  * math.sqrt(1.0 + 1.0 / n))
         deviations = np.array([self.deviation(row) for row in aligned])
         self.deviation_sd_ = float(np.std(deviations, ddof=1))
         self.mean_factor_ = float(student.isf(self.false_alarm_rate / 4.0, n - 1) * math.sqrt(1.0 + 1.0 / n))

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from process_parts import good_parts, make_part
-from scipy.stats import norm
+from scipy.stats import t as student
 
 from greybox.errors import GreyboxError
 from greybox.process.envelope import Envelope, level_direction, moving_mean, relevelled
@@ -38,7 +38,7 @@ def test_envelope_learns_the_cut_where_the_parts_cut_and_sets_its_limits_by_the_
     assert envelope.cut_[inside].all() and not envelope.cut_[outside].any()
     assert envelope.cut_load_ == pytest.approx(2.0, abs=0.05)  # friction 1 + cut 1 on the raw signal
     length = envelope.centre_.size
-    expected = norm.isf(1e-3 / (4 * length / envelope.width_)) * math.sqrt(1 + 1 / 12)
+    expected = student.isf(1e-3 / (4 * length / envelope.width_), 5 * 11) * math.sqrt(1 + 1 / 12)
     assert envelope.band_factor_ == pytest.approx(expected)
     assert envelope.air_.any() and not (envelope.air_ & envelope.cut_).any()
 
