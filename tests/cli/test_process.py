@@ -76,3 +76,18 @@ def test_raw_envelope_and_one_line_refusals(series, capsys, tmp_path):
         assert main(["process", "check", str(force), parts[0], "--model", str(other), "--out",
                      str(tmp_path / "r2")]) == 2
         assert "SHA-256 differs" in capsys.readouterr().err
+
+
+def test_a_csv_series_without_part_column_is_split_at_its_rests(series, capsys, tmp_path):
+    from greybox.data.io import read_log, write_log
+
+    long = read_log(series / "parts" / "X_series.mcap")
+    write_log(long.replace(extras={}), tmp_path / "series.csv")
+    parts = sorted(str(p) for p in (series / "parts").glob("X_part00*.mcap"))
+    raw = tmp_path / "raw.json"
+    assert main(["process", "teach", "--raw", *parts[:6], "--out", str(raw), "--relevel", "--min-rest", "0.8"]) == 0
+    assert main(["process", "check", str(raw), str(tmp_path / "series.csv"), "--out", str(tmp_path / "r")]) == 0
+    assert "8 parts checked" in capsys.readouterr().out
+    rows = json.loads((tmp_path / "r" / "report.json").read_text())["parts"]
+    assert [r["part"] for r in rows] == list(range(1, 9))  # counted in order, split at the 1 s loading rests
+    assert [r["flagged"] for r in rows] == [False] * 6 + [True, True]
