@@ -130,9 +130,9 @@ def add_parser(subparsers) -> None:
                        help="last part of the sharp tool (default %(default)s)")
     parts.add_argument("--breakage", metavar="PART:SECONDS",
                        help="the tool breaks in PART at SECONDS after the start of the part's log; no load after")
-    parts.add_argument("--missing-blank", type=POSITIVE_INT, action="append", default=[], metavar="PART",
+    parts.add_argument("--missing-blank", type=POSITIVE_INT, action="append", metavar="PART",
                        help="a part without blank: no cutting load (repeatable)")
-    parts.add_argument("--oversized-blank", type=POSITIVE_INT, action="append", default=[], metavar="PART",
+    parts.add_argument("--oversized-blank", type=POSITIVE_INT, action="append", metavar="PART",
                        help="a part with an oversized blank: the load times --oversize-factor (repeatable)")
     parts.add_argument("--oversize-factor", type=POSITIVE, default=ToolEvents.oversize_factor, metavar="F",
                        help="load factor of an oversized blank, above 1 (default %(default)s)")
@@ -345,8 +345,8 @@ def _run_parts(args: argparse.Namespace) -> int:
     axis = program.axis if program is not None else (axes[0] if axes else "X")
     breakage = _part_and_seconds(args.breakage, "--breakage") if args.breakage else (None, None)
     events = ToolEvents(wear_pct_per_part=args.wear, wear_start_part=args.wear_start, breakage_part=breakage[0],
-                        breakage_time_s=breakage[1], missing_blank=tuple(args.missing_blank),
-                        oversized_blank=tuple(args.oversized_blank), oversize_factor=args.oversize_factor)
+                        breakage_time_s=breakage[1], missing_blank=tuple(args.missing_blank or ()),
+                        oversized_blank=tuple(args.oversized_blank or ()), oversize_factor=args.oversize_factor)
     cutting = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm, teeth=args.teeth,
                           return_pass=args.cutting_return_pass,
                           workpiece_mm=None if program is not None else PART_WORKPIECE_MM)
