@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["KINDS", "MISSING_SHARE", "Stretch", "PartCheck", "check_part"]
+__all__ = ["KINDS", "MISSING_SHARE", "Stretch", "PartCheck", "check_part", "stretch_kind"]
 
 #: The kinds of a stretch.
 KINDS = ("rise", "drop", "missing cut", "extra cut")
@@ -115,7 +115,18 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
 
 
-def _kind(envelope, signal: np.ndarray, a: int, b: int) -> tuple[str, float]:
+def stretch_kind(envelope, signal: np.ndarray, a: int, b: int) -> tuple[str, float]:
+    """Kind and mean load deviation [signal unit] of the stretch ``[a, b)`` of an aligned signal (module docstring).
+
+    Parameters
+    ----------
+    envelope : Envelope
+        The envelope.
+    signal : ndarray, shape (L,)
+        The part's smoothed signal on the reference grid.
+    a, b : int
+        First and one past the last position of the stretch.
+    """
     direction = envelope.direction_[a:b]
     deviation = float(np.nanmean(direction * (signal[a:b] - envelope.centre_[a:b])))
     cut = envelope.cut_[a:b]
@@ -146,7 +157,7 @@ def check_part(envelope, part) -> PartCheck:
     stretches = []
     dt = envelope.sample_time_
     for a, b in _runs(outside):
-        kind, deviation = _kind(envelope, signal, a, b)
+        kind, deviation = stretch_kind(envelope, signal, a, b)
         stretches.append(Stretch(kind, (a + shift) * dt, (b - 1 + shift) * dt, float(np.nanmax(excess[a:b])),
                                  deviation))
     load = (envelope.direction_ * signal)[envelope.cut_]
