@@ -21,7 +21,7 @@ rules (docs/layout.md, "Layer rules"):
 - prediction (``greybox.predict``) sits above the models, the data and
   ``evaluate`` (metrics, regimes, figures), which import nothing of it, and
   below its users, which it imports nothing of: ``live``, ``monitor``,
-  ``discover``, ``control``, ``reproduce``, ``cli``;
+  ``process``, ``discover``, ``control``, ``reproduce``, ``cli``;
 - the model layer as a whole (:data:`MODEL_LAYER`: the model kinds in
   ``models`` with their registry, the file format, the
   identification and data layers they stand on) imports nothing outside it:
@@ -58,8 +58,8 @@ MODEL_LAYER = ("greybox.base", "greybox.errors", "greybox.threads", "greybox.ato
 ABOVE_MODELS = ("greybox.evaluate", "greybox.predict", "greybox.discover", "greybox.reproduce", "greybox.control",
                 "greybox.cli")
 #: Layers prediction must not depend on (they use it, or stand beside it).
-ABOVE_PREDICT = ("greybox.live", "greybox.monitor", "greybox.discover", "greybox.control", "greybox.reproduce",
-                 "greybox.cli")
+ABOVE_PREDICT = ("greybox.live", "greybox.monitor", "greybox.process", "greybox.discover", "greybox.control",
+                 "greybox.reproduce", "greybox.cli")
 
 
 def _within(module: str, package: str) -> bool:

@@ -47,6 +47,7 @@ SUMMARIES = {
     "live": "process current (and force) of a live stream from the controller (MQTT or stdin), with limits",
     "examples": "write the example axis and machine files into a folder",
     "monitor": "fingerprint axis logs into a history, detect friction changes, write a dashboard",
+    "process": "teach an envelope of the cutting force from good parts, check parts against it",
 }
 #: Sub-command modules, in the order ``greybox --help`` lists them.
 COMMANDS = tuple(SUMMARIES)

@@ -14,8 +14,23 @@ from ..twin.effects import EFFECTS, effect_parameters
 from ..twin.family import synthesize_family
 from ..twin.laws import TRUTH_LAWS
 from ..twin.noise import CurrentNoise
+from ..twin.part_series import PART_WORKPIECE_MM, PartSeriesSpec, ToolEvents, WarmUp
 from ..twin.trajectories import DATASETS, DEFAULT_DATASETS, MIN_DURATION_S
-from ._types import FINITE, MAX_SEED, NON_NEGATIVE, POSITIVE, POSITIVE_INT, SEED, SIGNED_FRACTION, positive
+from ._types import (
+    FINITE,
+    MAX_SEED,
+    NON_NEGATIVE,
+    NON_NEGATIVE_INT,
+    POSITIVE,
+    POSITIVE_INT,
+    SEED,
+    SIGNED_FRACTION,
+    NumberRange,
+    positive,
+)
+
+#: A friction drop of the warm-up, in [0, 1).
+DROP = NumberRange(float, low=0, high=1, high_open=True, description="a fraction in [0, 1)")
 
 
 def add_parser(subparsers) -> None:
@@ -93,6 +108,38 @@ def add_parser(subparsers) -> None:
                         help="with --history: the date of day 0 (default %(default)s)")
     parser.add_argument("--machine", metavar="NAME", default="twin",
                         help="with --history: the machine name written to the logs (default %(default)s)")
+    parts = parser.add_argument_group(
+        "part series", "with --parts N: the same NC program (the built-in part, or --plan PROGRAM) cut N times "
+        "over a shift through the machine's warm-up, with tool events; writes DIR/<axis>_partNNN.mcap and/or "
+        "DIR/<axis>_series.mcap (with a 'part' counter column), the truth DIR/<axis>_parts.json and the "
+        "program DIR/<axis>_part.mpf (docs/process.md)")
+    parts.add_argument("--parts", type=POSITIVE_INT, metavar="N", help="write a part series of N parts")
+    parts.add_argument("--part-layout", choices=("parts", "series", "both"), default="both",
+                       help="one log per part, one long log, or both (default %(default)s)")
+    parts.add_argument("--warmup-drop", type=DROP, default=WarmUp.drop, metavar="F",
+                       help="share by which the friction falls on a fully warm machine (default %(default)s)")
+    parts.add_argument("--warmup-time", type=positive("seconds"), default=WarmUp.time_constant_s, metavar="S",
+                       help="time constant [s] of the warming while the machine runs (default %(default)s)")
+    parts.add_argument("--cooling-time", type=positive("seconds"), default=WarmUp.cooling_time_constant_s,
+                       metavar="S", help="time constant [s] of the cooling during a pause (default %(default)s)")
+    parts.add_argument("--pause", action="append", default=[], metavar="PART:SECONDS",
+                       help="a pause before PART during which the machine cools (repeatable)")
+    parts.add_argument("--wear", type=NON_NEGATIVE, default=0.0, metavar="PCT",
+                       help="tool wear: the cutting load rises by PCT %% per part after --wear-start")
+    parts.add_argument("--wear-start", type=NON_NEGATIVE_INT, default=1, metavar="PART",
+                       help="last part of the sharp tool (default %(default)s)")
+    parts.add_argument("--breakage", metavar="PART:SECONDS",
+                       help="the tool breaks in PART at SECONDS after the start of the part's log; no load after")
+    parts.add_argument("--missing-blank", type=POSITIVE_INT, action="append", metavar="PART",
+                       help="a part without blank: no cutting load (repeatable)")
+    parts.add_argument("--oversized-blank", type=POSITIVE_INT, action="append", metavar="PART",
+                       help="a part with an oversized blank: the load times --oversize-factor (repeatable)")
+    parts.add_argument("--oversize-factor", type=POSITIVE, default=ToolEvents.oversize_factor, metavar="F",
+                       help="load factor of an oversized blank, above 1 (default %(default)s)")
+    parts.add_argument("--loading", type=NON_NEGATIVE, default=PartSeriesSpec.loading_s, metavar="S",
+                       help="wait [s] at rest before each part (default %(default)s)")
+    parts.add_argument("--jitter", type=NON_NEGATIVE, default=PartSeriesSpec.jitter_s, metavar="S",
+                       help="largest random extra wait [s] before each part (default %(default)s)")
     parser.add_argument("--force", action="store_true",
                         help="write into a non-empty DIR, overwriting files of the same name")
     parser.set_defaults(run=run)
@@ -270,7 +317,59 @@ def _run_history(args: argparse.Namespace) -> int:
     return 0
 
 
+def _part_and_seconds(text: str, option: str) -> tuple[int, float]:
+    part, sep, seconds = str(text).partition(":")
+    try:
+        value = (int(part), float(seconds))
+    except ValueError:
+        value = None
+    if not sep or value is None or value[0] < 1 or not value[1] >= 0:
+        raise GreyboxError(f"{option} {text!r}: expected PART:SECONDS, a part from 1 and a non-negative time")
+    return value
+
+
+def _run_parts(args: argparse.Namespace) -> int:
+    """``synth --parts N``: a part series through the warm-up (:mod:`greybox.twin.part_series`)."""
+    from ..nc.gcode import read_program
+    from ..twin.part_series import synthesize_part_series
+
+    given = [flag for flag, value in (("--family", args.family), ("--history", args.history),
+                                      ("--effect", args.effect), ("--duration", args.duration),
+                                      ("--one-file", args.one_file)) if value is not None]
+    if given:
+        raise GreyboxError(f"--parts writes a part series; {', '.join(given)} does not apply")
+    program = read_program(args.plan) if args.plan else None
+    axes = list(dict.fromkeys(a.strip().upper() for a in (args.axis or []) if a.strip()))
+    if len(axes) > 1 or (program is not None and axes and axes != [program.axis]):
+        raise GreyboxError("--parts runs one axis: give one --axis (or none with --plan: the program's)")
+    axis = program.axis if program is not None else (axes[0] if axes else "X")
+    breakage = _part_and_seconds(args.breakage, "--breakage") if args.breakage else (None, None)
+    events = ToolEvents(wear_pct_per_part=args.wear, wear_start_part=args.wear_start, breakage_part=breakage[0],
+                        breakage_time_s=breakage[1], missing_blank=tuple(args.missing_blank or ()),
+                        oversized_blank=tuple(args.oversized_blank or ()), oversize_factor=args.oversize_factor)
+    cutting = CuttingSpec(strength_A=args.cutting_strength, spindle_rpm=args.spindle_rpm, teeth=args.teeth,
+                          return_pass=args.cutting_return_pass,
+                          workpiece_mm=None if program is not None else PART_WORKPIECE_MM)
+    spec = PartSeriesSpec(parts=args.parts, axis=axis, program=program, cutting=cutting,
+                          warm_up=WarmUp(args.warmup_drop, args.warmup_time, args.cooling_time), events=events,
+                          loading_s=args.loading, jitter_s=args.jitter,
+                          pauses=tuple(_part_and_seconds(text, "--pause") for text in args.pause),
+                          noise=CurrentNoise(std_A=args.noise_std))
+    written = synthesize_part_series(spec, args.seed, args.out, layout=args.part_layout, force=args.force,
+                                     truth_channels=ESSENTIAL_TRUTH_CHANNELS if args.truth == "essential" else None,
+                                     progress=print)
+    print(f"part series of {args.parts} parts on {axis} (seed {args.seed}) -> {args.out}; truth in {written[-1]}")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.parts is not None:
+        return _run_parts(args)
+    part_options = [flag for flag, value in (("--pause", args.pause), ("--wear", args.wear),
+                                             ("--breakage", args.breakage), ("--missing-blank", args.missing_blank),
+                                             ("--oversized-blank", args.oversized_blank)) if value]
+    if part_options:
+        raise GreyboxError(f"{', '.join(part_options)} needs --parts N")
     if args.history is not None:
         return _run_history(args)
     given = [flag for flag, value in (("--drift", args.drift), ("--start-date", args.start_date != "2026-01-01"),

@@ -120,7 +120,8 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
                  effect_strength: float = 0.2, effect_params: dict | None = None,
                  cutting: bool | CuttingSpec | None = None, duration_s: float | None = None,
                  plant: PlantParameters | None = None, noise: CurrentNoise | None = None,
-                 sensors: Sensors | None = None, trajectory: Trajectory | None = None) -> AxisLog:
+                 sensors: Sensors | None = None, trajectory: Trajectory | None = None,
+                 cutting_scale=None) -> AxisLog:
     """Synthesise one axis log.
 
     Parameters
@@ -153,6 +154,9 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
         The motion to run instead of the dataset's (e.g. an NC program,
         :func:`greybox.twin.nc_run.program_trajectory`); ``dataset`` then only labels the log and
         seeds its noise.
+    cutting_scale : array_like, shape (n,), optional
+        Factor of the cutting load at each log sample (tool events of a part series,
+        :mod:`greybox.twin.part_series`: 0 after a breakage); default 1.
 
     Returns
     -------
@@ -191,6 +195,8 @@ def make_dataset(axis: str = "X", dataset: str = "A", seed: int = 0, *, effect: 
     if cutting:
         spec = cutting if isinstance(cutting, CuttingSpec) else CuttingSpec()
         process = cutting_current(spec, time, response.position_mm, response.velocity_mm_s)
+        if cutting_scale is not None:
+            process = process * np.broadcast_to(np.asarray(cutting_scale, dtype=float), process.shape)
         response = response.under_load(process)
     truth = {"truth_friction_A": response.friction_A, "truth_inertia_A": response.inertia_A,
              "truth_cogging_A": response.cogging_A}

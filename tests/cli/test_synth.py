@@ -97,3 +97,40 @@ def test_synth_family_writes_each_member_with_its_own_law_and_a_catalogue(tmp_pa
         expected = member_dataset(member, "C", duration_s=4.0, cutting=True)
         np.testing.assert_array_equal(log.current, expected.current)
         assert set(log.extras) == {"truth_current_A", "truth_process_A", "truth_process_force_N"}
+
+
+def test_synth_parts_writes_a_series_with_its_events_and_truth(tmp_path, capsys):
+    import json
+
+    program = tmp_path / "part.mpf"
+    program.write_text("G0 X-226\nG1 X-272 F600\nG1 X-226 F2000\n")
+    args = ["synth", "--parts", "2", "--plan", str(program), "--out", str(tmp_path / "o"), "--seed", "1",
+            "--breakage", "2:3.5", "--loading", "0.5", "--part-layout", "series", "--warmup-drop", "0.3"]
+    assert main(args) == 0
+    assert "part series of 2 parts on X" in capsys.readouterr().out
+    truth = json.loads((tmp_path / "o" / "X_parts.json").read_text())
+    assert truth["warm_up"]["drop"] == 0.3 and truth["events"][0]["kind"] == "breakage"
+    series = read_log(tmp_path / "o" / "X_series.mcap")
+    second = series.extras["part"] == 2
+    assert np.abs(series.extras["truth_process_A"][second]).max() > 0.0
+    assert not any((tmp_path / "o").glob("X_part0*.mcap"))  # series layout only
+    assert main(args) == 2 and "exists" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--parts", "2", "--breakage", "2"], "--breakage '2': expected PART:SECONDS"),
+    (["--parts", "2", "--pause", "0:10"], "--pause '0:10'"),
+    (["--parts", "2", "--axis", "X", "Y"], "--parts runs one axis"),
+    (["--parts", "2", "--family", "2"], "--family does not apply"),
+    (["--axis", "X", "--wear", "2"], "--wear needs --parts N"),
+    (["--parts", "2", "--warmup-drop", "1"], "argument --warmup-drop"),
+])
+def test_synth_parts_errors_are_one_line_messages(tmp_path, capsys, args, message):
+    try:
+        status = main(["synth", "--out", str(tmp_path / "o"), "--seed", "0", *args])
+    except SystemExit as stop:
+        status = stop.code
+    assert status == 2
+    error = capsys.readouterr().err
+    assert message in error and "Traceback" not in error
+    assert not (tmp_path / "o").exists()

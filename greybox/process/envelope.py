@@ -1,0 +1,475 @@
+"""The teach-in envelope: the signal of good parts along the part, its spread, and the limits of a check.
+
+:meth:`Envelope.fit` lays every good part on the sample grid of a reference part (the one of median
+length) by the bounded velocity shift of :mod:`~greybox.process.alignment`, smooths each with a moving mean
+of ``smoothing_s`` and learns per position
+
+- the centre ``c_i`` (mean of the parts) and the spread ``s_i`` (their standard deviation, pooled over a
+  window of five smoothing lengths and floored at half its median, so that a few parts give a usable band);
+- the load direction ``d_i`` (the sign of the reference's velocity, 0 at standstill), the cut samples (where
+  the load ``d_i c_i`` exceeds its direction's air level by more than ``cut_share`` of the largest excess,
+  :func:`cut_samples`) and the air samples (moving, farther than one smoothing length from a cut).
+
+With ``relevel=True`` each part is first re-levelled on its own air samples, per direction of motion (the
+friction's level changes as the machine warms up; at standstill the direction is the last motion's, whose
+friction the axis holds):
+
+- a model's signal (process force or current) should be zero in air: the model's current without process
+  ``m_i`` (inertia and friction) is scaled, ``beta = sum(y_i m_i) / sum(m_i^2)`` over the air samples of the
+  direction, and ``beta m_i`` removed from the samples of that direction (a friction that changes by a factor
+  changes the signal in proportion to the friction the model predicts, along the whole part);
+- the raw current has no model: the median of its deviation from the centre over the air samples of the
+  direction is removed (an offset).
+
+**Limits, from the false-alarm rate** ``alpha`` per good part, split evenly between two checks:
+
+- the band: a position is outside when ``|y_i - c_i| > k_b s_i``; with ``m = L / w`` nearly independent
+  smoothed values per part of ``L`` samples (``w`` samples per smoothing length) and Gaussian deviations,
+  ``k_b = t_nu(alpha / (4 m)) sqrt(1 + 1/n)`` for ``n`` teach-in parts (``t_nu(p)`` the upper ``p`` quantile
+  of Student's t, two-sided, with ``nu = 5 (n - 1)`` degrees of freedom: the spread is pooled over five
+  smoothing lengths of ``n`` parts);
+- the part's mean load deviation over the cut samples, ``D = mean_cut(d_i (y_i - c_i))``: outside when
+  ``|D| > k_m sd(D)``, ``sd(D)`` over the teach-in parts and ``k_m = t_{n-1}(alpha / 4) sqrt(1 + 1/n)``
+  (Student's t, two-sided). A worn tool raises ``D`` long before single positions leave the band.
+
+The rule assumes Gaussian, independent deviations; how many false alarms it gives on good parts is
+measured (``scripts/process_head_to_head.py``), not promised. An envelope is saved as JSON (no pickle) and
+validated fully when loaded (:meth:`Envelope.load`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import t as student
+
+from ..atomic import write_text_atomic
+from ..errors import GreyboxError
+from .alignment import STANDSTILL_MM_S, best_shift, shifted
+
+__all__ = ["ENVELOPE_FORMAT", "Envelope", "cut_samples", "level_direction", "moving_mean", "relevelled"]
+
+#: Format tag of an envelope file.
+ENVELOPE_FORMAT = "greybox-envelope/1"
+#: Percentile of the load over a direction's samples taken as its air level (:func:`cut_samples`).
+AIR_PERCENTILE = 20.0
+#: Pooling window of the spread, in smoothing lengths.
+SPREAD_POOL = 5
+
+
+def moving_mean(values, width: int, *, complete: bool = False) -> np.ndarray:
+    """Centred moving mean over ``width`` samples, ignoring NaN (NaN where a window holds none).
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        Samples; NaN marks missing ones.
+    width : int
+        Window [samples], at least 1.
+    complete : bool, default False
+        NaN also where the window holds fewer than ``width`` valid samples (at the ends, next to missing ones).
+    """
+    v = np.asarray(values, dtype=float)
+    valid = np.isfinite(v)
+    sums = np.concatenate(([0.0], np.cumsum(np.where(valid, v, 0.0))))
+    counts = np.concatenate(([0], np.cumsum(valid)))
+    half = int(width) // 2
+    index = np.arange(v.size)
+    low, high = np.clip(index - half, 0, v.size), np.clip(index - half + int(width), 0, v.size)
+    n = counts[high] - counts[low]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n >= (int(width) if complete else 1), (sums[high] - sums[low]) / np.maximum(n, 1), np.nan)
+
+
+def level_direction(velocity) -> np.ndarray:
+    """Direction whose friction the axis holds: the sign of the velocity, at standstill the last motion's.
+
+    Parameters
+    ----------
+    velocity : array_like, shape (n,)
+        Axis velocity [mm/s or deg/s]; a rest before the first motion takes the last motion's direction (a part
+        of a series starts where the same program's previous part ended).
+    """
+    v = np.asarray(velocity, dtype=float)
+    sign = np.where(np.abs(v) > STANDSTILL_MM_S, np.sign(v), 0.0)
+    moving = np.flatnonzero(sign)
+    if moving.size == 0:
+        return sign
+    last = np.maximum.accumulate(np.where(sign != 0, np.arange(v.size), -1))
+    return np.where(last >= 0, sign[np.maximum(last, 0)], sign[moving[-1]])
+
+
+def relevelled(signal, direction, air, *, target=None, template=None) -> tuple[np.ndarray, dict]:
+    """A part's signal re-levelled on its air samples, per direction (module docstring).
+
+    Parameters
+    ----------
+    signal : ndarray, shape (L,)
+        The part's signal on the reference grid (NaN where it has no sample).
+    direction : ndarray, shape (L,)
+        Direction whose friction is held per position (:func:`level_direction`): -1 or 1 (0: left alone).
+    air : ndarray of bool, shape (L,)
+        Air samples.
+    target : ndarray, shape (L,), optional
+        Level of the air samples (the centre) for an offset; used without ``template``.
+    template : ndarray, shape (L,), optional
+        The model's current without process: scaled to the air samples, which should read zero.
+
+    Returns
+    -------
+    signal : ndarray
+        Re-levelled.
+    corrections : dict
+        ``{"negative": ..., "positive": ...}``: the factor ``beta`` [signal unit per A] removed with a template,
+        else the offset [signal unit] (0 for a direction without air samples).
+    """
+    out = np.array(signal, dtype=float)
+    corrections = {}
+    for sign, name in ((-1, "negative"), (1, "positive")):
+        side = direction == sign
+        picked = air & side & np.isfinite(out)
+        if template is not None:
+            m = np.asarray(template, dtype=float)
+            picked &= np.isfinite(m)
+            energy = float(np.sum(m[picked] ** 2))
+            beta = float(np.sum(out[picked] * m[picked]) / energy) if energy > 0 else 0.0
+            out[side] -= beta * m[side]
+            corrections[name] = beta
+        else:
+            offset = float(np.median(out[picked] - target[picked])) if picked.any() else 0.0
+            out[side] -= offset
+            corrections[name] = offset
+    return out, corrections
+
+
+def cut_samples(centre, direction, share: float) -> np.ndarray:
+    """Where the part cuts: the load ``d_i c_i`` above its air level by more than ``share`` of the largest excess.
+
+    The air level of a direction is the 20th percentile of the load over its samples (a part moves in air
+    for a share of its time in either direction: a model's signal is zero there, the raw current the friction).
+
+    Parameters
+    ----------
+    centre : ndarray, shape (L,)
+        The taught centre.
+    direction : ndarray, shape (L,)
+        Direction of motion per position: -1, 0 or 1.
+    share : float
+        Share of the largest excess, in (0, 1).
+    """
+    load = direction * centre
+    excess = np.zeros_like(load)
+    for sign in (-1, 1):
+        side = (direction == sign) & np.isfinite(load)
+        if side.any():
+            excess[side] = load[side] - np.percentile(load[side], AIR_PERCENTILE)
+    top = float(np.nanmax(excess))
+    return (excess > share * top) if top > 0 else np.zeros(load.shape, dtype=bool)
+
+
+def _dilated(mask: np.ndarray, width: int) -> np.ndarray:
+    return moving_mean(mask.astype(float), 2 * int(width) + 1) > 0
+
+
+class Envelope:
+    """Teach-in envelope of a part's signal (module docstring).
+
+    Parameters
+    ----------
+    false_alarm_rate : float, default 1e-3
+        False alarms per good part the limits are set for, in (0, 0.5).
+    smoothing_s : float, default 0.1
+        Moving-mean window [s] of the signal.
+    max_shift_s : float, default 1.0
+        Largest timing difference [s] between parts the alignment tries.
+    relevel : bool, default False
+        Re-level each part on its air samples per direction before comparing.
+    cut_share : float, default 0.2
+        Cut samples: where the taught load exceeds this share of its largest value, in (0, 1).
+    """
+
+    def __init__(self, *, false_alarm_rate: float = 1e-3, smoothing_s: float = 0.1, max_shift_s: float = 1.0,
+                 relevel: bool = False, cut_share: float = 0.2):
+        self.false_alarm_rate = false_alarm_rate
+        self.smoothing_s = smoothing_s
+        self.max_shift_s = max_shift_s
+        self.relevel = relevel
+        self.cut_share = cut_share
+
+    def _check_params(self) -> None:
+        if not 0.0 < self.false_alarm_rate < 0.5:
+            raise GreyboxError(f"false-alarm rate must be in (0, 0.5) per part, got {self.false_alarm_rate}")
+        if not (self.smoothing_s > 0 and self.max_shift_s >= 0):
+            raise GreyboxError("smoothing must be positive and the largest shift non-negative")
+        if not 0.0 < self.cut_share < 1.0:
+            raise GreyboxError(f"cut share must be in (0, 1), got {self.cut_share}")
+
+    # ------------------------------------------------------------------ fit
+    def fit(self, parts, *, unit: str = "", signal: dict | None = None) -> "Envelope":
+        """Learn the envelope from good parts.
+
+        Parameters
+        ----------
+        parts : sequence of Part
+            At least three good parts of one program (:class:`~greybox.process.parts.Part`).
+        unit : str, default ""
+            Unit of the signal.
+        signal : dict, optional
+            Description of the signal (:meth:`~greybox.process.parts.PartSignal.describe`).
+
+        Returns
+        -------
+        Envelope
+            self.
+        """
+        self._check_params()
+        parts = list(parts)
+        if len(parts) < 3:
+            raise GreyboxError(f"teach-in needs at least 3 good parts, got {len(parts)}")
+        dt = float(np.median([part.sample_time for part in parts]))
+        if not dt > 0:
+            raise GreyboxError("teach-in: a part has fewer than two samples")
+        reference = sorted(parts, key=lambda part: len(part.time))[len(parts) // 2]
+        self.sample_time_ = dt
+        self.width_ = max(1, int(round(self.smoothing_s / dt)))
+        self.max_shift_ = int(round(self.max_shift_s / dt))
+        self.reference_velocity_ = np.asarray(reference.velocity, dtype=float)
+        length = self.reference_velocity_.size
+        self.direction_ = np.where(np.abs(self.reference_velocity_) > STANDSTILL_MM_S,
+                                   np.sign(self.reference_velocity_), 0.0)
+        self.held_direction_ = level_direction(self.reference_velocity_)
+        self.scaled_ = all(part.level is not None for part in parts)
+        raw = [self._aligned(part) for part in parts]
+        first = np.vstack([moving_mean(row, self.width_) for row, _, _ in raw])
+        centre = np.nanmean(first, axis=0)
+        self.cut_ = cut_samples(centre, self.direction_, self.cut_share)
+        self.air_ = (self.direction_ != 0) & ~_dilated(self.cut_, self.width_)
+        aligned = first
+        if self.relevel:
+            aligned = np.vstack([moving_mean(self._relevelled(part, row, template, shift, centre)[0], self.width_)
+                                 for part, (row, template, shift) in zip(parts, raw)])
+            centre = np.nanmean(aligned, axis=0)
+        self.centre_ = centre
+        spread = np.nanstd(aligned, axis=0, ddof=1)
+        pooled = np.sqrt(moving_mean(spread ** 2, SPREAD_POOL * self.width_))
+        self.spread_ = np.maximum(pooled, 0.5 * float(np.nanmedian(pooled)))
+        n = len(parts)
+        independent = max(1.0, length / self.width_)
+        self.band_factor_ = float(student.isf(self.false_alarm_rate / (4.0 * independent), (n - 1) * SPREAD_POOL)
+                                  * math.sqrt(1.0 + 1.0 / n))
+        deviations = np.array([self.deviation(row) for row in aligned])
+        self.deviation_sd_ = float(np.std(deviations, ddof=1))
+        self.mean_factor_ = float(student.isf(self.false_alarm_rate / 4.0, n - 1) * math.sqrt(1.0 + 1.0 / n))
+        levels = [float(np.median(self.direction_[self.air_ & (self.direction_ == s)] *
+                                  centre[self.air_ & (self.direction_ == s)]))
+                  if np.any(self.air_ & (self.direction_ == s)) else 0.0 for s in (-1, 1)]
+        self.air_level_ = np.where(self.direction_ < 0, levels[0], np.where(self.direction_ > 0, levels[1], 0.0))
+        self.cut_load_ = float(np.mean((self.direction_ * centre)[self.cut_])) if self.cut_.any() else 0.0
+        self.n_parts_ = n
+        self.unit_ = str(unit)
+        self.signal_ = dict(signal or {})
+        self.parts_ = [{"source": Path(part.source).name, "number": part.number} for part in parts]
+        return self
+
+    def _aligned(self, part) -> tuple[np.ndarray, np.ndarray | None, int]:
+        """The part's signal and template on the reference grid (unsmoothed), and its shift [samples]."""
+        shift = best_shift(self.reference_velocity_, part.velocity, self.max_shift_)
+        length = self.reference_velocity_.size
+        template = None if part.level is None or not self.scaled_ else shifted(part.level, shift, length)
+        return shifted(part.signal, shift, length), template, shift
+
+    def _relevelled(self, part, signal, template, shift, centre) -> tuple[np.ndarray, dict]:
+        """Re-level a part's aligned signal; a force is re-levelled as its process current, then converted."""
+        if not self.scaled_:
+            return relevelled(signal, self.held_direction_, self.air_, target=centre)
+        if template is None:
+            raise GreyboxError("the envelope re-levels a model's signal; the part has no model current")
+        if part.current is None or part.convert is None:
+            return relevelled(signal, self.held_direction_, self.air_, template=template)
+        length = self.reference_velocity_.size
+        current, corrections = relevelled(shifted(part.current, shift, length), self.held_direction_, self.air_,
+                                          template=template)
+        return part.convert(current, shifted(part.velocity, shift, length)), corrections
+
+    def deviation(self, aligned) -> float:
+        """Mean load deviation ``D`` [signal unit] of an aligned signal over the cut samples.
+
+        Parameters
+        ----------
+        aligned : ndarray, shape (L,)
+            A smoothed signal on the reference grid (re-levelled if the envelope re-levels).
+        """
+        values = (self.direction_ * (np.asarray(aligned, dtype=float) - self.centre_))[self.cut_]
+        finite = values[np.isfinite(values)]
+        return float(finite.mean()) if finite.size else 0.0
+
+    def prepared(self, part) -> tuple[np.ndarray, int, dict]:
+        """A part's signal as the envelope compares it: aligned, smoothed, re-levelled if set.
+
+        Parameters
+        ----------
+        part : Part
+            The part.
+
+        Returns
+        -------
+        signal : ndarray, shape (L,)
+            On the reference grid (NaN where the part has no sample).
+        shift : int
+            Its shift [samples] against the reference.
+        offsets : dict
+            The re-levelling offsets (empty without re-levelling).
+        """
+        aligned, template, shift = self._aligned(part)
+        offsets: dict = {}
+        if self.relevel:
+            aligned, offsets = self._relevelled(part, aligned, template, shift, self.centre_)
+        return moving_mean(aligned, self.width_, complete=True), shift, offsets
+
+    @property
+    def band_(self) -> np.ndarray:
+        """Half-width of the band per position [signal unit]."""
+        return self.band_factor_ * self.spread_
+
+    @property
+    def deviation_limit_(self) -> float:
+        """Limit of ``|D|`` [signal unit]."""
+        return self.mean_factor_ * self.deviation_sd_
+
+    # ------------------------------------------------------------------ files
+    _ARRAYS = ("reference_velocity_", "direction_", "held_direction_", "centre_", "spread_", "cut_", "air_",
+               "air_level_")
+    _NUMBERS = ("sample_time_", "band_factor_", "deviation_sd_", "mean_factor_", "cut_load_")
+    _INTEGERS = ("width_", "max_shift_", "n_parts_")
+
+    def to_dict(self) -> dict:
+        """JSON-able content: the settings, the learned arrays and figures."""
+        params = {"false_alarm_rate": self.false_alarm_rate, "smoothing_s": self.smoothing_s,
+                  "max_shift_s": self.max_shift_s, "relevel": bool(self.relevel), "cut_share": self.cut_share}
+        arrays = {name: [bool(v) for v in getattr(self, name)] if name in ("cut_", "air_")
+                  else [float(v) for v in getattr(self, name)] for name in self._ARRAYS}
+        return {"format": ENVELOPE_FORMAT, "params": params, "unit": self.unit_, "signal": self.signal_,
+                "scaled": bool(self.scaled_),
+                "parts": self.parts_, **{name: float(getattr(self, name)) for name in self._NUMBERS},
+                **{name: int(getattr(self, name)) for name in self._INTEGERS}, "arrays": arrays}
+
+    def save(self, path: str | PathLike) -> Path:
+        """Write the envelope as JSON, atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The envelope file.
+        """
+        return write_text_atomic(path, json.dumps(self.to_dict(), allow_nan=False) + "\n")
+
+    @classmethod
+    def from_dict(cls, content, source: str = "envelope") -> "Envelope":
+        """An envelope from :meth:`to_dict`'s content, every field checked.
+
+        Parameters
+        ----------
+        content : dict
+            The content.
+        source : str, default "envelope"
+            Name for the messages.
+
+        Raises
+        ------
+        GreyboxError
+            Naming the source and the first field that is missing or wrong.
+        """
+        def bad(what: str) -> GreyboxError:
+            return GreyboxError(f"{source}: not a valid envelope file ({what})")
+
+        if not isinstance(content, dict) or content.get("format") != ENVELOPE_FORMAT:
+            raise bad(f"format is not {ENVELOPE_FORMAT}")
+        params = content.get("params")
+        if not isinstance(params, dict) or set(params) != {"false_alarm_rate", "smoothing_s", "max_shift_s",
+                                                           "relevel", "cut_share"}:
+            raise bad("params")
+        if not isinstance(params["relevel"], bool) or not all(
+                isinstance(params[k], (int, float)) and not isinstance(params[k], bool)
+                for k in ("false_alarm_rate", "smoothing_s", "max_shift_s", "cut_share")):
+            raise bad("params")
+        envelope = cls(**params)
+        try:
+            envelope._check_params()
+        except GreyboxError as error:
+            raise bad(str(error)) from None
+        for name in cls._NUMBERS:
+            value = content.get(name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise bad(name)
+            setattr(envelope, name, float(value))
+        for name in cls._INTEGERS:
+            value = content.get(name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise bad(name)
+            setattr(envelope, name, value)
+        if envelope.sample_time_ <= 0 or envelope.width_ < 1 or envelope.n_parts_ < 3 or envelope.deviation_sd_ < 0:
+            raise bad("sample time, smoothing, parts or spread out of range")
+        arrays = content.get("arrays")
+        if not isinstance(arrays, dict) or set(arrays) != set(cls._ARRAYS):
+            raise bad("arrays")
+        length = None
+        for name in cls._ARRAYS:
+            values = arrays[name]
+            if not isinstance(values, list) or not values or (length is not None and len(values) != length):
+                raise bad(f"{name}: missing, empty or of another length")
+            length = len(values)
+            if name in ("cut_", "air_"):
+                if not all(isinstance(v, bool) for v in values):
+                    raise bad(f"{name}: not all true/false")
+                setattr(envelope, name, np.array(values, dtype=bool))
+            else:
+                if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+                    raise bad(f"{name}: not all numbers")
+                array = np.array(values, dtype=float)
+                if not np.all(np.isfinite(array)):
+                    raise bad(f"{name}: not finite")
+                setattr(envelope, name, array)
+        if not (np.all(np.isin(envelope.direction_, (-1.0, 0.0, 1.0)))
+                and np.all(np.isin(envelope.held_direction_, (-1.0, 0.0, 1.0)))) or np.any(envelope.spread_ <= 0):
+            raise bad("direction not -1/0/1 or spread not positive")
+        if not isinstance(content.get("scaled"), bool):
+            raise bad("scaled")
+        envelope.scaled_ = content["scaled"]
+        if not isinstance(content.get("unit"), str) or not isinstance(content.get("signal"), dict) \
+                or not isinstance(content.get("parts"), list):
+            raise bad("unit, signal or parts")
+        envelope.unit_, envelope.signal_, envelope.parts_ = content["unit"], content["signal"], content["parts"]
+        return envelope
+
+    @classmethod
+    def load(cls, path: str | PathLike) -> "Envelope":
+        """Read and validate an envelope file (JSON; nothing in it is executed).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The envelope file.
+
+        Raises
+        ------
+        GreyboxError
+            For a missing, unreadable or invalid file, naming it.
+        """
+        name = Path(path).name
+        try:
+            text = Path(path).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as error:
+            raise GreyboxError(f"{name}: cannot read the envelope file ({error.__class__.__name__})") from None
+
+        def refuse(constant):
+            raise ValueError(f"{constant} is not a number")
+
+        try:
+            content = json.loads(text, parse_constant=refuse)
+        except (ValueError, RecursionError) as error:
+            raise GreyboxError(f"{name}: not a valid envelope file (not JSON: {error})") from None
+        return cls.from_dict(content, name)
