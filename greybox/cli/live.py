@@ -5,10 +5,12 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._types import FRACTION, POSITIVE, positive
+from ._types import FRACTION, POSITIVE, POSITIVE_INT, positive
 
 
 def add_parser(subparsers) -> None:
+    from ..live.messages import MAX_MESSAGE_BYTES, MAX_MESSAGE_DEPTH
+    from ..live.report import LINE_INTERVAL_S, LINES_PER_INTERVAL
     from ..models.chunked import DEFAULT_CHUNK_S
 
     parser = subparsers.add_parser(
@@ -61,6 +63,13 @@ def add_parser(subparsers) -> None:
                         help="cut-off [Hz] of the derivative filter (default as 'greybox predict')")
     parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
+    parser.add_argument("--max-message-bytes", type=POSITIVE_INT, default=MAX_MESSAGE_BYTES, metavar="N",
+                        help=f"refuse a larger message in one line (default {MAX_MESSAGE_BYTES})")
+    parser.add_argument("--max-depth", type=POSITIVE_INT, default=MAX_MESSAGE_DEPTH, metavar="N",
+                        help=f"refuse JSON nested deeper (default {MAX_MESSAGE_DEPTH}; the message shapes need 2)")
+    parser.add_argument("--lines-per-interval", type=POSITIVE_INT, default=LINES_PER_INTERVAL, metavar="N",
+                        help=f"lines said per {LINE_INTERVAL_S:g} s about messages and samples (default "
+                        f"{LINES_PER_INTERVAL}); the rest are counted in one summary line per {LINE_INTERVAL_S:g} s")
     parser.add_argument("--connect-timeout", type=positive("seconds"), default=10.0, metavar="S",
                         help="seconds to wait for the broker at the start (default 10)")
     parser.set_defaults(run=run)
@@ -73,6 +82,7 @@ def _say(line: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..data.io import parse_column_mapping
     from ..live.limits import parse_duration, parse_limit
+    from ..live.messages import MessageBounds
     from ..live.run import run_live
 
     outcome = run_live(
@@ -82,7 +92,9 @@ def run(args: argparse.Namespace) -> int:
         hold_s=parse_duration(args.limit_hold), exit_on_alarm=args.exit_on_alarm, stats_path=args.stats,
         sample_time=args.sample_time, tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz, chunk_s=args.chunk_s,
         columns=parse_column_mapping(args.columns) if args.columns else None, axis=args.axis,
-        connect_timeout=args.connect_timeout, say=_say)
+        connect_timeout=args.connect_timeout,
+        bounds=MessageBounds(max_bytes=args.max_message_bytes, max_depth=args.max_depth),
+        lines_per_interval=args.lines_per_interval, say=_say)
     for path in outcome.recorded:
         _say(f"recorded {path}")
     return outcome.status

@@ -13,7 +13,7 @@ import json
 from typing import Callable, Mapping
 
 from ..atomic import write_text_atomic
-from .messages import Decoder, MessageError
+from .messages import DEFAULT_BOUNDS, Decoder, MessageBounds, MessageError
 from .session import LiveSession
 from .sources import ConnectionChange, Received
 from .stats import LiveStats
@@ -30,6 +30,8 @@ class MachineSession:
         One session per axis (each with ``subtopic`` its axis name).
     say : callable
         ``say(line)`` for the lines of the machine (messages no axis takes, the broker connection).
+    bounds : MessageBounds, optional
+        The largest message taken.
 
     Attributes
     ----------
@@ -37,11 +39,12 @@ class MachineSession:
         The counters of the messages (received, rejected) and of the broker connection.
     """
 
-    def __init__(self, sessions: Mapping[str, LiveSession], *, say: Callable[[str], None]):
+    def __init__(self, sessions: Mapping[str, LiveSession], *, say: Callable[[str], None],
+                 bounds: MessageBounds = DEFAULT_BOUNDS):
         self.sessions = dict(sessions)
         self.say = say
         self.stats = LiveStats()
-        self._decoder = Decoder()
+        self._decoder = Decoder(bounds)
 
     @property
     def alarmed(self) -> bool:

@@ -23,10 +23,12 @@ from .broker import is_address, parse_address
 from .estimator import LiveEstimator
 from .limits import Limit, LimitWatch
 from .machine import MachineSession
+from .messages import DEFAULT_BOUNDS, MessageBounds
 from .recording import DEFAULT_RECORD_S, Recorder
+from .report import LINES_PER_INTERVAL, LineLimiter
 from .session import LiveSession
 from .sinks import LineSink, MqttSink
-from .sources import LineSource, MqttSource
+from .sources import Idle, LineSource, MqttSource
 from .stats import LiveStats
 
 __all__ = ["ALARM_STATUS", "LiveOutcome", "run_live", "settled_memory"]
@@ -142,7 +144,7 @@ def _sink(spec: str, stdout: TextIO, connect_timeout: float):
 
 
 def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
-                  axis, source, say):
+                  axis, source, say, bounds):
     """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
     from ..data.axis_config import read_axis_config
     from ..models.registry import model_kind
@@ -158,14 +160,14 @@ def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, re
             attrs={"model_file": str(model_path), "source": str(source)})
         watch = LimitWatch(list(limits), hold_s=hold_s) if limits else None
         session = LiveSession(LiveEstimator(model, axis_config=config, **options), out, say=say, limits=watch,
-                              recorder=recorder, mapping=mapping, axis=axis)
+                              recorder=recorder, mapping=mapping, axis=axis, bounds=bounds)
         return session, model_kind(model), [recorder] if recorder is not None else []
 
     return build
 
 
 def _machine_session(model_path, machine_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
-                     source, say):
+                     source, say, bounds):
     """A function of the sink that builds the sessions of a machine model's axes: (session, kind, recorders)."""
     from pathlib import Path
 
@@ -192,9 +194,10 @@ def _machine_session(model_path, machine_path, options: dict, *, record_dir, rec
                 say=lambda line, axis=axis: say(f"{axis}: {line}"),
                 limits=LimitWatch(list(limits), hold_s=hold_s) if limits else None, recorder=recorder,
                 mapping=dict(entry.channels) if entry is not None and entry.channels else None, axis=axis,
-                subtopic=axis)
+                subtopic=axis, bounds=bounds)
         kinds = sorted({model_kind(model) for model in machine.models.values()})
-        return MachineSession(sessions, say=say), f"machine ({', '.join(machine.axes)}: {', '.join(kinds)})", recorders
+        described_kind = f"machine ({', '.join(machine.axes)}: {', '.join(kinds)})"
+        return MachineSession(sessions, say=say, bounds=bounds), described_kind, recorders
 
     return build
 
@@ -205,6 +208,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
              exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
              columns: Mapping[str, str] | None = None, axis: str | None = None, connect_timeout: float = 10.0,
+             bounds: MessageBounds = DEFAULT_BOUNDS, lines_per_interval: int = LINES_PER_INTERVAL,
              say: Callable[[str], None] = print, stdin: TextIO | None = None,
              stdout: TextIO | None = None) -> LiveOutcome:
     """Estimate the process current (and force) of a live stream with a model trained on air cuts.
@@ -249,6 +253,11 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         Axis to take from messages holding several.
     connect_timeout : float, default 10.0
         Seconds to wait for the broker at the start.
+    bounds : MessageBounds, optional
+        The largest message taken (bytes, JSON nesting, samples); a larger one is refused in one line.
+    lines_per_interval : int, default 20
+        Lines of the stream (messages skipped, samples dropped, gaps, alarms) said per 10 s; those beyond
+        are counted and summed up in one line per 10 s. Every line is cut to 300 characters.
     say : callable, default print
         ``say(line)`` for each line of text.
     stdin, stdout : text file, optional
@@ -269,15 +278,18 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     from ..machine_model import is_machine_model
 
     options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s)
+    lines = LineLimiter(say, burst=lines_per_interval)
     if is_machine_model(model_path):
         build = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
-                                 limits=limits, hold_s=hold_s, columns=columns, source=source, say=say)
+                                 limits=limits, hold_s=hold_s, columns=columns, source=source, say=lines,
+                                 bounds=bounds)
     else:
         if machine_path:
             raise GreyboxError("--machine applies to a machine model (a directory written by 'greybox train "
                                "--axes'); give one axis's mechanics with --axis-config")
         build = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
-                              limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=say)
+                              limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=lines,
+                              bounds=bounds)
     stream = _source(source, stdin or sys.stdin, connect_timeout)
     out = None
     try:
@@ -297,11 +309,13 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                 f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
             last_stats = time.monotonic()
             for item in stream:
-                with deferred.held():
-                    session.handle(item)
-                if session.alarmed and exit_on_alarm:
-                    status = ALARM_STATUS
-                    break
+                lines.tick()
+                if not isinstance(item, Idle):
+                    with deferred.held():
+                        session.handle(item)
+                    if session.alarmed and exit_on_alarm:
+                        status = ALARM_STATUS
+                        break
                 if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
                     session.write_stats(stats_path)
                     last_stats = time.monotonic()
@@ -310,6 +324,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                     session.finish()
             stopped = status != 0
     finally:
+        lines.flush()
         try:
             session.close(stopped=stopped)
             stream.close()

@@ -16,7 +16,7 @@ import numpy as np
 from ..data.log import AxisLog
 from .estimator import LiveEstimator, Lost, RunStart, StepOutput
 from .limits import LimitWatch
-from .messages import Decoder, MessageError, MessageLogs, estimate_message
+from .messages import DEFAULT_BOUNDS, Decoder, MessageBounds, MessageError, MessageLogs, estimate_message
 from .recording import Recorder
 from .sources import ConnectionChange, Received
 from .stats import LiveStats
@@ -57,6 +57,8 @@ class LiveSession:
         Axis to take from messages holding several.
     subtopic : str, optional
         The axis of a machine's session: its output messages carry ``"axis"`` and go to ``<TOPIC>/<axis>``.
+    bounds : MessageBounds, optional
+        The largest message taken.
 
     Attributes
     ----------
@@ -68,7 +70,8 @@ class LiveSession:
 
     def __init__(self, estimator: LiveEstimator, sink, *, say: Callable[[str], None],
                  limits: LimitWatch | None = None, recorder: Recorder | None = None,
-                 mapping: Mapping[str, str] | None = None, axis: str | None = None, subtopic: str | None = None):
+                 mapping: Mapping[str, str] | None = None, axis: str | None = None, subtopic: str | None = None,
+                 bounds: MessageBounds = DEFAULT_BOUNDS):
         self.estimator = estimator
         self.sink = sink
         self.say = say
@@ -79,7 +82,7 @@ class LiveSession:
         self.subtopic = subtopic
         self.stats = LiveStats()
         self.alarmed = False
-        self._decoder = Decoder()
+        self._decoder = Decoder(bounds)
         self._logs = MessageLogs(mapping=self.mapping)
         self._signature: tuple | None = None
         self._offline_since: float | None = None

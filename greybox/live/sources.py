@@ -2,7 +2,8 @@
 
 A source is an iterable of :class:`Received` messages and :class:`ConnectionChange` events, in the order
 they happened; it ends when the stream does (end of the text stream; an MQTT source runs until the
-command is stopped).
+command is stopped). An MQTT source also gives an :class:`Idle` each time no message came for its poll
+interval, so that the command can do what is due while the stream is quiet.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from typing import Iterator, TextIO
 
 from .broker import BrokerAddress, Connection
 
-__all__ = ["Received", "ConnectionChange", "LineSource", "MqttSource"]
+__all__ = ["Received", "ConnectionChange", "Idle", "LineSource", "MqttSource"]
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,19 @@ class ConnectionChange:
     time_s: float
 
 
+@dataclass(frozen=True)
+class Idle:
+    """No message came for the source's poll interval.
+
+    Attributes
+    ----------
+    time_s : float
+        When, ``time.time()`` [s].
+    """
+
+    time_s: float
+
+
 class LineSource:
     """Messages as lines of a text stream: JSON lines, or CSV lines after a header line.
 
@@ -88,9 +102,9 @@ class MqttSource:
         Broker and topic (wildcards allowed).
     connect_timeout : float, default 10.0
         Seconds to wait for the broker at the start.
-    poll_s : float, default 0.2
-        How long the iteration waits for a message before checking again (the command stays responsive
-        to signals).
+    poll_s : float, default 0.1
+        How long the iteration waits for a message before it gives an :class:`Idle` (the command stays
+        responsive to signals and does what is due while the stream is quiet).
 
     Raises
     ------
@@ -98,7 +112,7 @@ class MqttSource:
         When the broker cannot be reached at the start.
     """
 
-    def __init__(self, address: BrokerAddress, *, connect_timeout: float = 10.0, poll_s: float = 0.2):
+    def __init__(self, address: BrokerAddress, *, connect_timeout: float = 10.0, poll_s: float = 0.1):
         self.address = address
         self.poll_s = float(poll_s)
         self._queue: queue.Queue = queue.Queue()
@@ -112,11 +126,12 @@ class MqttSource:
     def _state(self, connected: bool, time_s: float) -> None:
         self._queue.put(ConnectionChange(connected, time_s))
 
-    def __iter__(self) -> Iterator[Received | ConnectionChange]:
+    def __iter__(self) -> Iterator[Received | ConnectionChange | Idle]:
         while True:
             try:
                 item = self._queue.get(timeout=self.poll_s)
             except queue.Empty:
+                yield Idle(time.time())
                 continue
             if isinstance(item, ConnectionChange):
                 yield item
