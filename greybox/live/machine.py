@@ -115,6 +115,11 @@ class MachineSession:
         lines += [f"{axis} {session.stats_line()}" for axis, session in self.sessions.items()]
         return "\n".join(lines)
 
+    def counters(self) -> dict:
+        """The counters of the machine and of each axis as they are now, JSON-able."""
+        return {**self.stats.to_dict(),
+                "axes": {axis: session.current_stats().to_dict() for axis, session in self.sessions.items()}}
+
     def write_stats(self, path) -> None:
         """Write the counters of the machine and of each axis to a JSON file, atomically.
 
@@ -123,6 +128,4 @@ class MachineSession:
         path : path-like
             The stats file.
         """
-        document = {**self.stats.to_dict(),
-                    "axes": {axis: session.current_stats().to_dict() for axis, session in self.sessions.items()}}
-        write_text_atomic(path, json.dumps(document, indent=1) + "\n")
+        write_text_atomic(path, json.dumps(self.counters(), indent=1) + "\n")

@@ -19,7 +19,8 @@ from typing import Callable, Mapping, TextIO
 
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S
-from .broker import is_address, parse_address
+from .broker import BrokerOptions
+from .endpoints import open_endpoints
 from .estimator import LiveEstimator
 from .limits import Limit, LimitWatch
 from .machine import MachineSession
@@ -27,8 +28,7 @@ from .messages import DEFAULT_BOUNDS, MessageBounds
 from .recording import DEFAULT_RECORD_S, Recorder
 from .report import LINES_PER_INTERVAL, LineLimiter
 from .session import LiveSession
-from .sinks import LineSink, MqttSink
-from .sources import Idle, LineSource, MqttSource
+from .sources import Idle
 from .stats import LiveStats
 
 __all__ = ["ALARM_STATUS", "LiveOutcome", "run_live", "settled_memory"]
@@ -127,22 +127,6 @@ def settled_memory():
         gc.unfreeze()
 
 
-def _source(spec: str, stdin: TextIO, connect_timeout: float):
-    if spec == "-":
-        return LineSource(stdin)
-    if is_address(spec):
-        return MqttSource(parse_address(spec, "--source"), connect_timeout=connect_timeout)
-    raise GreyboxError(f"--source {spec}: give '-' (lines on stdin) or mqtt://HOST[:PORT]/TOPIC")
-
-
-def _sink(spec: str, stdout: TextIO, connect_timeout: float):
-    if spec == "-":
-        return LineSink(stdout)
-    if is_address(spec):
-        return MqttSink(parse_address(spec, "--sink"), connect_timeout=connect_timeout)
-    raise GreyboxError(f"--sink {spec}: give '-' (lines on stdout) or mqtt://HOST[:PORT]/TOPIC")
-
-
 def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
                   axis, source, say, bounds):
     """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
@@ -199,7 +183,18 @@ def _machine_session(model_path, machine_path, options: dict, *, record_dir, rec
         described_kind = f"machine ({', '.join(machine.axes)}: {', '.join(kinds)})"
         return MachineSession(sessions, say=say, bounds=bounds), described_kind, recorders
 
-    return build
+    return build, list(machine.axes)
+
+
+def _sink_changes(out, session, say) -> None:
+    """Say and count the losses and returns of the sink's broker connection."""
+    for change in out.changes():
+        if change.connected:
+            say(f"sink's broker connection back; {out.queued} output message(s) queued go out now")
+        else:
+            session.stats.output_disconnections += 1
+            say(f"sink's broker connection lost ({change.reason}); output messages are queued "
+                f"(at most {out.connection.options.queue_size}) until it is back")
 
 
 def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None, machine_path=None,
@@ -207,8 +202,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
              record_s: float = DEFAULT_RECORD_S, limits: list[Limit] = (), hold_s: float = 0.0,
              exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
-             columns: Mapping[str, str] | None = None, axis: str | None = None, connect_timeout: float = 10.0,
-             bounds: MessageBounds = DEFAULT_BOUNDS, lines_per_interval: int = LINES_PER_INTERVAL,
+             columns: Mapping[str, str] | None = None, axis: str | None = None, broker: BrokerOptions | None = None,
+             status_topic: str | None = None, bounds: MessageBounds = DEFAULT_BOUNDS,
+             lines_per_interval: int = LINES_PER_INTERVAL,
              say: Callable[[str], None] = print, stdin: TextIO | None = None,
              stdout: TextIO | None = None) -> LiveOutcome:
     """Estimate the process current (and force) of a live stream with a model trained on air cuts.
@@ -219,9 +215,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         Model file written by ``greybox train``, or a machine model (a directory written by ``greybox train
         --axes``): then one session per axis (:mod:`greybox.live.machine`).
     source : str
-        ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt://HOST[:PORT]/TOPIC``.
+        ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC`` (wildcards allowed).
     sink : str, default "-"
-        ``-`` (JSON lines on ``stdout``) or ``mqtt://HOST[:PORT]/TOPIC``.
+        ``-`` (JSON lines on ``stdout``) or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC``.
     axis_config_path : path-like, optional
         Axis file (TOML): the process force (torque) and the channel names.
     machine_path : path-like, optional
@@ -251,8 +247,11 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         file's channels).
     axis : str, optional
         Axis to take from messages holding several.
-    connect_timeout : float, default 10.0
-        Seconds to wait for the broker at the start.
+    broker : BrokerOptions, optional
+        Log-in, TLS, client id, QoS, session and queue of the broker connections.
+    status_topic : str, optional
+        Topic of the retained status (online/offline, the counters every 10 s); default
+        ``<sink topic>/status`` with an MQTT sink.
     bounds : MessageBounds, optional
         The largest message taken (bytes, JSON nesting, samples); a larger one is refused in one line.
     lines_per_interval : int, default 20
@@ -280,36 +279,39 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s)
     lines = LineLimiter(say, burst=lines_per_interval)
     if is_machine_model(model_path):
-        build = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
+        build, axes = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
                                  limits=limits, hold_s=hold_s, columns=columns, source=source, say=lines,
                                  bounds=bounds)
     else:
         if machine_path:
             raise GreyboxError("--machine applies to a machine model (a directory written by 'greybox train "
                                "--axes'); give one axis's mechanics with --axis-config")
-        build = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
+        build, axes = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
                               limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=lines,
-                              bounds=bounds)
-    stream = _source(source, stdin or sys.stdin, connect_timeout)
-    out = None
+                              bounds=bounds), [None]
+    ends = open_endpoints(source, sink, options=broker or BrokerOptions(), status_topic=status_topic, axes=axes,
+                          limit_columns=[limit.column for limit in limits], stdin=stdin or sys.stdin,
+                          stdout=stdout or sys.stdout)
+    stream, out = ends.stream, ends.out
     try:
-        out = _sink(sink, stdout or sys.stdout, connect_timeout)
         session, kind, recorders = build(out)
+        session.warm_up()
     except BaseException:
-        stream.close()
-        if out is not None:
-            out.close()
+        ends.close()
         raise
     status, stopped = 0, True
     deferred = _Deferred()
     try:
-        session.warm_up()
         with deferred, settled_memory():
-            say(f"greybox live: {kind} model {model_path}, reading "
-                f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
+            say(f"greybox live: {kind} model {model_path}, reading {'stdin' if source == '-' else stream.address}, "
+                f"writing {'stdout' if sink == '-' else out.address}"
+                + (f", status on {ends.status.topic}" if ends.status is not None else ""))
             last_stats = time.monotonic()
             for item in stream:
                 lines.tick()
+                _sink_changes(out, session, lines)
+                if ends.status is not None and ends.status.due():
+                    ends.status.publish("online", session.counters())
                 if not isinstance(item, Idle):
                     with deferred.held():
                         session.handle(item)
@@ -326,6 +328,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     finally:
         lines.flush()
         try:
+            if ends.status is not None:
+                ends.status.publish("offline", session.counters())
             session.close(stopped=stopped)
             stream.close()
         finally:

@@ -87,6 +87,7 @@ class LiveSession:
         self._signature: tuple | None = None
         self._offline_since: float | None = None
         self._run = 0  # run of the last estimates
+        self._last_s = float("nan")  # time of the last sample estimated
         self._open = True
 
     def handle(self, item: Received | ConnectionChange) -> None:
@@ -148,7 +149,12 @@ class LiveSession:
         """The counters, with the samples waiting now."""
         if self._open:
             self.stats.waiting = self.estimator.waiting
+            self.stats.outputs_lost, self.stats.outputs_queued = self.sink.lost, self.sink.queued
         return self.stats
+
+    def counters(self) -> dict:
+        """The counters as they are now, JSON-able."""
+        return self.current_stats().to_dict()
 
     def write_stats(self, path) -> None:
         """Write the counters (as they are now) to a JSON file, atomically.
@@ -162,8 +168,15 @@ class LiveSession:
 
     def warm_up(self) -> None:
         """Load the compiled kernels before the stream starts, so that the first message is not kept waiting
-        (:meth:`LiveEstimator.warm_up`)."""
-        self.estimator.warm_up()
+        (:meth:`LiveEstimator.warm_up`); check the limits against the columns of the output then.
+
+        Raises
+        ------
+        GreyboxError
+            When a limit names a column the output lacks (e.g. the force without an axis file).
+        """
+        if self.estimator.warm_up() and self.limits is not None:
+            self.limits.check_columns(self.estimator.output_columns)
 
     def finish(self) -> None:
         """The end of the stream: the samples still waiting are estimated as the end of a log."""
@@ -190,7 +203,7 @@ class LiveSession:
                 self.recorder.close()
         finally:
             self.sink.close()
-            self.stats.outputs_lost = self.sink.lost
+            self.stats.outputs_lost, self.stats.outputs_queued = self.sink.lost, self.sink.queued
 
     def connection(self, change: ConnectionChange, *, quiet: bool = False) -> None:
         """Count a loss or return of the broker connection, and say it.
@@ -230,15 +243,22 @@ class LiveSession:
                 if self.recorder is not None and run:
                     self.recorder.new_run()
                 if self.limits is not None:
-                    self.limits.rearm()
+                    self._alarms(self.limits.rearm(self._last_s), seq)
             if self.recorder is not None:
                 self.recorder.add(result)
             if self.limits is not None:
-                for alarm in self.limits.check(part):
-                    self.alarmed = True
-                    self.stats.alarms += 1
-                    self.sink.alarm(alarm.message(), subtopic=self.subtopic)
-                    self.say(alarm.line())
+                self._alarms(self.limits.check(part), seq)
+            self._last_s = float(part["time_s"][-1]) if len(part["time_s"]) else self._last_s
+
+    def _alarms(self, alarms, seq) -> None:
+        for alarm in alarms:
+            if alarm.state == "raised":
+                self.alarmed = True
+                self.stats.alarms += 1
+            else:
+                self.stats.alarms_cleared += 1
+            self.sink.alarm(alarm.message(seq), subtopic=self.subtopic, column=alarm.column)
+            self.say(alarm.line())
 
     def _event(self, event) -> None:
         if isinstance(event, Dropped):

@@ -13,7 +13,7 @@ import time
 from dataclasses import dataclass
 from typing import Iterator, TextIO
 
-from .broker import BrokerAddress, Connection
+from .broker import BrokerAddress, BrokerOptions, Connection
 
 __all__ = ["Received", "ConnectionChange", "Idle", "LineSource", "MqttSource"]
 
@@ -50,10 +50,13 @@ class ConnectionChange:
         The new state.
     time_s : float
         When, ``time.time()`` [s].
+    reason : str
+        Why, in the broker's or paho's words ("" for a return).
     """
 
     connected: bool
     time_s: float
+    reason: str = ""
 
 
 @dataclass(frozen=True)
@@ -100,8 +103,10 @@ class MqttSource:
     ----------
     address : BrokerAddress
         Broker and topic (wildcards allowed).
-    connect_timeout : float, default 10.0
-        Seconds to wait for the broker at the start.
+    options : BrokerOptions, optional
+        Log-in, TLS, client id, QoS of the subscription, session.
+    will : tuple of (str, str), optional
+        ``(topic, text)`` the broker publishes, retained, when the connection is lost without a goodbye.
     poll_s : float, default 0.1
         How long the iteration waits for a message before it gives an :class:`Idle` (the command stays
         responsive to signals and does what is due while the stream is quiet).
@@ -112,19 +117,20 @@ class MqttSource:
         When the broker cannot be reached at the start.
     """
 
-    def __init__(self, address: BrokerAddress, *, connect_timeout: float = 10.0, poll_s: float = 0.1):
+    def __init__(self, address: BrokerAddress, options: BrokerOptions | None = None, *,
+                 will: tuple[str, str] | None = None, poll_s: float = 0.1):
         self.address = address
         self.poll_s = float(poll_s)
         self._queue: queue.Queue = queue.Queue()
         self._count = 0
-        self.connection = Connection(address, subscribe=address.topic, connect_timeout=connect_timeout,
+        self.connection = Connection(address, options, role="in", subscribe=address.topic, will=will,
                                      on_message=self._message, on_state=self._state)
 
     def _message(self, topic: str, payload: bytes, arrived_s: float) -> None:
         self._queue.put((topic, payload, arrived_s))
 
-    def _state(self, connected: bool, time_s: float) -> None:
-        self._queue.put(ConnectionChange(connected, time_s))
+    def _state(self, connected: bool, time_s: float, reason: str) -> None:
+        self._queue.put(ConnectionChange(connected, time_s, reason))
 
     def __iter__(self) -> Iterator[Received | ConnectionChange | Idle]:
         while True:
@@ -139,6 +145,18 @@ class MqttSource:
             topic, payload, arrived_s = item
             self._count += 1
             yield Received(payload, f"message {self._count} on {topic}", arrived_s, topic)
+
+    def status(self, topic: str, text: str) -> None:
+        """Publish the service's status (retained) on ``topic`` (when no MQTT sink carries it).
+
+        Parameters
+        ----------
+        topic : str
+            The status topic.
+        text : str
+            JSON text.
+        """
+        self.connection.publish(topic, text, retain=True)
 
     def close(self) -> None:
         """Disconnect from the broker."""

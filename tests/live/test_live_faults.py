@@ -117,8 +117,17 @@ def test_limits_raise_one_alarm_per_stretch_and_can_end_the_stream(model_file, c
     assert long_stretches >= 1
     assert outcome.stats.alarms == long_stretches
     alarms = [json.loads(line) for line in lines if '"alarm"' in line]
-    assert len(alarms) == long_stretches and all(alarm["value"] > bound for alarm in alarms)
-    assert sum(line.startswith("ALARM") for line in said) == long_stretches
+    raised = [alarm for alarm in alarms if alarm["state"] == "raised"]
+    assert len(raised) == long_stretches and all(alarm["value"] > bound for alarm in raised)
+    assert sum(line.startswith("ALARM:") for line in said) == long_stretches
+    # each is cleared at the first sample back within the limit (the stretches ending before the log does)
+    ended = (stops - starts >= 3) & (stops < len(force))
+    cleared = [alarm for alarm in alarms if alarm["state"] == "cleared"]
+    assert len(cleared) == outcome.stats.alarms_cleared == int(np.sum(ended))
+    assert [alarm["time_s"] for alarm in cleared] == pytest.approx(list(expected["time_s"][stops[ended]]), abs=1e-12)
+    # the seq of the message whose samples raised or cleared it (none for the tail finished at the end)
+    assert all("wall_time" in alarm and "seq" in alarm for alarm in alarms)
+    assert any(isinstance(alarm["seq"], int) for alarm in alarms)
     _, stopped, _, _ = run(path, json_batches(cut_raw, (10,)), limits=[Limit("force_process_N", bound)],
                            hold_s=0.004, exit_on_alarm=True)
     assert stopped.status == ALARM_STATUS and stopped.stats.alarms == 1
