@@ -119,8 +119,6 @@ class BrokerOptions:
     def __post_init__(self):
         if self.qos not in (0, 1):
             raise GreyboxError(f"--qos {self.qos}: give 0 or 1")
-        if self.password is not None and not self.username:
-            raise GreyboxError("a broker password needs a user name: give --username or mqtt://USER@HOST/TOPIC")
         if self.key_file and not self.cert_file:
             raise GreyboxError("--tls-key needs --tls-cert (the client certificate it belongs to)")
         if self.client_id is not None and not (0 < len(self.client_id) <= 200 and self.client_id.isprintable()):

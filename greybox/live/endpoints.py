@@ -105,7 +105,7 @@ def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_top
             raise GreyboxError(f"--sink {sink_at or status_topic}: the source's topic filter {source_at.topic} "
                                f"receives {looped[0]}, where the command publishes: it would read its own output; "
                                "give the sink a topic outside the filter")
-    options = options if options.client_id else _with_client_id(options)
+    options = _completed(options, [address for address in (source_at, sink_at) if address is not None])
     will = (status_topic, will_message(options.client_id)) if status_topic is not None else None
     stream = LineSource(stdin) if source_at is None else MqttSource(
         source_at, options, will=will if sink_at is None else None)
@@ -119,7 +119,13 @@ def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_top
     return Endpoints(stream, out, status)
 
 
-def _with_client_id(options: BrokerOptions) -> BrokerOptions:
+def _completed(options: BrokerOptions, addresses) -> BrokerOptions:
+    """The options with a client id, and with the user name of an address (one user for the source and sink)."""
     from dataclasses import replace
 
-    return replace(options, client_id=default_client_id())
+    names = {address.username for address in addresses if address.username} | (
+        {options.username} if options.username else set())
+    if len(names) > 1:
+        raise GreyboxError("the user names of --source, --sink and --username differ: give one user name")
+    return replace(options, client_id=options.client_id or default_client_id(),
+                   username=next(iter(names)) if names else None)
