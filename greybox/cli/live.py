@@ -15,6 +15,7 @@ def add_parser(subparsers) -> None:
     from ..live.broker import PASSWORD_ENV
     from ..live.messages import MAX_MESSAGE_BYTES, MAX_MESSAGE_DEPTH
     from ..live.report import LINE_INTERVAL_S, LINES_PER_INTERVAL
+    from ..live.sources import DEFAULT_IDLE_S
     from ..models.chunked import DEFAULT_CHUNK_S
 
     parser = subparsers.add_parser(
@@ -101,6 +102,9 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--lines-per-interval", type=POSITIVE_INT, default=LINES_PER_INTERVAL, metavar="N",
                         help=f"lines said per {LINE_INTERVAL_S:g} s about messages and samples (default "
                         f"{LINES_PER_INTERVAL}); the rest are counted in one summary line per {LINE_INTERVAL_S:g} s")
+    parser.add_argument("--idle-s", type=POSITIVE, default=DEFAULT_IDLE_S, metavar="S",
+                        help=f"after S seconds without a message, estimate the samples waiting for their look-ahead "
+                        f"as the end of a run (default {DEFAULT_IDLE_S:g}; the next sample starts a new run)")
     parser.add_argument("--connect-timeout", type=positive("seconds"), default=10.0, metavar="S",
                         help="seconds to wait for the broker at the start (default 10)")
     for action in parser._actions:
@@ -161,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
         columns=parse_column_mapping(args.columns) if args.columns else None, axis=args.axis,
         broker=broker, status_topic=args.status_topic,
         bounds=MessageBounds(max_bytes=args.max_message_bytes, max_depth=args.max_depth),
-        lines_per_interval=args.lines_per_interval, say=_say)
+        lines_per_interval=args.lines_per_interval, idle_s=args.idle_s, say=_say)
     for path in outcome.recorded:
         _say(f"recorded {path}")
     return outcome.status

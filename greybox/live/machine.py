@@ -98,6 +98,17 @@ class MachineSession:
         for session in self.sessions.values():
             session.finish()
 
+    def idle(self, idle_s: float) -> None:
+        """The stream went quiet, for every axis (:meth:`LiveSession.idle`).
+
+        Parameters
+        ----------
+        idle_s : float
+            Seconds since the last message.
+        """
+        for session in self.sessions.values():
+            session.idle(idle_s)
+
     def close(self, *, stopped: bool = False) -> None:
         """Close every axis's recording and the sink.
 

@@ -28,7 +28,7 @@ from .messages import DEFAULT_BOUNDS, MessageBounds
 from .recording import DEFAULT_RECORD_S, Recorder
 from .report import LINES_PER_INTERVAL, LineLimiter
 from .session import LiveSession
-from .sources import Idle
+from .sources import DEFAULT_IDLE_S, Idle
 from .stats import LiveStats
 
 __all__ = ["ALARM_STATUS", "LiveOutcome", "run_live", "settled_memory"]
@@ -204,7 +204,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
              columns: Mapping[str, str] | None = None, axis: str | None = None, broker: BrokerOptions | None = None,
              status_topic: str | None = None, bounds: MessageBounds = DEFAULT_BOUNDS,
-             lines_per_interval: int = LINES_PER_INTERVAL,
+             lines_per_interval: int = LINES_PER_INTERVAL, idle_s: float | None = DEFAULT_IDLE_S,
              say: Callable[[str], None] = print, stdin: TextIO | None = None,
              stdout: TextIO | None = None) -> LiveOutcome:
     """Estimate the process current (and force) of a live stream with a model trained on air cuts.
@@ -257,6 +257,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     lines_per_interval : int, default 20
         Lines of the stream (messages skipped, samples dropped, gaps, alarms) said per 10 s; those beyond
         are counted and summed up in one line per 10 s. Every line is cut to 300 characters.
+    idle_s : float or None, default 0.5
+        After this many seconds without a message (on a broker) the samples waiting for their look-ahead are
+        estimated as the end of a run, so that the tail of a stream comes out; None: never.
     say : callable, default print
         ``say(line)`` for each line of text.
     stdin, stdout : text file, optional
@@ -306,13 +309,19 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
             say(f"greybox live: {kind} model {model_path}, reading {'stdin' if source == '-' else stream.address}, "
                 f"writing {'stdout' if sink == '-' else out.address}"
                 + (f", status on {ends.status.topic}" if ends.status is not None else ""))
-            last_stats = time.monotonic()
+            last_stats = last_message = time.monotonic()
             for item in stream:
                 lines.tick()
                 _sink_changes(out, session, lines)
                 if ends.status is not None and ends.status.due():
                     ends.status.publish("online", session.counters())
-                if not isinstance(item, Idle):
+                if isinstance(item, Idle):
+                    quiet = time.monotonic() - last_message
+                    if idle_s is not None and quiet >= idle_s:
+                        with deferred.held():
+                            session.idle(quiet)
+                else:
+                    last_message = time.monotonic()
                     with deferred.held():
                         session.handle(item)
                     if session.alarmed and exit_on_alarm:

@@ -182,6 +182,21 @@ class LiveSession:
         """The end of the stream: the samples still waiting are estimated as the end of a log."""
         self._publish(self.estimator.finish(), None)
 
+    def idle(self, idle_s: float) -> None:
+        """The stream went quiet: the samples waiting are estimated as the end of a run (the next sample
+        starts a new one, from the model's initial state).
+
+        Parameters
+        ----------
+        idle_s : float
+            Seconds since the last message, said in the line.
+        """
+        pending = self.estimator.waiting + self.estimator.timeline.held
+        if pending:
+            self.say(f"no message for {idle_s:.2g} s: the {pending} sample(s) waiting are estimated as the end of "
+                     "a run; the next sample starts a new one")
+            self.finish()
+
     def close(self, *, stopped: bool = False) -> None:
         """Write the recording's last file and close the sink.
 

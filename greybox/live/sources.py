@@ -15,7 +15,10 @@ from typing import Iterator, TextIO
 
 from .broker import BrokerAddress, BrokerOptions, Connection
 
-__all__ = ["Received", "ConnectionChange", "Idle", "LineSource", "MqttSource"]
+__all__ = ["DEFAULT_IDLE_S", "Received", "ConnectionChange", "Idle", "LineSource", "MqttSource"]
+
+#: Seconds without a message after which the samples waiting are estimated as the end of a run (``--idle-s``).
+DEFAULT_IDLE_S = 0.5
 
 
 @dataclass(frozen=True)

@@ -54,10 +54,13 @@ def json_batches(log, sizes) -> list[str]:
     return out
 
 
-def joined(lines) -> dict[str, np.ndarray]:
-    """The estimate columns of JSON output lines (alarm messages left out), joined."""
+def joined(lines, ordered: bool = False) -> dict[str, np.ndarray]:
+    """The estimate columns of JSON output lines (alarm messages left out), joined (in time order with
+    ``ordered``: messages queued while the broker was away may arrive after newer ones)."""
     rows = [json.loads(line) for line in lines if line.strip()]
     rows = [row for row in rows if "alarm" not in row]
+    if ordered:
+        rows.sort(key=lambda row: row["time_s"][0])
     return {name: np.concatenate([np.asarray(row[name], dtype=float) for row in rows])
             for name in rows[0] if name != "seq"}
 
