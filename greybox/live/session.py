@@ -196,6 +196,8 @@ class LiveSession:
             self.say(f"no message for {idle_s:.2g} s: the {pending} sample(s) waiting are estimated as the end of "
                      "a run; the next sample starts a new one")
             self.finish()
+        if self.recorder is not None:
+            self.recorder.flush()  # the recording on disk too, while the stream is quiet
 
     def close(self, *, stopped: bool = False) -> None:
         """Write the recording's last file and close the sink.
