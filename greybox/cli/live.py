@@ -127,6 +127,7 @@ def _record_given(action: argparse.Action) -> None:
 
 def _configured(args: argparse.Namespace) -> argparse.Namespace:
     """``args`` with the options of ``--config`` that the command line does not give."""
+    from ..errors import GreyboxError
     from ._live_config import read_config
 
     parser, given = args.live_parser, getattr(args, "given", frozenset())
@@ -136,7 +137,7 @@ def _configured(args: argparse.Namespace) -> argparse.Namespace:
             if dest not in given:
                 setattr(args, dest, value)
     if not args.source:
-        parser.error("--source is required (on the command line or in --config)")
+        raise GreyboxError("--source is required (on the command line or in --config)")
     return args
 
 

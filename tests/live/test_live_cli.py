@@ -127,3 +127,16 @@ def test_sigkill_loses_at_most_a_second_of_the_recording(model_file, cut_raw, tm
     n = len(table)
     np.testing.assert_array_equal(table["time_s"].to_numpy(), sent["time_s"][:n])
     np.testing.assert_allclose(table["force_process_N"].to_numpy(), sent["force_process_N"][:n], rtol=0, atol=1e-9)
+
+
+def test_the_config_file_gives_options_the_command_line_overrides(model_file, tmp_path, capsys):
+    config = tmp_path / "live.toml"
+    config.write_text('source = "-"\nsink = "file.txt"\nlimit = ["force_process_N=5"]\n')
+    # the sink of the file is overridden; the limit on the force, without an axis file, is refused at the start
+    assert run_cli(["live", model_file("coulomb"), "--config", config, "--sink", "-"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--limit force_process_N: no such output column" in err[0], err
+    assert "the force needs --axis-config" in err[0]
+    config.write_text('sink = "-"\n')
+    assert run_cli(["live", model_file("coulomb"), "--config", config]) == 2
+    assert "--source is required" in capsys.readouterr().err
