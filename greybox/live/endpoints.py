@@ -114,7 +114,7 @@ def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_top
     except BaseException:
         stream.close()
         raise
-    carrier = out if sink_at is not None else stream
+    carrier = (out if sink_at is not None else stream).connection
     status = StatusTopic(carrier, status_topic, options.client_id) if status_topic is not None else None
     return Endpoints(stream, out, status)
 

@@ -154,18 +154,6 @@ class MqttSink:
         """
         self.connection.publish(f"{self._topic(subtopic)}/alarm/{column}", text, retain=True)
 
-    def status(self, topic: str, text: str) -> None:
-        """Publish the service's status (retained) on ``topic``.
-
-        Parameters
-        ----------
-        topic : str
-            The status topic.
-        text : str
-            JSON text.
-        """
-        self.connection.publish(topic, text, retain=True)
-
     def close(self, wait_s: float = 5.0) -> None:
         """Wait (at most ``wait_s``) for the queued messages to be acknowledged, then disconnect; closing
         again does nothing.

@@ -149,18 +149,8 @@ class MqttSource:
             self._count += 1
             yield Received(payload, f"message {self._count} on {topic}", arrived_s, topic)
 
-    def status(self, topic: str, text: str) -> None:
-        """Publish the service's status (retained) on ``topic`` (when no MQTT sink carries it).
-
-        Parameters
-        ----------
-        topic : str
-            The status topic.
-        text : str
-            JSON text.
-        """
-        self.connection.publish(topic, text, retain=True)
-
     def close(self) -> None:
-        """Disconnect from the broker."""
+        """Disconnect from the broker (after the status it carries is acknowledged, at most 2 s)."""
+        if self.connection.connected:
+            self.connection.wait_for_queue(2.0)
         self.connection.close()

@@ -56,8 +56,9 @@ class StatusTopic:
 
     Parameters
     ----------
-    carrier : MqttSink or MqttSource
-        The connection that publishes it (its will is :func:`will_message` on ``topic``).
+    carrier : Connection
+        The connection that publishes it (the sink's or the source's; its will is :func:`will_message` on
+        ``topic``).
     topic : str
         The status topic.
     client_id : str
@@ -86,8 +87,8 @@ class StatusTopic:
         counters : dict
             The counters.
         """
-        self.carrier.status(self.topic, status_message(state, client_id=self.client_id, counters=counters,
-                                                       started=self.started))
+        self.carrier.publish(self.topic, status_message(state, client_id=self.client_id, counters=counters,
+                                                        started=self.started), retain=True)
         self.last_s = time.monotonic()
 
     def due(self) -> bool:
