@@ -114,8 +114,9 @@ def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_top
     except BaseException:
         stream.close()
         raise
-    carrier = (out if sink_at is not None else stream).connection
-    status = StatusTopic(carrier, status_topic, options.client_id) if status_topic is not None else None
+    status = None
+    if status_topic is not None:  # a broker carries it: the sink's, or else the source's
+        status = StatusTopic((out if sink_at is not None else stream).connection, status_topic, options.client_id)
     return Endpoints(stream, out, status)
 
 
