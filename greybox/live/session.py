@@ -241,8 +241,8 @@ class LiveSession:
             away = change.time_s - self._offline_since if self._offline_since is not None else 0.0
             self.stats.offline_s += away
             self._offline_since = None
-            say(f"broker connection back after {away:.1f} s; messages of that time are missing "
-                "(a gap in the time stamps re-initialises the model's state)")
+            say(f"broker connection back after {away:.1f} s; the messages the broker kept for the session (QoS 1) "
+                "come now, any missing make a gap in the time stamps (the model's state re-initialised)")
 
     def _publish(self, out: StepOutput, seq) -> None:
         for event in out.events:
