@@ -5,10 +5,17 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._types import FRACTION, POSITIVE, positive
+from ._types import FRACTION, POSITIVE, POSITIVE_INT, NumberRange, positive
+
+#: The QoS levels taken.
+QOS = NumberRange(int, low=0, high=1, description="a QoS of 0 or 1")
 
 
 def add_parser(subparsers) -> None:
+    from ..live.broker import PASSWORD_ENV
+    from ..live.messages import MAX_MESSAGE_BYTES, MAX_MESSAGE_DEPTH
+    from ..live.report import LINE_INTERVAL_S, LINES_PER_INTERVAL
+    from ..live.sources import DEFAULT_IDLE_S
     from ..models.chunked import DEFAULT_CHUNK_S
 
     parser = subparsers.add_parser(
@@ -23,11 +30,38 @@ def add_parser(subparsers) -> None:
                         help="model file written by 'greybox train' (.gbm), or a machine model directory ('greybox "
                         "train --axes'): one estimate per axis, from one topic per axis (topics ending in the axis "
                         "name) or from messages of every axis's columns (X_position_mm, ...)")
-    parser.add_argument("--source", required=True, metavar="SOURCE",
-                        help="'-' (JSON or CSV lines on stdin) or mqtt://HOST[:PORT]/TOPIC")
+    parser.add_argument("--config", metavar="TOML",
+                        help="read options from this file: keys are the option names (record_s = 60, limit = "
+                        "['force_process_N=1500'], tls_ca = 'ca.pem', ...); the command line overrides them")
+    parser.add_argument("--source", metavar="SOURCE",
+                        help="'-' (JSON or CSV lines on stdin) or mqtt[s]://[USER@]HOST[:PORT]/TOPIC (wildcards + "
+                        "and #; mqtts for TLS); required, here or in --config")
     parser.add_argument("--sink", default="-", metavar="SINK",
-                        help="'-' (JSON lines on stdout, the default) or mqtt://HOST[:PORT]/TOPIC (alarms on "
-                        "TOPIC/alarm)")
+                        help="'-' (JSON lines on stdout, the default) or mqtt[s]://[USER@]HOST[:PORT]/TOPIC (alarms "
+                        "retained on TOPIC/alarm/COLUMN, the status on TOPIC/status)")
+    parser.add_argument("--username", metavar="USER", help="broker user name (or USER@ in the address)")
+    parser.add_argument("--password-file", metavar="FILE",
+                        help=f"file whose first line is the broker password (default: the environment variable "
+                        f"{PASSWORD_ENV}); never on the command line")
+    parser.add_argument("--tls-ca", metavar="PEM", help="CA certificate of the broker's certificate (mqtts://; "
+                        "default the system's CAs)")
+    parser.add_argument("--tls-cert", metavar="PEM", help="client certificate, for brokers that require one")
+    parser.add_argument("--tls-key", metavar="PEM", help="key of the client certificate")
+    parser.add_argument("--client-id", metavar="ID",
+                        help="MQTT client id (the connections are ID-in and ID-out); default unique per host and "
+                        "process; give a fixed one per instance so that a restarted service takes up its session")
+    parser.add_argument("--qos", type=QOS, default=1, metavar="N",
+                        help="QoS of the subscription, the estimates and the alarms: 1 (default, none lost while the "
+                        "broker is away) or 0")
+    parser.add_argument("--session-expiry", type=POSITIVE_INT, default=3600, metavar="S",
+                        help="seconds the broker keeps the session (and the messages for it) after a loss "
+                        "(default 3600)")
+    parser.add_argument("--queue-size", type=POSITIVE_INT, default=100_000, metavar="N",
+                        help="most output messages held while the broker is away (default 100000); beyond, counted "
+                        "as lost")
+    parser.add_argument("--status-topic", metavar="TOPIC",
+                        help="retained status (online/offline, the counters every 10 s) on this topic; default "
+                        "SINK_TOPIC/status with an MQTT sink")
     parser.add_argument("--axis-config", metavar="TOML",
                         help="axis metadata: adds force_process_N (torque_process_Nm), channel names")
     parser.add_argument("--machine", metavar="TOML",
@@ -61,9 +95,50 @@ def add_parser(subparsers) -> None:
                         help="cut-off [Hz] of the derivative filter (default as 'greybox predict')")
     parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
+    parser.add_argument("--max-message-bytes", type=POSITIVE_INT, default=MAX_MESSAGE_BYTES, metavar="N",
+                        help=f"refuse a larger message in one line (default {MAX_MESSAGE_BYTES})")
+    parser.add_argument("--max-depth", type=POSITIVE_INT, default=MAX_MESSAGE_DEPTH, metavar="N",
+                        help=f"refuse JSON nested deeper (default {MAX_MESSAGE_DEPTH}; the message shapes need 2)")
+    parser.add_argument("--lines-per-interval", type=POSITIVE_INT, default=LINES_PER_INTERVAL, metavar="N",
+                        help=f"lines said per {LINE_INTERVAL_S:g} s about messages and samples (default "
+                        f"{LINES_PER_INTERVAL}); the rest are counted in one summary line per {LINE_INTERVAL_S:g} s")
+    parser.add_argument("--idle-s", type=POSITIVE, default=DEFAULT_IDLE_S, metavar="S",
+                        help=f"after S seconds without a message, estimate the samples waiting for their look-ahead "
+                        f"as the end of a run (default {DEFAULT_IDLE_S:g}; the next sample starts a new run)")
     parser.add_argument("--connect-timeout", type=positive("seconds"), default=10.0, metavar="S",
                         help="seconds to wait for the broker at the start (default 10)")
-    parser.set_defaults(run=run)
+    for action in parser._actions:
+        _record_given(action)
+    parser.set_defaults(run=run, live_parser=parser)
+
+
+def _record_given(action: argparse.Action) -> None:
+    """Make ``action`` note its destination in ``namespace.given`` when the command line gives it."""
+    base = type(action)
+
+    class Given(base):
+        def __call__(self, parser, namespace, values, option_string=None):
+            namespace.given = getattr(namespace, "given", frozenset()) | {self.dest}
+            super().__call__(parser, namespace, values, option_string)
+
+    Given.__name__ = base.__name__
+    action.__class__ = Given
+
+
+def _configured(args: argparse.Namespace) -> argparse.Namespace:
+    """``args`` with the options of ``--config`` that the command line does not give."""
+    from ..errors import GreyboxError
+    from ._live_config import read_config
+
+    parser, given = args.live_parser, getattr(args, "given", frozenset())
+    if args.config:
+        actions = {action.dest: action for action in parser._actions if action.option_strings}
+        for dest, value in read_config(args.config, actions).items():
+            if dest not in given:
+                setattr(args, dest, value)
+    if not args.source:
+        raise GreyboxError("--source is required (on the command line or in --config)")
+    return args
 
 
 def _say(line: str) -> None:
@@ -72,9 +147,16 @@ def _say(line: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..data.io import parse_column_mapping
+    from ..live.broker import BrokerOptions, read_password
     from ..live.limits import parse_duration, parse_limit
+    from ..live.messages import MessageBounds
     from ..live.run import run_live
 
+    args = _configured(args)
+    broker = BrokerOptions(username=args.username, password=read_password(args.password_file), ca_file=args.tls_ca,
+                           cert_file=args.tls_cert, key_file=args.tls_key, client_id=args.client_id, qos=args.qos,
+                           session_expiry_s=args.session_expiry, queue_size=args.queue_size,
+                           connect_timeout=args.connect_timeout)
     outcome = run_live(
         args.model, source=args.source, sink=args.sink, axis_config_path=args.axis_config, machine_path=args.machine,
         record_dir=args.record,
@@ -82,7 +164,9 @@ def run(args: argparse.Namespace) -> int:
         hold_s=parse_duration(args.limit_hold), exit_on_alarm=args.exit_on_alarm, stats_path=args.stats,
         sample_time=args.sample_time, tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz, chunk_s=args.chunk_s,
         columns=parse_column_mapping(args.columns) if args.columns else None, axis=args.axis,
-        connect_timeout=args.connect_timeout, say=_say)
+        broker=broker, status_topic=args.status_topic,
+        bounds=MessageBounds(max_bytes=args.max_message_bytes, max_depth=args.max_depth),
+        lines_per_interval=args.lines_per_interval, idle_s=args.idle_s, say=_say)
     for path in outcome.recorded:
         _say(f"recorded {path}")
     return outcome.status

@@ -158,6 +158,8 @@ class LiveEstimator:
         Running figures of every sample estimated (with ``keep_tally``).
     runs : int
         Runs started (1 + gaps).
+    output_columns : tuple of str or None
+        The columns of the estimates, once :meth:`warm_up` ran.
     """
 
     def __init__(self, model, *, axis_config: AxisConfig | None = None, sample_time: float | None = None,
@@ -170,6 +172,7 @@ class LiveEstimator:
         self.timeline = Timeline(sample_time=sample_time, tolerance=tolerance)
         self.tally = ProcessTally() if keep_tally else None
         self.runs = 0
+        self.output_columns: tuple | None = None
         self._run: _Run | None = None
 
     @property
@@ -208,6 +211,8 @@ class LiveEstimator:
                 + trial.finish().results
         except (GreyboxError, AttributeError, ValueError):  # a model file without its fit's record, an option
             return False  # out of range: the stream's first message says what is wrong
+        if ran:
+            self.output_columns = tuple(ran[0].columns())
         return bool(ran)
 
     def step(self, log: AxisLog) -> StepOutput:

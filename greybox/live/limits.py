@@ -12,7 +12,8 @@ import json
 import math
 import re
 from dataclasses import dataclass
-from typing import Mapping
+from datetime import datetime, timezone
+from typing import Iterable, Mapping
 
 import numpy as np
 
@@ -54,9 +55,12 @@ class Alarm:
     since_s : float
         Time of the stretch's first sample [s].
     time_s : float
-        Time of the sample that completed the hold [s].
+        Raised: time of the sample that completed the hold [s]. Cleared: time of the first sample back
+        within the limit, or of the run's last sample when it ended at a gap [s].
     hold_s : float
         The hold time [s].
+    state : {"raised", "cleared"}
+        Whether the alarm is raised or cleared.
     """
 
     column: str
@@ -65,14 +69,26 @@ class Alarm:
     since_s: float
     time_s: float
     hold_s: float
+    state: str = "raised"
 
-    def message(self) -> str:
-        """The alarm as JSON text (the alarm message of a sink)."""
-        return json.dumps({"alarm": "limit", "column": self.column, "limit": self.bound, "value": self.value,
-                           "since_s": self.since_s, "time_s": self.time_s, "hold_s": self.hold_s})
+    def message(self, seq=None) -> str:
+        """The alarm as JSON text (the alarm message of a sink), with the wall-clock time it is sent.
+
+        Parameters
+        ----------
+        seq : object, optional
+            The ``"seq"`` of the input message whose samples raised or cleared it.
+        """
+        wall = datetime.now(timezone.utc).isoformat(timespec="milliseconds")
+        return json.dumps({"alarm": "limit", "state": self.state, "column": self.column, "limit": self.bound,
+                           "value": self.value, "since_s": self.since_s, "time_s": self.time_s,
+                           "hold_s": self.hold_s, "wall_time": wall, "seq": seq})
 
     def line(self) -> str:
         """The alarm in one line of text."""
+        if self.state == "cleared":
+            return (f"ALARM CLEARED: |{self.column}| back within {self.bound:g} at t = {self.time_s:.4f} s "
+                    f"(above since t = {self.since_s:.4f} s, largest {self.value:.4g})")
         return (f"ALARM: |{self.column}| above {self.bound:g} since t = {self.since_s:.4f} s "
                 f"({1e3 * (self.time_s - self.since_s):.1f} ms, hold {1e3 * self.hold_s:g} ms), "
                 f"largest {self.value:.4g}")
@@ -140,13 +156,52 @@ class LimitWatch:
         self._raised: dict[str, bool] = {limit.column: False for limit in self.limits}
         self._checked = False
 
-    def rearm(self) -> None:
-        """Forget the stretches in progress (a new run starts)."""
+    def rearm(self, time_s: float = math.nan) -> list[Alarm]:
+        """Forget the stretches in progress (a run ended at a gap); the alarms raised are cleared.
+
+        Parameters
+        ----------
+        time_s : float, optional
+            Time of the last sample of the run that ended [s].
+
+        Returns
+        -------
+        list of Alarm
+            The alarms cleared.
+        """
+        cleared = [self._cleared(limit, time_s) for limit in self.limits if self._raised[limit.column]]
         for column in self._since:
             self._since[column], self._peak[column], self._raised[column] = None, 0.0, False
+        return cleared
+
+    def _cleared(self, limit: Limit, time_s: float) -> Alarm:
+        name = limit.column
+        return Alarm(name, limit.bound, self._peak[name], self._since[name], time_s, self.hold_s, "cleared")
+
+    def check_columns(self, columns: Iterable[str]) -> None:
+        """Refuse a limit on a column the output lacks (at the start, with the columns of the output).
+
+        Parameters
+        ----------
+        columns : iterable of str
+            The output columns.
+
+        Raises
+        ------
+        GreyboxError
+            When a limit names a column not among them.
+        """
+        columns = list(columns)
+        missing = [limit.column for limit in self.limits if limit.column not in columns]
+        if missing:
+            names = ", ".join(name for name in columns if name != "time_s")
+            raise GreyboxError(f"--limit {missing[0]}: no such output column; the columns are {names}"
+                               + ("" if "force_process_N" in columns or "torque_process_Nm" in columns
+                                  else " (the force needs --axis-config)"))
+        self._checked = True
 
     def check(self, columns: Mapping[str, np.ndarray]) -> list[Alarm]:
-        """The alarms raised by the next samples.
+        """The alarms raised and cleared by the next samples, in time order per column.
 
         Parameters
         ----------
@@ -159,13 +214,7 @@ class LimitWatch:
             When a limit names a column the output lacks (checked on the first call).
         """
         if not self._checked:
-            missing = [limit.column for limit in self.limits if limit.column not in columns]
-            if missing:
-                names = ", ".join(name for name in columns if name != "time_s")
-                raise GreyboxError(f"--limit {missing[0]}: no such output column; the columns are {names}"
-                                   + ("" if "force_process_N" in columns or "torque_process_Nm" in columns
-                                      else " (the force needs --axis-config)"))
-            self._checked = True
+            self.check_columns(columns)
         alarms = []
         time = columns["time_s"]
         for limit in self.limits:
@@ -173,6 +222,8 @@ class LimitWatch:
             magnitude = np.abs(columns[name])
             for t, value in zip(time.tolist(), magnitude.tolist()):
                 if not value > limit.bound:
+                    if self._raised[name]:
+                        alarms.append(self._cleared(limit, t))
                     self._since[name], self._peak[name], self._raised[name] = None, 0.0, False
                     continue
                 if self._since[name] is None:

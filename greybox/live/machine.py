@@ -13,7 +13,7 @@ import json
 from typing import Callable, Mapping
 
 from ..atomic import write_text_atomic
-from .messages import Decoder, MessageError
+from .messages import DEFAULT_BOUNDS, Decoder, MessageBounds, MessageError
 from .session import LiveSession
 from .sources import ConnectionChange, Received
 from .stats import LiveStats
@@ -30,6 +30,8 @@ class MachineSession:
         One session per axis (each with ``subtopic`` its axis name).
     say : callable
         ``say(line)`` for the lines of the machine (messages no axis takes, the broker connection).
+    bounds : MessageBounds, optional
+        The largest message taken.
 
     Attributes
     ----------
@@ -37,11 +39,12 @@ class MachineSession:
         The counters of the messages (received, rejected) and of the broker connection.
     """
 
-    def __init__(self, sessions: Mapping[str, LiveSession], *, say: Callable[[str], None]):
+    def __init__(self, sessions: Mapping[str, LiveSession], *, say: Callable[[str], None],
+                 bounds: MessageBounds = DEFAULT_BOUNDS):
         self.sessions = dict(sessions)
         self.say = say
         self.stats = LiveStats()
-        self._decoder = Decoder()
+        self._decoder = Decoder(bounds)
 
     @property
     def alarmed(self) -> bool:
@@ -95,6 +98,17 @@ class MachineSession:
         for session in self.sessions.values():
             session.finish()
 
+    def idle(self, idle_s: float) -> None:
+        """The stream went quiet, for every axis (:meth:`LiveSession.idle`).
+
+        Parameters
+        ----------
+        idle_s : float
+            Seconds since the last message.
+        """
+        for session in self.sessions.values():
+            session.idle(idle_s)
+
     def close(self, *, stopped: bool = False) -> None:
         """Close every axis's recording and the sink.
 
@@ -112,6 +126,11 @@ class MachineSession:
         lines += [f"{axis} {session.stats_line()}" for axis, session in self.sessions.items()]
         return "\n".join(lines)
 
+    def counters(self) -> dict:
+        """The counters of the machine and of each axis as they are now, JSON-able."""
+        return {**self.stats.to_dict(),
+                "axes": {axis: session.current_stats().to_dict() for axis, session in self.sessions.items()}}
+
     def write_stats(self, path) -> None:
         """Write the counters of the machine and of each axis to a JSON file, atomically.
 
@@ -120,6 +139,4 @@ class MachineSession:
         path : path-like
             The stats file.
         """
-        document = {**self.stats.to_dict(),
-                    "axes": {axis: session.current_stats().to_dict() for axis, session in self.sessions.items()}}
-        write_text_atomic(path, json.dumps(document, indent=1) + "\n")
+        write_text_atomic(path, json.dumps(self.counters(), indent=1) + "\n")

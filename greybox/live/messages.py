@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import json
 import math
+import re
+from dataclasses import dataclass
 from typing import Mapping, Union
 
 import msgspec
@@ -27,7 +29,8 @@ from ..data.log import AxisLog
 from ..data.units import EFFORT_QUANTITIES, log_from_columns, resolve_table
 from ..errors import GreyboxError, LogError
 
-__all__ = ["MessageError", "SEQUENCE_KEY", "MAX_MESSAGE_SAMPLES", "MAX_MESSAGE_BYTES", "parse_json",
+__all__ = ["MessageError", "SEQUENCE_KEY", "MAX_MESSAGE_SAMPLES", "MAX_MESSAGE_BYTES", "MAX_MESSAGE_DEPTH",
+           "MessageBounds", "DEFAULT_BOUNDS", "json_depth", "parse_json",
            "parse_csv_row", "csv_header", "Decoder", "message_log", "MessageLogs", "estimate_message"]
 
 #: Key of a message's sequence tag, echoed in the estimates it completes.
@@ -36,8 +39,62 @@ SEQUENCE_KEY = "seq"
 #: Most samples one message may hold (a minute at 500 Hz is 30 000); a larger one is refused.
 MAX_MESSAGE_SAMPLES = 100_000
 
-#: Most bytes of one message.
-MAX_MESSAGE_BYTES = 64 << 20
+#: Most bytes of one message by default (16 MiB: a minute at 500 Hz of five columns takes about 3 MB).
+MAX_MESSAGE_BYTES = 16 << 20
+
+#: Deepest nesting of JSON arrays and objects in a message by default (the shapes read need 2).
+MAX_MESSAGE_DEPTH = 8
+
+
+@dataclass(frozen=True)
+class MessageBounds:
+    """The largest message a stream takes; a larger one is refused before it is decoded.
+
+    Attributes
+    ----------
+    max_bytes : int
+        Most bytes of one message.
+    max_depth : int
+        Deepest nesting of JSON arrays and objects.
+    max_samples : int
+        Most samples of one message.
+    """
+
+    max_bytes: int = MAX_MESSAGE_BYTES
+    max_depth: int = MAX_MESSAGE_DEPTH
+    max_samples: int = MAX_MESSAGE_SAMPLES
+
+    def __post_init__(self):
+        for name in ("max_bytes", "max_depth", "max_samples"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"{name} must be a positive integer, got {value!r}")
+
+
+#: The bounds of a stream's messages by default.
+DEFAULT_BOUNDS = MessageBounds()
+
+#: The string literals of JSON text (escapes included), left out when the nesting is counted.
+_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"', re.DOTALL)
+_OPENING, _CLOSING = np.frombuffer(b"[{", dtype=np.uint8), np.frombuffer(b"]}", dtype=np.uint8)
+
+
+def json_depth(text: str | bytes) -> int:
+    """The deepest nesting of arrays and objects in JSON text, counted without parsing it (no recursion).
+
+    Brackets inside string literals are not counted; in text that is not JSON the count is an upper bound.
+
+    Parameters
+    ----------
+    text : str or bytes
+        The text.
+    """
+    data = text.encode("utf-8", "surrogatepass") if isinstance(text, str) else bytes(text)
+    codes = np.frombuffer(_STRING.sub(b"", data), dtype=np.uint8)
+    if not codes.size:
+        return 0
+    steps = np.isin(codes, _OPENING).astype(np.int64) - np.isin(codes, _CLOSING)
+    return max(0, int(np.cumsum(steps).max()))
 
 
 class MessageError(GreyboxError):
@@ -62,13 +119,15 @@ def _column(name: str, values) -> np.ndarray:
     return out
 
 
-def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
+def parse_json(text: str | bytes, bounds: MessageBounds = DEFAULT_BOUNDS) -> tuple[dict[str, np.ndarray], object]:
     """The columns and the sequence tag of one JSON message.
 
     Parameters
     ----------
     text : str or bytes
         The message (UTF-8).
+    bounds : MessageBounds, optional
+        The largest message taken (size, nesting, samples).
 
     Returns
     -------
@@ -80,22 +139,24 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
     Raises
     ------
     MessageError
-        For text that is not JSON, not an object or a list of objects, columns of different lengths or
-        values that are not numbers.
+        For text that is not JSON, not an object or a list of objects, columns of different lengths,
+        values that are not numbers, or a message beyond ``bounds``.
     """
-    if len(text) > MAX_MESSAGE_BYTES:
-        raise MessageError(f"the message holds {len(text)} bytes, more than {MAX_MESSAGE_BYTES}")
+    _check_size(len(text), bounds)
     decoded = _typed_columns(text)
     if decoded is not None:
         columns, seq = decoded
-        return _checked(columns), seq
+        return _checked(columns, bounds), seq
+    depth = json_depth(text)  # the general readers below recurse once per level: bounded first
+    if depth > bounds.max_depth:
+        raise MessageError(f"JSON nested {depth} levels deep, more than {bounds.max_depth}")
     try:  # msgspec reads strict JSON a few times faster; json.loads takes what it refuses (NaN) or explains why
         value = _DECODER.decode(text)
     except msgspec.DecodeError:
         value = None
     try:
         value = json.loads(text) if value is None else value
-    except (ValueError, UnicodeDecodeError) as exc:
+    except (ValueError, UnicodeDecodeError, RecursionError) as exc:
         raise MessageError(f"not JSON ({exc})") from None
     seq = None
     if isinstance(value, list):
@@ -113,7 +174,12 @@ def parse_json(text: str | bytes) -> tuple[dict[str, np.ndarray], object]:
         columns = {name: _column(name, column) for name, column in value.items() if name != SEQUENCE_KEY}
     else:
         raise MessageError("a message must be a JSON object (one sample, or columns of a batch) or a list of objects")
-    return _checked(columns), seq
+    return _checked(columns, bounds), seq
+
+
+def _check_size(size: int, bounds: MessageBounds) -> None:
+    if size > bounds.max_bytes:
+        raise MessageError(f"the message holds {size} bytes, more than {bounds.max_bytes}")
 
 
 def _typed_columns(text: str | bytes) -> tuple[dict[str, np.ndarray], object] | None:
@@ -141,15 +207,15 @@ def _typed_columns(text: str | bytes) -> tuple[dict[str, np.ndarray], object] | 
     return columns, seq
 
 
-def _checked(columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def _checked(columns: dict[str, np.ndarray], bounds: MessageBounds) -> dict[str, np.ndarray]:
     """The columns of a message, refused when empty, of different lengths or too long."""
     lengths = {len(column) for column in columns.values()}
     if not columns or lengths == {0}:
         raise MessageError("the message holds no samples")
     if len(lengths) > 1:
         raise MessageError(f"the columns have different lengths ({', '.join(map(str, sorted(lengths)))})")
-    if max(lengths) > MAX_MESSAGE_SAMPLES:
-        raise MessageError(f"the message holds {max(lengths)} samples, more than {MAX_MESSAGE_SAMPLES}")
+    if max(lengths) > bounds.max_samples:
+        raise MessageError(f"the message holds {max(lengths)} samples, more than {bounds.max_samples}")
     return columns
 
 
@@ -205,13 +271,19 @@ class Decoder:
     A payload starting with ``{`` or ``[`` is JSON; any other is a CSV line, after a header that must be
     the stream's first line. Lines starting with ``#`` are comments (a CSV log's metadata preamble).
 
+    Parameters
+    ----------
+    bounds : MessageBounds, optional
+        The largest message taken (size, nesting, samples).
+
     Attributes
     ----------
     header : list of str or None
         The CSV header once read.
     """
 
-    def __init__(self):
+    def __init__(self, bounds: MessageBounds = DEFAULT_BOUNDS):
+        self.bounds = bounds
         self.header: list[str] | None = None
         self._started = False
 
@@ -228,6 +300,7 @@ class Decoder:
         MessageError
             For a message that cannot be read (see :func:`parse_json`, :func:`parse_csv_row`).
         """
+        _check_size(len(payload), self.bounds)
         if isinstance(payload, bytes):
             try:
                 payload = payload.decode("utf-8")
@@ -238,7 +311,7 @@ class Decoder:
             return None
         first, self._started = not self._started, True
         if text[0] in "{[":
-            return parse_json(text)
+            return parse_json(text, self.bounds)
         if self.header is None:
             if not first:
                 raise MessageError("not JSON (a CSV header must be the stream's first line)")

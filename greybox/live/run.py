@@ -19,14 +19,16 @@ from typing import Callable, Mapping, TextIO
 
 from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S
-from .broker import is_address, parse_address
+from .broker import BrokerOptions
+from .endpoints import open_endpoints
 from .estimator import LiveEstimator
 from .limits import Limit, LimitWatch
 from .machine import MachineSession
+from .messages import DEFAULT_BOUNDS, MessageBounds
 from .recording import DEFAULT_RECORD_S, Recorder
+from .report import LINES_PER_INTERVAL, LineLimiter
 from .session import LiveSession
-from .sinks import LineSink, MqttSink
-from .sources import LineSource, MqttSource
+from .sources import DEFAULT_IDLE_S, Idle
 from .stats import LiveStats
 
 __all__ = ["ALARM_STATUS", "LiveOutcome", "run_live", "settled_memory"]
@@ -125,24 +127,8 @@ def settled_memory():
         gc.unfreeze()
 
 
-def _source(spec: str, stdin: TextIO, connect_timeout: float):
-    if spec == "-":
-        return LineSource(stdin)
-    if is_address(spec):
-        return MqttSource(parse_address(spec, "--source"), connect_timeout=connect_timeout)
-    raise GreyboxError(f"--source {spec}: give '-' (lines on stdin) or mqtt://HOST[:PORT]/TOPIC")
-
-
-def _sink(spec: str, stdout: TextIO, connect_timeout: float):
-    if spec == "-":
-        return LineSink(stdout)
-    if is_address(spec):
-        return MqttSink(parse_address(spec, "--sink"), connect_timeout=connect_timeout)
-    raise GreyboxError(f"--sink {spec}: give '-' (lines on stdout) or mqtt://HOST[:PORT]/TOPIC")
-
-
 def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
-                  axis, source, say):
+                  axis, source, say, bounds):
     """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
     from ..data.axis_config import read_axis_config
     from ..models.registry import model_kind
@@ -158,14 +144,14 @@ def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, re
             attrs={"model_file": str(model_path), "source": str(source)})
         watch = LimitWatch(list(limits), hold_s=hold_s) if limits else None
         session = LiveSession(LiveEstimator(model, axis_config=config, **options), out, say=say, limits=watch,
-                              recorder=recorder, mapping=mapping, axis=axis)
+                              recorder=recorder, mapping=mapping, axis=axis, bounds=bounds)
         return session, model_kind(model), [recorder] if recorder is not None else []
 
     return build
 
 
 def _machine_session(model_path, machine_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
-                     source, say):
+                     source, say, bounds):
     """A function of the sink that builds the sessions of a machine model's axes: (session, kind, recorders)."""
     from pathlib import Path
 
@@ -192,11 +178,23 @@ def _machine_session(model_path, machine_path, options: dict, *, record_dir, rec
                 say=lambda line, axis=axis: say(f"{axis}: {line}"),
                 limits=LimitWatch(list(limits), hold_s=hold_s) if limits else None, recorder=recorder,
                 mapping=dict(entry.channels) if entry is not None and entry.channels else None, axis=axis,
-                subtopic=axis)
+                subtopic=axis, bounds=bounds)
         kinds = sorted({model_kind(model) for model in machine.models.values()})
-        return MachineSession(sessions, say=say), f"machine ({', '.join(machine.axes)}: {', '.join(kinds)})", recorders
+        described_kind = f"machine ({', '.join(machine.axes)}: {', '.join(kinds)})"
+        return MachineSession(sessions, say=say, bounds=bounds), described_kind, recorders
 
-    return build
+    return build, list(machine.axes)
+
+
+def _sink_changes(out, session, say) -> None:
+    """Say and count the losses and returns of the sink's broker connection."""
+    for change in out.changes():
+        if change.connected:
+            say(f"sink's broker connection back; {out.queued} output message(s) queued go out now")
+        else:
+            session.stats.output_disconnections += 1
+            say(f"sink's broker connection lost ({change.reason}); output messages are queued "
+                f"(at most {out.connection.options.queue_size}) until it is back")
 
 
 def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None, machine_path=None,
@@ -204,7 +202,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
              record_s: float = DEFAULT_RECORD_S, limits: list[Limit] = (), hold_s: float = 0.0,
              exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
-             columns: Mapping[str, str] | None = None, axis: str | None = None, connect_timeout: float = 10.0,
+             columns: Mapping[str, str] | None = None, axis: str | None = None, broker: BrokerOptions | None = None,
+             status_topic: str | None = None, bounds: MessageBounds = DEFAULT_BOUNDS,
+             lines_per_interval: int = LINES_PER_INTERVAL, idle_s: float | None = DEFAULT_IDLE_S,
              say: Callable[[str], None] = print, stdin: TextIO | None = None,
              stdout: TextIO | None = None) -> LiveOutcome:
     """Estimate the process current (and force) of a live stream with a model trained on air cuts.
@@ -215,9 +215,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         Model file written by ``greybox train``, or a machine model (a directory written by ``greybox train
         --axes``): then one session per axis (:mod:`greybox.live.machine`).
     source : str
-        ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt://HOST[:PORT]/TOPIC``.
+        ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC`` (wildcards allowed).
     sink : str, default "-"
-        ``-`` (JSON lines on ``stdout``) or ``mqtt://HOST[:PORT]/TOPIC``.
+        ``-`` (JSON lines on ``stdout``) or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC``.
     axis_config_path : path-like, optional
         Axis file (TOML): the process force (torque) and the channel names.
     machine_path : path-like, optional
@@ -247,8 +247,19 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         file's channels).
     axis : str, optional
         Axis to take from messages holding several.
-    connect_timeout : float, default 10.0
-        Seconds to wait for the broker at the start.
+    broker : BrokerOptions, optional
+        Log-in, TLS, client id, QoS, session and queue of the broker connections.
+    status_topic : str, optional
+        Topic of the retained status (online/offline, the counters every 10 s); default
+        ``<sink topic>/status`` with an MQTT sink.
+    bounds : MessageBounds, optional
+        The largest message taken (bytes, JSON nesting, samples); a larger one is refused in one line.
+    lines_per_interval : int, default 20
+        Lines of the stream (messages skipped, samples dropped, gaps, alarms) said per 10 s; those beyond
+        are counted and summed up in one line per 10 s. Every line is cut to 300 characters.
+    idle_s : float or None, default 0.5
+        After this many seconds without a message (on a broker) the samples waiting for their look-ahead are
+        estimated as the end of a run, so that the tail of a stream comes out; None: never.
     say : callable, default print
         ``say(line)`` for each line of text.
     stdin, stdout : text file, optional
@@ -269,39 +280,53 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     from ..machine_model import is_machine_model
 
     options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s)
+    lines = LineLimiter(say, burst=lines_per_interval)
     if is_machine_model(model_path):
-        build = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
-                                 limits=limits, hold_s=hold_s, columns=columns, source=source, say=say)
+        build, axes = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
+                                 limits=limits, hold_s=hold_s, columns=columns, source=source, say=lines,
+                                 bounds=bounds)
     else:
         if machine_path:
             raise GreyboxError("--machine applies to a machine model (a directory written by 'greybox train "
                                "--axes'); give one axis's mechanics with --axis-config")
-        build = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
-                              limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=say)
-    stream = _source(source, stdin or sys.stdin, connect_timeout)
-    out = None
+        build, axes = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
+                              limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=lines,
+                              bounds=bounds), [None]
+    ends = open_endpoints(source, sink, options=broker or BrokerOptions(), status_topic=status_topic, axes=axes,
+                          limit_columns=[limit.column for limit in limits], stdin=stdin or sys.stdin,
+                          stdout=stdout or sys.stdout)
+    stream, out = ends.stream, ends.out
     try:
-        out = _sink(sink, stdout or sys.stdout, connect_timeout)
         session, kind, recorders = build(out)
+        session.warm_up()
     except BaseException:
-        stream.close()
-        if out is not None:
-            out.close()
+        ends.close()
         raise
     status, stopped = 0, True
     deferred = _Deferred()
     try:
-        session.warm_up()
         with deferred, settled_memory():
-            say(f"greybox live: {kind} model {model_path}, reading "
-                f"{'stdin' if source == '-' else source}, writing {'stdout' if sink == '-' else sink}")
-            last_stats = time.monotonic()
+            say(f"greybox live: {kind} model {model_path}, reading {'stdin' if source == '-' else stream.address}, "
+                f"writing {'stdout' if sink == '-' else out.address}"
+                + (f", status on {ends.status.topic}" if ends.status is not None else ""))
+            last_stats = last_message = time.monotonic()
             for item in stream:
-                with deferred.held():
-                    session.handle(item)
-                if session.alarmed and exit_on_alarm:
-                    status = ALARM_STATUS
-                    break
+                lines.tick()
+                _sink_changes(out, session, lines)
+                if ends.status is not None and ends.status.due():
+                    ends.status.publish("online", session.counters())
+                if isinstance(item, Idle):
+                    quiet = time.monotonic() - last_message
+                    if idle_s is not None and quiet >= idle_s:
+                        with deferred.held():
+                            session.idle(quiet)
+                else:
+                    last_message = time.monotonic()
+                    with deferred.held():
+                        session.handle(item)
+                    if session.alarmed and exit_on_alarm:
+                        status = ALARM_STATUS
+                        break
                 if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
                     session.write_stats(stats_path)
                     last_stats = time.monotonic()
@@ -310,7 +335,10 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                     session.finish()
             stopped = status != 0
     finally:
+        lines.flush()
         try:
+            if ends.status is not None:
+                ends.status.publish("offline", session.counters())
             session.close(stopped=stopped)
             stream.close()
         finally:

@@ -16,7 +16,7 @@ import numpy as np
 from ..data.log import AxisLog
 from .estimator import LiveEstimator, Lost, RunStart, StepOutput
 from .limits import LimitWatch
-from .messages import Decoder, MessageError, MessageLogs, estimate_message
+from .messages import DEFAULT_BOUNDS, Decoder, MessageBounds, MessageError, MessageLogs, estimate_message
 from .recording import Recorder
 from .sources import ConnectionChange, Received
 from .stats import LiveStats
@@ -57,6 +57,8 @@ class LiveSession:
         Axis to take from messages holding several.
     subtopic : str, optional
         The axis of a machine's session: its output messages carry ``"axis"`` and go to ``<TOPIC>/<axis>``.
+    bounds : MessageBounds, optional
+        The largest message taken.
 
     Attributes
     ----------
@@ -68,7 +70,8 @@ class LiveSession:
 
     def __init__(self, estimator: LiveEstimator, sink, *, say: Callable[[str], None],
                  limits: LimitWatch | None = None, recorder: Recorder | None = None,
-                 mapping: Mapping[str, str] | None = None, axis: str | None = None, subtopic: str | None = None):
+                 mapping: Mapping[str, str] | None = None, axis: str | None = None, subtopic: str | None = None,
+                 bounds: MessageBounds = DEFAULT_BOUNDS):
         self.estimator = estimator
         self.sink = sink
         self.say = say
@@ -79,11 +82,12 @@ class LiveSession:
         self.subtopic = subtopic
         self.stats = LiveStats()
         self.alarmed = False
-        self._decoder = Decoder()
+        self._decoder = Decoder(bounds)
         self._logs = MessageLogs(mapping=self.mapping)
         self._signature: tuple | None = None
         self._offline_since: float | None = None
         self._run = 0  # run of the last estimates
+        self._last_s = float("nan")  # time of the last sample estimated
         self._open = True
 
     def handle(self, item: Received | ConnectionChange) -> None:
@@ -145,7 +149,12 @@ class LiveSession:
         """The counters, with the samples waiting now."""
         if self._open:
             self.stats.waiting = self.estimator.waiting
+            self.stats.outputs_lost, self.stats.outputs_queued = self.sink.lost, self.sink.queued
         return self.stats
+
+    def counters(self) -> dict:
+        """The counters as they are now, JSON-able."""
+        return self.current_stats().to_dict()
 
     def write_stats(self, path) -> None:
         """Write the counters (as they are now) to a JSON file, atomically.
@@ -159,12 +168,36 @@ class LiveSession:
 
     def warm_up(self) -> None:
         """Load the compiled kernels before the stream starts, so that the first message is not kept waiting
-        (:meth:`LiveEstimator.warm_up`)."""
-        self.estimator.warm_up()
+        (:meth:`LiveEstimator.warm_up`); check the limits against the columns of the output then.
+
+        Raises
+        ------
+        GreyboxError
+            When a limit names a column the output lacks (e.g. the force without an axis file).
+        """
+        if self.estimator.warm_up() and self.limits is not None:
+            self.limits.check_columns(self.estimator.output_columns)
 
     def finish(self) -> None:
         """The end of the stream: the samples still waiting are estimated as the end of a log."""
         self._publish(self.estimator.finish(), None)
+
+    def idle(self, idle_s: float) -> None:
+        """The stream went quiet: the samples waiting are estimated as the end of a run (the next sample
+        starts a new one, from the model's initial state).
+
+        Parameters
+        ----------
+        idle_s : float
+            Seconds since the last message, said in the line.
+        """
+        pending = self.estimator.waiting + self.estimator.timeline.held
+        if pending:
+            self.say(f"no message for {idle_s:.2g} s: the {pending} sample(s) waiting are estimated as the end of "
+                     "a run; the next sample starts a new one")
+            self.finish()
+        if self.recorder is not None:
+            self.recorder.flush()  # the recording on disk too, while the stream is quiet
 
     def close(self, *, stopped: bool = False) -> None:
         """Write the recording's last file and close the sink.
@@ -187,7 +220,7 @@ class LiveSession:
                 self.recorder.close()
         finally:
             self.sink.close()
-            self.stats.outputs_lost = self.sink.lost
+            self.stats.outputs_lost, self.stats.outputs_queued = self.sink.lost, self.sink.queued
 
     def connection(self, change: ConnectionChange, *, quiet: bool = False) -> None:
         """Count a loss or return of the broker connection, and say it.
@@ -208,8 +241,8 @@ class LiveSession:
             away = change.time_s - self._offline_since if self._offline_since is not None else 0.0
             self.stats.offline_s += away
             self._offline_since = None
-            say(f"broker connection back after {away:.1f} s; messages of that time are missing "
-                "(a gap in the time stamps re-initialises the model's state)")
+            say(f"broker connection back after {away:.1f} s; the messages the broker kept for the session (QoS 1) "
+                "come now, any missing make a gap in the time stamps (the model's state re-initialised)")
 
     def _publish(self, out: StepOutput, seq) -> None:
         for event in out.events:
@@ -227,15 +260,22 @@ class LiveSession:
                 if self.recorder is not None and run:
                     self.recorder.new_run()
                 if self.limits is not None:
-                    self.limits.rearm()
+                    self._alarms(self.limits.rearm(self._last_s), seq)
             if self.recorder is not None:
                 self.recorder.add(result)
             if self.limits is not None:
-                for alarm in self.limits.check(part):
-                    self.alarmed = True
-                    self.stats.alarms += 1
-                    self.sink.alarm(alarm.message(), subtopic=self.subtopic)
-                    self.say(alarm.line())
+                self._alarms(self.limits.check(part), seq)
+            self._last_s = float(part["time_s"][-1]) if len(part["time_s"]) else self._last_s
+
+    def _alarms(self, alarms, seq) -> None:
+        for alarm in alarms:
+            if alarm.state == "raised":
+                self.alarmed = True
+                self.stats.alarms += 1
+            else:
+                self.stats.alarms_cleared += 1
+            self.sink.alarm(alarm.message(seq), subtopic=self.subtopic, column=alarm.column)
+            self.say(alarm.line())
 
     def _event(self, event) -> None:
         if isinstance(event, Dropped):

@@ -2,7 +2,8 @@
 
 A source is an iterable of :class:`Received` messages and :class:`ConnectionChange` events, in the order
 they happened; it ends when the stream does (end of the text stream; an MQTT source runs until the
-command is stopped).
+command is stopped). An MQTT source also gives an :class:`Idle` each time no message came for its poll
+interval, so that the command can do what is due while the stream is quiet.
 """
 
 from __future__ import annotations
@@ -12,9 +13,12 @@ import time
 from dataclasses import dataclass
 from typing import Iterator, TextIO
 
-from .broker import BrokerAddress, Connection
+from .broker import BrokerAddress, BrokerOptions, Connection
 
-__all__ = ["Received", "ConnectionChange", "LineSource", "MqttSource"]
+__all__ = ["DEFAULT_IDLE_S", "Received", "ConnectionChange", "Idle", "LineSource", "MqttSource"]
+
+#: Seconds without a message after which the samples waiting are estimated as the end of a run (``--idle-s``).
+DEFAULT_IDLE_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -49,9 +53,25 @@ class ConnectionChange:
         The new state.
     time_s : float
         When, ``time.time()`` [s].
+    reason : str
+        Why, in the broker's or paho's words ("" for a return).
     """
 
     connected: bool
+    time_s: float
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class Idle:
+    """No message came for the source's poll interval.
+
+    Attributes
+    ----------
+    time_s : float
+        When, ``time.time()`` [s].
+    """
+
     time_s: float
 
 
@@ -86,11 +106,13 @@ class MqttSource:
     ----------
     address : BrokerAddress
         Broker and topic (wildcards allowed).
-    connect_timeout : float, default 10.0
-        Seconds to wait for the broker at the start.
-    poll_s : float, default 0.2
-        How long the iteration waits for a message before checking again (the command stays responsive
-        to signals).
+    options : BrokerOptions, optional
+        Log-in, TLS, client id, QoS of the subscription, session.
+    will : tuple of (str, str), optional
+        ``(topic, text)`` the broker publishes, retained, when the connection is lost without a goodbye.
+    poll_s : float, default 0.1
+        How long the iteration waits for a message before it gives an :class:`Idle` (the command stays
+        responsive to signals and does what is due while the stream is quiet).
 
     Raises
     ------
@@ -98,25 +120,27 @@ class MqttSource:
         When the broker cannot be reached at the start.
     """
 
-    def __init__(self, address: BrokerAddress, *, connect_timeout: float = 10.0, poll_s: float = 0.2):
+    def __init__(self, address: BrokerAddress, options: BrokerOptions | None = None, *,
+                 will: tuple[str, str] | None = None, poll_s: float = 0.1):
         self.address = address
         self.poll_s = float(poll_s)
         self._queue: queue.Queue = queue.Queue()
         self._count = 0
-        self.connection = Connection(address, subscribe=address.topic, connect_timeout=connect_timeout,
+        self.connection = Connection(address, options, role="in", subscribe=address.topic, will=will,
                                      on_message=self._message, on_state=self._state)
 
     def _message(self, topic: str, payload: bytes, arrived_s: float) -> None:
         self._queue.put((topic, payload, arrived_s))
 
-    def _state(self, connected: bool, time_s: float) -> None:
-        self._queue.put(ConnectionChange(connected, time_s))
+    def _state(self, connected: bool, time_s: float, reason: str) -> None:
+        self._queue.put(ConnectionChange(connected, time_s, reason))
 
-    def __iter__(self) -> Iterator[Received | ConnectionChange]:
+    def __iter__(self) -> Iterator[Received | ConnectionChange | Idle]:
         while True:
             try:
                 item = self._queue.get(timeout=self.poll_s)
             except queue.Empty:
+                yield Idle(time.time())
                 continue
             if isinstance(item, ConnectionChange):
                 yield item
@@ -126,5 +150,7 @@ class MqttSource:
             yield Received(payload, f"message {self._count} on {topic}", arrived_s, topic)
 
     def close(self) -> None:
-        """Disconnect from the broker."""
+        """Disconnect from the broker (after the status it carries is acknowledged, at most 2 s)."""
+        if self.connection.connected:
+            self.connection.wait_for_queue(2.0)
         self.connection.close()

@@ -44,8 +44,14 @@ class LiveStats:
         Time without a broker connection [s].
     alarms : int
         Alarms raised.
+    alarms_cleared : int
+        Alarms cleared.
     outputs_lost : int
-        Estimate or alarm messages that could not be published.
+        Estimate or alarm messages that could not be published (the queue full while the broker was away).
+    outputs_queued : int
+        Estimate or alarm messages published and not yet acknowledged by the broker.
+    output_disconnections : int
+        Losses of the sink's connection to the broker.
     """
 
     messages: int = 0
@@ -59,7 +65,10 @@ class LiveStats:
     disconnections: int = 0
     offline_s: float = 0.0
     alarms: int = 0
+    alarms_cleared: int = 0
     outputs_lost: int = 0
+    outputs_queued: int = 0
+    output_disconnections: int = 0
 
     def drop(self, reason: str, count: int) -> None:
         """Count samples dropped for their time stamps.
@@ -99,7 +108,8 @@ class LiveStats:
                 f"received, {self.samples_estimated} estimated, {sum(self.dropped.values())} dropped"
                 f"{parts(self.dropped)}, {sum(self.lost.values())} lost{parts(self.lost)}, {self.waiting} waiting; "
                 f"{self.gaps} gap(s), {self.disconnections} disconnection(s) ({self.offline_s:.1f} s offline), "
-                f"{self.alarms} alarm(s), {self.outputs_lost} output message(s) lost")
+                f"{self.alarms} alarm(s) ({self.alarms_cleared} cleared), {self.outputs_lost} output message(s) "
+                f"lost, {self.outputs_queued} queued, {self.output_disconnections} sink disconnection(s)")
 
     def to_dict(self) -> dict:
         """JSON-able counters, with ``skipped`` (dropped + lost)."""

@@ -92,6 +92,11 @@ class Timeline:
         self._held: list[AxisLog] = []  # samples before the nominal step is known
         self._last: float | None = None
 
+    @property
+    def held(self) -> int:
+        """Samples held until the nominal step is known."""
+        return sum(len(log) for log in self._held)
+
     def push(self, log: AxisLog) -> list:
         """The events of a message's samples, in order: kept samples (AxisLog), :class:`Dropped`, :class:`Gap`.
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import live_helpers
 import pandas as pd
 import pytest
-from live_helpers import EXAMPLE_AXIS, QUICK, Broker, run_cli
+from live_helpers import EXAMPLE_AXIS, QUICK, Broker, Certificates, run_cli
 
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
@@ -67,16 +67,47 @@ def offline(live_root, cut_raw):
     return get
 
 
-@pytest.fixture
-def broker(tmp_path):
-    """A running Mosquitto broker of its own; skips (naming the Debian package) when mosquitto is absent."""
+def _mosquitto() -> str:
     binary = live_helpers.mosquitto_binary()
     if binary is None:
         pytest.skip("the mosquitto broker is not installed (Debian/Ubuntu package 'mosquitto': "
                     "apt-get install mosquitto)")
-    running = Broker(binary, tmp_path)
+    return binary
+
+
+@pytest.fixture
+def broker(tmp_path):
+    """A running Mosquitto broker of its own; skips (naming the Debian package) when mosquitto is absent."""
+    running = Broker(_mosquitto(), tmp_path)
     running.start()
     try:
         yield running
     finally:
         running.stop()
+
+
+@pytest.fixture
+def make_broker(tmp_path):
+    """``make_broker(users=..., acl=..., tls=..., persistence=...)``: a running Mosquitto broker of those settings
+    (:class:`live_helpers.Broker`), in a folder of its own; stopped after the test."""
+    made = []
+
+    def make(**settings) -> Broker:
+        folder = tmp_path / f"broker{len(made)}"
+        folder.mkdir()
+        running = Broker(_mosquitto(), folder, **settings)
+        made.append(running)
+        running.start()
+        return running
+
+    yield make
+    for running in made:
+        running.stop()
+
+
+@pytest.fixture
+def certificates(tmp_path) -> Certificates:
+    """A CA, a broker and a client certificate made for the test (PEM files)."""
+    folder = tmp_path / "pki"
+    folder.mkdir()
+    return Certificates(folder)

@@ -54,10 +54,13 @@ def json_batches(log, sizes) -> list[str]:
     return out
 
 
-def joined(lines) -> dict[str, np.ndarray]:
-    """The estimate columns of JSON output lines (alarm messages left out), joined."""
+def joined(lines, ordered: bool = False) -> dict[str, np.ndarray]:
+    """The estimate columns of JSON output lines (alarm messages left out), joined (in time order with
+    ``ordered``: messages queued while the broker was away may arrive after newer ones)."""
     rows = [json.loads(line) for line in lines if line.strip()]
     rows = [row for row in rows if "alarm" not in row]
+    if ordered:
+        rows.sort(key=lambda row: row["time_s"][0])
     return {name: np.concatenate([np.asarray(row[name], dtype=float) for row in rows])
             for name in rows[0] if name != "seq"}
 
@@ -68,10 +71,15 @@ def joined(lines) -> dict[str, np.ndarray]:
 BROKER_START_S = 10.0
 
 
-def mosquitto_binary() -> str | None:
-    """The ``mosquitto`` program (also looked for in the sbin folders, where Debian installs it)."""
+def _program(name: str) -> str | None:
+    """A program of the mosquitto package (also looked for in the sbin folders, where Debian installs the broker)."""
     path = os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin", "/usr/local/sbin"])
-    return shutil.which("mosquitto", path=path)
+    return shutil.which(name, path=path)
+
+
+def mosquitto_binary() -> str | None:
+    """The ``mosquitto`` program."""
+    return _program("mosquitto")
 
 
 def free_port() -> int:
@@ -91,13 +99,40 @@ def _wait_for_port(port: int, deadline: float) -> bool:
 
 
 class Broker:
-    """A Mosquitto broker on 127.0.0.1 at a free port, for one test; ``restart()`` stops and starts it."""
+    """A Mosquitto broker on 127.0.0.1 at a free port, for one test; ``restart()`` stops and starts it.
 
-    def __init__(self, binary: str, folder: Path):
+    With ``users`` (``{name: password}``) it takes only those users (a password file made by
+    ``mosquitto_passwd``), and with ``acl`` (lines of an ACL file) only what it allows; with ``tls`` (a
+    :class:`Certificates`) the listener is TLS, requiring a client certificate; with ``persistence`` the
+    sessions and their queued messages survive a restart.
+    """
+
+    def __init__(self, binary: str, folder: Path, *, users: dict | None = None, acl: list[str] | None = None,
+                 tls: "Certificates | None" = None, persistence: bool = False):
         self.binary = binary
         self.port = free_port()
+        self.tls = tls
         self.config = folder / "mosquitto.conf"
-        self.config.write_text(f"listener {self.port} 127.0.0.1\nallow_anonymous true\npersistence false\n")
+        lines = [f"listener {self.port} 127.0.0.1", f"allow_anonymous {'false' if users else 'true'}",
+                 f"persistence {'true' if persistence else 'false'}", "set_tcp_nodelay true"]
+        if hasattr(os, "geteuid") and os.geteuid() == 0:
+            lines.append("user root")  # as root, mosquitto would become 'mosquitto' and not read the test's files
+        if persistence:
+            lines += [f"persistence_location {folder}/", "autosave_interval 1"]
+        if users:
+            passwords = folder / "passwords"
+            passwords.write_text("")
+            for name, password in users.items():
+                subprocess.run([_program("mosquitto_passwd"), "-b", str(passwords), name, password], check=True,
+                               capture_output=True)
+            lines.append(f"password_file {passwords}")
+        if acl is not None:
+            (folder / "acl").write_text("\n".join(acl) + "\n")
+            lines.append(f"acl_file {folder / 'acl'}")
+        if tls is not None:
+            lines += [f"cafile {tls.ca}", f"certfile {tls.server_cert}", f"keyfile {tls.server_key}",
+                      "require_certificate true"]
+        self.config.write_text("\n".join(lines) + "\n")
         self.log = folder / "mosquitto.log"
         self.process = None
 
@@ -124,8 +159,37 @@ class Broker:
         time.sleep(down_s)
         self.start()
 
-    def url(self, topic: str) -> str:
-        return f"mqtt://127.0.0.1:{self.port}/{topic}"
+    def url(self, topic: str, user: str | None = None) -> str:
+        scheme = "mqtts" if self.tls is not None else "mqtt"
+        return f"{scheme}://{user + '@' if user else ''}127.0.0.1:{self.port}/{topic}"
+
+    def kill(self) -> None:
+        """Stop the broker at once (SIGKILL)."""
+        if self.process is not None:
+            self.process.kill()
+            self.process.wait(timeout=5)
+            self.process = None
+
+
+class Certificates:
+    """A CA, a broker certificate for 127.0.0.1 and a client certificate, as PEM files in ``folder`` (trustme)."""
+
+    def __init__(self, folder: Path):
+        import trustme
+
+        ca = trustme.CA()
+        server = ca.issue_cert("127.0.0.1", "localhost")
+        client = ca.issue_cert("greybox-client@example.org")
+        self.ca, self.server_cert, self.server_key = folder / "ca.pem", folder / "server.pem", folder / "server.key"
+        self.client_cert, self.client_key = folder / "client.pem", folder / "client.key"
+        ca.cert_pem.write_to_path(str(self.ca))
+        server.cert_chain_pems[0].write_to_path(str(self.server_cert))
+        server.private_key_pem.write_to_path(str(self.server_key))
+        client.cert_chain_pems[0].write_to_path(str(self.client_cert))
+        client.private_key_pem.write_to_path(str(self.client_key))
+        other = trustme.CA()  # a CA the broker does not know
+        self.other_ca = folder / "other-ca.pem"
+        other.cert_pem.write_to_path(str(self.other_ca))
 
 
 
@@ -133,19 +197,27 @@ class Broker:
 class Subscriber:
     """A paho-mqtt client of the test that collects the messages of a topic filter."""
 
-    def __init__(self, port: int, topic: str):
+    def __init__(self, port: int, topic: str, *, user: tuple[str, str] | None = None,
+                 tls: "Certificates | None" = None, qos: int = 0, retained: bool = True):
         import threading
 
         import paho.mqtt.client as mqtt
 
         self.messages: list[tuple[str, bytes, float]] = []
+        self.retained: dict[str, bytes] = {}
         self.connections = 0
+        self.qos = qos
         self._lock = threading.Lock()
-        self.client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2, client_id=f"test-{os.getpid()}-{topic}")
+        self.client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2, client_id=f"test-{os.getpid()}-{topic}",
+                                  clean_session=qos == 0)
         self.client.reconnect_delay_set(min_delay=1, max_delay=1)
+        if user is not None:
+            self.client.username_pw_set(*user)
+        if tls is not None:
+            self.client.tls_set(ca_certs=str(tls.ca), certfile=str(tls.client_cert), keyfile=str(tls.client_key))
 
         def connected(client, userdata, flags, reason_code, properties=None):
-            client.subscribe(topic)
+            client.subscribe(topic, qos=qos)
 
         def subscribed(client, userdata, mid, reason_codes, properties=None):
             with self._lock:
@@ -161,13 +233,16 @@ class Subscriber:
     def _add(self, message) -> None:
         with self._lock:
             self.messages.append((message.topic, message.payload, time.time()))
+            self.retained[message.topic] = message.payload
 
     def payloads(self, topic: str) -> list[str]:
         with self._lock:
             return [payload.decode() for name, payload, _ in self.messages if name == topic]
 
-    def publish(self, topic: str, payload: str) -> None:
-        self.client.publish(topic, payload.encode(), qos=0).wait_for_publish(5)
+    def publish(self, topic: str, payload: str, wait: bool = True) -> None:
+        info = self.client.publish(topic, payload.encode(), qos=self.qos)
+        if wait:
+            info.wait_for_publish(5)
 
     def close(self) -> None:
         self.client.disconnect()
@@ -186,12 +261,13 @@ def wait_until(condition, what: str, timeout_s: float = 30.0) -> None:
 class LiveProcess:
     """``greybox live`` in a subprocess, its stderr lines collected by a thread."""
 
-    def __init__(self, *args):
+    def __init__(self, *args, env: dict | None = None):
         import sys
         import threading
 
         self.process = subprocess.Popen([sys.executable, "-m", "greybox", "live", *map(str, args)], text=True,
-                                        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                        env=None if env is None else {**os.environ, **env})
         self.lines: list[str] = []
         self._reader = threading.Thread(target=self._read, daemon=True)
         self._reader.start()

@@ -99,3 +99,44 @@ def test_broker_tests_skip_naming_the_package_without_mosquitto(monkeypatch, req
     monkeypatch.setattr(live_helpers, "mosquitto_binary", lambda: None)
     with pytest.raises(pytest.skip.Exception, match="package 'mosquitto'"):
         request.getfixturevalue("broker")
+
+
+@pytest.mark.slow
+def test_sigkill_loses_at_most_a_second_of_the_recording(model_file, cut_raw, tmp_path):
+    path = model_file("gms")
+    record = tmp_path / "rec"
+    process = greybox(path, "--source", "-", "--axis-config", EXAMPLE_AXIS, "--record", record)
+    try:
+        out = []
+        for message in json_batches(cut_raw, (10,)):  # the stream stays open, as a broker's would
+            process.stdin.write(message + "\n")
+            process.stdin.flush()
+        while sum(len(json.loads(line)["time_s"]) for line in out) < len(cut_raw) - 200:
+            out.append(process.stdout.readline())
+        process.kill()
+        process.wait(timeout=TIMEOUT_S)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    sent = joined(out)
+    parts = sorted(record.glob("live-*.parquet"))
+    assert parts and all(".part-" in part.name for part in parts)  # the file in progress: its parts
+    table = pd.concat([pd.read_parquet(part) for part in parts], ignore_index=True)
+    lost_s = sent["time_s"][-1] - table["time_s"].iloc[-1]
+    assert lost_s <= 1.0, f"{lost_s:.3f} s of estimates lost"
+    n = len(table)
+    np.testing.assert_array_equal(table["time_s"].to_numpy(), sent["time_s"][:n])
+    np.testing.assert_allclose(table["force_process_N"].to_numpy(), sent["force_process_N"][:n], rtol=0, atol=1e-9)
+
+
+def test_the_config_file_gives_options_the_command_line_overrides(model_file, tmp_path, capsys):
+    config = tmp_path / "live.toml"
+    config.write_text('source = "-"\nsink = "file.txt"\nlimit = ["force_process_N=5"]\n')
+    # the sink of the file is overridden; the limit on the force, without an axis file, is refused at the start
+    assert run_cli(["live", model_file("coulomb"), "--config", config, "--sink", "-"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--limit force_process_N: no such output column" in err[0], err
+    assert "the force needs --axis-config" in err[0]
+    config.write_text('sink = "-"\n')
+    assert run_cli(["live", model_file("coulomb"), "--config", config]) == 2
+    assert "--source is required" in capsys.readouterr().err

@@ -117,8 +117,17 @@ def test_limits_raise_one_alarm_per_stretch_and_can_end_the_stream(model_file, c
     assert long_stretches >= 1
     assert outcome.stats.alarms == long_stretches
     alarms = [json.loads(line) for line in lines if '"alarm"' in line]
-    assert len(alarms) == long_stretches and all(alarm["value"] > bound for alarm in alarms)
-    assert sum(line.startswith("ALARM") for line in said) == long_stretches
+    raised = [alarm for alarm in alarms if alarm["state"] == "raised"]
+    assert len(raised) == long_stretches and all(alarm["value"] > bound for alarm in raised)
+    assert sum(line.startswith("ALARM:") for line in said) == long_stretches
+    # each is cleared at the first sample back within the limit (the stretches ending before the log does)
+    ended = (stops - starts >= 3) & (stops < len(force))
+    cleared = [alarm for alarm in alarms if alarm["state"] == "cleared"]
+    assert len(cleared) == outcome.stats.alarms_cleared == int(np.sum(ended))
+    assert [alarm["time_s"] for alarm in cleared] == pytest.approx(list(expected["time_s"][stops[ended]]), abs=1e-12)
+    # the seq of the message whose samples raised or cleared it (none for the tail finished at the end)
+    assert all("wall_time" in alarm and "seq" in alarm for alarm in alarms)
+    assert any(isinstance(alarm["seq"], int) for alarm in alarms)
     _, stopped, _, _ = run(path, json_batches(cut_raw, (10,)), limits=[Limit("force_process_N", bound)],
                            hold_s=0.004, exit_on_alarm=True)
     assert stopped.status == ALARM_STATUS and stopped.stats.alarms == 1
@@ -147,3 +156,35 @@ def test_recording_is_the_predict_table_in_rolling_files(model_file, offline, cu
     np.testing.assert_allclose(table.to_numpy(), expected.to_numpy(), rtol=0, atol=1e-9)
     meta = json.loads(pq.read_schema(files[0]).metadata[b"greybox"])
     assert meta["attrs"]["model_kind"] == "gmssvr" and meta["attrs"]["live"]["file"] == 0
+
+
+def test_a_deep_and_a_huge_message_give_one_short_line_each_and_the_stream_goes_on(model_file, cut_raw):
+    path = model_file("gms")
+    clean = json_batches(cut_raw, (10,))
+    expected, _, _, _ = run(path, clean)
+    deep = "[" * 1000 + "]" * 1000
+    huge = '{"time_s": [' + "1.0, " * (50 * 2**20 // 5) + "1.0]}"  # 50 MB
+    messages = list(clean)
+    messages.insert(7, deep)
+    messages.insert(30, huge)
+    live, outcome, said, _ = run(path, messages)
+    assert_same(live, expected)
+    skipped = [line for line in said if "skipped" in line]
+    assert len(skipped) == 2 and all(len(line) <= 400 for line in said)
+    assert "nested 1000 levels deep" in skipped[0] and f"holds {len(huge) + 1} bytes" in skipped[1]
+    assert outcome.stats.rejected == 2 and outcome.stats.samples_estimated == len(cut_raw)
+
+
+def test_a_flood_of_malformed_messages_is_summed_up(model_file, cut_raw):
+    path = model_file("coulomb")
+    messages = json_batches(cut_raw, (10,))
+    flood = [f"not JSON {k} " + "z" * 10_000 for k in range(500)]
+    live, outcome, said, _ = run(path, messages[:5] + flood + messages[5:], lines_per_interval=5)
+    assert outcome.stats.rejected == 500 and outcome.stats.samples_estimated == len(cut_raw)
+    summary = [line for line in said if "held back" in line]
+    assert len(summary) == 1 and summary[0].endswith("the last: stdin line 505: skipped: not JSON (a CSV header must "
+                                                     "be the stream's first line)")
+    held = int(summary[0].split()[0])
+    said_skipped = sum(line.startswith("stdin line") for line in said)
+    assert said_skipped <= 5 and said_skipped + held == 500  # five lines of the stream at most, the rest counted
+    assert all(len(line) <= 700 for line in said)

@@ -7,7 +7,16 @@ import json
 import numpy as np
 import pytest
 
-from greybox.live.messages import Decoder, MessageError, MessageLogs, estimate_message, message_log, parse_json
+from greybox.live.messages import (
+    Decoder,
+    MessageBounds,
+    MessageError,
+    MessageLogs,
+    estimate_message,
+    json_depth,
+    message_log,
+    parse_json,
+)
 
 ROWS = [{"time_s": 0.0, "position_mm": 1.0, "velocity_mm_s": 0.5, "current_A": 0.1},
         {"time_s": 0.002, "position_mm": 1.001, "velocity_mm_s": 0.5, "current_A": 0.2}]
@@ -156,3 +165,29 @@ def test_number_columns_read_as_the_general_reader_reads_them():
         {"time_s": [1.0], "position_mm": [2.5], "current_A": [-3.0]}
     with pytest.raises(MessageError, match="column 'current_A' holds 'x', not a number"):
         parse_json('{"time_s": 1, "position_mm": 2.5, "current_A": "x"}')
+
+
+@pytest.mark.parametrize("text", ["[" * 1000 + "]" * 1000, '{"a": ' * 1000 + "1" + "}" * 1000,
+                                  '{"time_s": [0], "x": ' + "[" * 5000 + "]" * 5000 + "}"])
+def test_deep_nesting_is_refused_without_recursion(text):
+    with pytest.raises(MessageError, match=r"JSON nested \d+ levels deep, more than 8"):
+        parse_json(text)
+    with pytest.raises(MessageError, match="more than 3"):
+        Decoder(MessageBounds(max_depth=3)).decode(text.encode())
+
+
+def test_json_depth_counts_brackets_outside_strings():
+    assert json_depth(b'{"a": [1, 2], "b": "[[[\\"[{"}') == 2
+    assert json_depth("[[], [[]]]") == 3 and json_depth("1") == 0
+    assert json_depth(json.dumps(ROWS)) == 2  # the shapes of a message need two levels
+
+
+def test_a_message_over_the_size_bound_is_refused_before_it_is_read():
+    text = json.dumps({"time_s": [0.0, 0.002], "position_mm": [1.0, 2.0], "current_A": [0.0, 0.0]})
+    assert parse_json(text, MessageBounds(max_bytes=len(text)))[0]["time_s"].size == 2
+    with pytest.raises(MessageError, match=f"holds {len(text)} bytes, more than {len(text) - 1}"):
+        Decoder(MessageBounds(max_bytes=len(text) - 1)).decode(text.encode())
+    with pytest.raises(MessageError, match="holds 2 samples, more than 1"):
+        parse_json(text, MessageBounds(max_samples=1))
+    with pytest.raises(ValueError, match="max_depth"):
+        MessageBounds(max_depth=0)

@@ -47,3 +47,29 @@ def test_a_file_that_cannot_be_written_is_reported_at_close(tmp_path, model_file
     with pytest.raises(GreyboxError, match="not finite"):
         recorder.close()
     assert recorder.written == [] and not list((tmp_path / "rec").iterdir())
+
+
+def test_part_files_hold_what_a_kill_would_leave_and_go_once_the_file_is_whole(tmp_path, model_file, cut_raw):
+    import pandas as pd
+
+    model = load_model(model_file("gms"))
+    results = _results(model, cut_raw)
+    folder = tmp_path / "rec"
+    recorder = Recorder(folder, model=model, chunk_s=60.0, every_s=60.0, flush_s=0.2)
+    added = []
+    for result in results:
+        recorder.add(result)
+        added.append(result)
+        recorder._collect(wait=False)
+        recorder._writer is None or recorder._writer.submit(lambda: None).result()  # the writer done with the parts
+        parts = sorted(folder.glob("live-*.part-*.parquet"))
+        on_disk = pd.concat([pd.read_parquet(part) for part in parts]) if parts else pd.DataFrame({"time_s": []})
+        everything = np.concatenate([part.time for part in added])
+        # what is on disk is the estimates in order, all but less than flush_s of log time at the end
+        np.testing.assert_array_equal(on_disk["time_s"].to_numpy(), everything[:len(on_disk)])
+        assert everything[-1] - (on_disk["time_s"].iloc[-1] if len(on_disk) else everything[0] - 0.002) < 0.2 + 0.03
+    assert len(list(folder.glob("live-*.part-*.parquet"))) >= 5
+    recorder.close()
+    assert [path.name for path in sorted(folder.iterdir())] == [path.name for path in recorder.written]
+    whole = pd.read_parquet(recorder.written[0])
+    np.testing.assert_array_equal(whole["time_s"].to_numpy(), np.concatenate([part.time for part in results]))
