@@ -143,7 +143,8 @@ def test_twin_shapes_are_standardised_quantiles_and_set_the_default_threshold():
     assert np.all(np.abs(draws.mean(axis=1)) < 0.05) and np.all(np.abs(draws.std(axis=1) - 1.0) < 0.05)
     local = draws[FEATURES.index("local_excess")]
     assert np.mean((local - local.mean()) ** 3) > 0.3  # a largest value along the travel: skewed to high values
-    detector = ChangeDetector().fit(_table({}, default=np.random.default_rng(4).normal(1.0, 0.01, 40)))
+    detector = ChangeDetector(shapes="twin", per_feature=False).fit(
+        _table({}, default=np.random.default_rng(4).normal(1.0, 0.01, 40)))
     assert detector.threshold_ == pytest.approx(calibrated_threshold(
         baseline_days=28, n_features=len(FEATURES), false_alarms_per_year=0.5, shapes=shapes))
     assert detector.threshold_ > calibrated_threshold(baseline_days=28, n_features=len(FEATURES),
