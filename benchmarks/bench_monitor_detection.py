@@ -17,8 +17,8 @@ calibrated for 0.5 false alarms per axis-year on the shapes of the axis' own bas
 axes' shapes as a prior; ``--false-alarms-per-year`` sets another target, ``--shapes twin --common-threshold``
 gives the detector of issue 34). Printed per drift kind: the days from the onset to the first alarm of each
 seed (and their median), the feature and direction it named, and the alarms of the stable axes (with the
-axis-days watched after the baseline); for ``none``, the false alarms per axis-year with two 95 % intervals (exact Poisson, and
-resampling the axes, which allows for the alarms of one axis' correlated features coming together).
+axis-days watched after the baseline); for ``none``, the false alarms per axis-year with two 95 % intervals
+(exact Poisson, and resampling the axes, which allows for the alarms of one axis' correlated features coming together).
 
 Seeds: below 1000 are for development (100-105 and 300-314 chose k and checked the calibration target's
 cost, 200-229 gave the feature shapes, ``scripts/stable_twin_shapes.py``); 1000-1014 were used while the
