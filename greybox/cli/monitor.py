@@ -31,6 +31,9 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--spindle-load", metavar="COLUMN",
                         help="column of the logs with the spindle load: fit only where the spindle idles (below "
                              "its 5th percentile plus a fifth of its span to the 99th, 0.2 s apart from any cut)")
+    parser.add_argument("--find-cuts", action="store_true",
+                        help="production logs without a spindle-load column: fit only where the current follows a "
+                             "friction model learned from each log's fastest moves (greybox.monitor.cutting)")
     parser.add_argument("--workers", type=NumberRange(int, low=1), metavar="N",
                         help="fingerprint the logs on a local Dask cluster of N processes (greybox.fleet); default "
                              "one after the other in this process")
@@ -43,15 +46,24 @@ def add_parser(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..monitor.report import baseline_note
     from ..monitor.workflow import run_monitor
 
     result = run_monitor(args.logs, args.history, args.out, machine=args.machine, axis=args.axis,
                          model_path=args.model, spindle_column=args.spindle_load,
+                         find_cuts=args.find_cuts,
                          baseline_days=args.baseline_days, scheduler=args.scheduler, workers=args.workers,
                          progress=print, force=args.force)
     trends = result.detector.trends_
-    print(f"{result.fitted} logs fingerprinted, {result.known} already in the history; "
+    copies = f", {len(result.duplicates)} copies of logs filed under another day (not filed)" \
+        if result.duplicates else ""
+    print(f"{result.fitted} logs fingerprinted, {result.known} already in the history{copies}; "
           f"{len(trends)} axes, {len(result.detector.alarms_)} alarms")
+    for copy in result.duplicates:
+        print(f"note: {copy}")
+    for trend in trends:
+        if len(trend.dates) <= result.detector.baseline_days:
+            print(f"note: {trend.machine}/{trend.axis}: {baseline_note(trend, result.detector)}")
     for alarm in result.detector.alarms_:
         print(f"alarm: {alarm.describe()}")
     print(f"dashboard -> {result.page}")

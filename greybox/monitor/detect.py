@@ -54,7 +54,7 @@ from ..errors import ParameterError
 from .fingerprint import FEATURES
 
 __all__ = ["Alarm", "AxisTrend", "ChangeDetector", "STABLE_SHAPES_FILE", "calibrated_threshold", "cusum",
-           "stable_shapes", "travel_departure"]
+           "plant_shapes", "stable_shapes", "travel_departure"]
 
 
 def cusum(z, *, k: float = 0.5, h: float = 5.0, clip: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
@@ -114,6 +114,47 @@ def stable_shapes(features=FEATURES) -> np.ndarray:
     return np.array([document["quantiles"][name] for name in features], dtype=float)
 
 
+def plant_shapes(baseline_days, prior, *, prior_days: float, levels: int = 201) -> np.ndarray:
+    """The shapes of the features' daily values on a plant's own baseline days, with the twin's as a prior.
+
+    Per feature, the baseline days of every axis are standardised by that axis' baseline mean and standard
+    deviation and pooled; the twin's shape (``prior``, quantiles) joins them with the weight of
+    ``prior_days`` days, spread evenly over its quantiles. The result is the weighted quantiles of the pool.
+
+    Parameters
+    ----------
+    baseline_days : sequence of sequence of ndarray
+        Per feature, the baseline days of each axis (values in the feature's unit; NaN left out).
+    prior : array_like, shape (n_features, m)
+        Per feature, quantiles of the prior shape at ``m`` evenly spaced levels [standard deviations].
+    prior_days : float
+        Weight of the prior [days]; the plant's days weigh one each.
+    levels : int, default 201
+        Quantile levels returned, evenly spaced from 0 to 1.
+
+    Returns
+    -------
+    ndarray, shape (n_features, levels)
+        Per feature, the quantiles [standard deviations], ascending.
+    """
+    prior = np.asarray(prior, dtype=float)
+    rows = []
+    for feature_days, prior_row in zip(baseline_days, prior):
+        pooled = []
+        for days in feature_days:
+            days = np.asarray(days, dtype=float)
+            days = days[np.isfinite(days)]
+            if len(days) >= 3 and np.std(days, ddof=1) > 0.0:
+                pooled.append((days - days.mean()) / np.std(days, ddof=1))
+        values = np.concatenate([prior_row] + pooled)
+        weights = np.concatenate([np.full(len(prior_row), prior_days / len(prior_row)),
+                                  np.ones(sum(len(p) for p in pooled))])
+        order = np.argsort(values)
+        cumulative = (np.cumsum(weights[order]) - 0.5 * weights[order]) / weights.sum()
+        rows.append(np.interp(np.linspace(0.0, 1.0, levels), cumulative, values[order]))
+    return np.array(rows)
+
+
 @functools.lru_cache(maxsize=32)
 def _yearly_maxima(shape: tuple | None, baseline_days: int, k: float, clip: float, n_sim: int,
                    seed: int) -> np.ndarray:
@@ -136,7 +177,8 @@ def _yearly_maxima(shape: tuple | None, baseline_days: int, k: float, clip: floa
 
 
 def calibrated_threshold(*, baseline_days: int, n_features: int, false_alarms_per_year: float = 0.5,
-                         k: float = 1.0, clip: float = 3.0, shapes=None, n_sim: int = 2000, seed: int = 0) -> float:
+                         k: float = 1.0, clip: float = 3.0, shapes=None, per_feature: bool = False,
+                         n_sim: int = 2000, seed: int = 0):
     """The CUSUM threshold that gives a set number of false alarms per axis and year on stable axes.
 
     Stable axes are simulated over ``baseline_days`` plus 365 days: independent daily values of each
@@ -165,6 +207,10 @@ def calibrated_threshold(*, baseline_days: int, n_features: int, false_alarms_pe
         Per feature, quantiles of its standardised stable daily values at ``m`` evenly spaced levels from 0
         to 1 [standard deviations] (:func:`stable_shapes`); the days are drawn from them by interpolation.
         Without them every feature's days are standard normal.
+    per_feature : bool, default False
+        With ``shapes``: one threshold per feature, each set so that the feature's two sums raise an equal
+        share, ``false_alarms_per_year / n_features``, of the false alarms (a feature with heavy tails gets a
+        higher threshold, the others keep a lower one); without it one threshold for all.
     n_sim : int, default 2000
         Simulated stable series per feature.
     seed : int, default 0
@@ -172,8 +218,8 @@ def calibrated_threshold(*, baseline_days: int, n_features: int, false_alarms_pe
 
     Returns
     -------
-    float
-        Threshold ``h`` [standard deviations].
+    float or ndarray of shape (n_features,)
+        Threshold ``h`` [standard deviations]; per feature with ``per_feature``.
     """
     share = false_alarms_per_year / (2.0 * n_features)
     if not 0.0 < share < 1.0:
@@ -186,8 +232,11 @@ def calibrated_threshold(*, baseline_days: int, n_features: int, false_alarms_pe
                 or not np.all(np.isfinite(shapes)) or np.any(np.diff(shapes, axis=1) < 0.0):
             raise ParameterError(f"shapes must hold {n_features} rows of at least 2 ascending quantiles, "
                                  f"got shape {shapes.shape}")
-        maxima = np.concatenate([_yearly_maxima(tuple(row), baseline_days, float(k), float(clip), n_sim, seed + i)
-                                 for i, row in enumerate(shapes)])
+        per_row = [_yearly_maxima(tuple(row), baseline_days, float(k), float(clip), n_sim, seed + i)
+                   for i, row in enumerate(shapes)]
+        if per_feature:
+            return np.array([np.quantile(row, 1.0 - share) for row in per_row])
+        maxima = np.concatenate(per_row)
     return float(np.quantile(maxima, 1.0 - share))
 
 
@@ -357,10 +406,17 @@ class ChangeDetector:
     false_alarms_per_year : float, default 0.5
         Expected false alarms per axis and year on stable axes, which sets the default ``h``: half the
         issue's limit of one, so that a measured rate can confirm the limit.
-    shapes : {"twin", "normal"}, default "twin"
+    shapes : {"plant", "twin", "normal"}, default "plant"
         What the threshold's calibration draws stable days from: each feature's daily values on stable twin
         axes (:func:`stable_shapes`: the local excess, a largest value along the travel, is skewed to high
-        values) or independent standard normal values.
+        values); the plant's own baseline days, every axis of the history standardised by its baseline and
+        pooled per feature, with the twin's shapes as a prior worth ``prior_days`` days
+        (:func:`plant_shapes`); or independent standard normal values.
+    prior_days : float, default 28.0
+        Weight [days] of the twin's shapes in ``shapes="plant"``: one axis' baseline.
+    per_feature : bool, default True
+        One threshold per feature, each calibrated on its own shape for an equal share of the false alarms
+        (:func:`calibrated_threshold`); without it one threshold for all features.
     clip : float, default 3.0
         Standardised daily values are clipped to ``[-clip, clip]`` [baseline standard deviations].
     features : sequence of str, optional
@@ -369,7 +425,10 @@ class ChangeDetector:
     Attributes
     ----------
     threshold_ : float
-        The threshold ``h`` used [baseline standard deviations].
+        The threshold ``h`` used, the largest of ``thresholds_`` [baseline standard deviations].
+    thresholds_ : dict of str to float
+        The threshold of each feature watched [baseline standard deviations] (all the same unless
+        ``per_feature``).
     trends_ : list of AxisTrend
         One per machine and axis, most severe first.
     alarms_ : list of Alarm
@@ -377,12 +436,15 @@ class ChangeDetector:
     """
 
     def __init__(self, *, baseline_days: int = 28, k: float = 1.0, h: float | None = None,
-                 false_alarms_per_year: float = 0.5, shapes: str = "twin", clip: float = 3.0, features=None):
+                 false_alarms_per_year: float = 0.5, shapes: str = "plant", prior_days: float = 28.0,
+                 per_feature: bool = True, clip: float = 3.0, features=None):
         self.baseline_days = baseline_days
         self.k = k
         self.h = h
         self.false_alarms_per_year = false_alarms_per_year
         self.shapes = shapes
+        self.prior_days = prior_days
+        self.per_feature = per_feature
         self.clip = clip
         self.features = features
 
@@ -399,8 +461,10 @@ class ChangeDetector:
         if unknown or not features:
             raise ParameterError(f"unknown features {', '.join(unknown) or '(none given)'}; "
                                  f"choose from {', '.join(FEATURES)}")
-        if self.shapes not in ("twin", "normal"):
-            raise ParameterError(f"shapes must be 'twin' or 'normal', got {self.shapes!r}")
+        if self.shapes not in ("plant", "twin", "normal"):
+            raise ParameterError(f"shapes must be 'plant', 'twin' or 'normal', got {self.shapes!r}")
+        if not (np.isfinite(self.prior_days) and self.prior_days > 0.0):
+            raise ParameterError(f"prior_days must be a positive number of days, got {self.prior_days!r}")
         return features
 
     def fit(self, table: pa.Table) -> "ChangeDetector":
@@ -417,23 +481,31 @@ class ChangeDetector:
             ``self``. An axis with no more days than ``baseline_days`` gets its trend but no alarm.
         """
         features = self._check_params()
-        self.threshold_ = self.h if self.h is not None else calibrated_threshold(
-            baseline_days=self.baseline_days, n_features=len(features),
-            false_alarms_per_year=self.false_alarms_per_year, k=self.k, clip=self.clip,
-            shapes=stable_shapes(features) if self.shapes == "twin" else None)
-        trends = []
         keys = sorted(set(zip(table.column("machine").to_pylist(), table.column("axis").to_pylist())))
         machines, axes = np.array(table.column("machine").to_pylist()), np.array(table.column("axis").to_pylist())
-        for machine, axis in keys:
-            rows = table.filter(pa.array((machines == machine) & (axes == axis)))
-            trends.append(self._trend(machine, axis, rows, features))
+        axis_rows = [table.filter(pa.array((machines == machine) & (axes == axis))) for machine, axis in keys]
+        daily = [_daily(rows) for rows in axis_rows]
+        shapes = None
+        if self.shapes == "twin":
+            shapes = stable_shapes(features)
+        elif self.shapes == "plant":
+            shapes = plant_shapes([[values[f][:self.baseline_days] for _, values, _, _ in daily] for f in features],
+                                  stable_shapes(features), prior_days=self.prior_days)
+        calibrated = self.h if self.h is not None else calibrated_threshold(
+            baseline_days=self.baseline_days, n_features=len(features),
+            false_alarms_per_year=self.false_alarms_per_year, k=self.k, clip=self.clip, shapes=shapes,
+            per_feature=self.per_feature and shapes is not None)
+        self.thresholds_ = dict(zip(features, np.broadcast_to(np.asarray(calibrated, float), len(features)).tolist()))
+        self.threshold_ = max(self.thresholds_.values())
+        trends = [self._trend(machine, axis, rows, features, days)
+                  for (machine, axis), rows, days in zip(keys, axis_rows, daily)]
         trends.sort(key=lambda t: (-t.severity, t.machine, t.axis))
         self.trends_ = trends
         self.alarms_ = [alarm for trend in trends for alarm in trend.alarms]
         return self
 
-    def _trend(self, machine: str, axis: str, rows: pa.Table, features) -> AxisTrend:
-        days, values, lower, upper = _daily(rows)
+    def _trend(self, machine: str, axis: str, rows: pa.Table, features, daily) -> AxisTrend:
+        days, values, lower, upper = daily
         trend = AxisTrend(machine, axis, days, values, lower, upper, travel_map=_daily_map(rows, days))
         n_base = min(self.baseline_days, len(days))
         for feature in features:
@@ -448,13 +520,14 @@ class ChangeDetector:
                 sd = float(np.nanmedian(width)) / (2 * 1.96) if np.any(np.isfinite(width)) else 0.0
                 sd = sd or 1e-12
             trend.baseline[feature] = (mean, sd)
-            up, low = cusum((x - mean) / sd, k=self.k, h=self.threshold_, clip=self.clip)
+            h = self.thresholds_[feature]
+            up, low = cusum((x - mean) / sd, k=self.k, h=h, clip=self.clip)
             trend.upper_sum[feature], trend.lower_sum[feature] = up, low
             if len(days) <= self.baseline_days:
                 continue
-            trend.severity = max(trend.severity, float(max(up.max(), low.max())) / self.threshold_)
+            trend.severity = max(trend.severity, float(max(up.max(), low.max())) / h)
             for direction, sums in (("rises", up), ("falls", low)):
-                alarm = self._alarm(machine, axis, feature, direction, days, x, base, mean, sd, sums)
+                alarm = self._alarm(machine, axis, feature, direction, days, x, base, mean, sd, sums, h)
                 if alarm is not None:
                     start, detected = days.index(alarm.start), days.index(alarm.detected)
                     where, departure = travel_departure(trend.travel_map[0], trend.travel_map[1], slice(0, n_base),
@@ -463,9 +536,9 @@ class ChangeDetector:
         trend.alarms.sort(key=lambda a: (a.detected, -abs(a.shift)))
         return trend
 
-    def _alarm(self, machine, axis, feature, direction, days, x, base, mean, sd, sums) -> Alarm | None:
-        """The first crossing of ``h`` by the sum ``sums`` of ``direction``, if any."""
-        crossed = np.flatnonzero(sums >= self.threshold_)
+    def _alarm(self, machine, axis, feature, direction, days, x, base, mean, sd, sums, h) -> Alarm | None:
+        """The first crossing of the threshold ``h`` by the sum ``sums`` of ``direction``, if any."""
+        crossed = np.flatnonzero(sums >= h)
         if not len(crossed):
             return None
         detected = int(crossed[0])

@@ -23,7 +23,8 @@ from ..evaluate.table import Table
 from .detect import ChangeDetector
 from .fingerprint import FEATURE_UNITS
 
-__all__ = ["axis_figure", "interactive_axis_html", "interactive_travel_html", "travel_map_figure", "write_report"]
+__all__ = ["axis_figure", "baseline_note", "interactive_axis_html", "interactive_travel_html", "travel_map_figure",
+           "write_report"]
 
 
 def axis_figure(trend, detector: ChangeDetector, path) -> Path | None:
@@ -238,6 +239,28 @@ def interactive_travel_html(trend, detector: ChangeDetector, div_id: str) -> str
     return figure.to_html(full_html=False, include_plotlyjs=False, div_id=div_id)
 
 
+def baseline_note(trend, detector: ChangeDetector) -> str:
+    """One line on an axis whose baseline is not complete yet: nothing can be detected on it so far.
+
+    Parameters
+    ----------
+    trend : AxisTrend
+        The axis.
+    detector : ChangeDetector
+        The fitted detector (its baseline length).
+
+    Returns
+    -------
+    str
+        The line; empty when the axis has more days than the baseline.
+    """
+    days, needed = len(trend.dates), detector.baseline_days
+    if days > needed:
+        return ""
+    return (f"baseline not yet complete: {days} of {needed} days with a fingerprint; too few days to detect "
+            f"anything, changes are watched from day {needed + 1} on ({needed + 1 - days} more days)")
+
+
 def write_report(detector: ChangeDetector, out_dir) -> Path:
     """Write the dashboard ``out_dir/index.html`` of a fitted detector.
 
@@ -260,12 +283,12 @@ def write_report(detector: ChangeDetector, out_dir) -> Path:
         first = trend.alarms[0] if trend.alarms else None
         rows.append([trend.machine, trend.axis, str(len(trend.dates)),
                      f"{trend.dates[0].isoformat()} to {trend.dates[-1].isoformat()}", f"{trend.severity:.2f}",
-                     first.describe().split(": ", 1)[1] if first else "none",
+                     first.describe().split(": ", 1)[1] if first else baseline_note(trend, detector) or "none",
                      "stale: retrain (greybox train) on recent air moves" if first else "current"])
     axes_table = Table("Axes, most severe first", ["machine", "axis", "days", "period", "severity", "first alarm",
                                                     "model"], rows,
-                       [f"Severity: largest CUSUM sum over its calibrated threshold h = {detector.threshold_:.2f} "
-                        "(1 or more: an alarm). "
+                       [f"Severity: largest CUSUM sum over its feature's calibrated threshold (h = "
+                        f"{min(detector.thresholds_.values()):.2f} to {detector.threshold_:.2f}; 1 or more: an alarm). "
                         f"Baseline: the first {detector.baseline_days} days of each axis."])
     alarm_rows = [[a.machine, a.axis, a.feature, a.direction, a.start.isoformat(), a.detected.isoformat(),
                    f"{a.shift:+.1f}", "" if not np.isfinite(a.p_value) else f"{a.p_value:.2g}"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import datetime as dt
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -13,17 +13,26 @@ import numpy as np
 from ..data.io import read_log
 from ..data.prepare import prepare
 from ..errors import GreyboxError, LogError
+from .cutting import uncut_samples
 from .detect import ChangeDetector
 from .fingerprint import FrictionFingerprint, spindle_idle_samples, unloaded_samples
 from .history import append_fingerprint, compact_history, file_sha256, find_log, read_history, row_path
 from .report import write_report
 
-__all__ = ["FingerprintJob", "MonitorResult", "fingerprint_file", "fingerprint_job", "log_date", "run_monitor"]
+__all__ = ["DuplicateLogError", "FingerprintJob", "MonitorResult", "fingerprint_file", "fingerprint_job", "log_date",
+           "run_monitor"]
 
 #: ``format`` of the manifest a fleet run of the fingerprints leaves in the history (``_manifest.json``).
 MONITOR_FORMAT = "greybox-monitor"
 
+#: Axis name of a log of one axis that names none, without ``--axis``.
+DEFAULT_AXIS = "axis"
+
 _DATE_IN_NAME = re.compile(r"(\d{4}-\d{2}-\d{2})")
+
+
+class DuplicateLogError(LogError):
+    """A log whose bytes the history already holds under another day of the same machine and axis (a copy)."""
 
 
 def log_date(log, path) -> dt.date:
@@ -61,8 +70,24 @@ def log_date(log, path) -> dt.date:
     return day
 
 
+def _read_axis(path, axis: str | None):
+    """The log of ``axis`` in ``path``; a file of one axis without an axis name is that axis (``--axis`` names it)."""
+    if axis is None:
+        return read_log(path)
+    try:
+        return read_log(path, axis=axis)
+    except LogError as error:
+        try:
+            log = read_log(path)
+        except GreyboxError:
+            raise error from None
+        if log.axis not in (None, "", axis):
+            raise error from None
+        return log
+
+
 def fingerprint_file(path, history, *, machine: str | None = None, axis: str | None = None, model=None,
-                     spindle_column: str | None = None,
+                     spindle_column: str | None = None, find_cuts: bool = False,
                      fingerprint: FrictionFingerprint | None = None) -> tuple[Path, bool]:
     """Fingerprint one log file into the history, unless the same file is there already.
 
@@ -75,7 +100,8 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     machine : str, optional
         Machine name; default the log's ``machine`` attribute.
     axis : str, optional
-        Axis to read from a file of several axes (and its name); default the log's own axis.
+        Axis to read from a file of several axes, and its name; a file of one axis is read whole under this
+        name. Default the log's own axis, else :data:`DEFAULT_AXIS`.
     model : estimator, optional
         Reference model of the axis: only the samples where its residual stays within its noise are fitted
         (:func:`~greybox.monitor.fingerprint.unloaded_samples`); without it (and without ``spindle_column``)
@@ -83,6 +109,11 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     spindle_column : str, optional
         Column of the log with the spindle load: only the samples where the spindle idles are fitted
         (:func:`~greybox.monitor.fingerprint.spindle_idle_samples`); with ``model`` too, only those both keep.
+    find_cuts : bool, default False
+        Production logs without a spindle-load column: only the samples where the current follows a
+        friction model learned from the log's fastest moves are fitted
+        (:func:`~greybox.monitor.cutting.uncut_samples`); with ``model`` or ``spindle_column``, only those all
+        keep.
     fingerprint : FrictionFingerprint, optional
         Settings of the fit; default :class:`FrictionFingerprint()`.
 
@@ -90,18 +121,24 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     -------
     (Path, bool)
         The history file of the log's row, and whether it was fitted now (False: already in the history).
+
+    Raises
+    ------
+    DuplicateLogError
+        If the history holds the same bytes under another day of the same machine and axis: a copy of one
+        log under two dates is filed once, under the first day filed.
     """
     if Path(path).is_file():  # a log already in the history under the machine and axis asked for: not read again
         known = find_log(history, file_sha256(path))
-        if known is not None and machine in (None, known[0]) and axis in (None, known[1]):
+        named = _DATE_IN_NAME.search(Path(path).name)
+        if known is not None and machine in (None, known[0]) and axis in (None, known[1]) \
+                and (named is None or named.group(1) == known[2].isoformat()):
             return known[3], False
-    log = read_log(path, axis=axis) if axis is not None else read_log(path)
+    log = _read_axis(path, axis)
     machine = machine or (log.attrs.get("machine") if isinstance(log.attrs, dict) else None)
     if not machine:
         raise LogError(path, "no machine name: the log has no 'machine' attribute; give --machine")
-    name = axis or log.axis
-    if not name:
-        raise LogError(path, "no axis name in the log; give --axis")
+    name = axis or log.axis or DEFAULT_AXIS
     if log.effort_unit != "A":
         raise LogError(path, f"effort in {log.effort_unit}: fingerprints are of motor current in A")
     date = log_date(log, path)
@@ -110,12 +147,15 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     known = find_log(history, sha)
     if known is not None and known[:3] == (str(machine), str(name), date):
         return known[3], False
+    if known is not None and known[:2] == (str(machine), str(name)):
+        raise DuplicateLogError(path, f"the same bytes as the log of {machine}/{name} filed under "
+                                      f"{known[2].isoformat()}: a copy, not filed again under {date.isoformat()}")
     if spindle_column is not None and spindle_column not in log.extras:
         raise LogError(path, f"no spindle-load column {spindle_column!r}; the log has "
                              f"{', '.join(sorted(log.extras)) or 'no extra columns'}")
     runs = prepare(log)
     unloaded = None
-    if model is not None or spindle_column is not None:
+    if model is not None or spindle_column is not None or find_cuts:
         unloaded = []
         for run in runs:
             keep = np.ones(len(run), dtype=bool)
@@ -123,6 +163,8 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
                 keep &= unloaded_samples(run.effort - model.predict(run))
             if spindle_column is not None:
                 keep &= spindle_idle_samples(run.extras[spindle_column])
+            if find_cuts:
+                keep &= uncut_samples(run.velocity, run.acceleration, run.effort)
             unloaded.append(keep)
     fitted = (fingerprint or FrictionFingerprint()).fit(runs, unloaded=unloaded)
     written = append_fingerprint(history, machine=str(machine), axis=str(name), date=date, sha256=sha,
@@ -148,6 +190,8 @@ class FingerprintJob:
         Reference model file, loaded by the worker.
     spindle_column : str or None
         Spindle-load column.
+    find_cuts : bool
+        Find the cutting stretches from the current.
     """
 
     path: str
@@ -156,6 +200,7 @@ class FingerprintJob:
     axis: str | None = None
     model_path: str | None = None
     spindle_column: str | None = None
+    find_cuts: bool = False
 
 
 def fingerprint_job(job: FingerprintJob) -> dict:
@@ -180,29 +225,34 @@ def fingerprint_job(job: FingerprintJob) -> dict:
             from ..persistence import load_model
 
             model = load_model(job.model_path)
-        row, new = fingerprint_file(job.path, job.history, machine=job.machine, axis=job.axis, model=model,
-                                    spindle_column=job.spindle_column)
+        try:
+            row, new = fingerprint_file(job.path, job.history, machine=job.machine, axis=job.axis, model=model,
+                                        spindle_column=job.spindle_column, find_cuts=job.find_cuts)
+        except DuplicateLogError as copy:
+            return {"output": None, "fitted": False, "duplicate": str(copy)}
         return {"output": str(row), "fitted": bool(new)}
 
     return attempt(str(job.path), work)
 
 
-def _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, scheduler, workers,
-                       progress) -> tuple[int, int]:
-    """Fingerprint ``logs`` on a Dask cluster (:func:`greybox.fleet.run_tasks`); the logs fitted and known."""
+def _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, find_cuts, scheduler, workers,
+                       progress) -> tuple[int, int, list]:
+    """Fingerprint ``logs`` on a Dask cluster (:func:`greybox.fleet.run_tasks`); the logs fitted, known, and the
+    copies found (one line each)."""
     from ..fleet import log_stamp, run_tasks
 
     jobs = [FingerprintJob(str(path), str(history), machine, axis, None if model_path is None else str(model_path),
-                           spindle_column) for path in logs]
+                           spindle_column, find_cuts) for path in logs]
     for job in jobs:
         if not Path(job.path).is_file():
             raise LogError(job.path, "no such log file")
     stamps = [{"log": job.path, **log_stamp(job.path), "machine": machine, "axis": axis,
-               "model": job.model_path, "spindle_column": spindle_column} for job in jobs]
+               "model": job.model_path, "spindle_column": spindle_column, "find_cuts": find_cuts} for job in jobs]
 
     def report(done: int, total: int, entry: dict) -> None:
         if progress is not None:
-            state = entry.get("error") or ("fingerprinted" if entry.get("fitted") else "already in the history")
+            state = entry.get("error") or entry.get("duplicate") or (
+                "fingerprinted" if entry.get("fitted") else "already in the history")
             progress(f"[{done}/{total}] {entry['log']}: {state}")
 
     manifest = run_tasks(fingerprint_job, jobs, stamps, out_dir=history, header={"format": MONITOR_FORMAT},
@@ -212,7 +262,8 @@ def _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column,
         raise GreyboxError(f"{len(failed)} of {len(jobs)} logs failed (listed in {Path(history) / '_manifest.json'});"
                            f" the first: {failed[0]['error']}")
     fitted = sum(bool(entry.get("fitted")) and entry["status"] == "ok" for entry in manifest["logs"])
-    return fitted, len(jobs) - fitted
+    copies = [entry["duplicate"] for entry in manifest["logs"] if entry.get("duplicate")]
+    return fitted, len(jobs) - fitted - len(copies), copies
 
 
 @dataclass
@@ -229,16 +280,21 @@ class MonitorResult:
         The detector fitted on the whole history.
     page : Path
         The dashboard written.
+    duplicates : list of str
+        One line per log not filed because the history holds the same bytes under another day
+        (:class:`DuplicateLogError`).
     """
 
     fitted: int
     known: int
     detector: ChangeDetector
     page: Path
+    duplicates: list = field(default_factory=list)
 
 
 def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
-                model_path=None, spindle_column: str | None = None, baseline_days: int = 28,
+                model_path=None, spindle_column: str | None = None, find_cuts: bool = False,
+                baseline_days: int = 28,
                 scheduler: str | None = None, workers: int | None = None,
                 progress: Callable[[str], None] | None = None, force: bool = False) -> MonitorResult:
     """Fingerprint ``logs`` into ``history``, compact it, detect changes over the whole history, write the dashboard.
@@ -263,6 +319,9 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         Reference model file (``greybox train``) to find the stretches without process load.
     spindle_column : str, optional
         Column of the logs with the spindle load, to find the stretches without process load.
+    find_cuts : bool, default False
+        Production logs without a spindle-load column: find the stretches without process load from the
+        current (:func:`~greybox.monitor.cutting.uncut_samples`).
     baseline_days : int, default 28
         Days that set each feature's baseline.
     scheduler : str, optional
@@ -290,19 +349,24 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise GreyboxError(f"workers must be a positive whole number, got {workers!r}")
     if logs and (scheduler is not None or workers is not None):
-        fitted, known = _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, scheduler,
-                                           workers, progress)
+        fitted, known, duplicates = _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column,
+                                                       find_cuts, scheduler, workers, progress)
         logs = []
     else:
         fitted = known = 0
+        duplicates = []
     model = None
     if model_path is not None and logs:
         from ..persistence import load_model
 
         model = load_model(model_path)
     for path in logs:
-        row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model,
-                                    spindle_column=spindle_column)
+        try:
+            row, new = fingerprint_file(path, history, machine=machine, axis=axis, model=model,
+                                        spindle_column=spindle_column, find_cuts=find_cuts)
+        except DuplicateLogError as copy:
+            duplicates.append(str(copy))
+            continue
         fitted, known = fitted + new, known + (not new)
         if progress is not None:
             progress(f"{path}: {'fingerprinted' if new else 'already in the history'} -> {row}")
@@ -313,4 +377,4 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         raise GreyboxError(f"{history}: the history holds no fingerprints; give logs to fingerprint")
     detector.fit(table)
     page = write_report(detector, out_dir)
-    return MonitorResult(fitted, known, detector, page)
+    return MonitorResult(fitted, known, detector, page, duplicates)

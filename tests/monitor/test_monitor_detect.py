@@ -9,7 +9,7 @@ import pyarrow as pa
 import pytest
 
 from greybox.errors import ParameterError
-from greybox.monitor.detect import ChangeDetector, calibrated_threshold, cusum, stable_shapes
+from greybox.monitor.detect import ChangeDetector, calibrated_threshold, cusum, plant_shapes, stable_shapes
 from greybox.monitor.fingerprint import FEATURES
 from greybox.monitor.history import SCHEMA, SCHEMA_VERSION
 
@@ -143,7 +143,8 @@ def test_twin_shapes_are_standardised_quantiles_and_set_the_default_threshold():
     assert np.all(np.abs(draws.mean(axis=1)) < 0.05) and np.all(np.abs(draws.std(axis=1) - 1.0) < 0.05)
     local = draws[FEATURES.index("local_excess")]
     assert np.mean((local - local.mean()) ** 3) > 0.3  # a largest value along the travel: skewed to high values
-    detector = ChangeDetector().fit(_table({}, default=np.random.default_rng(4).normal(1.0, 0.01, 40)))
+    detector = ChangeDetector(shapes="twin", per_feature=False).fit(
+        _table({}, default=np.random.default_rng(4).normal(1.0, 0.01, 40)))
     assert detector.threshold_ == pytest.approx(calibrated_threshold(
         baseline_days=28, n_features=len(FEATURES), false_alarms_per_year=0.5, shapes=shapes))
     assert detector.threshold_ > calibrated_threshold(baseline_days=28, n_features=len(FEATURES),
@@ -171,3 +172,60 @@ def test_too_few_days_no_alarm_and_bad_settings():
         ChangeDetector(baseline_days=2).fit(_table({"sliding_pos": x}))
     with pytest.raises(ParameterError, match="unknown features bogus"):
         ChangeDetector(features=["bogus"]).fit(_table({"sliding_pos": x}))
+
+
+def test_plant_shapes_weigh_the_plant_days_against_the_prior():
+    prior = stable_shapes()[:1]
+    rng = np.random.default_rng(5)
+    skewed = [rng.lognormal(0.0, 0.6, 28) for _ in range(40)]  # 40 axes' baselines of one feature, skewed high
+    none = plant_shapes([[]], prior, prior_days=28.0)[0]
+    assert np.allclose(none[10:-10], np.interp(np.linspace(0, 1, 201), np.linspace(0, 1, prior.shape[1]),
+                                               prior[0])[10:-10], atol=0.05)  # without plant days: the prior
+    pooled = plant_shapes([skewed], prior, prior_days=28.0)[0]
+    standardised = np.concatenate([(d - d.mean()) / d.std(ddof=1) for d in skewed])
+    # 1120 plant days against 28 of the prior: the plant's quantiles, a long upper tail and a short lower one
+    assert pooled[100] == pytest.approx(np.median(standardised), abs=0.05)
+    assert pooled[-3] > 2.0 * -pooled[2]
+    heavy = plant_shapes([skewed], prior, prior_days=1e6)[0]  # a prior of a million days: the prior
+    assert heavy[100] == pytest.approx(prior[0][prior.shape[1] // 2], abs=0.02)
+
+
+def test_threshold_of_each_feature_from_the_plant_baseline():
+    rng = np.random.default_rng(6)
+    tables = []
+    for machine in range(12):  # a plant of 12 axes: 336 baseline days per feature
+        series = {name: rng.normal(1.0, 0.01, 40) for name in FEATURES}
+        series["noise"] = 1.0 + 0.01 * rng.lognormal(0.0, 0.8, 40)  # one feature skewed to high values
+        tables.append(_table(series, machine=f"m{machine}"))
+    plant = pa.concat_tables(tables)
+    detector = ChangeDetector().fit(plant)
+    h = detector.thresholds_
+    assert h["noise"] > max(h[name] for name in FEATURES if name != "noise") + 0.3
+    assert detector.threshold_ == max(h.values())
+    # the twin's shapes alone, one threshold: the plant's skew does not reach it
+    twin = ChangeDetector(shapes="twin", per_feature=False).fit(plant)
+    assert set(twin.thresholds_.values()) == {twin.threshold_} and twin.threshold_ < h["noise"]
+    # per feature, each for an equal share: on the twin's own shapes the thresholds are those of the calibration
+    per_feature = ChangeDetector(shapes="twin").fit(plant).thresholds_
+    expected = calibrated_threshold(baseline_days=28, n_features=len(FEATURES), false_alarms_per_year=0.5,
+                                    shapes=stable_shapes(), per_feature=True)
+    assert np.allclose([per_feature[name] for name in FEATURES], expected)
+
+
+@pytest.mark.slow
+def test_per_feature_thresholds_hold_the_rate_on_a_skewed_feature():
+    # nine normal features and one skewed; simulated stable years drawn apart from the calibration's seed
+    rng = np.random.default_rng(33)
+    gaussian = np.quantile(np.random.default_rng(78).standard_normal(400_000), np.linspace(0.0, 1.0, 201))
+    shapes = np.vstack([gaussian] * 9 + [_skewed_shapes(1)[0]])
+    h = calibrated_threshold(baseline_days=28, n_features=10, false_alarms_per_year=1.0, shapes=shapes,
+                             per_feature=True)
+    assert h[-1] > h[0] + 0.3 and np.allclose(h[:9], h[0], atol=0.2)
+    skewed = rng.lognormal(0.0, 0.5, (20_000, 28 + 365))
+    gauss = rng.standard_normal((20_000, 28 + 365))
+    # each feature raises its share, 1/10 of one false alarm a year: the skewed one no more than the others
+    assert abs(_false_alarms_per_axis_year(skewed, h[-1], 10) - 1.0) < 0.2
+    assert abs(_false_alarms_per_axis_year(gauss, h[0], 10) - 1.0) < 0.2
+    # one threshold for all (the common calibration) lets the skewed feature raise more than its share
+    common = calibrated_threshold(baseline_days=28, n_features=10, false_alarms_per_year=1.0, shapes=shapes)
+    assert _false_alarms_per_axis_year(skewed, common, 10) > 1.3
