@@ -30,7 +30,7 @@ from typing import Callable, Sequence
 
 from .errors import GreyboxError
 from .identify.inertia import SPRING_SHARE_LIMIT, spring_share
-from .identify.selection import choose, held_out_folds, score_candidates, selection_record
+from .identify.selection import choose, held_out_folds, score_candidates, selection_record, speed_fold
 from .models.friction.backlash import BacklashModel
 from .models.registry import MODEL_CLASSES
 
@@ -189,7 +189,15 @@ def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[
             extra = [(spec, build_candidate(spec, inertia=inertia)) for spec in gap_tried]
             models += extra
             scores += score_candidates(extra, folds, workers=workers, progress=progress)
-    chosen = choose(scores)
+    notes += [f"{score.label} disqualified: {score.error}" for score in scores
+              if score.error is not None and score.fold_re]
+    speed = speed_fold(folds)
+    chosen = choose(scores, speed)
+    if speed is not None:
+        trained, held = folds[speed].speeds()
+        notes.append(f"{folds[speed].name} holds out runs faster than those it trains on (99th percentile of |v| "
+                     f"{held:.4g} against {trained:.4g}): a candidate predicting it worse than the simplest one by "
+                     "more than that one's standard error was not chosen")
     model = models[chosen][1].fit(list(runs))
     model.selection_ = selection_record(scores, folds, chosen, notes)
     return model

@@ -166,8 +166,8 @@ class KernelRegressionModel(CurrentModel):
         """Raw SVR inputs of a chunk of a run, shape (n, n_features), and the state after it."""
         raise NotImplementedError
 
-    def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
-        """As :meth:`CurrentModel.outside_training <greybox.models.estimator.CurrentModel.outside_training>`, with
+    def _input_region(self, log: AxisLog) -> dict[str, np.ndarray]:
+        """The input flags of :meth:`~greybox.models.estimator.CurrentModel.outside_training`, with
         ``"inputs"``: True where any SVR input lies outside its range over the training data. Computed
         in chunks, so that the inputs of a long run need not be held at once.
 
