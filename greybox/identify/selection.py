@@ -256,7 +256,7 @@ def score_candidates(candidates: Sequence[tuple[str, object]], folds: Sequence[F
             fits[c].append(n_params)
             score.seconds += seconds
         if progress is not None:
-            figure = f"RE {figures[0]:.2f} %" if error is None else "failed"
+            figure = f"RE {figures[0]:.2f} % ({figures[3]:.1f} s)" if error is None else "failed"
             progress(f"{candidates[c][0]} without {folds[f].name}: {figure}")
 
     if workers <= 1 or len(jobs) <= 1:

@@ -17,6 +17,7 @@ from __future__ import annotations
 from typing import Iterable
 
 import numpy as np
+from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 
 from ..base import EFFORT, LENGTH, ModelProtocol, Parameter
@@ -335,6 +336,20 @@ class CurrentModel(ModelProtocol):
     def first_stage(self):
         """Unfitted model of the first stage of a two-stage model; ``None`` for a one-stage model (default)."""
         return None
+
+    def held_out_search(self) -> "CurrentModel":
+        """An unfitted copy whose identification searches less, for scoring on held-out runs.
+
+        ``greybox train --model auto`` fits every candidate once per fold only to score it on runs it did not
+        see, and refits the chosen one with the full search (:mod:`greybox.model_choice`). Models whose
+        identification is a multi-start or Bayesian search return a copy with fewer starts or calls; the
+        others (default) a plain copy.
+
+        Returns
+        -------
+        CurrentModel
+        """
+        return clone(self)
 
     def fit_staged(self, logs, stage2_logs=None, *, progress=None, first_stage=None) -> "CurrentModel":
         """Fit a model whose stages may learn from different runs.

@@ -239,3 +239,16 @@ def test_a_choice_that_does_not_carry_to_speed_loses_to_the_simplest():
     assert choose([simplest, complex_]) == 1  # without the speed rule: the lowest mean, the simplest beyond one SE
     assert choose([simplest, complex_], speed=0) == 0  # 22 > 20 + 1.5
     assert choose([simplest, complex_, middle], speed=0) == 2  # 21 <= 21.5
+
+
+def test_the_folds_fit_each_candidate_with_a_smaller_search_of_the_same_model():
+    for spec in ("gms:offset", "gmssvr:asymmetric", "lugre:offset", "stribeck:asymmetric,backlash"):
+        full = build_candidate(spec)
+        fold = full.held_out_search()
+        assert type(fold) is type(full) and fold is not full
+        settings, reduced = full.get_params(deep=True), fold.get_params(deep=True)
+        changed = {name for name in settings if not isinstance(settings[name], BaseEstimator)
+                   and settings[name] != reduced[name]}
+        # only the size of the search differs: no option of the candidate
+        assert changed and all(name.split("__")[-1] in ("n_starts", "n_calls", "refine") for name in changed)
+        assert all(reduced[name] < settings[name] for name in changed)

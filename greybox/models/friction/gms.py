@@ -22,6 +22,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 
 from ...base import EFFORT, LENGTH, LinearPart, Parameter
@@ -74,6 +75,10 @@ _ALPHA_SPREAD = 20.0
 
 #: Bounds of the element-fraction logits (alpha_i proportional to exp(u_i), u_1 = 0).
 _LOGIT_BOUND = 6.0
+
+#: ``n_starts`` of a fit that only scores a candidate on held-out runs (:meth:`GMSModel.held_out_search`): the
+#: initial guess and the fixed slow-slip starts, whose basins decide the fit; the perturbed starts refine it.
+HELD_OUT_STARTS = 1
 
 #: Largest ``s_0 / s_inf`` whatever the runs allow: a break-away friction ten times the sliding one is beyond
 #: lubricated guides and screws. The runs usually bound it tighter (:class:`ShapeLimits`).
@@ -567,6 +572,15 @@ class GMSModel(CurrentModel):
         lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND), curve_lower, [np.log(1e-3)]))
         upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND), curve_upper, [np.log(MAX_SLIP_STEP_RATIO)]))
         return theta, lower, upper, ShapeLimits.of_runs(runs, static)
+
+    def held_out_search(self) -> "GMSModel":
+        """A copy searching from the initial guess and the fixed slow-slip starts only (no perturbed starts).
+
+        Returns
+        -------
+        GMSModel
+        """
+        return clone(self).set_params(n_starts=min(self.n_starts, HELD_OUT_STARTS))
 
     def _check_params(self) -> None:
         n = self.n_elements
