@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from axis_dev_data import axis_dev
 from friction_signals import motion_log, velocity_profile
 from sklearn.base import BaseEstimator
 
-from greybox.data.io import read_log
-from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError, ParameterError
 from greybox.identify.selection import (
     EXPLODING_FACTOR,
@@ -180,19 +178,6 @@ def test_dynamic_models_behind_a_gap_are_tried_when_the_runs_show_one(width, tri
     assert any("a gap:" in note for note in model.selection_["notes"]) is tried
 
 
-#: The independent development data (../shared/data/independent beside the repository).
-INDEPENDENT = Path(__file__).resolve().parents[3] / "shared" / "data" / "independent"
-
-
-def _axis_dev(name: str):
-    """An axis_dev air cut, prepared; skips when the development data are absent."""
-    path = INDEPENDENT / "axis_dev" / f"{name}.csv"
-    if not path.is_file():
-        pytest.skip(f"independent development data not found: no file {path}")
-    (run,) = prepare(read_log(path))
-    return run
-
-
 class _Runaway(BaseEstimator):
     """A Coulomb model whose prediction runs away: thirty times the fitted one (a blown-up identification)."""
 
@@ -209,7 +194,7 @@ class _Runaway(BaseEstimator):
 
 
 def test_an_exploding_fold_disqualifies_a_candidate_with_a_note():
-    runs = [_axis_dev("aircut_A"), _axis_dev("aircut_C")]
+    runs = [axis_dev("aircut_A"), axis_dev("aircut_C")]
     folds = held_out_folds(runs, ["aircut_A.csv", "aircut_C.csv"])
     scores = score_candidates([("coulomb:offset", CoulombModel(fit_offset=True)), ("runaway", _Runaway())], folds)
     floors = [fold.zero_re() for fold in folds]

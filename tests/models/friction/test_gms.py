@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from axis_dev_data import axis_dev
 from friction_reference import gms_reference
 from friction_signals import STEP, motion_log, velocity_profile
 
-from greybox.data.io import read_log
-from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError, ParameterError
 from greybox.identify.initial import static_initial_guess
 from greybox.models.estimator import check_plausible
@@ -297,9 +294,6 @@ def test_staged_identification_gives_the_same_model_for_every_seed():
         np.testing.assert_array_equal(getattr(first, name), getattr(second, name))
 
 
-#: The independent development data (../shared/data/independent beside the repository).
-INDEPENDENT = Path(__file__).resolve().parents[4] / "shared" / "data" / "independent"
-
 #: The GMS that the full search identified on axis_dev's aircut_B alone before its shape was held to the limits
 #: the runs give (greybox train --model gms, main d2f4090): s_0 1218 times s_inf, 42 A predicted on 0.7 A air cuts.
 BLOWN_UP = {"alpha": np.array([0.00484706, 0.0561903, 0.938963]) / 1.00000036,
@@ -308,17 +302,8 @@ BLOWN_UP = {"alpha": np.array([0.00484706, 0.0561903, 0.938963]) / 1.00000036,
             "v_s": 0.417509}
 
 
-def _axis_dev(name: str):
-    """An axis_dev air cut, prepared; skips when the development data are absent."""
-    path = INDEPENDENT / "axis_dev" / f"{name}.csv"
-    if not path.is_file():
-        pytest.skip(f"independent development data not found: no file {path}")
-    (run,) = prepare(read_log(path))
-    return run
-
-
 def test_the_runs_bound_the_stribeck_ratio_and_the_deflections():
-    run = _axis_dev("aircut_B")
+    run = axis_dev("aircut_B")
     static = static_initial_guess([run])
     limits = ShapeLimits.of_runs([run], static)
     assert 1.0 <= limits.ratio <= MAX_STRIBECK_RATIO
@@ -329,7 +314,7 @@ def test_the_runs_bound_the_stribeck_ratio_and_the_deflections():
 
 
 def test_a_blown_up_fit_is_refused_in_one_line():
-    run = _axis_dev("aircut_B")
+    run = axis_dev("aircut_B")
     model = fitted(BLOWN_UP, inertia=0.000593083)
     model._set_fit_info([run])
     with pytest.raises(GreyboxError) as caught:
@@ -343,7 +328,7 @@ def test_a_blown_up_fit_is_refused_in_one_line():
 @pytest.mark.parametrize("name", ["aircut_A", "aircut_B", "aircut_C"])
 def test_a_fit_on_one_air_cut_predicts_the_others_within_three_times_its_error(name):
     """Issue 40: a GMS fitted on one axis_dev air cut alone predicts the others within 3x its training RMSE."""
-    runs = {other: _axis_dev(other) for other in ("aircut_A", "aircut_B", "aircut_C")}
+    runs = {other: axis_dev(other) for other in ("aircut_A", "aircut_B", "aircut_C")}
     model = GMSModel().fit(runs[name])
     training = np.sqrt(np.mean((model.predict(runs[name]) - runs[name].effort) ** 2))
     for other, run in runs.items():
