@@ -14,7 +14,10 @@ first stage (``gms:asymmetric``, ``gmssvr:asymmetric``), among them
 model, and :data:`GAP_CANDIDATES` (dynamic models behind a backlash) join
 them when a static model behind a backlash shows a gap; :func:`choose_model` scores each by leave-one-run-out
 cross-validation (:mod:`greybox.identify.selection`), refits the chosen one
-on every run and keeps the table it chose from in ``selection_``.
+on every run and keeps the table it chose from in ``selection_``. The folds fit each candidate with its
+held-out search (:meth:`~greybox.models.estimator.CurrentModel.held_out_search`: the GMS search without
+its perturbed starts, 10 instead of 25 Bayesian calls of an SVR stage): a fold's fit only scores the
+candidate, and the chosen one is refitted with the full search.
 
 Before any candidate is fitted the runs are checked for an inertia that
 could only stand in for a spring (:mod:`greybox.identify.inertia`): when one
@@ -30,7 +33,7 @@ from typing import Callable, Sequence
 
 from .errors import GreyboxError
 from .identify.inertia import SPRING_SHARE_LIMIT, spring_share
-from .identify.selection import choose, held_out_folds, score_candidates, selection_record
+from .identify.selection import choose, held_out_folds, score_candidates, selection_record, speed_fold
 from .models.friction.backlash import BacklashModel
 from .models.registry import MODEL_CLASSES
 
@@ -126,6 +129,12 @@ def build_candidate(spec: str, *, inertia: float | None = None):
     return BacklashModel(base=model) if backlash else model
 
 
+def _screened(models):
+    """The candidates as the folds fit them: each one's held-out search (``held_out_search``: fewer starts or
+    Bayesian calls); the chosen one is refitted with its full search."""
+    return [(spec, model.held_out_search()) for spec, model in models]
+
+
 def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[str] = DEFAULT_CANDIDATES,
                  gap_candidates: Sequence[str] = GAP_CANDIDATES, inertia: float | None = None, n_blocks: int = 3,
                  workers: int = 1, progress: Callable[[str], None] | None = None):
@@ -178,7 +187,7 @@ def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[
                          "effort is a motor's)")
     models = [(spec, build_candidate(spec, inertia=inertia)) for spec in candidates]
     folds = held_out_folds(runs, groups, n_blocks=n_blocks)
-    scores = score_candidates(models, folds, workers=workers, progress=progress)
+    scores = score_candidates(_screened(models), folds, workers=workers, progress=progress)
     labels = [score.label for score in scores]
     gap_tried = [spec for spec in gap_candidates if spec not in labels]
     if gap_tried and all(spec in labels for spec in GAP_EVIDENCE):
@@ -188,8 +197,16 @@ def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[
                          f"(RE {behind.re:.2f} against {without.re:.2f} %), so {', '.join(gap_tried)} were tried too")
             extra = [(spec, build_candidate(spec, inertia=inertia)) for spec in gap_tried]
             models += extra
-            scores += score_candidates(extra, folds, workers=workers, progress=progress)
-    chosen = choose(scores)
+            scores += score_candidates(_screened(extra), folds, workers=workers, progress=progress)
+    notes += [f"{score.label} disqualified: {score.error}" for score in scores
+              if score.error is not None and score.fold_re]
+    speed = speed_fold(folds)
+    chosen = choose(scores, speed)
+    if speed is not None:
+        trained, held = folds[speed].speeds()
+        notes.append(f"{folds[speed].name} holds out runs faster than those it trains on (99th percentile of |v| "
+                     f"{held:.4g} against {trained:.4g}): a candidate predicting it worse than the simplest one by "
+                     "more than that one's standard error was not chosen")
     model = models[chosen][1].fit(list(runs))
     model.selection_ = selection_record(scores, folds, chosen, notes)
     return model

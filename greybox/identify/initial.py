@@ -22,6 +22,7 @@ from .static import fit_coulomb, fit_stribeck, stribeck_curve
 
 __all__ = ["SLIDING_DISTANCE_MM", "DEFAULT_DEFLECTION_MM", "motion_direction", "distance_since_reversal",
            "sliding_mask", "samples_at_speed", "static_initial_guess", "direction_level_ratio", "presliding_deflection",
+           "presliding_travels", "largest_friction",
            "check_motion"]
 
 #: Travel since the last reversal [mm] after which a sample counts as sliding.
@@ -207,6 +208,61 @@ def direction_level_ratio(runs: Sequence[AxisLog], *, min_distance: float = SLID
     return float(np.clip(levels["coulomb_neg"] / levels["coulomb_pos"], *bounds))
 
 
+def largest_friction(runs: Sequence[AxisLog], static: dict[str, float]) -> float:
+    """The largest friction measured: ``|effort - J a - offset|`` over all samples, with the static fit's ``J``.
+
+    Every run starts from rest, so the drive overcame the break-away friction in it: no friction level of
+    a model of these runs, at rest or at a speed they covered, lies beyond this measured one.
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        Prepared runs.
+    static : dict
+        Static fit (:func:`static_initial_guess`): ``J`` [A s^2/mm] and ``offset`` [A] used.
+
+    Returns
+    -------
+    float
+        [A] (or the effort unit of the runs).
+    """
+    return float(max(np.max(np.abs(run.effort - static["J"] * run.acceleration - static["offset"])) for run in runs))
+
+
+def presliding_travels(runs: Sequence[AxisLog], static: dict[str, float], *, fraction: float = 0.8,
+                       min_distance: float = SLIDING_DISTANCE_MM) -> np.ndarray:
+    """Travel after each reversal from sliding until the friction recovered ``fraction`` of its new level [mm].
+
+    Parameters
+    ----------
+    runs, static, fraction, min_distance
+        As in :func:`presliding_deflection`.
+
+    Returns
+    -------
+    ndarray
+        One travel [mm] per reversal that starts and ends in sliding and recovers; empty when none does.
+    """
+    travels = []
+    for run in runs:
+        v = run.velocity
+        friction = run.effort - static["J"] * run.acceleration - static["offset"] - static["viscous"] * v
+        level = stribeck_curve(v, static["static"], static["coulomb"], static["v_s"])
+        direction = motion_direction(v)
+        distance = distance_since_reversal(run.time, v)
+        starts = np.flatnonzero((direction[1:] != direction[:-1]) & (direction[1:] != 0)
+                                & (direction[:-1] != 0)) + 1
+        ends = np.append(starts[1:], v.size)
+        for start, end in zip(starts, ends):
+            if distance[start - 1] < min_distance or distance[end - 1] < min_distance:
+                continue
+            d = direction[start]
+            recovered = np.flatnonzero(d * friction[start:end] >= fraction * level[start:end])
+            if recovered.size and distance[start + recovered[0]] > 0.0:
+                travels.append(distance[start + recovered[0]])
+    return np.asarray(travels, dtype=float)
+
+
 def presliding_deflection(runs: Sequence[AxisLog], static: dict[str, float], *, fraction: float = 0.8,
                           min_distance: float = SLIDING_DISTANCE_MM) -> float | None:
     """Break-away deflection of an equivalent single spring from the reversals [mm].
@@ -235,23 +291,5 @@ def presliding_deflection(runs: Sequence[AxisLog], static: dict[str, float], *, 
     float or None
         ``delta`` [mm], or ``None`` when the data have no such reversal.
     """
-    travels = []
-    for run in runs:
-        v = run.velocity
-        friction = run.effort - static["J"] * run.acceleration - static["offset"] - static["viscous"] * v
-        level = stribeck_curve(v, static["static"], static["coulomb"], static["v_s"])
-        direction = motion_direction(v)
-        distance = distance_since_reversal(run.time, v)
-        starts = np.flatnonzero((direction[1:] != direction[:-1]) & (direction[1:] != 0)
-                                & (direction[:-1] != 0)) + 1
-        ends = np.append(starts[1:], v.size)
-        for start, end in zip(starts, ends):
-            if distance[start - 1] < min_distance or distance[end - 1] < min_distance:
-                continue
-            d = direction[start]
-            recovered = np.flatnonzero(d * friction[start:end] >= fraction * level[start:end])
-            if recovered.size and distance[start + recovered[0]] > 0.0:
-                travels.append(distance[start + recovered[0]])
-    if not travels:
-        return None
-    return float(np.median(travels)) / (1.0 + fraction)
+    travels = presliding_travels(runs, static, fraction=fraction, min_distance=min_distance)
+    return float(np.median(travels)) / (1.0 + fraction) if travels.size else None

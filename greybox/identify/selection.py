@@ -40,10 +40,20 @@ from ..json_values import jsonable
 from ..metrics import relative_error, rmse
 
 __all__ = ["Fold", "CandidateScore", "held_out_folds", "score_candidates", "choose", "selection_record",
-           "check_selection_record", "RULE"]
+           "check_selection_record", "speed_fold", "RULE", "EXPLODING_FACTOR", "SPEED_MARGIN"]
 
 #: The choice rule, as recorded with the result.
-RULE = ("lowest mean held-out RE; among candidates within one standard error of it, the fewest parameters")
+RULE = ("lowest mean held-out RE; among candidates within one standard error of it, the fewest parameters; "
+        "a fold's RE beyond 2 times that of predicting zero disqualifies; on the fold that holds out the fastest "
+        "runs, no worse than the simplest candidate by more than its standard error")
+
+#: A held-out RE above this multiple of the RE of predicting zero effort on the same fold disqualifies [-]:
+#: predicting nothing is the floor every model must beat; twice its error is a prediction that ran away.
+EXPLODING_FACTOR = 2.0
+
+#: A fold tests speed when its held-out runs are faster than its training runs by this factor [-] (99th
+#: percentiles of ``|v|``): a fifth beyond the fastest training speed is a regime the training runs did not show.
+SPEED_MARGIN = 1.2
 
 #: Samples a held-out stretch needs at least (one second at 2 ms), so that it holds motion and reversals.
 MIN_FOLD_SAMPLES = 500
@@ -66,6 +76,35 @@ class Fold:
     name: str
     train: list
     test: list
+
+    def speeds(self) -> tuple[float, float]:
+        """The 99th percentile of ``|v|`` of the training and of the held-out runs [mm/s]."""
+        return tuple(float(np.percentile(np.abs(np.concatenate([run.velocity for run in part])), 99))
+                     for part in (self.train, self.test))
+
+    def zero_re(self) -> float:
+        """The held-out RE [%] of predicting zero effort: the floor a model must beat."""
+        effort = np.concatenate([run.effort for run in self.test])
+        return relative_error(effort, np.zeros_like(effort))
+
+
+def speed_fold(folds: Sequence[Fold]) -> int | None:
+    """Index of the fold whose held-out runs are fastest beyond its training runs' speed, if any.
+
+    Parameters
+    ----------
+    folds : sequence of Fold
+        From :func:`held_out_folds`.
+
+    Returns
+    -------
+    int or None
+        The fold with the highest held-out speed among those whose held-out speed exceeds
+        :data:`SPEED_MARGIN` times its training speed (:meth:`Fold.speeds`); None when none does.
+    """
+    speeds = [fold.speeds() for fold in folds]
+    faster = [i for i, (train, test) in enumerate(speeds) if test > SPEED_MARGIN * train]
+    return max(faster, key=lambda i: speeds[i][1]) if faster else None
 
 
 @dataclass
@@ -217,7 +256,7 @@ def score_candidates(candidates: Sequence[tuple[str, object]], folds: Sequence[F
             fits[c].append(n_params)
             score.seconds += seconds
         if progress is not None:
-            figure = f"RE {figures[0]:.2f} %" if error is None else "failed"
+            figure = f"RE {figures[0]:.2f} % ({figures[3]:.1f} s)" if error is None else "failed"
             progress(f"{candidates[c][0]} without {folds[f].name}: {figure}")
 
     if workers <= 1 or len(jobs) <= 1:
@@ -229,20 +268,31 @@ def score_candidates(candidates: Sequence[tuple[str, object]], folds: Sequence[F
         with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=context) as pool:
             for job, outcome in zip(jobs, pool.map(_job, arguments)):
                 record(job, outcome)
+    floors = [fold.zero_re() for fold in folds]
     for score, n_params in zip(scores, fits):
         score.n_params = int(np.median(n_params)) if n_params else 0
         if score.error is not None:
             score.fold_re, score.fold_rmse = [], []
+            continue
+        for fold, re, floor in zip(folds, score.fold_re, floors):
+            if not re <= EXPLODING_FACTOR * floor:
+                score.error = (f"{fold.name}: held-out RE {re:.4g} % exploded (beyond {EXPLODING_FACTOR:g} times the "
+                               f"{floor:.4g} % of predicting zero)")
+                break
     return scores
 
 
-def choose(scores: Sequence[CandidateScore]) -> int:
+def choose(scores: Sequence[CandidateScore], speed: int | None = None) -> int:
     """Index of the chosen candidate by the one-standard-error rule (:data:`RULE`).
 
     Parameters
     ----------
     scores : sequence of CandidateScore
-        Scored candidates; failed ones are never chosen.
+        Scored candidates; failed (or exploded) ones are never chosen.
+    speed : int, optional
+        Index of the fold that tests speed (:func:`speed_fold`): candidates that predict it worse than the
+        simplest candidate (fewest parameters, then the first) by more than that one's standard error are
+        not chosen.
 
     Returns
     -------
@@ -257,6 +307,11 @@ def choose(scores: Sequence[CandidateScore]) -> int:
     if not scored:
         reasons = "; ".join(f"{score.label}: {score.error}" for score in scores)
         raise GreyboxError(f"no candidate model could be scored on the held-out runs ({reasons})")
+    if speed is not None:
+        simplest = scores[min(scored, key=lambda i: scores[i].n_params)]
+        spread = simplest.re_se
+        ceiling = simplest.fold_re[speed] + (spread if math.isfinite(spread) else 0.0)
+        scored = [i for i in scored if scores[i].fold_re[speed] <= ceiling]
     best = min(scored, key=lambda i: scores[i].re)
     spread = scores[best].re_se
     limit = scores[best].re + (spread if math.isfinite(spread) else 0.0)

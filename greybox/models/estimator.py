@@ -17,19 +17,21 @@ from __future__ import annotations
 from typing import Iterable
 
 import numpy as np
+from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 
 from ..base import EFFORT, LENGTH, ModelProtocol, Parameter
 from ..data.log import AxisLog, as_log_list
 from ..data.quantities import MOTIONS, Motion
-from ..errors import LogError, ParameterError, Setting
+from ..errors import GreyboxError, LogError, ParameterError, Setting
 from ..identify.inertia import axis_inertia_note, inertia_note
 from ..identify.intervals import with_intervals
 from ..identify.progress import make_progress
 from ..metrics import rmse
 
 __all__ = ["CurrentModel", "StreamView", "check_inertia", "check_runs", "extrapolates", "outside_any",
-           "EXTRAPOLATION_WARNING_SHARE", "MAX_PARAMETER_MAGNITUDE", "STANDSTILL_SHARE"]
+           "EXTRAPOLATION_WARNING_SHARE", "MAX_PARAMETER_MAGNITUDE", "PLAUSIBLE_EFFORT_FACTOR", "STANDSTILL_SHARE",
+           "check_plausible"]
 
 #: Largest magnitude of an identified parameter a model file may carry: currents of a feed axis are
 #: amperes, stiffnesses thousands of A/mm; 1e12 in any unit is a corrupt or hostile file.
@@ -37,6 +39,25 @@ MAX_PARAMETER_MAGNITUDE = 1e12
 
 #: Learned attributes that record the training region: name -> channel of the runs (range [mm] or [mm/s]).
 _REGION_CHANNELS = {"position_range_mm_": "position", "velocity_range_mm_s_": "velocity"}
+
+#: Learned attribute that records the range of the measured effort of the training runs [A, N or Nm]: a
+#: prediction beyond it is flagged ``"effort"`` by :meth:`CurrentModel.outside_training`.
+_EFFORT_RANGE = "effort_range_"
+
+#: A fit is refused when its simulated effort, on its own runs or at a constant speed within the speeds
+#: they covered, exceeds this multiple of the largest effort measured in them [-]: friction at a speed the
+#: drive moved at cannot exceed what the drive produced to move there (the break-away level included,
+#: since every run starts from rest), so an effort three times beyond it is a search that ran into
+#: parameters that contradict the runs (docs/defaults.md, "Identification that cannot blow up silently").
+PLAUSIBLE_EFFORT_FACTOR = 3.0
+
+#: Constant speeds of the plausibility probe, as shares of the largest training speed [-], each held in
+#: both directions for :data:`_PROBE_TRAVEL_MM` of travel or :data:`_PROBE_MIN_S`, whichever is longer
+#: (capped at :data:`_PROBE_MAX_S`): slow enough to reach the static level a Stribeck curve extrapolates to.
+_PROBE_SHARES = (1.0, 0.3, 0.1, 0.03, 0.01)
+_PROBE_TRAVEL_MM = 2.0
+_PROBE_MIN_S = 0.2
+_PROBE_MAX_S = 4.0
 
 #: Speed below which a memoryless model's sample counts as standstill, as a share of the largest training
 #: speed [-]: flagged ``"standstill"`` by :meth:`CurrentModel.outside_training`.
@@ -81,6 +102,68 @@ def extrapolates(shares: dict, share: float) -> bool:
     """
     beyond = max([value for name, value in shares.items() if name != "standstill"] or [0.0])
     return share > EXTRAPOLATION_WARNING_SHARE and beyond > 0.0
+
+
+def _probe(model: "CurrentModel", runs: list[AxisLog]) -> tuple[AxisLog, np.ndarray]:
+    """Constant speeds within the training speeds, both directions (no acceleration): :func:`check_plausible`.
+
+    Returns the probe run and the mask of its steady samples: the second half of each constant speed (the
+    jumps between speeds are no motion a drive makes; a dynamic model's transient there is not judged).
+    """
+    step = float(model.sample_time_)
+    top = float(max(np.max(np.abs(run.velocity)) for run in runs))
+    pieces, steady = [], []
+    for share in _PROBE_SHARES:
+        speed = share * top
+        seconds = float(np.clip(_PROBE_TRAVEL_MM / speed, _PROBE_MIN_S, _PROBE_MAX_S)) if speed > 0 else _PROBE_MIN_S
+        n = max(int(round(seconds / step)), 2)
+        for direction in (1.0, -1.0):
+            pieces.append(np.full(n, direction * speed))
+            steady.append(np.arange(n) >= n // 2)
+    velocity = np.concatenate(pieces)
+    time = np.arange(velocity.size) * step
+    start = float(np.mean([np.median(run.position) for run in runs]))
+    position = start + np.concatenate(([0.0], np.cumsum(velocity[:-1] * step)))
+    return AxisLog(time=time, position=position, effort=np.zeros(velocity.size), velocity=velocity,
+                   acceleration=np.zeros(velocity.size), effort_unit=runs[0].effort_unit,
+                   motion=runs[0].motion), np.concatenate(steady)
+
+
+def check_plausible(model: "CurrentModel", runs: list[AxisLog]) -> None:
+    """Refuse a fitted model whose simulated effort is far beyond any effort measured in its training runs.
+
+    The model predicts its own runs and a probe of constant speeds within the speeds they covered
+    (shares :data:`_PROBE_SHARES` of the largest, both directions, no acceleration; judged in the second
+    half of each speed, once a dynamic model has settled); neither may exceed
+    :data:`PLAUSIBLE_EFFORT_FACTOR` times the largest measured effort.
+
+    Parameters
+    ----------
+    model : CurrentModel
+        The model just fitted on ``runs``.
+    runs : list of AxisLog
+        Its prepared training runs.
+
+    Raises
+    ------
+    GreyboxError
+        One line naming the model, where it predicts what, against the largest measured effort.
+    """
+    largest = float(max(np.max(np.abs(run.effort)) for run in runs))
+    limit = PLAUSIBLE_EFFORT_FACTOR * largest
+    unit = runs[0].effort_unit
+    probe, steady = _probe(model, runs)
+    cases = [(f"on its own run {run.source or i + 1}", run, np.ones(len(run), dtype=bool))
+             for i, run in enumerate(runs)]
+    for what, run, judged in cases + [("at a constant speed", probe, steady)]:
+        predicted = np.where(judged, model.predict(run), 0.0)
+        worst = int(np.argmax(np.abs(predicted))) if predicted.size else 0
+        if predicted.size and not (np.isfinite(predicted[worst]) and abs(predicted[worst]) <= limit):
+            raise GreyboxError(
+                f"{type(model).__name__} fit refused: it predicts {predicted[worst]:.4g} {unit} {what} at "
+                f"{run.velocity[worst]:.4g} {run.units.velocity_unit}, beyond {PLAUSIBLE_EFFORT_FACTOR:g} times the "
+                f"largest effort measured in its runs ({largest:.4g} {unit}): its identified parameters contradict "
+                f"the runs ({model.parameter_summary()})")
 
 
 def check_runs(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
@@ -187,12 +270,13 @@ class CurrentModel(ModelProtocol):
             self._fit_runs(runs, make_progress(progress))
             note = inertia_note(runs, float(self.J_), f"{self.effort_unit_} s^2/{self.units_.length}")
             self.notes_ = [] if note is None else [note]
-            return self
-        known = float(self.inertia)
-        self._fit_runs([run.replace(effort=run.effort - known * run.acceleration,
-                                    acceleration=np.zeros(len(run))) for run in runs], make_progress(progress))
-        self.J_ = known
-        self.notes_ = []
+        else:
+            known = float(self.inertia)
+            self._fit_runs([run.replace(effort=run.effort - known * run.acceleration,
+                                        acceleration=np.zeros(len(run))) for run in runs], make_progress(progress))
+            self.J_ = known
+            self.notes_ = []
+        check_plausible(self, runs)
         return self
 
     def check_axis_inertia(self, expected: float, source: str = "the axis file") -> str | None:
@@ -252,6 +336,20 @@ class CurrentModel(ModelProtocol):
     def first_stage(self):
         """Unfitted model of the first stage of a two-stage model; ``None`` for a one-stage model (default)."""
         return None
+
+    def held_out_search(self) -> "CurrentModel":
+        """An unfitted copy whose identification searches less, for scoring on held-out runs.
+
+        ``greybox train --model auto`` fits every candidate once per fold only to score it on runs it did not
+        see, and refits the chosen one with the full search (:mod:`greybox.model_choice`). Models whose
+        identification is a multi-start or Bayesian search return a copy with fewer starts or calls; the
+        others (default) a plain copy.
+
+        Returns
+        -------
+        CurrentModel
+        """
+        return clone(self)
 
     def fit_staged(self, logs, stage2_logs=None, *, progress=None, first_stage=None) -> "CurrentModel":
         """Fit a model whose stages may learn from different runs.
@@ -348,7 +446,7 @@ class CurrentModel(ModelProtocol):
             The region check's state after the chunk.
         """
         run, start, step = self._chunk_arguments(log, state, sample_time)
-        return self._stream_step(step)(run, start, region)
+        return self._flagged_step(step)(run, start, region)
 
     def stream_view(self, first: AxisLog, *, sample_time: float) -> "StreamView":
         """The model for the chunks of one stream: the checks of the model and of the stream done once here.
@@ -378,7 +476,17 @@ class CurrentModel(ModelProtocol):
         self._check_predict_runs(first)
         if not (np.isfinite(sample_time) and sample_time > 0.0):
             raise LogError(first.source or None, f"the step must be a positive number of seconds, got {sample_time!r}")
-        return StreamView(self, self._stream_step(float(sample_time)))
+        return StreamView(self, self._flagged_step(float(sample_time)))
+
+    def _flagged_step(self, sample_time: float):
+        """:meth:`_stream_step` with the ``"effort"`` flag of its prediction added (:meth:`effort_flags`)."""
+        inner = self._stream_step(sample_time)
+
+        def step(run, state, region):
+            current, end, flags, region = inner(run, state, region)
+            return current, end, {**flags, **self.effort_flags(current)}, region
+
+        return step
 
     def _stream_step(self, sample_time: float):
         """``step(run, state, region) -> (current, state, flags, region)`` of checked chunks at ``sample_time``.
@@ -468,6 +576,20 @@ class CurrentModel(ModelProtocol):
         return with_intervals(self, [Parameter(p.name, p.value, p.unit.replace(EFFORT, unit).replace(LENGTH, length),
                                                p.description) for p in rows])
 
+    def parameter_summary(self) -> str:
+        """The identified scalar parameters as one line of text (``"s_0 = 1.8 mm, ..."``), for messages.
+
+        Returns
+        -------
+        str
+        """
+        check_is_fitted(self)
+        rows = self._own_parameters() + [Parameter("J", self.J_, f"{EFFORT} s^2/{LENGTH}", ""),
+                                         Parameter("offset", self.offset_, EFFORT, "")]
+        unit, length = self.effort_unit_, self.units_.length
+        return ", ".join(f"{p.name} = {float(p.value):.4g} {p.unit.replace(EFFORT, unit).replace(LENGTH, length)}"
+                         .rstrip(" -") for p in rows if np.ndim(p.value) == 0)
+
     @property
     def units_(self) -> Motion:
         """Units of the axis the model was fitted on (a model file without the record: a linear axis)."""
@@ -504,13 +626,13 @@ class CurrentModel(ModelProtocol):
         self.motion_ = runs[0].motion
         self.sample_time_ = float(np.median([run.sample_time for run in runs]))
         self.n_samples_fit_ = int(sum(len(run) for run in runs))
-        for name, channel in _REGION_CHANNELS.items():
+        for name, channel in {**_REGION_CHANNELS, _EFFORT_RANGE: "effort"}.items():
             values = np.concatenate([getattr(run, channel) for run in runs])
             setattr(self, name, [float(np.min(values)), float(np.max(values))])
 
     def _widen_region(self, other: "CurrentModel") -> None:
         """Widen the training region to cover the one of ``other`` (a fitted stage this model contains)."""
-        for name in _REGION_CHANNELS:
+        for name in [*_REGION_CHANNELS, _EFFORT_RANGE]:
             theirs = getattr(other, name, None)  # None: a stage loaded from a file that predates the record
             if theirs is not None:
                 ours = getattr(self, name)
@@ -531,11 +653,50 @@ class CurrentModel(ModelProtocol):
             lies outside the range of the training runs (kernel models add ``"inputs"``, their input
             space). A memoryless model (:meth:`initial_state` None: Coulomb, Stribeck, SVR) adds
             ``"standstill"``: speeds below :data:`STANDSTILL_SHARE` of the largest training speed, where
-            the drive holds a friction left by the last motion that such a model cannot know. Empty for a
-            model loaded from a file that predates the record of the ranges.
+            the drive holds a friction left by the last motion that such a model cannot know. ``"effort"``
+            (:meth:`effort_flags`): where the prediction leaves the range of the efforts measured in the
+            training runs. Empty for a model loaded from a file that predates the record of the ranges.
         """
+        return {**self._input_region(log), **self.effort_flags(self.predict(log))}
+
+    def _input_region(self, log: AxisLog) -> dict[str, np.ndarray]:
+        """The flags of :meth:`outside_training` that the run's inputs give (all but ``"effort"``)."""
         flags, _ = self.outside_training_chunk(log, self.region_state(), sample_time=log.sample_time)
         return flags
+
+    def effort_flags(self, predicted: np.ndarray) -> dict[str, np.ndarray]:
+        """Where a prediction leaves the range of the efforts measured in the training runs.
+
+        A friction model that predicts an effort the drive never produced on its training runs extrapolates,
+        whatever its inputs: this catches a prediction that runs away inside the ranges of position and speed.
+
+        Parameters
+        ----------
+        predicted : ndarray, shape (n,)
+            The model's prediction of a run or chunk [A, N or Nm].
+
+        Returns
+        -------
+        dict of str to ndarray of bool
+            ``{"effort": ...}``; empty for a model file that predates the record (``effort_range_``).
+
+        Raises
+        ------
+        ParameterError
+            If the record is not two finite numbers, the first not above the second (a corrupt model file).
+        """
+        bounds = getattr(self, _EFFORT_RANGE, None)
+        if bounds is None:
+            return {}
+        try:
+            low, high = (float(value) for value in bounds)
+        except (TypeError, ValueError):
+            low = high = float("nan")
+        if not (np.isfinite(low) and np.isfinite(high) and low <= high):
+            raise ParameterError(f"{_EFFORT_RANGE} (the range of the training efforts) must be two finite numbers, "
+                                 f"low then high, got {bounds!r}")
+        predicted = np.asarray(predicted, dtype=float)
+        return {"effort": ~((predicted >= low) & (predicted <= high))}
 
     def region_state(self):
         """State carried by :meth:`outside_training_chunk` from chunk to chunk of a run, at its start.
@@ -560,7 +721,8 @@ class CurrentModel(ModelProtocol):
         Returns
         -------
         flags : dict of str to ndarray of bool
-            As :meth:`outside_training` for the chunk's samples.
+            As :meth:`outside_training` for the chunk's samples, but for ``"effort"``, which needs the
+            prediction (:meth:`predict_flag_chunk` gives both).
         state : object
             The state after the chunk: the ``state`` of the next chunk.
         """

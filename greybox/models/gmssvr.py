@@ -185,6 +185,15 @@ class GMSSVRModel(KernelRegressionModel):
 
     first_stage_param = "gms"
 
+    def held_out_search(self) -> "GMSSVRModel":
+        """A copy with fewer Bayesian calls and the GMS stage's held-out search (for scoring on held-out runs).
+
+        Returns
+        -------
+        GMSSVRModel
+        """
+        return super().held_out_search().set_params(gms=self.first_stage().held_out_search())
+
     def first_stage(self) -> GMSModel:
         """Unfitted GMS stage: a clone of ``gms`` (``GMSModel()`` by default)."""
         return clone(GMSModel() if self.gms is None else self.gms)

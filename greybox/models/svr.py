@@ -94,6 +94,10 @@ def coulomb_viscous_proxy(runs: Sequence[AxisLog], inertia: float | None = None
     return J, float(coef[2]), float(coef[0]), float(coef[1])
 
 
+#: ``n_calls`` of a fit that only scores a candidate on held-out runs (:meth:`KernelRegressionModel.held_out_search`).
+HELD_OUT_CALLS = 10
+
+
 class KernelRegressionModel(CurrentModel):
     """Shared parts of the current models with an RBF support vector regression stage.
 
@@ -115,6 +119,15 @@ class KernelRegressionModel(CurrentModel):
 
     #: ``{setting name: input column}`` of the inputs the kernel weighs by a setting of that name.
     _weighted: Mapping[str, int] = {}
+
+    def held_out_search(self) -> "KernelRegressionModel":
+        """A copy whose Bayesian search of the SVR hyperparameters makes at most :data:`HELD_OUT_CALLS` calls.
+
+        Returns
+        -------
+        KernelRegressionModel
+        """
+        return super().held_out_search().set_params(n_calls=min(self.n_calls, HELD_OUT_CALLS))
 
     def _check_params(self) -> None:
         names = HYPERPARAMETERS + tuple(self._weighted)
@@ -166,8 +179,8 @@ class KernelRegressionModel(CurrentModel):
         """Raw SVR inputs of a chunk of a run, shape (n, n_features), and the state after it."""
         raise NotImplementedError
 
-    def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
-        """As :meth:`CurrentModel.outside_training <greybox.models.estimator.CurrentModel.outside_training>`, with
+    def _input_region(self, log: AxisLog) -> dict[str, np.ndarray]:
+        """The input flags of :meth:`~greybox.models.estimator.CurrentModel.outside_training`, with
         ``"inputs"``: True where any SVR input lies outside its range over the training data. Computed
         in chunks, so that the inputs of a long run need not be held at once.
 

@@ -158,7 +158,7 @@ def windows(tmp_path_factory):
     root = tmp_path_factory.mktemp("windows")
     model = CoulombModel().fit(prepare([_sine_log(5.0)]))
     paths = {"c": save_model(model, root / "c.gbm")}
-    del model.position_range_mm_, model.velocity_range_mm_s_  # as a file written before the record
+    del model.position_range_mm_, model.velocity_range_mm_s_, model.effort_range_  # as a file written before
     paths["old"] = save_model(model, root / "old.gbm")
     for name, offset in (("same", 0.0), ("shifted", 3.0)):
         paths[name] = root / f"{name}.csv"

@@ -153,7 +153,7 @@ def test_the_note_names_the_log_and_the_model_only_above_the_threshold(narrow):
 
 def test_a_model_file_without_its_training_region_gets_one_note_and_no_rows(narrow, tmp_path):
     old = CoulombModel().fit(_window_log("train", 5.0))
-    del old.position_range_mm_, old.velocity_range_mm_s_  # as a file written before the record
+    del old.position_range_mm_, old.velocity_range_mm_s_, old.effort_range_  # as a file written before the record
     loaded = load_model(save_model(old, tmp_path / "old.gbm"))
     runs = [_window_log("wide", 12.0, seed=4), _window_log("much", 5.0, offset_mm=3.0)]
     records, notes = _notes({"old": loaded, "c": narrow}, runs, ["wide", "much"])

@@ -6,17 +6,20 @@ import math
 
 import numpy as np
 import pytest
+from axis_dev_data import axis_dev
 from friction_signals import motion_log, velocity_profile
 from sklearn.base import BaseEstimator
 
 from greybox.errors import GreyboxError, ParameterError
 from greybox.identify.selection import (
+    EXPLODING_FACTOR,
     CandidateScore,
     check_selection_record,
     choose,
     held_out_folds,
     score_candidates,
     selection_record,
+    speed_fold,
 )
 from greybox.model_choice import build_candidate, choose_model
 from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
@@ -173,3 +176,64 @@ def test_dynamic_models_behind_a_gap_are_tried_when_the_runs_show_one(width, tri
     labels = [c["label"] for c in model.selection_["candidates"]]
     assert ("coulomb:backlash" in labels) is tried
     assert any("a gap:" in note for note in model.selection_["notes"]) is tried
+
+
+class _Runaway(BaseEstimator):
+    """A Coulomb model whose prediction runs away: thirty times the fitted one (a blown-up identification)."""
+
+    def fit(self, runs):
+        self.model_ = CoulombModel(fit_offset=True).fit(runs)
+        return self
+
+    @property
+    def n_params(self):
+        return self.model_.n_params + 1
+
+    def predict(self, runs):
+        return 30.0 * self.model_.predict(runs)
+
+
+def test_an_exploding_fold_disqualifies_a_candidate_with_a_note():
+    runs = [axis_dev("aircut_A"), axis_dev("aircut_C")]
+    folds = held_out_folds(runs, ["aircut_A.csv", "aircut_C.csv"])
+    scores = score_candidates([("coulomb:offset", CoulombModel(fit_offset=True)), ("runaway", _Runaway())], folds)
+    floors = [fold.zero_re() for fold in folds]
+    assert all(100.0 <= floor < 200.0 for floor in floors)  # a current that changes sign
+    coulomb, runaway = scores
+    assert coulomb.error is None and all(re < EXPLODING_FACTOR * f for re, f in zip(coulomb.fold_re, floors))
+    assert runaway.error is not None and "exploded" in runaway.error and "predicting zero" in runaway.error
+    assert math.isnan(runaway.re) and len(runaway.fold_re) == 2  # out, not averaged, its figures kept
+    assert choose(scores) == 0
+    record = selection_record(scores, folds, 0)
+    check_selection_record(record)
+
+
+def test_speed_fold_is_the_one_holding_out_faster_runs():
+    slow, fast, other = _coulomb_run(2), _coulomb_run(1), _coulomb_run(3)  # 99th percentiles 22, 54, 21 mm/s
+    folds = held_out_folds([slow, fast, other], ["slow.csv", "fast.csv", "other.csv"])
+    assert speed_fold(folds) == 1
+    same = held_out_folds([slow, other], ["a.csv", "b.csv"])
+    assert speed_fold(same) is None  # runs of one speed: no fold tests speed
+
+
+def test_a_choice_that_does_not_carry_to_speed_loses_to_the_simplest():
+    # fold 0 holds out the fastest run: the complex candidate wins the mean but predicts that fold worse
+    simplest = _score("coulomb:offset", [20.0, 14.0, 14.0, 14.0], 4)  # mean 15.5, SE 1.5
+    complex_ = _score("lugre:asymmetric", [22.0, 8.0, 8.0, 8.0], 9)  # mean 11.5, SE 3.5
+    middle = _score("stribeck:offset", [21.0, 9.0, 9.0, 9.0], 6)  # mean 12, SE 3
+    assert choose([simplest, complex_]) == 1  # without the speed rule: the lowest mean, the simplest beyond one SE
+    assert choose([simplest, complex_], speed=0) == 0  # 22 > 20 + 1.5
+    assert choose([simplest, complex_, middle], speed=0) == 2  # 21 <= 21.5
+
+
+def test_the_folds_fit_each_candidate_with_a_smaller_search_of_the_same_model():
+    for spec in ("gms:offset", "gmssvr:asymmetric", "lugre:offset", "stribeck:asymmetric,backlash"):
+        full = build_candidate(spec)
+        fold = full.held_out_search()
+        assert type(fold) is type(full) and fold is not full
+        settings, reduced = full.get_params(deep=True), fold.get_params(deep=True)
+        changed = {name for name in settings if not isinstance(settings[name], BaseEstimator)
+                   and settings[name] != reduced[name]}
+        # only the size of the search differs: no option of the candidate
+        assert changed and all(name.split("__")[-1] in ("n_starts", "n_calls", "refine") for name in changed)
+        assert all(reduced[name] < settings[name] for name in changed)

@@ -34,7 +34,8 @@ def test_the_region_is_the_range_of_the_training_runs_and_the_flags_follow_it(lo
     assert model.position_range_mm_ == [logs["A"].position.min(), logs["A"].position.max()]
     assert model.velocity_range_mm_s_ == [logs["A"].velocity.min(), logs["A"].velocity.max()]
     inside = model.outside_training(logs["A"])
-    assert set(inside) == {"position", "velocity", "standstill"}  # a memoryless model flags standstill too
+    # a memoryless model flags standstill too; every model a prediction beyond the trained efforts
+    assert set(inside) == {"position", "velocity", "standstill", "effort"}
     assert not inside["position"].any() and not inside["velocity"].any()
     far = model.outside_training(logs["D"])
     low, high = model.position_range_mm_
@@ -48,7 +49,7 @@ def test_gms_svr_adds_its_input_space_and_covers_both_stages(logs):
     assert model.position_range_mm_ == [both.min(), both.max()]
     assert model.input_range_.shape == (2, 2 + len(model.gms_.alpha_))
     flags = model.outside_training(logs["D"])
-    assert set(flags) == {"position", "velocity", "inputs"}
+    assert set(flags) == {"position", "velocity", "inputs", "effort"}
     assert np.all(flags["inputs"][flags["position"]])  # position is one of the inputs
     again = model.outside_training(logs["C"])
     assert not again["position"].any() and not again["inputs"].any()
@@ -64,7 +65,8 @@ def test_predict_reports_records_and_marks_the_samples_outside(logs, tmp_path, c
     captured = capsys.readouterr()
     assert status == 0, captured.err
     meta = json.loads(Path(str(out) + ".json").read_text())["attrs"]["extrapolation"]
-    assert meta["share"] > EXTRAPOLATION_WARNING_SHARE and set(meta["by"]) == {"position", "velocity", "standstill"}
+    assert meta["share"] > EXTRAPOLATION_WARNING_SHARE
+    assert set(meta["by"]) == {"position", "velocity", "standstill", "effort"}
     assert f"outside the training region: {100 * meta['share']:.1f} % of the samples" in captured.out
     note = [line for line in captured.err.splitlines()
             if line.startswith("note: cut.mcap:") and "standstill" not in line]
@@ -101,7 +103,7 @@ def test_inside_the_window_there_is_no_note_and_every_format_carries_the_column(
 
 def test_a_model_file_without_a_region_still_predicts_and_says_so(logs, tmp_path, capsys):
     model = StribeckModel().fit(logs["A"])
-    del model.position_range_mm_, model.velocity_range_mm_s_  # as a file written before the record
+    del model.position_range_mm_, model.velocity_range_mm_s_, model.effort_range_  # as a file written before
     save_model(model, tmp_path / "old.gbm")
     loaded = load_model(tmp_path / "old.gbm")
     assert loaded.outside_training(logs["D"]) == {}
@@ -135,8 +137,9 @@ def test_gms_svr_predicts_and_flags_a_chunk_with_one_gms_pass_as_it_does_apart(l
             chunk, state, region, sample_time=run.sample_time)
         expected, state = model.predict_chunk(chunk, state, sample_time=run.sample_time)
         expected_flags, region = model.outside_training_chunk(chunk, region, sample_time=run.sample_time)
+        expected_flags.update(model.effort_flags(expected))  # the flag of the prediction, beside those of the inputs
         np.testing.assert_array_equal(current, expected)
-        assert flags.keys() == expected_flags.keys() and "inputs" in flags
+        assert flags.keys() == expected_flags.keys() and "inputs" in flags and "effort" in flags
         for name in flags:
             np.testing.assert_array_equal(flags[name], expected_flags[name])
         for ours, theirs in ((state_together, state), (region_together, region)):

@@ -142,6 +142,9 @@ class BacklashModel(CurrentModel):
         ``GMSModel()`` by default.
     width : float, optional
         Backlash [mm] (the motor travel across the gap); identified from the data when None.
+    refine : bool, default True
+        Refine the best width of the grid by a bounded scalar search (up to 8 more fits of the base); False
+        keeps the grid's best (:meth:`held_out_search`).
 
     Attributes
     ----------
@@ -161,19 +164,31 @@ class BacklashModel(CurrentModel):
         "A" or "N".
     """
 
-    def __init__(self, *, base=None, width: float | None = None):
+    def __init__(self, *, base=None, width: float | None = None, refine: bool = True):
         self.base = base
         self.width = width
+        self.refine = refine
 
     # ---------------------------------------------------------------- fitting
     def _check_params(self) -> None:
         if self.base is not None and (not isinstance(self.base, CurrentModel) or isinstance(self.base, BacklashModel)):
             raise ParameterError(f"base must be a current model other than BacklashModel, got "
                                  f"{type(self.base).__name__}")
+        self._check_flags("refine")
         width = self.width
         if width is not None and not (isinstance(width, (int, float, np.number)) and not isinstance(width, bool)
                                       and np.isfinite(width) and width >= 0.0):
             raise ParameterError(f"width must be a non-negative backlash in mm or None, got {width!r}")
+
+    def held_out_search(self) -> "BacklashModel":
+        """A copy whose base model searches less (:meth:`CurrentModel.held_out_search`) and that keeps the grid's
+        best width unrefined: the grid tells a gap from none, which is what a fold scores.
+
+        Returns
+        -------
+        BacklashModel
+        """
+        return clone(self).set_params(base=self._base_template().held_out_search(), refine=False)
 
     def _base_template(self):
         """Unfitted base model (a clone of ``base``, ``GMSModel()`` by default)."""
@@ -199,9 +214,9 @@ class BacklashModel(CurrentModel):
             cost(float(self.width))
         else:
             widths = [0.0] + list(np.geomspace(1e-3, 1.0, _N_GRID) * 0.5 * stroke(runs))
-            n_trials = len(widths) + _N_REFINE
+            n_trials = len(widths) + _N_REFINE * int(self.refine)
             best = int(np.argmin([cost(w) for w in widths]))
-            if best > 0:
+            if best > 0 and self.refine:
                 logs = np.log(widths[1:])
                 low, high = logs[max(best - 2, 0)], logs[min(best, len(logs) - 1)]
                 minimize_scalar(lambda x: cost(float(np.exp(x))), bounds=(low, high), method="bounded",

@@ -22,6 +22,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from sklearn.base import clone
 from sklearn.utils.validation import check_is_fitted
 
 from ...base import EFFORT, LENGTH, LinearPart, Parameter
@@ -30,7 +31,9 @@ from ...identify.initial import (
     DEFAULT_DEFLECTION_MM,
     check_motion,
     direction_level_ratio,
+    largest_friction,
     presliding_deflection,
+    presliding_travels,
     static_initial_guess,
 )
 from ...identify.linear import bounded_lstsq
@@ -41,7 +44,8 @@ from .directions import direction_pair, viscous_columns
 from .kernels import direction_curves, gms_friction_kernel, gms_trajectory_kernel
 from .plant_laws import gms_plant_law
 
-__all__ = ["GMSModel", "GMSState", "check_gms_parameters", "simulate_gms", "gms_trajectory", "gms_trajectory_runner"]
+__all__ = ["GMSModel", "GMSState", "ShapeLimits", "MAX_STRIBECK_RATIO", "BREAKAWAY_MARGIN", "check_gms_parameters",
+           "simulate_gms", "gms_trajectory", "gms_trajectory_runner"]
 
 #: Largest ``T C / min(s_0, s_inf)`` the identification allows: the slip step
 #: then relaxes monotonically (no overshoot), well inside the stability limit 2.
@@ -71,6 +75,72 @@ _ALPHA_SPREAD = 20.0
 
 #: Bounds of the element-fraction logits (alpha_i proportional to exp(u_i), u_1 = 0).
 _LOGIT_BOUND = 6.0
+
+#: ``n_starts`` of a fit that only scores a candidate on held-out runs (:meth:`GMSModel.held_out_search`): the
+#: initial guess and the fixed slow-slip starts, whose basins decide the fit; the perturbed starts refine it.
+HELD_OUT_STARTS = 1
+
+#: Largest ``s_0 / s_inf`` whatever the runs allow: a break-away friction ten times the sliding one is beyond
+#: lubricated guides and screws. The runs usually bound it tighter (:class:`ShapeLimits`).
+MAX_STRIBECK_RATIO = 10.0
+
+#: How far the break-away level ``K s_0`` may exceed the largest friction the runs measured [-]: a run that
+#: never rests long enough, or a static fit whose Coulomb level is off, shows less than the full level.
+BREAKAWAY_MARGIN = 2.0
+
+
+class ShapeLimits(NamedTuple):
+    """Bounds of a GMS shape that the training runs give (:meth:`GMSModel._shape` holds every trial to them).
+
+    Attributes
+    ----------
+    ratio : float
+        Largest ``s_0 / s_inf`` [-] per direction: :data:`BREAKAWAY_MARGIN` times the largest friction
+        measured (:func:`~greybox.identify.initial.largest_friction`) over the static fit's Coulomb level, at
+        least 1, at most :data:`MAX_STRIBECK_RATIO`. In steady sliding the friction is ``K s(v)``, so
+        ``K s_inf`` is the Coulomb level and ``K s_0`` the break-away level, which no run exceeded by much:
+        every run starts from rest, and the drive broke the axis free.
+    deflection : float
+        Largest break-away deflection of the largest element, ``max(alpha_i) s_0`` and ``max(alpha_i) s_inf``
+        [mm]: the longest travel after a reversal from sliding within which the friction recovered 80 % of
+        its new level (:func:`~greybox.identify.initial.presliding_travels`); the element that carries the
+        most force cannot need more travel to break away than the runs showed. Infinite when the runs have
+        no such reversal.
+    """
+
+    ratio: float
+    deflection: float
+
+    @classmethod
+    def of_runs(cls, runs, static: dict) -> "ShapeLimits":
+        """The limits the prepared ``runs`` and their static fit (``static_initial_guess``) give.
+
+        Parameters
+        ----------
+        runs : list of AxisLog
+            Prepared runs.
+        static : dict
+            :func:`~greybox.identify.initial.static_initial_guess` of the runs.
+        """
+        coulomb = float(static["coulomb"])
+        ratio = BREAKAWAY_MARGIN * largest_friction(runs, static) / coulomb if coulomb > 0.0 else MAX_STRIBECK_RATIO
+        travels = presliding_travels(runs, static)
+        return cls(float(np.clip(ratio, 1.0, MAX_STRIBECK_RATIO)),
+                   float(travels.max()) if travels.size else np.inf)
+
+    def hold(self, s_0: np.ndarray, s_inf: np.ndarray, largest: float) -> tuple[np.ndarray, np.ndarray]:
+        """``s_0`` and ``s_inf`` [mm] (one value per direction) held to the limits.
+
+        Parameters
+        ----------
+        s_0, s_inf : ndarray
+            Break-away deflections at rest and at high speed [mm].
+        largest : float
+            The largest element fraction ``max(alpha_i)`` [-].
+        """
+        most = self.deflection / largest
+        s_inf = np.minimum(s_inf, most)
+        return np.minimum(np.minimum(s_0, self.ratio * s_inf), most), s_inf
 
 
 class GMSState(NamedTuple):
@@ -459,8 +529,8 @@ class GMSModel(CurrentModel):
         self.staged = staged
 
     # ---------------------------------------------------------------- identification
-    def _shape(self, theta, max_step):
-        """``alpha, s_0, s_inf, v_s, C`` from the search vector ``theta``.
+    def _shape(self, theta, max_step, limits: ShapeLimits):
+        """``alpha, s_0, s_inf, v_s, C`` from the search vector ``theta``, the deflections held to ``limits``.
 
         ``theta = (u_2..u_N, log s_0, log s_inf, log v_s, log r)``, or with
         ``log s_0, log s_inf, log v_s`` of positive then of negative motion
@@ -469,13 +539,15 @@ class GMSModel(CurrentModel):
         n = self.n_elements
         alpha = _alpha_from_logits(theta[: n - 1])
         curve = np.exp(theta[n - 1:-1]).reshape(-1, 3)
+        curve[:, 0], curve[:, 1] = limits.hold(curve[:, 0], curve[:, 1], float(alpha.max()))
         s_0, s_inf, v_s = (curve[:, j] if self.asymmetric else float(curve[0, j]) for j in range(3))
         return alpha, s_0, s_inf, v_s, float(np.exp(theta[-1])) * float(curve[:, :2].min()) / max_step
 
     def _initial_shape(self, runs):
         """Stage 1: initial shape vector and its bounds from a static fit and the reversals.
 
-        Returns ``theta`` (see :meth:`_shape`) and its lower and upper bounds.
+        Returns ``theta`` (see :meth:`_shape`), its lower and upper bounds, and the :class:`ShapeLimits` of
+        the runs.
         When ``asymmetric``, the deflections of the two directions start in
         the ratio of the two directions' sliding levels (their mean as in the
         symmetric model).
@@ -499,7 +571,16 @@ class GMSModel(CurrentModel):
         theta = np.concatenate((logits, curve, [np.log(0.5)]))
         lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND), curve_lower, [np.log(1e-3)]))
         upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND), curve_upper, [np.log(MAX_SLIP_STEP_RATIO)]))
-        return theta, lower, upper
+        return theta, lower, upper, ShapeLimits.of_runs(runs, static)
+
+    def held_out_search(self) -> "GMSModel":
+        """A copy searching from the initial guess and the fixed slow-slip starts only (no perturbed starts).
+
+        Returns
+        -------
+        GMSModel
+        """
+        return clone(self).set_params(n_starts=min(self.n_starts, HELD_OUT_STARTS))
 
     def _check_params(self) -> None:
         n = self.n_elements
@@ -514,12 +595,12 @@ class GMSModel(CurrentModel):
         check_motion(runs)
         regression = _Regression(runs, n, self.fit_offset, self.asymmetric)
         max_step = max(regression.steps)
-        theta, full_lower, full_upper = self._initial_shape(runs)
+        theta, full_lower, full_upper, limits = self._initial_shape(runs)
         n_curves = 2 if self.asymmetric else 1
         full_scale = np.concatenate((np.ones(n - 1), np.tile([0.5, 0.5, 0.5], n_curves), [1.0]))
 
         def full_residuals(t):
-            return regression.solve(self._shape(t, max_step))[1]
+            return regression.solve(self._shape(t, max_step, limits))[1]
 
         n_evaluations = 0
         if self.staged:
@@ -583,7 +664,7 @@ class GMSModel(CurrentModel):
                                 max_iter=self.max_iter, stage="GMS", progress=progress)
         n_evaluations += result.n_evaluations
 
-        shape = self._shape(result.x, max_step)
+        shape = self._shape(result.x, max_step, limits)
         x, residual = regression.solve(shape)
         shape, x, residual, self.n_pruned_ = self._pruned(runs, shape, x, residual)
         alpha, s_0, s_inf, v_s, c = shape

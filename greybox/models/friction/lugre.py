@@ -282,6 +282,15 @@ class LuGreModel(CurrentModel):
         self.random_state = random_state
         self.max_iter = max_iter
 
+    def held_out_search(self) -> "LuGreModel":
+        """A copy searching from the initial guess only (no perturbed starts), for scoring on held-out runs.
+
+        Returns
+        -------
+        LuGreModel
+        """
+        return super().held_out_search().set_params(n_starts=1)
+
     def _check_params(self) -> None:
         self._check_flags("fit_offset", "asymmetric")
         check_direction_settings(self.asymmetric, self.fit_offset)
