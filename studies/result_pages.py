@@ -170,7 +170,8 @@ VIEWS = {
 }
 
 
-def render_text(text: str, *, read: Callable[[str], dict] = read_record, where: str = "page") -> str:
+def render_text(text: str, *, read: Callable[[str], dict] = read_record, where: str = "page",
+                keep: tuple = ()) -> str:
     """``text`` with every marked stretch rendered anew from its record.
 
     Parameters
@@ -181,6 +182,8 @@ def render_text(text: str, *, read: Callable[[str], dict] = read_record, where: 
         Record name -> record.
     where : str, default "page"
         The page's name, for the error message.
+    keep : tuple of str, default ()
+        Records being re-made: the stretches that read them are left as they stand.
 
     Returns
     -------
@@ -197,6 +200,8 @@ def render_text(text: str, *, read: Callable[[str], dict] = read_record, where: 
         view = VIEWS.get(match["view"])
         if view is None:
             raise GreyboxError(f"{where}: no view {match['view']!r}; views: {', '.join(VIEWS)}")
+        if set(view.records) & set(keep):
+            return match[0]
         for name in view.records:
             if name not in records:
                 records[name] = read(name)
