@@ -225,7 +225,7 @@ def cited_records(text: str) -> set[str]:
     return {name for match in BLOCK.finditer(text) if match["view"] in VIEWS for name in VIEWS[match["view"]].records}
 
 
-def render_pages(pages=PAGES, *, check: bool = False) -> list[Path]:
+def render_pages(pages=PAGES, *, check: bool = False, keep: tuple = ()) -> list[Path]:
     """Render every page's marked stretches from the records, writing the pages that change.
 
     Parameters
@@ -234,6 +234,8 @@ def render_pages(pages=PAGES, *, check: bool = False) -> list[Path]:
         The pages.
     check : bool, default False
         Only report the pages that would change; write nothing.
+    keep : tuple of str, default ()
+        Records whose stretches are left as they stand (not made yet).
 
     Returns
     -------
@@ -243,7 +245,7 @@ def render_pages(pages=PAGES, *, check: bool = False) -> list[Path]:
     changed = []
     for page in map(Path, pages):
         text = page.read_text(encoding="utf-8")
-        rendered = render_text(text, where=str(page.relative_to(ROOT)))
+        rendered = render_text(text, where=str(page.relative_to(ROOT)), keep=keep)
         if rendered != text:
             changed.append(page)
             if not check:
