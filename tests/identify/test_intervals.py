@@ -141,7 +141,8 @@ def test_equal_elements_of_a_gms_model_are_not_separately_identifiable():
     # two elements of equal fraction follow the same trajectory: only the sum of their stiffnesses shows
     runs = prepare([make_dataset("X", "A", seed=3, duration_s=6)])
     model = GMSModel(n_elements=2, n_starts=1, max_iter=30).fit(runs)
-    model.alpha_ = np.array([0.5, 0.5])
+    # two equal elements made from the first the fit kept (the pre-sliding limits of the data may prune one)
+    model.alpha_, model.k_ = np.array([0.5, 0.5]), np.full(2, model.k_[0])
     rows = {row.name: row for row in attach_intervals(model, runs).parameter_table()}
     assert rows["k"].flag == "not identifiable" and np.all(np.isnan(rows["k"].lower))
     assert rows["J"].flag != "not identifiable"
