@@ -25,8 +25,9 @@ PATH = re.compile(r"(?<![\w./-])((?:greybox|tests|docs|studies|scripts|benchmark
 #: Citations of files outside the repository.
 OUTSIDE = re.compile(r"DESIGN\.md|\.\./shared/(?!data\b)")
 
-#: Paths a text may name without their existing: built by the docs build.
-GENERATED = ("docs/_build/", "docs/api/", "docs/auto_examples/")
+#: Paths a text may name without their existing: built by the docs build, or measured records (whether each
+#: record a page renders exists and is current is tests/studies/test_result_pages.py's to check).
+GENERATED = ("docs/_build/", "docs/api/", "docs/auto_examples/", "docs/results/")
 
 
 def _texts():
