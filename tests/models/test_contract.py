@@ -70,7 +70,8 @@ NOT_PARAMETERS = {"effort_unit_", "motion_", "sample_time_", "n_samples_fit_", "
                   "cv_rmse_", "optimised_", "at_bounds_", "search_history_", "input_mean_", "input_scale_",
                   "input_weights_", "support_vectors_",
                   "dual_coef_", "gms_", "base_", "effects_", "velocity_scale_mm_s_", "position_range_mm_",
-                  "friction_shape_base_", "friction_shape_viscous_", "velocity_range_mm_s_", "input_range_"}
+                  "friction_shape_base_", "friction_shape_viscous_", "velocity_range_mm_s_", "input_range_",
+                  "effort_range_"}
 
 #: Chunk length [s] that puts chunk boundaries inside motions.
 CHUNK_S = 0.77

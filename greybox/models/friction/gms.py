@@ -599,70 +599,82 @@ class GMSModel(CurrentModel):
         n_curves = 2 if self.asymmetric else 1
         full_scale = np.concatenate((np.ones(n - 1), np.tile([0.5, 0.5, 0.5], n_curves), [1.0]))
 
-        def full_residuals(t):
-            return regression.solve(self._shape(t, max_step, limits))[1]
+        def search(held: ShapeLimits):
+            """The shape search with every trial held to ``held``: ``(result, evaluations)``."""
+            def full_residuals(t):
+                return regression.solve(self._shape(t, max_step, held))[1]
 
-        n_evaluations = 0
-        if self.staged:
-            # stage 2: fractions, common deflection scale (and the ratio of the directions), slip rate;
-            # the Stribeck velocities and the ratio s_0 / s_inf of each direction kept
-            deflections = np.zeros(theta.size, dtype=bool)
-            deflections[n - 1:-1] = np.tile([True, True, False], n_curves)
-            negative = np.zeros(theta.size, dtype=bool)
-            negative[n + 2:-1] = self.asymmetric
-            negative &= deflections
+            n_evaluations = 0
+            if self.staged:
+                # stage 2: fractions, common deflection scale (and the ratio of the directions), slip rate;
+                # the Stribeck velocities and the ratio s_0 / s_inf of each direction kept
+                deflections = np.zeros(theta.size, dtype=bool)
+                deflections[n - 1:-1] = np.tile([True, True, False], n_curves)
+                negative = np.zeros(theta.size, dtype=bool)
+                negative[n + 2:-1] = self.asymmetric
+                negative &= deflections
 
-            def expand(p):
-                out = theta.copy()
-                out[: n - 1] = p[: n - 1]
-                out[deflections] += p[n - 1]
-                if self.asymmetric:
-                    out[negative] += p[n]
-                out[-1] = p[-1]
-                return out
+                def expand(p):
+                    out = theta.copy()
+                    out[: n - 1] = p[: n - 1]
+                    out[deflections] += p[n - 1]
+                    if self.asymmetric:
+                        out[negative] += p[n]
+                    out[-1] = p[-1]
+                    return out
 
-            extra = int(self.asymmetric)
-            p0 = np.concatenate((theta[: n - 1], np.zeros(1 + extra), [theta[-1]]))
-            lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND), np.full(1 + extra, -np.log(1e2)),
-                                    [np.log(1e-3)]))
-            upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND), np.full(1 + extra, np.log(1e2)),
-                                    [np.log(MAX_SLIP_STEP_RATIO)]))
-            slower_slips = [np.concatenate((p0[:-1], [np.log(ratio)])) for ratio in _SLOW_SLIP_RATIOS]
-            presliding = multistart_results(lambda p: full_residuals(expand(p)), p0, lower, upper,
-                                            scale=np.concatenate((np.ones(n - 1), np.full(1 + extra, 0.5), [1.0])),
-                                            n_starts=self.n_starts, method=self.method, max_iter=self.max_iter,
-                                            stage="GMS pre-sliding", progress=progress, fixed_starts=slower_slips,
-                                            deviates=fixed_design(self.n_starts - 1, p0.size))
-            # stage 3: all shape parameters from every pre-sliding fit; the best joint fit wins
-            joints = []  # (result, start index)
-            for index, start in enumerate(presliding):
-                n_evaluations += start.n_evaluations
-                joint = local_search(full_residuals, np.clip(expand(start.x), full_lower, full_upper), full_lower,
-                                     full_upper, scale=full_scale, method=self.method, max_iter=self.max_iter,
-                                     stage="GMS joint", progress=progress, start=index, n_starts=len(presliding),
-                                     best_so_far=min((j.cost for j, _ in joints), default=np.inf))
-                n_evaluations += joint.n_evaluations
-                joints.append((joint, index))
-            if self.method == "nelder-mead":
-                # the simplex stalls short of the minimum in many dimensions: trust-region least squares ends it,
-                # from every joint fit (they stall at different points of one flat valley), so that a fit from a
-                # seed-independent start is compared with the others at its own minimum
-                for rank, (joint, index) in enumerate(joints):
-                    polished = local_search(full_residuals, joint.x, full_lower, full_upper, scale=full_scale,
-                                            method="least-squares", max_iter=_POLISH_EVALUATIONS, stage="GMS joint",
-                                            progress=progress, best_so_far=min(j.cost for j, _ in joints))
-                    n_evaluations += polished.n_evaluations
-                    if polished.cost < joint.cost:
-                        joints[rank] = (polished, index)
-            best = min(joint.cost for joint, _ in joints)
-            result = min((pair for pair in joints if pair[0].cost <= best * (1.0 + _COST_TIE)),
-                         key=lambda pair: pair[1])[0]
-            result.n_evaluations = 0  # counted above
-        else:
-            result = multistart(full_residuals, theta, full_lower, full_upper, scale=full_scale,
-                                n_starts=self.n_starts, random_state=self.random_state, method=self.method,
-                                max_iter=self.max_iter, stage="GMS", progress=progress)
-        n_evaluations += result.n_evaluations
+                extra = int(self.asymmetric)
+                p0 = np.concatenate((theta[: n - 1], np.zeros(1 + extra), [theta[-1]]))
+                lower = np.concatenate((np.full(n - 1, -_LOGIT_BOUND), np.full(1 + extra, -np.log(1e2)),
+                                        [np.log(1e-3)]))
+                upper = np.concatenate((np.full(n - 1, _LOGIT_BOUND), np.full(1 + extra, np.log(1e2)),
+                                        [np.log(MAX_SLIP_STEP_RATIO)]))
+                slower_slips = [np.concatenate((p0[:-1], [np.log(ratio)])) for ratio in _SLOW_SLIP_RATIOS]
+                presliding = multistart_results(lambda p: full_residuals(expand(p)), p0, lower, upper,
+                                                scale=np.concatenate((np.ones(n - 1), np.full(1 + extra, 0.5), [1.0])),
+                                                n_starts=self.n_starts, method=self.method, max_iter=self.max_iter,
+                                                stage="GMS pre-sliding", progress=progress, fixed_starts=slower_slips,
+                                                deviates=fixed_design(self.n_starts - 1, p0.size))
+                # stage 3: all shape parameters from every pre-sliding fit; the best joint fit wins
+                joints = []  # (result, start index)
+                for index, start in enumerate(presliding):
+                    n_evaluations += start.n_evaluations
+                    joint = local_search(full_residuals, np.clip(expand(start.x), full_lower, full_upper), full_lower,
+                                         full_upper, scale=full_scale, method=self.method, max_iter=self.max_iter,
+                                         stage="GMS joint", progress=progress, start=index, n_starts=len(presliding),
+                                         best_so_far=min((j.cost for j, _ in joints), default=np.inf))
+                    n_evaluations += joint.n_evaluations
+                    joints.append((joint, index))
+                if self.method == "nelder-mead":
+                    # the simplex stalls short of the minimum in many dimensions: trust-region least squares ends it,
+                    # from every joint fit (they stall at different points of one flat valley), so that a fit from a
+                    # seed-independent start is compared with the others at its own minimum
+                    for rank, (joint, index) in enumerate(joints):
+                        polished = local_search(full_residuals, joint.x, full_lower, full_upper, scale=full_scale,
+                                                method="least-squares", max_iter=_POLISH_EVALUATIONS, stage="GMS joint",
+                                                progress=progress, best_so_far=min(j.cost for j, _ in joints))
+                        n_evaluations += polished.n_evaluations
+                        if polished.cost < joint.cost:
+                            joints[rank] = (polished, index)
+                best = min(joint.cost for joint, _ in joints)
+                result = min((pair for pair in joints if pair[0].cost <= best * (1.0 + _COST_TIE)),
+                             key=lambda pair: pair[1])[0]
+                result.n_evaluations = 0  # counted above
+            else:
+                result = multistart(full_residuals, theta, full_lower, full_upper, scale=full_scale,
+                                    n_starts=self.n_starts, random_state=self.random_state, method=self.method,
+                                    max_iter=self.max_iter, stage="GMS", progress=progress)
+            n_evaluations += result.n_evaluations
+            return result, n_evaluations
+
+        # the runs' limits only where the free fit breaks them: holding every trial to them flattens the cost
+        # where a limit binds, which can stall a search whose optimum lies inside the limits
+        free = ShapeLimits(np.inf, np.inf)
+        result, n_evaluations = search(free)
+        if any(not np.array_equal(a, b) for a, b in zip(self._shape(result.x, max_step, free)[1:3],
+                                                        self._shape(result.x, max_step, limits)[1:3])):
+            result, more = search(limits)
+            n_evaluations += more
 
         shape = self._shape(result.x, max_step, limits)
         x, residual = regression.solve(shape)
