@@ -33,6 +33,7 @@ from numba import njit
 
 from ..errors import GreyboxError
 from .axes import axis_geometry
+from .built_on import BuiltOnPlant
 from .datasets import make_dataset, stored
 from .motion import MotionProfile
 from .plant import PlantParameters, PlantResponse, default_plant_parameters, fine_motion, maxwell_slip_kernel
@@ -218,7 +219,7 @@ def defect_profile(position_mm, centre_mm: float, width_mm: float) -> np.ndarray
 
 
 @dataclass(frozen=True)
-class AgedPlant:
+class AgedPlant(BuiltOnPlant):
     """The twin's plant with an axial play between motor and table and a local defect along the travel.
 
     Parameters
@@ -276,27 +277,10 @@ class AgedPlant:
         friction = np.where(closed[::stride], factor * maxwell, 0.0) + p.viscous_A_s_mm * speed[::stride]
         return PlantResponse(x_log, v_log, a_log, friction, p.inertia_A_s2_mm * a_log, cogging)
 
-    def axis_config(self, name: str = ""):
-        """The base plant's axis file (:meth:`PlantParameters.axis_config`).
-
-        Parameters
-        ----------
-        name : str, default ""
-            Axis name written into the axis file.
-        """
-        return self.base.axis_config(name)
-
-    def process_load(self, process_A, velocity_mm_s) -> np.ndarray:
-        """Process force [N] behind a process current [A] (:meth:`PlantParameters.process_load`).
-
-        Parameters
-        ----------
-        process_A : array_like
-            Process current [A].
-        velocity_mm_s : array_like
-            Axis velocity [mm/s].
-        """
-        return self.base.process_load(process_A, velocity_mm_s)
+    @property
+    def underlying(self) -> PlantParameters:
+        """The base plant, which gives the axis file and the process load."""
+        return self.base
 
     def to_dict(self) -> dict:
         """JSON-serialisable parameters: the base plant's, the play and the defect."""

@@ -42,6 +42,7 @@ from ..errors import GreyboxError
 from ..json_values import jsonable
 from ..nc.blocks import Dwell, Move, Program
 from .axes import axis_geometry
+from .built_on import BuiltOnPlant
 from .cutting import CuttingSpec, cutting_current
 from .datasets import SAMPLE_TIME_S, make_dataset, stored
 from .nc_run import program_trajectory
@@ -139,7 +140,7 @@ class WarmUp:
         return 1.0 - self.drop * np.asarray(warmth, dtype=float)
 
 
-class WarmPlant:
+class WarmPlant(BuiltOnPlant):
     """A truth plant whose friction is scaled sample by sample by the warm-up law.
 
     Parameters
@@ -173,27 +174,10 @@ class WarmPlant:
         factor = self.warm_up.level(self.warm_up.running(self.warmth, np.arange(n_samples) * sample_time_s))
         return replace(response, friction_A=response.friction_A * factor)
 
-    def axis_config(self, name: str = ""):
-        """The cold plant's axis file (:meth:`~greybox.twin.plant.PlantParameters.axis_config`).
-
-        Parameters
-        ----------
-        name : str, default ""
-            Axis name written into the axis file.
-        """
-        return self.plant.axis_config(name)
-
-    def process_load(self, process_A, velocity_mm_s):
-        """Process force [N] behind a process current [A] (:meth:`~greybox.twin.plant.PlantParameters.process_load`).
-
-        Parameters
-        ----------
-        process_A : array_like
-            Process current [A].
-        velocity_mm_s : array_like
-            Axis velocity [mm/s].
-        """
-        return self.plant.process_load(process_A, velocity_mm_s)
+    @property
+    def underlying(self):
+        """The cold plant, which gives the axis file and the process load."""
+        return self.plant
 
     def to_dict(self) -> dict:
         """The cold plant's parameters with the warm-up law and the starting warmth."""
