@@ -15,6 +15,7 @@ import warnings
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
+import numba
 import numpy as np
 from numba import njit
 
@@ -23,7 +24,7 @@ from ...identify.bayes import minimize_log_uniform
 from ...identify.cv import blocked_folds
 from ...identify.progress import ProgressEvent
 from ..handover import handover_rows, handover_weight
-from .rbf import BLOCK_SAMPLES, _expansion_blocks, expansion_cutoff, rbf_expansion
+from .rbf import BLOCK_SAMPLES, _expansion_blocks, add_expansion, expansion_cutoff, rbf_expansion, threads_for
 from .subset import coverage_subset
 
 __all__ = ["HYPERPARAMETERS", "WEIGHT_BOUNDS", "KernelFrame", "SVRExpansion", "coordinate_rows", "default_bounds",
@@ -376,6 +377,9 @@ class KernelFrame:
     def terms(self, X):
         """Expansion, hand-over weight and input-range flags of raw inputs ``X`` in one compiled pass.
 
+        A chunk of a log long enough to share (:func:`~greybox.models.kernel.rbf.threads_for`) has its
+        kernel sums dealt out over the threads of :func:`numba.get_num_threads`; the sums are the same.
+
         What :meth:`expansion`, :meth:`weight` and the model's ``"inputs"`` flag give, for the few samples of
         a live message: the per-call checks and copies of :func:`~greybox.models.kernel.rbf.rbf_expansion` are done
         once per frame.
@@ -397,7 +401,13 @@ class KernelFrame:
         X = np.ascontiguousarray(X, dtype=np.float64)
         arguments = self._arguments()
         expansion, weight, outside = np.empty(len(X)), np.empty(len(X)), np.empty(len(X), dtype=np.bool_)
-        frame_terms(X, *arguments, expansion, weight, outside)
+        support_t, alpha, _, gamma, cutoff = arguments[3:8]
+        threads = threads_for(len(X), numba.get_num_threads())
+        if threads == 1 or cutoff < 0.0:
+            frame_terms(X, *arguments, expansion, weight, outside)
+        else:  # a chunk of a log: the kernel sums over threads, the rest in one pass without them
+            frame_terms(X, *arguments[:7], -1.0, *arguments[8:], expansion, weight, outside)
+            add_expansion(self.coordinates(X), support_t, alpha, gamma, cutoff, expansion, threads)
         return expansion, (weight if arguments[-2] else None), (outside if arguments[-1] else None)
 
     def coordinates(self, X) -> np.ndarray:

@@ -47,7 +47,8 @@ from numba import njit
 
 from ...threads import shared_pool
 
-__all__ = ["rbf_expansion", "expansion_cutoff", "DEFAULT_TOLERANCE", "BLOCK_SAMPLES", "EXP_RELATIVE_ERROR",
+__all__ = ["rbf_expansion", "add_expansion", "threads_for", "expansion_cutoff",
+           "DEFAULT_TOLERANCE", "BLOCK_SAMPLES", "EXP_RELATIVE_ERROR",
            "MAX_CUTOFF"]
 
 #: Default bound on the sum of the terms left out of one sample [unit of the output, e.g. A].
@@ -235,15 +236,52 @@ def rbf_expansion(
     cutoff = None if n_samples == 0 else expansion_cutoff(alpha, tolerance)
     if cutoff is None:
         return out  # every term together stays within the tolerance
-    support_t = np.ascontiguousarray(sv.T)
-    n_blocks = -(-n_samples // BLOCK_SAMPLES)
-    threads = min(threads, max(1, n_blocks // _MIN_BLOCKS_PER_THREAD))
+    add_expansion(X, np.ascontiguousarray(sv.T), alpha, float(gamma), cutoff, out, threads)
+    return out
+
+
+def threads_for(n_samples: int, threads: int) -> int:
+    """Threads worth sharing the kernel sums of ``n_samples`` samples: at most ``threads``, at least 1.
+
+    Each thread gets :data:`_MIN_BLOCKS_PER_THREAD` blocks of :data:`BLOCK_SAMPLES` at least (a thread pool
+    costs more than it saves on fewer).
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples to evaluate.
+    threads : int
+        Threads available, >= 1.
+    """
+    return min(threads, max(1, -(-n_samples // BLOCK_SAMPLES) // _MIN_BLOCKS_PER_THREAD))
+
+
+def add_expansion(X, support_t, alpha, gamma: float, cutoff: float, out, threads: int) -> None:
+    """Add the kernel sums of the rows of ``X`` to ``out``, the blocks of samples dealt out over threads.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n_samples, n_features)
+        Points in the support vectors' coordinates, C-contiguous.
+    support_t : ndarray, shape (n_features, n_support)
+        Support vectors column-wise, C-contiguous.
+    alpha : ndarray, shape (n_support,)
+        Dual coefficients [unit of the output].
+    gamma : float
+        Kernel width parameter [1 / (unit of X)^2].
+    cutoff : float
+        :func:`expansion_cutoff` of ``alpha`` [1].
+    out : ndarray, shape (n_samples,)
+        Receives the sums, added to what it holds.
+    threads : int
+        Most threads to use; fewer for short inputs (:func:`threads_for`).
+    """
+    threads = threads_for(X.shape[0], threads)
     if threads == 1:
-        _expansion_blocks(X, support_t, alpha, float(gamma), cutoff, BLOCK_SAMPLES, 0, 1, out)
-        return out
+        _expansion_blocks(X, support_t, alpha, gamma, cutoff, BLOCK_SAMPLES, 0, 1, out)
+        return
     # blocks dealt out in turn: the work per block varies along a log, neighbouring blocks alike
-    parts = [shared_pool(threads).submit(_expansion_blocks, X, support_t, alpha, float(gamma), cutoff,
+    parts = [shared_pool(threads).submit(_expansion_blocks, X, support_t, alpha, gamma, cutoff,
                                          BLOCK_SAMPLES, k, threads, out) for k in range(threads)]
     for part in parts:
         part.result()
-    return out

@@ -8,7 +8,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from greybox.models.kernel import expansion as expansion_module
 from greybox.models.kernel.expansion import KernelFrame
+from greybox.models.kernel.rbf import BLOCK_SAMPLES, add_expansion, threads_for
 
 
 def _model(rng, *, weights=True, handover=True, ranges=True, n_support=40, n_features=3):
@@ -84,3 +86,23 @@ def test_terms_of_no_samples_are_empty():
     model, _ = _model(np.random.default_rng(1))
     expansion, weight, outside = KernelFrame(model).terms(np.empty((0, 3)))
     assert expansion.shape == weight.shape == outside.shape == (0,)
+
+
+def test_a_log_chunk_shares_its_kernel_sums_over_threads_and_gets_the_same_terms(monkeypatch):
+    rng = np.random.default_rng(11)
+    model, X = _model(rng)
+    walk = np.cumsum(rng.normal(scale=0.05, size=(160 * BLOCK_SAMPLES, X.shape[1])), axis=0)  # a log's slow drift
+    long = X.mean(axis=0) + walk * X.std(axis=0)
+    assert threads_for(len(long), 2) == 2 and threads_for(len(X), 2) == 1
+    monkeypatch.setattr(expansion_module.numba, "get_num_threads", lambda: 1)
+    alone = KernelFrame(model).terms(long)
+    shared = []
+    monkeypatch.setattr(expansion_module, "add_expansion", lambda *a: shared.append(a[-1]) or add_expansion(*a))
+    monkeypatch.setattr(expansion_module.numba, "get_num_threads", lambda: 2)
+    together = KernelFrame(model).terms(long)
+    assert shared == [2]  # the threaded path ran
+    for one, two in zip(alone, together):
+        np.testing.assert_array_equal(one, two)
+    step = slice(None, None, 97)
+    want_expansion, _, _ = reference_terms(model, long[step])
+    np.testing.assert_allclose(together[0][step], want_expansion, rtol=0, atol=1e-9)
