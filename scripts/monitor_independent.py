@@ -2,7 +2,7 @@
 
 Usage::
 
-    python scripts/monitor_independent.py [--data DIR] [--variants spindle,plain,air] [--json OUT] [--work DIR]
+    python scripts/monitor_independent.py [--data DIR] [--variants spindle,plain,air] [--json OUT|-] [--work DIR]
 
 For each machine of ``DIR`` (default ``../shared/data/independent/histories_dev`` beside the repository;
 ``DIR/truth.json`` holds per machine the drift kind and its onset date) the daily logs are run through
@@ -97,7 +97,8 @@ def run(data: Path, work: Path, variants: list, progress=print) -> dict:
                 logs = plain_copies(logs, work / "plain_logs" / name)
             column = SPINDLE_COLUMN if variant == "spindle" else None
             outcome = run_monitor(logs, work / variant / "history", work / variant / "report", machine=name,
-                                  spindle_column=column, find_cuts=variant == "plain")
+                                  spindle_column=column, find_cuts=variant == "plain",
+                                  force=True)  # the variant's one dashboard, made anew as each machine is filed
         # scored on the whole plant's history: the thresholds come from every machine's baseline days
         rows = [score_machine(name, truth[name], [a for a in outcome.detector.alarms_ if a.machine == name])
                 for name in sorted(truth)]
@@ -126,7 +127,7 @@ def main(argv=None) -> int:
     parser.add_argument("--variants", default="spindle,plain",
                         help="comma-separated: spindle (with the spindle-load column), plain (without it, "
                              "--find-cuts), air (without it, every log an air cut)")
-    parser.add_argument("--json", metavar="OUT", help="write the scores as JSON")
+    parser.add_argument("--json", metavar="OUT", help="write the scores as JSON ('-': print them, last)")
     parser.add_argument("--work", type=Path, help="work folder (histories, reports, copies); default a temporary one")
     args = parser.parse_args(argv)
     variants = [v for v in args.variants.split(",") if v]
@@ -138,7 +139,9 @@ def main(argv=None) -> int:
     met = all(row["ok"] for result in results.values() for row in result["machines"])
     print(f"targets ({TARGET_DAYS} days, right feature first, nothing before onset, stable quiet): "
           f"{'met' if met else 'NOT met'}")
-    if args.json:
+    if args.json == "-":
+        print(json.dumps({"variants": results, "met": met}))
+    elif args.json:
         write_text_atomic(args.json, json.dumps(results, indent=1))
     return 0
 

@@ -75,6 +75,12 @@ SPECS = {spec.name: spec for spec in (
     RecordSpec("default-tests", ("benchmarks/bench_test_run.py",),
                ("greybox", "tests", "studies", "data", "pyproject.toml", "benchmarks/bench_test_run.py"),
                "the default test run (pytest -q): tests passed, skipped, wall time"),
+    RecordSpec("monitor-independent",
+               ("scripts/monitor_independent.py", "--variants", "spindle,plain,air", "--json", "-"),
+               ("greybox/monitor", "greybox/data", "greybox/models", "greybox/identify",
+                "scripts/monitor_independent.py"),
+               "greybox monitor on the independent simulator's production histories (development split), "
+               "scored against their drift truth"),
 )}
 
 

@@ -137,6 +137,37 @@ def _readme_table(reproduction: dict, tests: dict) -> str:
             f"({_where(tests)}) | [installation and tests](docs/install.md) |\n")
 
 
+def _met(condition: bool) -> str:
+    return "met" if condition else "**not met**"
+
+
+def _monitor_independent(record: dict) -> str:
+    variants = record["figures"]["variants"]
+    names = list(variants)
+    labels = {"spindle": "`spindle`", "plain": "`plain` (`--find-cuts`)", "air": "`air`"}
+    lines = ["| machine (truth) | onset | " + " | ".join(labels.get(v, v) for v in names) + " |",
+             "|---|---|" + "---|" * len(names)]
+
+    def cell(row: dict) -> str:
+        if row["kind"] == "none":
+            return f"{row['n_alarms']} alarms"
+        if row["first"] is None:
+            return "never"
+        wrong = "" if row["right_first"] else " (wrong feature)"
+        return f"{row['first']}, +{row['delay_days']} days{wrong}"
+
+    machines = [row["machine"] for row in variants[names[0]]["machines"]]
+    for i, machine in enumerate(machines):
+        rows = [variants[v]["machines"][i] for v in names]
+        kind = rows[0]["kind"].replace("_", " ") if rows[0]["kind"] != "none" else "stable"
+        lines.append(f"| {machine} {kind} | {rows[0].get('onset', '-')} | " + " | ".join(cell(r) for r in rows) + " |")
+    before = [sum(r.get("alarms_before_onset", 0) for r in variants[v]["machines"]) for v in names]
+    lines.append("| alarms before an onset | | " + " | ".join(str(b) for b in before) + " |")
+    met = " / ".join(f"{v}: {_met(all(r['ok'] for r in variants[v]['machines']))}" for v in names)
+    return ("\n".join(lines) + f"\n\nTarget (within 7 days, the right feature first, nothing before an onset, "
+            f"nothing on the stable machine): {met}. `{record['command']}` ({_where(record)}).\n")
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -166,6 +197,7 @@ VIEWS = {
     "reproduce-hyperparameters": View(("reproduce",), _reproduce_table(hyperparameter_table, "hyperparameters")),
     "reproduce-summary": View(("reproduce",), _reproduce_summary),
     "default-tests-run": View(("default-tests",), _tests_run),
+    "monitor-independent": View(("monitor-independent",), _monitor_independent),
     "readme-measured": View(("reproduce", "default-tests"), _readme_table),
 }
 
