@@ -22,11 +22,12 @@ import time
 import unicodedata
 import warnings
 from pathlib import Path
-from typing import Callable, Iterator, Mapping, Sequence
+from typing import Callable, Iterator, Sequence
 from urllib.parse import quote, unquote
 
 from .atomic import write_text_atomic
 from .data.io import LOG_SUFFIXES
+from .data.reading import read_prepared
 from .errors import GreyboxError, Setting
 
 __all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_machines",
@@ -267,42 +268,6 @@ def log_stamp(path: str | os.PathLike) -> dict:
     """
     stat = os.stat(path)
     return {"size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
-
-
-def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None = None,
-                  notify: Callable[[str], None] | None = None) -> list:
-    """Read and prepare one log as ``greybox predict`` and ``greybox train`` do: its runs (AxisLog).
-
-    Parameters
-    ----------
-    path : str
-        Log file.
-    read : mapping
-        Options of reading and preparing: ``columns``, ``topic``, ``axis``, ``sample_time``,
-        ``time_tolerance`` (fraction of the step), ``cutoff_hz`` [Hz], ``resample`` [s], ``max_gap``
-        [steps] (:func:`greybox.data.io.read_log`, :func:`greybox.data.prepare.prepare`); missing ones
-        take their defaults.
-    columns : mapping, optional
-        Column mapping under ``read["columns"]`` (an axis file's channels).
-    notify : callable, optional
-        ``notify(line)`` with a ``note:`` line naming the gaps where the log was split into runs.
-    """
-    from .data.io import read_log
-    from .data.prepare import MAX_GAP_STEPS, prepare
-
-    columns = {**(columns or {}), **(read.get("columns") or {})} or None
-    resample = read.get("resample")
-    tolerance = read.get("time_tolerance", 0.25)
-    max_gap = read.get("max_gap", MAX_GAP_STEPS)
-    log = read_log(path, columns=columns, topic=read.get("topic"), sample_time=read.get("sample_time"),
-                   axis=read.get("axis"), time_tolerance=None if resample else tolerance)
-    runs = prepare([log], cutoff_hz=read.get("cutoff_hz"), sample_time=resample, tolerance=tolerance,
-                   max_gap_steps=max_gap)
-    if len(runs) > 1 and notify is not None:
-        starts = ", ".join(f"{run.attrs['split']['start_s']:.6g}" for run in runs[1:])
-        notify(f"note: {Path(path).name}: split into {len(runs)} runs at gaps longer than {max_gap:g} steps "
-               f"(--max-gap); the runs after the first start at t = {starts} s")
-    return runs
 
 
 def attempt(label: str, work: Callable[[], dict]) -> dict:

@@ -19,7 +19,8 @@ from importlib import metadata
 
 from .data.effort import EFFORT_UNITS
 
-__all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "PREPARATION_KEYS", "file_identity",
+__all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "TRAINING_ATTRIBUTE", "PREPARATION_KEYS",
+           "file_identity",
            "axis_warning", "training_file_warning", "training_record", "check_training_record",
            "preparation_differences", "model_quantity"]
 
@@ -76,6 +77,9 @@ def provenance_line(info: dict | None = None) -> str:
 # ------------------------------------------------------------------ how a model was made
 #: Name of the training record in a model file's records (:func:`greybox.persistence.save_model`).
 TRAINING_RECORD = "training"
+#: The learned attribute a trained model keeps its training record in (:func:`greybox.train.record_training`);
+#: :mod:`greybox.persistence` writes it as the file's :data:`TRAINING_RECORD` and sets it again on loading.
+TRAINING_ATTRIBUTE = "training_record_"
 #: Version of the training record's layout.
 TRAINING_RECORD_VERSION = 1
 #: Keys of the training record's ``preparation``: the options that change what a model sees of a log.
@@ -295,7 +299,7 @@ def preparation_of(runs, read) -> dict:
     runs : list of AxisLog
         The prepared runs; the first gives the sample time [s] and the derivative filter's cut-off [Hz].
     read : mapping
-        Options of reading and preparing (:func:`greybox.fleet.read_prepared`): ``resample`` [s],
+        Options of reading and preparing (:func:`greybox.data.reading.read_prepared`): ``resample`` [s],
         ``max_gap`` [steps], ``time_tolerance`` (fraction of the step); missing ones take their defaults.
     """
     from .data.prepare import MAX_GAP_STEPS
