@@ -176,9 +176,9 @@ def _label(entry: dict) -> str:
 
 
 def _run_per_machine(args: argparse.Namespace) -> int:
-    """``greybox train --per-machine``: a model per machine and axis on Dask (:mod:`greybox.fleet_train`)."""
+    """``greybox train --per-machine``: a model per machine and axis on Dask (:mod:`greybox.fleet.train`)."""
     from ..fleet import MANIFEST, expand_logs
-    from ..fleet_train import run_training, train_jobs
+    from ..fleet.train import run_training, train_jobs
     from ._fleet import check_out_dir, fleet_progress, report_fleet
 
     if args.intervals != "sandwich" or args.bootstrap is not None:

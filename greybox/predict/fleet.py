@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
 
+from ..data.reading import read_prepared
 from ..errors import GreyboxError
 from ..fleet import (
     MANIFEST,
@@ -42,7 +43,6 @@ from ..fleet import (
     out_dir_of,
     partition,
     read_manifest,
-    read_prepared,
     run_tasks,
 )
 

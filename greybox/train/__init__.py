@@ -4,7 +4,7 @@
 Each reads and prepares the logs, fits, attaches the parameter intervals and records how the model was
 made (:func:`record_training`: the model's ``training_record_``, which every model file it is saved to
 carries), and returns the model; given ``out``, it also saves it and checks the file reproduces it.
-``greybox train``, ``greybox compensate`` and the fleet (:mod:`greybox.fleet_train`) train through these.
+``greybox train``, ``greybox compensate`` and the fleet (:mod:`greybox.fleet.train`) train through these.
 """
 
 from .choice import train_auto_logs

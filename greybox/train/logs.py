@@ -1,7 +1,7 @@
 """Training a model on logs: read and prepare them, fit, attach intervals, record how it was made, save.
 
 :func:`train_logs` is the one entry point of training one model, beside :func:`greybox.predict.predict_logs`;
-``greybox train``, the fleet (:mod:`greybox.fleet_train`) and Python callers all go through it, so every
+``greybox train``, the fleet (:mod:`greybox.fleet.train`) and Python callers all go through it, so every
 model it returns carries the same training record (:func:`~greybox.train.record.record_training`), which
 :func:`greybox.persistence.save_model` writes into its file.
 """

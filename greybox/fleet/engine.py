@@ -2,7 +2,7 @@
 
 :func:`expand_logs` turns files, directories (searched recursively for log files) and glob patterns
 into the list of logs. :func:`run_tasks` is the one engine of every fleet run (``greybox predict`` over
-many logs in :mod:`greybox.predict.fleet`, ``greybox train --per-machine`` in :mod:`greybox.fleet_train`):
+many logs in :mod:`greybox.predict.fleet`, ``greybox train --per-machine`` in :mod:`greybox.fleet.train`):
 it runs one task per job on a Dask cluster, by default a local cluster of processes, one per core and one
 thread each, or the cluster of a scheduler address, so that the same command runs on a laptop and on a
 cluster; it skips the jobs complete from an earlier run, reports a job that fails and goes on, and writes
@@ -25,14 +25,13 @@ from pathlib import Path
 from typing import Callable, Iterator, Sequence
 from urllib.parse import quote, unquote
 
-from .atomic import write_text_atomic
-from .data.io import LOG_SUFFIXES
-from .data.reading import read_prepared
-from .errors import GreyboxError, Setting
+from ..atomic import write_text_atomic
+from ..data.io import LOG_SUFFIXES
+from ..errors import GreyboxError, Setting
 
 __all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_machines",
            "check_names", "check_out_dir", "decode_name", "encode_name", "expand_logs", "file_sha256", "fleet_summary",
-           "log_names", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared",
+           "log_names", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest",
            "run_tasks"]
 
 #: Name of the manifest in the output directory (a leading "_": dataset readers skip it).

@@ -28,9 +28,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .data.reading import read_prepared
-from .errors import GreyboxError
-from .fleet import (
+from ..data.reading import read_prepared
+from ..errors import GreyboxError
+from .engine import (
     MODELS_FORMAT,
     attempt,
     check_machines,
@@ -99,7 +99,7 @@ def train_jobs(logs: Sequence[Path], model, out_dir: str, *, axes: Sequence[str]
 
 def _hyperparameters(model) -> dict:
     """Kind and hyperparameters of a model as JSON values: a nested model likewise, other values as text."""
-    from .models.registry import model_kind
+    from ..models.registry import model_kind
 
     def value(item):
         if hasattr(item, "get_params"):
@@ -125,7 +125,7 @@ def _axis_of(runs: list, job: TrainJob) -> str:
 
 def _fit_and_save(job: TrainJob) -> dict:
     """Train the job's model on all its logs (:func:`greybox.train.train_logs`) and save it, checked."""
-    from .train import train_logs
+    from ..train import train_logs
 
     runs = [run for log in job.logs for run in read_prepared(log, job.read)]
     axis = partition(_axis_of(runs, job) or "-")
