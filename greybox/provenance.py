@@ -20,7 +20,7 @@ from importlib import metadata
 from .data.effort import EFFORT_UNITS
 
 __all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "TRAINING_ATTRIBUTE", "PREPARATION_KEYS",
-           "file_identity",
+           "file_identity", "file_sha256",
            "axis_warning", "training_file_warning", "training_record", "check_training_record",
            "preparation_differences", "model_quantity"]
 
@@ -92,6 +92,23 @@ _HEX = frozenset("0123456789abcdef")
 _MAX_FILES = 10_000
 
 
+def file_sha256(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes (hex), read block by block.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An existing file.
+    """
+    import hashlib
+
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
 def file_identity(path) -> dict:
     """Name, size and SHA-256 of a file, to tell later whether a log is the one a model was trained on.
 
@@ -105,15 +122,7 @@ def file_identity(path) -> dict:
     dict
         ``name`` (the file name without folders), ``bytes`` and ``sha256`` (hex digest of the content).
     """
-    import hashlib
-
-    digest = hashlib.sha256()
-    size = 0
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-            size += len(block)
-    return {"name": os.path.basename(os.fspath(path)), "bytes": size, "sha256": digest.hexdigest()}
+    return {"name": os.path.basename(os.fspath(path)), "bytes": os.path.getsize(path), "sha256": file_sha256(path)}
 
 
 def training_record(files, preparation: dict, runs, total: dict, ranges: dict, axis: str | None = None) -> dict:

@@ -15,7 +15,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import glob
-import hashlib
 import json
 import os
 import time
@@ -30,7 +29,7 @@ from ..data.io import LOG_SUFFIXES
 from ..errors import GreyboxError, Setting
 
 __all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_machines",
-           "check_names", "check_out_dir", "decode_name", "encode_name", "expand_logs", "file_sha256", "fleet_summary",
+           "check_names", "check_out_dir", "decode_name", "encode_name", "expand_logs", "fleet_summary",
            "log_names", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest",
            "run_tasks"]
 
@@ -193,21 +192,6 @@ def check_names(logs: Sequence[str], names: Sequence[str]) -> None:
             raise GreyboxError(f"{log}: its output would take the place of that of {seen[key]} on a file system "
                                "that ignores case; rename one of them")
         seen[key] = log
-
-
-def file_sha256(path: str | os.PathLike) -> str:
-    """SHA-256 of a file's bytes (hex), read block by block.
-
-    Parameters
-    ----------
-    path : str or path-like
-        An existing file.
-    """
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def partition(value: str) -> str:

@@ -36,7 +36,6 @@ from ..fleet import (
     check_machines,
     check_names,
     encode_name,
-    file_sha256,
     log_names,
     log_stamp,
     machine_of,
@@ -45,6 +44,7 @@ from ..fleet import (
     read_manifest,
     run_tasks,
 )
+from ..provenance import file_sha256
 
 __all__ = ["FORMAT_VERSION", "PREDICT_FORMAT", "FleetJob", "fleet_jobs", "machine_models", "model_of_log",
            "predict_log", "run_fleet"]
