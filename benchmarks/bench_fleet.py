@@ -9,7 +9,7 @@ Synthesises ``--logs`` cutting logs of the twin's X axis (dataset A of ``--durat
 different seeds) in two machine folders, trains ``--model`` on a short air cut, and runs the fleet
 command (the library call behind it, :func:`greybox.predict.fleet.run_fleet`) twice from scratch: a local
 cluster of 1 worker, then of 2. With ``--train`` the fleet trains instead a ``--model`` per machine on
-its logs (:func:`greybox.fleet_train.run_training`, two tasks; short logs, ``--duration 60``, keep it
+its logs (:func:`greybox.fleet.train.run_training`, two tasks; short logs, ``--duration 60``, keep it
 quick). Printed, measured in one run on this machine (its cores stated):
 
 - ``samples_per_s``: samples predicted and written (trained on) per second of wall time, cluster start
@@ -33,7 +33,7 @@ from pathlib import Path
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.fleet import expand_logs
-from greybox.fleet_train import run_training, train_jobs
+from greybox.fleet.train import run_training, train_jobs
 from greybox.models.registry import model_class
 from greybox.persistence import save_model
 from greybox.predict.fleet import fleet_jobs, run_fleet

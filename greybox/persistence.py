@@ -79,7 +79,7 @@ from .identify.intervals import check_intervals
 from .identify.selection import check_selection_record
 from .models import registry
 from .models.estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
-from .provenance import TRAINING_RECORD, check_training_record
+from .provenance import TRAINING_ATTRIBUTE, TRAINING_RECORD, check_training_record
 
 __all__ = ["DIGEST_MEMBER", "FORMAT_NAME", "FORMAT_VERSION", "KEY_ENV", "KEY_FILE_ENV", "RECORD_CHECKS",
            "RENAMED_ATTRIBUTES", "digest_document", "model_key", "save_model", "save_verified", "load_model",
@@ -142,7 +142,8 @@ class _Encoder:
         except KeyError as error:
             self.fail(where, str(error.args[0]))
         params = model.get_params(deep=False)
-        learned = {name: value for name, value in vars(model).items() if _ATTRIBUTE_NAME.match(name)}
+        learned = {name: value for name, value in vars(model).items()
+                   if _ATTRIBUTE_NAME.match(name) and name != TRAINING_ATTRIBUTE}  # that one is the file's record
         return {
             "kind": kind,
             "params": {name: self.value(value, f"{where}.{name}") for name, value in params.items()},
@@ -320,7 +321,9 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
     overwrite : bool, default False
         Replace an existing file; otherwise an existing file is an error.
     records : dict, optional
-        Records about the model by name (``{"training": ...}``), each checked by :data:`RECORD_CHECKS`.
+        Records about the model by name (``{"training": ...}``), each checked by :data:`RECORD_CHECKS`;
+        without a ``training`` record, the model's own (``training_record_``, set by
+        :func:`greybox.train.record_training`) where it has one.
     key : bytes, optional
         The plant's key the file is signed with (:data:`DIGEST_MEMBER`); default :func:`model_key`, none
         when it is not set.
@@ -351,6 +354,9 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
         "greybox_version": __version__,
         "model": encoder.estimator(model, "model"),
     }
+    own = getattr(model, TRAINING_ATTRIBUTE, None)
+    if own is not None and TRAINING_RECORD not in (records or {}):
+        records = {**(records or {}), TRAINING_RECORD: own}
     checked = _checked_records(records, path, "save")
     if checked:
         document["records"] = checked
@@ -562,7 +568,8 @@ def load_model(path: str | PathLike, *, records: bool = False, key: bytes | None
     -------
     estimator or (estimator, dict)
         A new instance of the saved model's class with its parameters and
-        learned attributes restored; it predicts exactly what the saved one did.
+        learned attributes restored; it predicts exactly what the saved one did. Its training record,
+        where the file holds one, is its ``training_record_`` again.
         With ``records``, the model and ``{name: record}``.
 
     Raises
@@ -628,6 +635,8 @@ def load_model(path: str | PathLike, *, records: bool = False, key: bytes | None
             raise ModelFileError(f"{path}: invalid {type(model).__name__} in the model file: {error}") from None
     if unused:
         raise ModelFileError(f"{path}: member {unused[0]} is not part of the model (no value refers to it)")
+    if TRAINING_RECORD in held:
+        setattr(model, TRAINING_ATTRIBUTE, held[TRAINING_RECORD])
     return (model, held) if records else model
 
 

@@ -19,7 +19,8 @@ from importlib import metadata
 
 from .data.effort import EFFORT_UNITS
 
-__all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "PREPARATION_KEYS", "file_identity",
+__all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "TRAINING_ATTRIBUTE", "PREPARATION_KEYS",
+           "file_identity", "file_sha256",
            "axis_warning", "training_file_warning", "training_record", "check_training_record",
            "preparation_differences", "model_quantity"]
 
@@ -76,6 +77,9 @@ def provenance_line(info: dict | None = None) -> str:
 # ------------------------------------------------------------------ how a model was made
 #: Name of the training record in a model file's records (:func:`greybox.persistence.save_model`).
 TRAINING_RECORD = "training"
+#: The learned attribute a trained model keeps its training record in (:func:`greybox.train.record_training`);
+#: :mod:`greybox.persistence` writes it as the file's :data:`TRAINING_RECORD` and sets it again on loading.
+TRAINING_ATTRIBUTE = "training_record_"
 #: Version of the training record's layout.
 TRAINING_RECORD_VERSION = 1
 #: Keys of the training record's ``preparation``: the options that change what a model sees of a log.
@@ -86,6 +90,23 @@ PREPARATION_TOLERANCE = 0.01
 EFFORT_QUANTITY_NAMES = tuple(EFFORT_UNITS)
 _HEX = frozenset("0123456789abcdef")
 _MAX_FILES = 10_000
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes (hex), read block by block.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An existing file.
+    """
+    import hashlib
+
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def file_identity(path) -> dict:
@@ -101,15 +122,7 @@ def file_identity(path) -> dict:
     dict
         ``name`` (the file name without folders), ``bytes`` and ``sha256`` (hex digest of the content).
     """
-    import hashlib
-
-    digest = hashlib.sha256()
-    size = 0
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-            size += len(block)
-    return {"name": os.path.basename(os.fspath(path)), "bytes": size, "sha256": digest.hexdigest()}
+    return {"name": os.path.basename(os.fspath(path)), "bytes": os.path.getsize(path), "sha256": file_sha256(path)}
 
 
 def training_record(files, preparation: dict, runs, total: dict, ranges: dict, axis: str | None = None) -> dict:
@@ -295,7 +308,7 @@ def preparation_of(runs, read) -> dict:
     runs : list of AxisLog
         The prepared runs; the first gives the sample time [s] and the derivative filter's cut-off [Hz].
     read : mapping
-        Options of reading and preparing (:func:`greybox.fleet.read_prepared`): ``resample`` [s],
+        Options of reading and preparing (:func:`greybox.data.reading.read_prepared`): ``resample`` [s],
         ``max_gap`` [steps], ``time_tolerance`` (fraction of the step); missing ones take their defaults.
     """
     from .data.prepare import MAX_GAP_STEPS

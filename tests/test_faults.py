@@ -1,7 +1,7 @@
 """Fault suite of issue 41 (and the two small items of issue 40): each fault, reproduced, gives its documented outcome.
 
 Fast cases run by default; the fleet, concurrency and history cases are beside their modules
-(``tests/test_fleet.py``, ``tests/predict/test_fleet.py``, ``tests/monitor/test_monitor_history.py``,
+(``tests/fleet/test_engine.py``, ``tests/predict/test_fleet.py``, ``tests/monitor/test_monitor_history.py``,
 ``tests/test_persistence.py``).
 """
 

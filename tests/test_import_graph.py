@@ -18,6 +18,13 @@ rules (docs/layout.md, "Layer rules"):
 - the model kinds (``greybox.models``: physical friction, kernel, augmented)
   import nothing of the layers above them: ``evaluate``, ``predict``,
   ``discover``, ``reproduce``, ``control``, ``cli``;
+- training (``greybox.train``) sits above the models, the model files and the
+  choice of a model, and below its users, which it imports nothing of: the
+  fleet, ``predict``, ``evaluate``, ``live``, ``monitor``, ``process``,
+  ``discover``, ``control``, ``reproduce``, ``cli``;
+- the fleet's engine (``greybox.fleet`` and ``greybox.fleet.engine``) imports
+  no workflow that runs on it (the fleet's training, ``train``, ``predict``,
+  ``monitor``, ...);
 - prediction (``greybox.predict``) sits above the models, the data and
   ``evaluate`` (metrics, regimes, figures), which import nothing of it, and
   below its users, which it imports nothing of: ``live``, ``monitor``,
@@ -57,6 +64,11 @@ MODEL_LAYER = ("greybox.base", "greybox.errors", "greybox.threads", "greybox.ato
                "greybox.persistence")
 ABOVE_MODELS = ("greybox.evaluate", "greybox.predict", "greybox.discover", "greybox.reproduce", "greybox.control",
                 "greybox.cli")
+#: Layers training (``greybox.train``) must not depend on: its users (the fleet, the compensation study, the
+#: command line) and the workflows beside it.
+ABOVE_TRAIN = ("greybox.fleet", "greybox.predict", "greybox.evaluate", "greybox.live",
+               "greybox.monitor", "greybox.process", "greybox.discover", "greybox.control", "greybox.reproduce",
+               "greybox.cli")
 #: Layers prediction must not depend on (they use it, or stand beside it).
 ABOVE_PREDICT = ("greybox.live", "greybox.monitor", "greybox.process", "greybox.discover", "greybox.control",
                  "greybox.reproduce", "greybox.cli")
@@ -269,6 +281,20 @@ def test_the_models_import_nothing_of_the_layers_above_them(graph):
                       lambda m: _within(m, "greybox.models"),
                       lambda t: any(_within(t, p) for p in ABOVE_MODELS))
     assert not found, "models/ depends on a layer above it:\n" + "\n".join(found)
+
+
+def test_the_fleet_engine_imports_no_workflow(graph):
+    assert "greybox.fleet.engine" in graph  # every fleet run's engine: predict and monitor import it
+    found = forbidden(graph, lambda m: m in ("greybox.fleet", "greybox.fleet.engine"),
+                      lambda t: any(_within(t, p) for p in ("greybox.fleet.train", "greybox.train", *ABOVE_TRAIN[1:])))
+    assert not found, "the fleet engine depends on a workflow that runs on it:\n" + "\n".join(found)
+
+
+def test_training_imports_nothing_of_its_users(graph):
+    assert "greybox.train.logs" in graph  # the one entry point of training
+    found = forbidden(graph, lambda m: _within(m, "greybox.train"),
+                      lambda t: any(_within(t, p) for p in ABOVE_TRAIN))
+    assert not found, "greybox/train/ depends on a layer above it:\n" + "\n".join(found)
 
 
 def test_prediction_imports_nothing_of_its_users_and_evaluate_nothing_of_prediction(graph):

@@ -11,7 +11,7 @@ from ..models.registry import model_class
 from ._model_options import MODEL_OPTIONS, CommandLineError
 from ._types import NON_NEGATIVE, POSITIVE_INT, SEED
 
-__all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting", "takes_hyperparameter"]
+__all__ = ["CommandLineError", "add_model_arguments", "build_model", "parse_setting"]
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model options",
@@ -67,21 +67,6 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
         group.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                            help="set any model hyperparameter, e.g. --set n_starts=8 or --set C=2.0 (repeatable; "
                            "VALUE is read as a JSON number, true, false or null, else as text)")
-
-
-def takes_hyperparameter(model, name: str) -> bool:
-    """Whether ``model`` or a model nested in it takes the hyperparameter ``name`` (so that its option applies).
-
-    Parameters
-    ----------
-    model : estimator
-        An unfitted or fitted model; its nested models (a first stage, the base behind a backlash) count.
-    name : str
-        Hyperparameter, e.g. ``"fit_offset"``.
-    """
-    stage = model.first_stage()
-    nested = stage.get_params(deep=True) if stage is not None else {}
-    return any(key == name or key.endswith("__" + name) for key in [*model.get_params(deep=True), *nested])
 
 
 def build_model(kind: str, args: argparse.Namespace):

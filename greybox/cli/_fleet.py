@@ -12,7 +12,8 @@ __all__ = ["check_out_dir", "fleet_progress", "read_options", "report_fleet"]
 
 
 def read_options(args: argparse.Namespace) -> dict:
-    """The options of reading and preparing logs (:func:`greybox.fleet.read_prepared`) as given on the command line.
+    """The options of reading and preparing logs (:func:`greybox.data.reading.read_prepared`) as given on the command
+    line.
 
     Parameters
     ----------

@@ -1,75 +1,21 @@
-"""The training record a model file keeps (``greybox train``), and the warning of predict and evaluate when a
-log is prepared otherwise than the training logs (:mod:`greybox.provenance`)."""
+"""The lines ``greybox info`` prints of a model file's training record (:mod:`greybox.train.record`), and the
+warning of predict and evaluate when a log is prepared otherwise than the training logs (:mod:`greybox.provenance`)."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-import numpy as np
-
-from ..data.effort import EFFORT_UNITS, check_one_axis, check_one_effort
 from ..data.prepare import MAX_GAP_STEPS
-from ..json_values import jsonable
-from ..metrics import metrics_table
-from ..provenance import TRAINING_RECORD, file_identity, preparation_warning, training_record
-from ..provenance import preparation_of as prepared_as
+from ..provenance import TRAINING_RECORD, preparation_warning
 
-__all__ = ["preparation_of", "record_training", "warn_preparation"]
+__all__ = ["record_lines", "region_lines", "warn_preparation"]
 
 
 def _read_options(args: argparse.Namespace) -> dict:
     """The preparation options in ``args`` (:func:`greybox.provenance.preparation_of`), defaults where absent."""
     return {"resample": getattr(args, "resample", None), "max_gap": getattr(args, "max_gap", MAX_GAP_STEPS),
             "time_tolerance": args.time_tolerance, "cutoff_hz": getattr(args, "cutoff_hz", None)}
-
-
-def preparation_of(args: argparse.Namespace, runs) -> dict:
-    """The preparation of prepared ``runs`` read with the options ``args`` (:func:`greybox.provenance.preparation_of`).
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        Parsed log options (:func:`~greybox.cli._options.add_log_arguments`).
-    runs : list of AxisLog
-        The prepared runs; the first gives the sample time [s] and the derivative filter's cut-off [Hz].
-    """
-    return prepared_as(runs, _read_options(args))
-
-
-def record_training(args: argparse.Namespace, files, names, runs, predictions) -> dict:
-    """The model file's records for a model fitted on ``runs``: ``{"training": record}``.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        Parsed options of ``greybox train``.
-    files : list of str
-        The training log files.
-    names : list of str
-        A name per run.
-    runs, predictions : list
-        The prepared runs and the fitted model's effort for each [A, or N, Nm].
-    """
-    quantity = check_one_effort(runs)
-    axis = check_one_axis(runs)
-    tables = [metrics_table(run.effort, prediction) for run, prediction in zip(runs, predictions)]
-    total = metrics_table(np.concatenate([run.effort for run in runs]), np.concatenate(predictions))
-
-    def figures(table) -> dict:
-        re = float(table["re"])
-        return {"samples": int(table["n"]), "rmse": float(table["rmse"]), "re_percent": jsonable(re)}
-
-    ranges = {}
-    for channel in ("position", "velocity", "acceleration"):
-        values = [getattr(run, channel) for run in runs if getattr(run, channel) is not None]
-        if values:
-            ranges[channel] = [float(min(v.min() for v in values)), float(max(v.max() for v in values))]
-    record = training_record([file_identity(path) for path in dict.fromkeys(files)], preparation_of(args, runs),
-                             [{"name": str(name), **figures(table)} for name, table in zip(names, tables)],
-                             {**figures(total), "unit": EFFORT_UNITS[quantity], "quantity": quantity}, ranges,
-                             axis=axis)
-    return {TRAINING_RECORD: record}
 
 
 def warn_preparation(records: dict, args: argparse.Namespace, runs, log_name: str, model_name: str,

@@ -8,29 +8,16 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from ..atomic import check_output_path
-from ..data.effort import (
-    EFFORT_UNITS,
-    check_effort_measured,
-    check_one_axis,
-    check_one_effort,
-    effort_quantity,
-    effort_text,
-)
+from ..data.effort import effort_text
 from ..errors import GreyboxError, ModelFileError
 from ..identify.intervals import METHODS as INTERVAL_METHODS
-from ..identify.intervals import attach_intervals
-from ..metrics import metrics_table
 from ..model_choice import DEFAULT_CANDIDATES
 from ..models.registry import MODEL_CLASSES
-from ..persistence import save_verified
-from ._advice import offset_note
-from ._build import add_model_arguments, build_model, takes_hyperparameter
+from ._build import add_model_arguments, build_model
+from ._fleet import read_options
 from ._model_text import model_lines
-from ._options import add_log_arguments, read_named_runs
-from ._provenance import record_training
+from ._options import add_log_arguments
 from ._types import POSITIVE_INT
 
 
@@ -106,46 +93,6 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(run=run)
 
 
-def _read(args: argparse.Namespace, paths, axis=None) -> tuple[list[str], list]:
-    """The runs of ``paths`` (of one axis of a machine: its channels from the machine file) and a name per run."""
-    if axis is None:
-        runs, names = read_named_runs(args, paths, list(paths))
-        return names, runs
-    from ._options import read_runs
-
-    columns = dict(axis.channels) or None
-    runs, names = [], []
-    for path in paths:
-        pieces = read_runs(args, path, columns=columns, axis=axis.name)
-        runs += pieces
-        names += [path] * len(pieces)
-    return names, runs
-
-
-def _read_all(args: argparse.Namespace, axis=None) -> tuple[list, list, list]:
-    """The names and runs of --train, and the runs of --stage2 (of one axis of a machine)."""
-    names, runs = _read(args, args.train, axis)
-    second_names, second = _read(args, args.stage2, axis) if args.stage2 else ([], [])
-    check_one_effort(runs + second)  # before any fit: a model of a current and a torque at once is neither
-    check_one_axis(runs + second)  # nor is a model of two axes
-    check_effort_measured(runs + second)
-    return names + second_names, runs, second
-
-
-def _fit(model, args: argparse.Namespace, names, runs, second):
-    """Fit ``model`` as the options say; return the names and runs it was fitted on."""
-    progress = None if args.quiet else True
-    _check_interval_options(args)
-    if args.stage2 and model.first_stage() is None:
-        raise GreyboxError(f"option --stage2 does not apply to the {args.model} model: it has one stage")
-    if not args.stage2:
-        model.fit(runs, progress=progress)
-    else:
-        model.fit_staged(runs, second, progress=progress)
-    _intervals(model, args, runs)
-    return names, runs + second
-
-
 def _check_interval_options(args: argparse.Namespace) -> None:
     """Refuse --bootstrap without --intervals bootstrap, or with fewer than 2 replicates."""
     if args.bootstrap is not None and args.intervals != "bootstrap":
@@ -154,40 +101,15 @@ def _check_interval_options(args: argparse.Namespace) -> None:
         raise GreyboxError(f"--bootstrap {args.bootstrap}: a bootstrap needs at least 2 replicates")
 
 
-def _intervals(model, args: argparse.Namespace, runs) -> None:
-    """Attach the parameter intervals --intervals asks for (of the runs the model, or its first stage, saw)."""
-    if args.intervals != "none":
-        started = time.perf_counter()
-        attach_intervals(model, runs, method=args.intervals, n_bootstrap=args.bootstrap or 100)
-        record = model.parameter_intervals_
-        print(f"95 % intervals by {args.intervals} over {record['n_clusters']} {record['clusters']} "
-              f"in {time.perf_counter() - started:.1f} s")
+def _notify(line: str) -> None:
+    print(line, file=sys.stderr)
 
 
-def _axis_inertia(config, runs, source: str) -> tuple[float | None, str]:
-    """The inertia an axis configuration gives, in the effort unit of ``runs`` [effort s^2/length], and ``source``."""
-    if config is None or not runs:
-        return None, ""
-    return config.model_inertia(runs[0].effort_unit), source
-
-
-def _read_axis_inertia(args: argparse.Namespace, runs) -> tuple[float | None, str]:
-    """The inertia of --axis-config for ``runs`` and its source; (None, "") without the option."""
-    if not args.axis_config:
-        return None, ""
-    from ..data.axis_config import INERTIA, read_axis_config
-
-    config = read_axis_config(args.axis_config)
-    if config.inertia_kg_m2 is None:
-        raise GreyboxError(f"{args.axis_config}: gives no {INERTIA}, the axis's inertia at the motor shaft that "
-                           "--axis-config of greybox train checks the model against")
-    return _axis_inertia(config, runs, f"the axis file {Path(args.axis_config).name}")
-
-
-def _check_inertia(model, expected: float | None, source: str) -> None:
-    """Note on the model (and so in its output and file) an identified inertia that disagrees with ``expected``."""
-    if expected is not None:
-        model.check_axis_inertia(expected, source)
+def _training_options(args: argparse.Namespace) -> dict:
+    """The options every variant of :mod:`greybox.train` takes, as given on the command line."""
+    _check_interval_options(args)
+    return {"read": read_options(args), "intervals": args.intervals, "n_bootstrap": args.bootstrap,
+            "overwrite": args.force, "report": print, "notify": _notify}
 
 
 def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
@@ -210,48 +132,41 @@ def _machine_axes(args: argparse.Namespace) -> tuple[str, list]:
     return machine.name, [machine.axis(name) for name in (names or list(machine.axes))]
 
 
-def _report_fit(model, names, runs, elapsed: float, label: str) -> list:
-    """Print the training error per run and the parameters; return the predictions."""
-    quantity = effort_quantity(runs[0])
-    unit = EFFORT_UNITS[quantity]
-    print(f"trained {label} on {len(runs)} run(s), {sum(len(r) for r in runs)} samples, "
+def _print_fit(model, elapsed: float, label: str) -> None:
+    """Print the training error per run (from the model's training record) and the parameters."""
+    record = model.training_record_
+    total = record["training_error"]
+    quantity = total["quantity"]
+
+    def row(name: str, figures: dict) -> str:
+        re = "-" if figures["re_percent"] is None else f"{figures['re_percent']:.3f}"
+        return f"  {name:<32} {figures['samples']:>8d} {figures['rmse']:>10.4g} {re:>7}"
+
+    print(f"trained {label} on {len(record['runs'])} run(s), {total['samples']} samples, "
           f"effort in {effort_text(quantity)}, in {elapsed:.1f} s")
-    print(f"  {'run':<32} {'samples':>8} {'RMSE ' + unit:>10} {'RE %':>7}")
-    predictions = [model.predict(run) for run in runs]
-    for path, run, prediction in zip(names, runs, predictions):
-        table = metrics_table(run.effort, prediction)
-        print(f"  {Path(path).name[-32:]:<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
-    if len(runs) > 1:
-        table = metrics_table(np.concatenate([r.effort for r in runs]), np.concatenate(predictions))
-        print(f"  {'all runs':<32} {table['n']:>8d} {table['rmse']:>10.4g} {table['re']:>7.3f}")
+    print(f"  {'run':<32} {'samples':>8} {'RMSE ' + total['unit']:>10} {'RE %':>7}")
+    for run in record["runs"]:
+        print(row(Path(run["name"]).name[-32:], run))
+    if len(record["runs"]) > 1:
+        print(row("all runs", total))
     print("  (RE = RMSE / mean |effort|)")
     print("\n".join(model_lines(model, quantity=quantity)))
-    if takes_hyperparameter(model, "fit_offset"):
-        offset_note([run.effort for run in runs], predictions, unit)
-    return predictions
 
 
 def _run_machine(args: argparse.Namespace) -> int:
-    from ..machine_model import MachineModel, check_machine_output, save_machine
+    from ..machine_model import MANIFEST
+    from ..train import train_machine_logs
 
     name, axes = _machine_axes(args)
-    check_machine_output(args.out, [axis.name for axis in axes], overwrite=args.force)
-    data = {axis.name: _read_all(args, axis) for axis in axes}  # every axis read before any training
-    models, predictions, records = {}, {}, {}
-    for axis in axes:
-        model = build_model(args.model, args)
-        started = time.perf_counter()
-        names, runs = _fit(model, args, *data[axis.name])
-        _check_inertia(model, *_axis_inertia(axis.config, runs, f"axis {axis.name} of the machine file"))
-        predictions[axis.name] = (runs, _report_fit(model, names, runs, time.perf_counter() - started,
-                                                    f"{args.model} for axis {axis.name}"))
-        records[axis.name] = record_training(args, list(args.train) + list(args.stage2 or ()), names, runs,
-                                             predictions[axis.name][1])
-        models[axis.name] = model
-    written = save_machine(MachineModel(models=models, name=name), args.out, overwrite=args.force, records=records,
-                           verify=predictions)
-    for path in written:
-        print(f"wrote {path}")
+    model = build_model(args.model, args)  # a bad option is one error before any log is read
+    machine = train_machine_logs(model, args.train, axes, name=name, stage2=args.stage2 or (),
+                                 out=args.out, progress=None if args.quiet else True,
+                                 on_fit=lambda axis, fitted, seconds: _print_fit(fitted, seconds,
+                                                                                 f"{args.model} for axis {axis}"),
+                                 **_training_options(args))
+    for axis in machine.axes:
+        print(f"wrote {Path(args.out) / f'{axis}.gbm'}")
+    print(f"wrote {Path(args.out) / MANIFEST}")
     return 0
 
 
@@ -261,10 +176,10 @@ def _label(entry: dict) -> str:
 
 
 def _run_per_machine(args: argparse.Namespace) -> int:
-    """``greybox train --per-machine``: a model per machine and axis on Dask (:mod:`greybox.fleet_train`)."""
+    """``greybox train --per-machine``: a model per machine and axis on Dask (:mod:`greybox.fleet.train`)."""
     from ..fleet import MANIFEST, expand_logs
-    from ..fleet_train import run_training, train_jobs
-    from ._fleet import check_out_dir, fleet_progress, read_options, report_fleet
+    from ..fleet.train import run_training, train_jobs
+    from ._fleet import check_out_dir, fleet_progress, report_fleet
 
     if args.intervals != "sandwich" or args.bootstrap is not None:
         raise GreyboxError("--intervals and --bootstrap do not apply with --per-machine: a fleet's models get the "
@@ -306,7 +221,7 @@ AUTO = "auto"
 
 def _run_auto(args: argparse.Namespace) -> int:
     """``greybox train --model auto``: choose the model by held-out runs, save it with the table."""
-    from ..model_choice import choose_model
+    from ..train import train_auto_logs
 
     for option, value in (("--per-machine", args.per_machine), ("--axes", args.axes), ("--machine", args.machine),
                           ("--stage2", args.stage2), ("--asymmetric", args.asymmetric), ("--offset", args.offset),
@@ -314,39 +229,19 @@ def _run_auto(args: argparse.Namespace) -> int:
         if value:
             raise GreyboxError(f"{option} does not apply with --model auto: write a candidate's options into "
                                "--candidates, e.g. --candidates gms:asymmetric,backlash stribeck:offset")
-    _check_interval_options(args)
-    out = Path(args.out)
-    check_output_path(out, overwrite=args.force, protect=list(args.train), error=ModelFileError,
-                      inputs_name="one of the training logs")
-    runs, groups = [], []
-    for path in args.train:
-        pieces, _ = read_named_runs(args, [path], [path])
-        runs += pieces
-        groups += [str(path)] * len(pieces)
-    check_one_effort(runs)
-    check_one_axis(runs)
-    check_effort_measured(runs)  # the held-out relative errors the choice compares would be undefined
     started = time.perf_counter()
-    report = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
-    inertia, source = _read_axis_inertia(args, runs)
-    if args.model_inertia is not None:
-        inertia = args.model_inertia  # --inertia or --load-side say more than the axis file
-    elif inertia is not None:
-        unit = f"{runs[0].effort_unit} s^2/{runs[0].units.length}"
-        print(f"inertia J = {inertia:.4g} {unit} from {source}: every candidate is fitted with it")
-    model = choose_model(runs, groups, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=inertia,
-                         workers=args.workers or os.cpu_count() or 1, progress=report)
-    _intervals(model, args, runs)
-    names = [Path(group).name for group in groups]
-    predictions = _report_fit(model, names, runs, time.perf_counter() - started,
-                              f"{model.selection_['chosen']} (chosen by held-out runs)")
-    save_verified(model, out, runs, predictions=predictions, overwrite=args.force,
-                  records=record_training(args, list(args.train), names, runs, predictions))
-    print(f"wrote {out}")
+    progress = None if args.quiet else (lambda line: print(f"  {line}", file=sys.stderr, flush=True))
+    model = train_auto_logs(args.train, candidates=args.candidates or DEFAULT_CANDIDATES, inertia=args.model_inertia,
+                            axis_config=args.axis_config, workers=args.workers, out=args.out, progress=progress,
+                            **_training_options(args))
+    _print_fit(model, time.perf_counter() - started, f"{model.selection_['chosen']} (chosen by held-out runs)")
+    print(f"wrote {args.out}")
     return 0
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..train import train_logs
+
     if args.model == AUTO:
         return _run_auto(args)
     if args.candidates:
@@ -365,17 +260,13 @@ def run(args: argparse.Namespace) -> int:
         if any(out.resolve() == Path(path).resolve() for path in inputs):
             raise ModelFileError(f"{out}: is one of the training logs; choose another output directory")
         return _run_machine(args)
-    out = Path(args.out)
-    check_output_path(out, overwrite=args.force, protect=inputs, error=ModelFileError,
-                      inputs_name="one of the training logs")
+    options = _training_options(args)
+    check_output_path(args.out, overwrite=args.force, protect=inputs, error=ModelFileError,
+                      inputs_name="one of the training logs")  # before the model's options: as every command
     model = build_model(args.model, args)
     started = time.perf_counter()
-    data = _read_all(args)
-    expected, source = _read_axis_inertia(args, data[1])  # a bad axis file stops before the fit
-    names, runs = _fit(model, args, *data)
-    _check_inertia(model, expected, source)
-    predictions = _report_fit(model, names, runs, time.perf_counter() - started, args.model)
-    save_verified(model, out, runs, predictions=predictions, overwrite=args.force,
-                  records=record_training(args, inputs, names, runs, predictions))
-    print(f"wrote {out}")
+    model = train_logs(model, args.train, stage2=args.stage2 or (), axis_config=args.axis_config, out=args.out,
+                       progress=None if args.quiet else True, **options)
+    _print_fit(model, time.perf_counter() - started, args.model)
+    print(f"wrote {args.out}")
     return 0

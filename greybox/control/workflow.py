@@ -18,6 +18,7 @@ from ..data.prepare import prepare
 from ..errors import GreyboxError
 from ..models.registry import model_kind
 from ..persistence import load_model
+from ..train import train_logs
 from ..twin import CurrentNoise, axis_geometry, make_dataset
 from .feedforward import InertiaFeedForward, ModelFeedForward
 from .loop import LoopResult, compare_feedforwards, controller_periods
@@ -185,7 +186,7 @@ def feedforward_models(plant, *, model_files: Sequence[str | PathLike] = (), kin
             runs = twin_training_runs(plant, seed=seed, duration_s=train_duration_s)
         for kind in kinds:
             started = time.perf_counter()
-            model = build(kind).fit(runs)
+            model = train_logs(build(kind), runs, intervals="none")
             say(f"fitted {kind} on {len(runs)} run(s) in {time.perf_counter() - started:.1f} s")
             entries.append((kind, "fitted", model))
     if not entries:

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import LogError
 from .quantities import MOTIONS, Motion
 
-__all__ = ["AxisLog", "as_log_list", "EFFORT_UNITS"]
+__all__ = ["AxisLog", "as_log_list", "split_runs", "EFFORT_UNITS"]
 
 #: Units of the drive effort a log may carry: motor current [A] or, for drives
 #: that log their load instead (e.g. the EMPS benchmark), force on the load side
@@ -240,3 +240,30 @@ def as_log_list(logs: AxisLog | Iterable[AxisLog]) -> list[AxisLog]:
         if not isinstance(run, AxisLog):
             raise TypeError(f"expected AxisLog, got {type(run).__name__}")
     return list(runs)
+
+
+def split_runs(runs: Sequence[AxisLog], prediction) -> list[np.ndarray]:
+    """Split a prediction of concatenated runs into one array per run (a list passes through).
+
+    Parameters
+    ----------
+    runs : sequence of AxisLog
+        The runs the prediction is of; their lengths set the split.
+    prediction : ndarray, shape (n,), or sequence of array_like
+        Prediction of the runs concatenated (``n`` the total number of samples), or one array per run
+        (checked against the runs' lengths and returned as float arrays).
+
+    Raises
+    ------
+    ValueError
+        If the lengths do not match the runs.
+    """
+    if isinstance(prediction, np.ndarray) and prediction.ndim == 1:
+        lengths = [len(run) for run in runs]
+        if prediction.size != sum(lengths):
+            raise ValueError(f"runs of {sum(lengths)} samples in all but a prediction of {prediction.size}")
+        return np.split(prediction, np.cumsum(lengths)[:-1])
+    parts = [np.asarray(p, dtype=np.float64) for p in prediction]
+    if [p.size for p in parts] != [len(run) for run in runs]:
+        raise ValueError("the predictions do not match the runs in number or length")
+    return parts

@@ -54,7 +54,7 @@ import scipy.sparse
 from threadpoolctl import threadpool_limits
 
 from ..base import LinearPart
-from ..data.log import AxisLog
+from ..data.log import AxisLog, split_runs
 from ..identify.projection import Nuisance, PositionScan, added_squares
 from ..json_values import jsonable
 from ..models.effects import Effect, EffectContext, effect, scan_periods
@@ -326,10 +326,9 @@ def _score_step(runs, part, context, names, *, rng, n_null, alpha, excluded_peri
     # null replicates: noise like the residual; refined once without the effects that pass
     best_columns = {name: candidates[name].columns(best[name]) for name in candidates
                     if candidates[name].grid is None or candidates[name].grid.size}
-    lengths = np.cumsum([len(run) for run in runs])[:-1]
     noise_residual, refined = residual_perp.ravel(), False
     while True:
-        noise = ResidualNoise.fit(np.split(noise_residual, lengths), [run.sample_time for run in runs],
+        noise = ResidualNoise.fit(split_runs(runs, noise_residual), [run.sample_time for run in runs],
                                   level_window_s=level_window_s)
         null_perp = nuisance.project(np.vstack(noise.simulate(n_null, rng)))
         step = _evaluate(candidates, observed, best, scans, families, structure, family_observed, nuisance,

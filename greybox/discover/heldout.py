@@ -45,7 +45,7 @@ from typing import Callable, Sequence
 import numpy as np
 import scipy.linalg
 
-from ..data.log import AxisLog
+from ..data.log import AxisLog, split_runs
 from ..errors import GreyboxError
 from ..identify.projection import Nuisance, PositionScan, added_squares
 from ..models.effects import Effect, EffectContext, scan_periods
@@ -203,8 +203,7 @@ class HeldOutTest:
                 self._null = np.empty((self.target.size, 0))
             else:
                 residual = Nuisance(self.columns).project(self.target[:, None]).ravel()
-                lengths = np.cumsum([len(run) for run in self.runs])[:-1]
-                noise = ResidualNoise.fit(np.split(residual, lengths), [run.sample_time for run in self.runs])
+                noise = ResidualNoise.fit(split_runs(self.runs, residual), [run.sample_time for run in self.runs])
                 self._null = np.vstack(noise.simulate(self.n_null, self.rng))
         return self._null
 

@@ -22,11 +22,11 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from ..data.log import AxisLog
+from ..data.log import AxisLog, split_runs
 from .plots import finish_figure, import_pyplot, legend_outside
 from .report import MODEL_LABELS
 
-__all__ = ["MODEL_COLORS", "effort_name", "error_boxplot", "time_comparison", "residual_vs_position", "split_runs"]
+__all__ = ["MODEL_COLORS", "effort_name", "error_boxplot", "time_comparison", "residual_vs_position"]
 
 #: Line colours of the models, the same in every figure.
 MODEL_COLORS = {
@@ -63,33 +63,6 @@ def effort_name(runs: Sequence[AxisLog]) -> tuple[str, str]:
     if len(units) != 1:
         raise ValueError(f"the runs carry effort in different units ({', '.join(units)}); draw them apart")
     return ("current" if units[0] == "A" else runs[0].units.load), units[0]
-
-
-def split_runs(runs: Sequence[AxisLog], prediction) -> list[np.ndarray]:
-    """Split a prediction of concatenated runs into one array per run (a list passes through).
-
-    Parameters
-    ----------
-    runs : sequence of AxisLog
-        The runs the prediction is of; their lengths set the split.
-    prediction : ndarray, shape (n,), or sequence of array_like
-        Prediction of the runs concatenated (``n`` the total number of samples), or one array per run
-        (checked against the runs' lengths and returned as float arrays).
-
-    Raises
-    ------
-    ValueError
-        If the lengths do not match the runs.
-    """
-    if isinstance(prediction, np.ndarray) and prediction.ndim == 1:
-        lengths = [len(run) for run in runs]
-        if prediction.size != sum(lengths):
-            raise ValueError(f"runs of {sum(lengths)} samples in all but a prediction of {prediction.size}")
-        return np.split(prediction, np.cumsum(lengths)[:-1])
-    parts = [np.asarray(p, dtype=np.float64) for p in prediction]
-    if [p.size for p in parts] != [len(run) for run in runs]:
-        raise ValueError("the predictions do not match the runs in number or length")
-    return parts
 
 
 def error_boxplot(panels: Sequence[tuple[str, Sequence[AxisLog], Mapping[str, object]]],

@@ -23,6 +23,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from ..data.log import split_runs
 from ..metrics import metrics_table
 from ..models.estimator import EXTRAPOLATION_WARNING_SHARE, extrapolates, outside_any
 from ..models.registry import model_kind
@@ -126,7 +127,7 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
         predictions[NOISE_FLOOR] = np.concatenate([run.extras[TRUTH_CHANNEL] for run in runs])
     records = []
     for name, prediction in predictions.items():
-        parts = np.split(prediction, np.cumsum([len(run) for run in runs])[:-1])
+        parts = split_runs(runs, prediction)
         per_log = {n: (run.effort, p) for n, run, p in zip(run_names, runs, parts)}
         record = metric_record(None, axis, name, "test", measured, prediction, run_names, per_log)
         record["kind"] = model_kind(models[name]) if name in models else NOISE_FLOOR

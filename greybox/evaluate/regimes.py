@@ -54,7 +54,7 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-from ..data.log import AxisLog, as_log_list
+from ..data.log import AxisLog, as_log_list, split_runs
 from ..errors import LogError
 from ..metrics import metrics_table
 
@@ -247,11 +247,7 @@ def metrics_by_regime(
     """
     runs = as_log_list(logs)
     if isinstance(logs, AxisLog) or (isinstance(predictions, np.ndarray) and predictions.ndim == 1):
-        joined = np.asarray(predictions, dtype=np.float64)
-        lengths = [len(run) for run in runs]
-        if joined.shape[0] != sum(lengths):
-            raise ValueError(f"runs of {sum(lengths)} samples in all but a prediction of {joined.shape[0]}")
-        predictions = np.split(joined, np.cumsum(lengths)[:-1])
+        predictions = split_runs(runs, np.asarray(predictions, dtype=np.float64))
     predictions = [np.asarray(p, dtype=np.float64).ravel() for p in predictions]
     if len(predictions) != len(runs):
         raise ValueError(f"{len(runs)} runs but {len(predictions)} predictions")

@@ -27,19 +27,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..identify.static import coulomb_regressors
+from ..windows import centred_mean
 
 __all__ = ["uncut_samples"]
-
-
-def _window_mean(values: np.ndarray, counts: np.ndarray, width: int) -> np.ndarray:
-    """Mean of ``values`` over a centred window of ``width`` samples, counting only where ``counts`` is 1."""
-    total = np.concatenate([[0.0], np.cumsum(values * counts)])
-    number = np.concatenate([[0.0], np.cumsum(counts)])
-    n = len(values)
-    half = width // 2
-    start = np.clip(np.arange(n) - half, 0, n)
-    stop = np.clip(np.arange(n) + width - half, 0, n)
-    return (total[stop] - total[start]) / np.maximum(number[stop] - number[start], 1.0)
 
 
 def _widen(flags: np.ndarray, pad: int) -> np.ndarray:
@@ -100,7 +90,7 @@ def uncut_samples(velocity, acceleration, effort, *, share: float = 0.5, min_spe
             break
         theta = np.linalg.lstsq(regressors[keep], y[keep], rcond=None)[0]
         residual = y - regressors @ theta
-        departure = _window_mean(residual, fast.astype(float), int(window))
+        departure = centred_mean(residual, int(window), counts=fast)
         level = np.where(v > 0.0, abs(theta[1]), abs(theta[2]))
         loaded = fast & (np.abs(departure) > tolerance * level)
         unloaded = ~_widen(loaded, int(pad))

@@ -52,6 +52,7 @@ from scipy import sparse
 from ..data.log import AxisLog, as_log_list
 from ..errors import LogError, ParameterError
 from ..identify.static import coulomb_from_normal_equations, coulomb_regressors
+from ..windows import centred_mean
 
 __all__ = ["FEATURES", "FEATURE_UNITS", "FrictionFingerprint", "reversal_widths", "spindle_idle_samples",
            "unloaded_samples"]
@@ -74,16 +75,6 @@ FEATURES = tuple(FEATURE_UNITS)
 
 #: Fewest unloaded moving samples per direction of motion for a fingerprint.
 MIN_SAMPLES_PER_DIRECTION = 100
-
-
-def _moving_rms(values: np.ndarray, width: int) -> np.ndarray:
-    """Root-mean-square of ``values`` over a centred window of ``width`` samples (shorter at the ends)."""
-    squares = np.concatenate([[0.0], np.cumsum(values * values)])
-    n = len(values)
-    half = width // 2
-    start = np.clip(np.arange(n) - half, 0, n)
-    stop = np.clip(np.arange(n) + width - half, 0, n)
-    return np.sqrt((squares[stop] - squares[start]) / np.maximum(stop - start, 1))
 
 
 def unloaded_samples(residual, *, noise_A: float | None = None, factor: float = 3.0, window: int = 50) -> np.ndarray:
@@ -120,7 +111,8 @@ def unloaded_samples(residual, *, noise_A: float | None = None, factor: float = 
         raise ParameterError(f"noise level must be a non-negative current, got {noise_A} A")
     if not factor > 0.0 or int(window) < 1:
         raise ParameterError("factor must be positive and window at least one sample")
-    return _moving_rms(r - np.median(r), int(window)) <= factor * noise_A
+    centred = r - np.median(r)
+    return np.sqrt(centred_mean(centred * centred, int(window))) <= factor * noise_A
 
 
 def spindle_idle_samples(load, *, threshold: float | None = None, pad: int = 100) -> np.ndarray:

@@ -49,7 +49,7 @@ import pyarrow.parquet as pq
 
 from ..atomic import atomic_output
 from ..errors import GreyboxError
-from ..fleet import file_sha256
+from ..provenance import file_sha256
 from .fingerprint import FEATURE_UNITS, FEATURES
 
 __all__ = ["COMPACTED_NAME", "HistoryError", "LOCK_NAME", "LOCK_TIMEOUT_S", "MAX_MAP_BINS", "MAX_ROWS", "SCHEMA",

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
 
+from ..data.reading import read_prepared
 from ..errors import GreyboxError
 from ..fleet import (
     MANIFEST,
@@ -35,16 +36,15 @@ from ..fleet import (
     check_machines,
     check_names,
     encode_name,
-    file_sha256,
     log_names,
     log_stamp,
     machine_of,
     out_dir_of,
     partition,
     read_manifest,
-    read_prepared,
     run_tasks,
 )
+from ..provenance import file_sha256
 
 __all__ = ["FORMAT_VERSION", "PREDICT_FORMAT", "FleetJob", "fleet_jobs", "machine_models", "model_of_log",
            "predict_log", "run_fleet"]

@@ -17,9 +17,10 @@ from ..evaluate.plots import (
     legend_outside,
     window_title,
 )
+from ..windows import centred_mean
 from .process import ProcessResult
 
-__all__ = ["envelope_indices", "moving_mean", "plot_machine_process", "plot_process"]
+__all__ = ["envelope_indices", "plot_machine_process", "plot_process"]
 
 
 def _shown(time: np.ndarray, window) -> slice:
@@ -30,32 +31,6 @@ def _shown(time: np.ndarray, window) -> slice:
     if shown.start >= shown.stop:
         raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
     return shown
-
-
-def moving_mean(values, window: int) -> np.ndarray:
-    """Centred moving mean over ``window`` samples, the window shortened at both ends of the signal.
-
-    Parameters
-    ----------
-    values : array_like
-        Signal.
-    window : int
-        Window length [samples], at least 1 (1 returns the signal).
-
-    Returns
-    -------
-    ndarray
-        Same length as ``values``; sample ``i`` is the mean of the samples of
-        the window centred on ``i`` that lie inside the signal.
-    """
-    values = np.asarray(values, dtype=float)
-    if window < 1:
-        raise ValueError(f"the window must hold at least one sample, got {window}")
-    sums = np.concatenate(([0.0], np.cumsum(values)))
-    index = np.arange(values.size)
-    start = np.clip(index - window // 2, 0, values.size)
-    stop = np.clip(index - window // 2 + window, 0, values.size)
-    return (sums[stop] - sums[start]) / (stop - start)
 
 
 def _mark_outside(ax, time, outside, max_points: int, label: str, color: str = "tab:orange") -> None:
@@ -136,7 +111,7 @@ def plot_process(result: ProcessResult, path: str | os.PathLike | None = None, *
                             color=color, alpha=0.25, lw=0, step="post", label=band_label)
         line(ax, values, lw=0.6, color=color, label=what)
         if mean_samples:
-            line(ax, moving_mean(values, mean_samples), lw=1.2, color=dark, label=f"moving mean over {mean_s:g} s")
+            line(ax, centred_mean(values, mean_samples), lw=1.2, color=dark, label=f"moving mean over {mean_s:g} s")
         ax.axhline(0.0, color="black", lw=0.5)
         legend_outside(ax)
 
@@ -231,7 +206,7 @@ def plot_machine_process(result, path: str | os.PathLike | None = None, *,
     for ax, (values, label) in zip(axes[:, 0], panels):
         ax.plot(*envelope(time[shown], values[shown], max_points), lw=0.6, color="tab:red", label="per sample")
         if mean_samples:
-            ax.plot(*envelope(time[shown], moving_mean(values, mean_samples)[shown], max_points), lw=1.2,
+            ax.plot(*envelope(time[shown], centred_mean(values, mean_samples)[shown], max_points), lw=1.2,
                     color="darkred", label=f"moving mean over {mean_s:g} s")
         ax.axhline(0.0, color="black", lw=0.5)
         ax.set_ylabel(label, fontsize="small")

@@ -159,7 +159,7 @@ class Request:
     chunk_s : float
         Chunk length of the model [s].
     read : dict
-        Options of reading and preparing the logs (:func:`greybox.fleet.read_prepared`).
+        Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`).
     force : bool
         Replace outputs that exist (never an input).
     scheduler : str or None

@@ -87,7 +87,7 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
     chunk_s : float, default 60.0
         Chunk length of the model [s].
     read : mapping, optional
-        Options of reading and preparing the logs (:func:`greybox.fleet.read_prepared`).
+        Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`).
     force : bool, default False
         Replace outputs that exist (never an input).
     scheduler : str, optional

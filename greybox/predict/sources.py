@@ -14,8 +14,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from ..data.reading import read_prepared
 from ..errors import GreyboxError, Setting
-from ..fleet import read_prepared
 from ..models.chunked import chunk_slices, samples_per_chunk
 from ..provenance import axis_warning, model_quantity, preparation_warning
 from .effort import align_effort

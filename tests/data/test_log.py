@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from greybox.data.log import AxisLog, as_log_list
+from greybox.data.log import AxisLog, as_log_list, split_runs
 from greybox.errors import LogError
 
 
@@ -66,3 +66,13 @@ def test_as_log_list_accepts_one_log_or_many():
         as_log_list([])
     with pytest.raises(TypeError):
         as_log_list([log, "file.csv"])
+
+
+def test_split_runs():
+    runs = [make_log(10), make_log(5)]
+    parts = split_runs(runs, np.arange(15.0))
+    assert [p.tolist() for p in parts] == [list(range(10)), list(range(10, 15))]
+    with pytest.raises(ValueError):
+        split_runs(runs, np.arange(14.0))
+    with pytest.raises(ValueError):
+        split_runs(runs, [np.zeros(10), np.zeros(4)])

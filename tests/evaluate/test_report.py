@@ -12,7 +12,7 @@ import pytest
 
 from greybox.data.log import AxisLog
 from greybox.errors import GreyboxError
-from greybox.evaluate.figures import error_boxplot, residual_vs_position, split_runs, time_comparison
+from greybox.evaluate.figures import error_boxplot, residual_vs_position, time_comparison
 from greybox.evaluate.html import render_html, write_html
 from greybox.evaluate.records import metric_record
 from greybox.evaluate.report import (
@@ -217,11 +217,3 @@ def test_figures_are_written(tmp_path):
         assert path.read_bytes()[:8] == PNG_MAGIC
 
 
-def test_split_runs():
-    runs = [reversing_log(10), reversing_log(5)]
-    parts = split_runs(runs, np.arange(15.0))
-    assert [p.tolist() for p in parts] == [list(range(10)), list(range(10, 15))]
-    with pytest.raises(ValueError):
-        split_runs(runs, np.arange(14.0))
-    with pytest.raises(ValueError):
-        split_runs(runs, [np.zeros(10), np.zeros(4)])

@@ -393,7 +393,7 @@ def test_train_by_bootstrap_and_a_bootstrap_count_without_it(tmp_path, capsys, c
 
 
 def test_a_fleets_models_carry_intervals(tmp_path):
-    from greybox.fleet_train import train_jobs, train_model
+    from greybox.fleet.train import train_jobs, train_model
 
     log = tmp_path / "logs" / "machine_1" / "run.csv"
     log.parent.mkdir(parents=True)

@@ -54,18 +54,6 @@ def test_thinned_picture_keeps_single_sample_peaks():
     matplotlib.pyplot.close(figure)
 
 
-def test_moving_mean_is_centred_and_exact_at_the_ends():
-    from greybox.predict.plot import moving_mean
-
-    values = np.array([1.0, 2.0, 3.0, 4.0, 10.0])
-    np.testing.assert_allclose(moving_mean(values, 3), [1.5, 2.0, 3.0, 17 / 3, 7.0])
-    np.testing.assert_array_equal(moving_mean(values, 1), values)
-    # a 100 Hz ripple sampled at 2 ms averages out over whole periods
-    t = np.arange(5000) * 0.002
-    ripple = -0.5 + 0.2 * np.sin(2 * np.pi * 100.0 * t)
-    np.testing.assert_allclose(moving_mean(ripple, 50)[100:-100], -0.5, atol=1e-12)
-
-
 def test_process_panel_draws_the_moving_mean():
     import matplotlib
     import matplotlib.pyplot

@@ -1,4 +1,4 @@
-"""The fleet engine (greybox.fleet) on a local Dask cluster: how its workers set numba's threads."""
+"""The fleet engine (greybox.fleet.engine) on a local Dask cluster: how its workers set numba's threads."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ import pytest
 SCRIPT = '''
 import numba
 
-from greybox.fleet import _run_on_cluster
+from greybox.fleet.engine import _run_on_cluster
 
 
 def task(job):
@@ -49,13 +49,13 @@ def test_a_worker_compiles_after_launching_its_threads_and_runs_them_on_one(tmp_
     assert result["value"] == 2 and result["threads"] == 1  # the task's kernels on one thread
 
 
-# -- output names of a fleet run (greybox.fleet.log_names, encode_name, check_names) --------------------------
+# -- output names of a fleet run (greybox.fleet.engine.log_names, encode_name, check_names) --------------------------
 
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from greybox.errors import GreyboxError  # noqa: E402
-from greybox.fleet import (  # noqa: E402
+from greybox.fleet.engine import (  # noqa: E402
     MANIFEST,
     MAX_NAME_BYTES,
     check_names,
@@ -122,7 +122,7 @@ from dataclasses import dataclass
 
 import dask
 
-from greybox.fleet import _run_on_cluster
+from greybox.fleet.engine import _run_on_cluster
 
 
 @dataclass(frozen=True)
@@ -161,7 +161,7 @@ def test_a_job_whose_worker_died_is_reported_by_its_log(tmp_path):
 def test_a_workers_warnings_go_to_the_manifest_and_the_summary_as_note_lines():
     import warnings
 
-    from greybox.fleet import attempt, fleet_summary
+    from greybox.fleet.engine import attempt, fleet_summary
 
     def work():
         warnings.warn("the log's clock jumps\nsecond line", UserWarning, stacklevel=2)
@@ -177,7 +177,7 @@ def test_a_workers_warnings_go_to_the_manifest_and_the_summary_as_note_lines():
 
 
 def test_folders_whose_names_give_one_machine_name_are_refused():
-    from greybox.fleet import check_machines
+    from greybox.fleet.engine import check_machines
 
     check_machines(["/p/a/m2/log.mcap", "/p/b/m2/log.mcap"])  # one name in two places: one machine, by design
     with pytest.raises(GreyboxError, match="the folders 'run 1' and 'run_1' both give the machine name run_1"):

@@ -2,7 +2,7 @@
 
 :func:`expand_logs` turns files, directories (searched recursively for log files) and glob patterns
 into the list of logs. :func:`run_tasks` is the one engine of every fleet run (``greybox predict`` over
-many logs in :mod:`greybox.predict.fleet`, ``greybox train --per-machine`` in :mod:`greybox.fleet_train`):
+many logs in :mod:`greybox.predict.fleet`, ``greybox train --per-machine`` in :mod:`greybox.fleet.train`):
 it runs one task per job on a Dask cluster, by default a local cluster of processes, one per core and one
 thread each, or the cluster of a scheduler address, so that the same command runs on a laptop and on a
 cluster; it skips the jobs complete from an earlier run, reports a job that fails and goes on, and writes
@@ -15,23 +15,22 @@ from __future__ import annotations
 import contextlib
 import functools
 import glob
-import hashlib
 import json
 import os
 import time
 import unicodedata
 import warnings
 from pathlib import Path
-from typing import Callable, Iterator, Mapping, Sequence
+from typing import Callable, Iterator, Sequence
 from urllib.parse import quote, unquote
 
-from .atomic import write_text_atomic
-from .data.io import LOG_SUFFIXES
-from .errors import GreyboxError, Setting
+from ..atomic import write_text_atomic
+from ..data.io import LOG_SUFFIXES
+from ..errors import GreyboxError, Setting
 
 __all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_machines",
-           "check_names", "check_out_dir", "decode_name", "encode_name", "expand_logs", "file_sha256", "fleet_summary",
-           "log_names", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest", "read_prepared",
+           "check_names", "check_out_dir", "decode_name", "encode_name", "expand_logs", "fleet_summary",
+           "log_names", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest",
            "run_tasks"]
 
 #: Name of the manifest in the output directory (a leading "_": dataset readers skip it).
@@ -195,21 +194,6 @@ def check_names(logs: Sequence[str], names: Sequence[str]) -> None:
         seen[key] = log
 
 
-def file_sha256(path: str | os.PathLike) -> str:
-    """SHA-256 of a file's bytes (hex), read block by block.
-
-    Parameters
-    ----------
-    path : str or path-like
-        An existing file.
-    """
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 def partition(value: str) -> str:
     """A partition value safe in a path: letters, digits, ``-``, ``_`` and ``.``.
 
@@ -267,42 +251,6 @@ def log_stamp(path: str | os.PathLike) -> dict:
     """
     stat = os.stat(path)
     return {"size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
-
-
-def read_prepared(path: str, read: Mapping, *, columns: Mapping[str, str] | None = None,
-                  notify: Callable[[str], None] | None = None) -> list:
-    """Read and prepare one log as ``greybox predict`` and ``greybox train`` do: its runs (AxisLog).
-
-    Parameters
-    ----------
-    path : str
-        Log file.
-    read : mapping
-        Options of reading and preparing: ``columns``, ``topic``, ``axis``, ``sample_time``,
-        ``time_tolerance`` (fraction of the step), ``cutoff_hz`` [Hz], ``resample`` [s], ``max_gap``
-        [steps] (:func:`greybox.data.io.read_log`, :func:`greybox.data.prepare.prepare`); missing ones
-        take their defaults.
-    columns : mapping, optional
-        Column mapping under ``read["columns"]`` (an axis file's channels).
-    notify : callable, optional
-        ``notify(line)`` with a ``note:`` line naming the gaps where the log was split into runs.
-    """
-    from .data.io import read_log
-    from .data.prepare import MAX_GAP_STEPS, prepare
-
-    columns = {**(columns or {}), **(read.get("columns") or {})} or None
-    resample = read.get("resample")
-    tolerance = read.get("time_tolerance", 0.25)
-    max_gap = read.get("max_gap", MAX_GAP_STEPS)
-    log = read_log(path, columns=columns, topic=read.get("topic"), sample_time=read.get("sample_time"),
-                   axis=read.get("axis"), time_tolerance=None if resample else tolerance)
-    runs = prepare([log], cutoff_hz=read.get("cutoff_hz"), sample_time=resample, tolerance=tolerance,
-                   max_gap_steps=max_gap)
-    if len(runs) > 1 and notify is not None:
-        starts = ", ".join(f"{run.attrs['split']['start_s']:.6g}" for run in runs[1:])
-        notify(f"note: {Path(path).name}: split into {len(runs)} runs at gaps longer than {max_gap:g} steps "
-               f"(--max-gap); the runs after the first start at t = {starts} s")
-    return runs
 
 
 def attempt(label: str, work: Callable[[], dict]) -> dict:

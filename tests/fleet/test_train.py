@@ -15,7 +15,7 @@ import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.fleet import MANIFEST, expand_logs
-from greybox.fleet_train import train_jobs, train_model
+from greybox.fleet.train import train_jobs, train_model
 from greybox.metrics import metrics_table
 from greybox.models.friction import CoulombModel
 from greybox.persistence import load_model
@@ -131,7 +131,7 @@ def test_each_log_is_predicted_with_its_machines_model(plant, trained, tmp_path,
 
 def test_a_run_stopped_midway_keeps_the_models_it_finished(plant, tmp_path, capsys, monkeypatch):
     import greybox.cli._fleet as cli_fleet
-    import greybox.fleet as fleet
+    import greybox.fleet.engine as fleet
 
     def stop_after_the_first(noun, quiet, label):
         def show(done, total, entry):

@@ -7,7 +7,8 @@ on the engine of every fleet run (:func:`greybox.fleet.run_tasks`: a local clust
 address, failures reported while the rest go on, complete models skipped on a re-run). The output
 directory (manifest format ``greybox-fleet-models``)::
 
-    OUT/<machine>/<axis>.gbm     the model of one axis of one machine, an ordinary greybox model file
+    OUT/<machine>/<axis>.gbm     the model of one axis of one machine, an ordinary greybox model file with
+                                 the training record of every model (:func:`greybox.train.train_logs`)
     OUT/_manifest.json           every model: machine, axis, the logs it was fitted on (paths, sizes,
                                  modification times), status (ok, skipped, failed with its one-line
                                  error), training RMSE and RE, samples, seconds and the worker's peak
@@ -23,15 +24,13 @@ predicts each log with its machine's model (:func:`greybox.predict.fleet.fleet_j
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
-import numpy as np
-
-from .errors import GreyboxError
-from .fleet import (
+from ..data.reading import read_prepared
+from ..errors import GreyboxError
+from .engine import (
     MODELS_FORMAT,
     attempt,
     check_machines,
@@ -39,10 +38,8 @@ from .fleet import (
     machine_of,
     out_dir_of,
     partition,
-    read_prepared,
     run_tasks,
 )
-from .identify.intervals import attach_intervals
 
 __all__ = ["TrainJob", "run_training", "train_jobs", "train_model"]
 
@@ -62,7 +59,7 @@ class TrainJob:
     out_dir : str
         Directory of the fleet's models.
     read : dict
-        Options of reading and preparing the logs (:func:`greybox.fleet.read_prepared`); ``read["axis"]``
+        Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`); ``read["axis"]``
         the axis read from logs of several, None for the logs' own.
     """
 
@@ -102,7 +99,7 @@ def train_jobs(logs: Sequence[Path], model, out_dir: str, *, axes: Sequence[str]
 
 def _hyperparameters(model) -> dict:
     """Kind and hyperparameters of a model as JSON values: a nested model likewise, other values as text."""
-    from .models.registry import model_kind
+    from ..models.registry import model_kind
 
     def value(item):
         if hasattr(item, "get_params"):
@@ -127,20 +124,17 @@ def _axis_of(runs: list, job: TrainJob) -> str:
 
 
 def _fit_and_save(job: TrainJob) -> dict:
-    """Fit the job's model on all its logs, save it, and measure the saved model on the training runs."""
-    from .metrics import metrics_table
-    from .persistence import load_model, save_model
+    """Train the job's model on all its logs (:func:`greybox.train.train_logs`) and save it, checked."""
+    from ..train import train_logs
 
     runs = [run for log in job.logs for run in read_prepared(log, job.read)]
     axis = partition(_axis_of(runs, job) or "-")
-    model = attach_intervals(copy.deepcopy(job.model).fit(runs), runs)  # sandwich: about 1 % of a GMS fit
     path = Path(job.out_dir) / job.machine / f"{axis}.gbm"
     path.parent.mkdir(parents=True, exist_ok=True)
-    saved = load_model(save_model(model, path, overwrite=True))
-    table = metrics_table(np.concatenate([run.effort for run in runs]),
-                          np.concatenate([saved.predict(run) for run in runs]))
-    return {"axis": axis, "output": str(path.relative_to(job.out_dir)), "runs": len(runs), "samples": table["n"],
-            "effort_unit": runs[0].effort_unit, "rmse": table["rmse"], "re": table["re"]}
+    model = train_logs(job.model, runs, files=job.logs, read=job.read, out=path, overwrite=True)
+    total = model.training_record_["training_error"]
+    return {"axis": axis, "output": str(path.relative_to(job.out_dir)), "runs": len(runs), "samples": total["samples"],
+            "effort_unit": total["unit"], "rmse": total["rmse"], "re": total["re_percent"]}
 
 
 def train_model(job: TrainJob) -> dict:
@@ -156,8 +150,9 @@ def train_model(job: TrainJob) -> dict:
     dict
         ``machine``, ``status`` (``ok`` or ``failed``), ``axis``, ``output`` (the model file, relative to
         the output directory), ``runs``, ``samples``, ``effort_unit``, the training ``rmse`` [A or N] and
-        ``re`` [%] of the saved model on all its runs (``RE = RMSE / mean(|effort|)``), ``seconds``,
-        ``peak_rss_mb``, and for a failure its ``error`` (one line). Never raises for a bad log.
+        ``re`` [%] of the model on all its runs (``RE = RMSE / mean(|effort|)``; from its training record,
+        which the saved file reproduces bit for bit), ``seconds``, ``peak_rss_mb``, and for a failure its
+        ``error`` (one line). Never raises for a bad log.
     """
     return {"machine": job.machine, **attempt(f"machine {job.machine}", lambda: _fit_and_save(job))}
 

@@ -1,0 +1,46 @@
+"""The one centred moving window (greybox.windows) against a plain loop over each sample's window."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from greybox.windows import centred_mean
+
+
+def _reference(values, width, counts=None):
+    """Each sample's window, summed by a loop: the definition written out."""
+    n = len(values)
+    counts = np.ones(n) if counts is None else np.asarray(counts, float)
+    out = np.empty(n)
+    for i in range(n):
+        inside = range(max(i - width // 2, 0), min(i - width // 2 + width, n))
+        number = sum(counts[k] for k in inside)
+        out[i] = sum(values[k] * counts[k] for k in inside) / max(number, 1.0)
+    return out
+
+
+def test_the_mean_is_centred_and_exact_at_the_ends():
+    values = np.array([1.0, 2.0, 3.0, 4.0, 10.0])
+    np.testing.assert_allclose(centred_mean(values, 3), [1.5, 2.0, 3.0, 17 / 3, 7.0])
+    np.testing.assert_array_equal(centred_mean(values, 1), values)
+    # a 100 Hz ripple sampled at 2 ms averages out over whole periods
+    t = np.arange(5000) * 0.002
+    ripple = -0.5 + 0.2 * np.sin(2 * np.pi * 100.0 * t)
+    np.testing.assert_allclose(centred_mean(ripple, 50)[100:-100], -0.5, atol=1e-12)
+
+
+@pytest.mark.parametrize("width", [1, 2, 5, 8, 40])
+def test_it_is_the_loop_over_each_window_with_and_without_counts(width):
+    rng = np.random.default_rng(width)
+    values = rng.normal(size=30)
+    counts = rng.random(30) < 0.4
+    counts[10:20] = False  # windows holding no counted sample give 0
+    np.testing.assert_allclose(centred_mean(values, width), _reference(values, width), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(centred_mean(values, width, counts=counts), _reference(values, width, counts),
+                               rtol=1e-12, atol=1e-12)
+
+
+def test_a_window_of_no_sample_is_refused():
+    with pytest.raises(ValueError, match="at least one sample"):
+        centred_mean([1.0, 2.0], 0)
