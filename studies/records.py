@@ -75,6 +75,11 @@ SPECS = {spec.name: spec for spec in (
     RecordSpec("default-tests", ("benchmarks/bench_test_run.py",),
                ("greybox", "tests", "studies", "data", "pyproject.toml", "benchmarks/bench_test_run.py"),
                "the default test run (pytest -q): tests passed, skipped, wall time"),
+    RecordSpec("live-low-latency", ("benchmarks/bench_live.py", "--low-latency"),
+               ("greybox/live", "greybox/predict", "greybox/models", "greybox/data", "greybox/twin",
+                "benchmarks/bench_live.py", "data", "examples/axis_x.toml"),
+               "greybox live --latency low: mean cut force against the exact mode on the twin's and the "
+               "independent split's cutting logs; publish-to-estimate and publish-to-alarm times through Mosquitto"),
 )}
 
 
