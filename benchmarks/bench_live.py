@@ -331,14 +331,13 @@ def cut_force(model_path, log, truth_n: np.ndarray, axis_config, batch: int) -> 
             "relative_difference": abs(means["low"] - means["exact"]) / abs(means["exact"])}
 
 
-def low_latency_force(folder: Path, batch: int) -> list[dict]:
-    """:func:`cut_force` on the twin's cutting logs and on the independent split's cut."""
+def low_latency_force(twin_model, folder: Path, batch: int) -> list[dict]:
+    """:func:`cut_force` on the twin's cutting logs (``twin_model``) and on the independent split's cut."""
     import pandas as pd
 
     from greybox.data.io import read_log
     from greybox.twin import make_dataset
 
-    twin_model = _model(None, folder)
     figures = []
     for dataset in ("C", "D"):
         log = make_dataset("X", dataset, 2024, cutting=True)
@@ -390,7 +389,7 @@ def main() -> None:
         if args.low_latency:
             figures = {"end_to_end_low": end_to_end(model_path, messages, Path(folder), args.batch, log.sample_time,
                                                     latency="low", alarm_limit=args.alarm_limit),
-                       "cut_force": low_latency_force(Path(folder), args.batch)}
+                       "cut_force": low_latency_force(model_path, Path(folder), args.batch)}
             figures.update({"model": str(args.model or "GMS+SVR fitted by the benchmark"), "log": args.log,
                             "seconds": log.duration, "cpu_count": os.cpu_count(), "load_average_start": load_at_start,
                             "load_average": os.getloadavg()})

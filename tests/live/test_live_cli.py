@@ -46,7 +46,9 @@ def test_bad_options_give_one_line_and_status_2(model_file, capsys):
              (["--source", "mqtt://127.0.0.1:99999/t"], "port"),
              (["--source", "-", "--limit", "force_process_N=abc"], "--limit force_process_N=abc"),
              (["--source", "-", "--limit-hold", "soon"], "--limit-hold soon"),
-             (["--source", "-", "--sink", "file.txt"], "--sink file.txt")]
+             (["--source", "-", "--sink", "file.txt"], "--sink file.txt"),
+             (["--source", "-", "--max-gap", "1"], "--max-gap"),
+             (["--source", "-", "--latency", "fast"], "--latency")]
     for argv, words in cases:
         assert run_cli(["live", path, *argv]) == 2
         err = capsys.readouterr().err.strip().splitlines()
