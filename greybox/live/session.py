@@ -261,19 +261,22 @@ class LiveSession:
         columns = parts[0] if len(parts) == 1 else {name: np.concatenate([part[name] for part in parts])
                                                     for name in parts[0]}
         self.stats.samples_estimated += out.n_samples
-        self.sink.estimate(estimate_message(columns, seq, axis=self.subtopic), subtopic=self.subtopic)
-        for run, result, part in zip(out.runs, out.results, parts):
-            if run != self._run:  # the estimates of a new run: a new file, the limits re-armed
+        starts = []  # whether each result starts a new run after the first: a new file
+        for run, part in zip(out.runs, parts):  # the alarms first: they are what a shop floor waits for
+            starts.append(run != self._run and run != 0)
+            if run != self._run:  # the estimates of a new run: the limits re-armed
                 self._run = run
-                if self.recorder is not None and run:
-                    self.recorder.new_run()
                 if self.limits is not None:
                     self._alarms(self.limits.rearm(self._last_s), seq)
-            if self.recorder is not None:
-                self.recorder.add(result)
             if self.limits is not None:
                 self._alarms(self.limits.check(part), seq)
             self._last_s = float(part["time_s"][-1]) if len(part["time_s"]) else self._last_s
+        self.sink.estimate(estimate_message(columns, seq, axis=self.subtopic), subtopic=self.subtopic)
+        if self.recorder is not None:
+            for start, result in zip(starts, out.results):
+                if start:
+                    self.recorder.new_run()
+                self.recorder.add(result)
 
     def _alarms(self, alarms, seq) -> None:
         for alarm in alarms:
