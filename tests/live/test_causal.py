@@ -26,6 +26,26 @@ def causal_reference(sos, x, step, differences):
     return np.array(out)
 
 
+def causal_loop_reference(sos, x, step, differences):
+    """Plain Python: direct form II transposed section by section from the first value's steady state, then
+    backward differences, sample by sample."""
+    state = [list(row * x[0]) for row in sosfilt_zi(sos)]
+    last, last_first, out = x[0], 0.0, [[] for _ in range(differences)]
+    for value in x:
+        for s in range(len(sos)):
+            b0, b1, b2, _, a1, a2 = sos[s]
+            y = b0 * value + state[s][0]
+            state[s][0] = b1 * value - a1 * y + state[s][1]
+            state[s][1] = b2 * value - a2 * y
+            value = y
+        first = (value - last) / step
+        out[0].append(first)
+        if differences == 2:
+            out[1].append((first - last_first) / step)
+        last, last_first = value, first
+    return np.array(out)
+
+
 @pytest.fixture(scope="module")
 def sos():
     return derivative_filter(STEP)[0]
@@ -41,6 +61,7 @@ def signal(n, seed=0):
 def test_kernel_equals_the_reference_whatever_the_messages(sos, differences):
     x = signal(700)
     expected = causal_reference(sos, x, STEP, differences)
+    np.testing.assert_allclose(causal_loop_reference(sos, x, STEP, differences), expected, rtol=1e-12, atol=1e-9)
     stream, start, got = CausalStream(sos, sample_time=STEP, differences=differences), 0, []
     for size in (1, 10, 7, 250, 3, 429):
         stream.push(x[start:start + size])
