@@ -33,6 +33,20 @@ kernels before it reads the first message (the compute runs warm up on the log's
 
 Without ``--model`` a GMS+SVR model is fitted on data/X_A.mcap and data/X_B.mcap with fixed
 hyperparameters (as benchmarks/bench_gmssvr_predict.py does).
+
+With ``--low-latency`` it measures the low-latency mode (``greybox live --latency low``, issue 42) instead:
+
+5. the cut force: the twin's cutting logs (``greybox.twin.make_dataset`` of X, datasets C and D, seed 2024,
+   ``cutting=True``) and the independent split's ``cut_D.csv``, each streamed through ``greybox live`` in
+   both modes (JSON messages of ``--batch`` samples, velocity logged, acceleration derived); the mean process
+   force over the samples where the true cutting force is not zero, per mode, and their relative difference;
+   the models are GMS+SVR with the fixed hyperparameters above, fitted on the air cuts of the same source
+   (data/X_A, X_B; aircut_A, B, C with the split's ``axis.toml``);
+6. end to end as 3., with ``--latency low`` and ``--limit current_process_A=LIMIT`` (``--alarm-limit``): per
+   message the time from its publication to its estimate, and per alarm message (raised or cleared) the time
+   from the publication of the message that raised or cleared it to the alarm's arrival.
+
+    nice -n 10 python benchmarks/bench_live.py --low-latency
 """
 
 from __future__ import annotations
@@ -60,7 +74,10 @@ ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "data"
 
 
-def _model(path: str | None, folder: Path) -> Path:
+INDEPENDENT = ROOT.parent / "shared" / "data" / "independent" / "axis_dev"
+
+
+def _model(path: str | None, folder: Path, train=(DATA / "X_A.mcap", DATA / "X_B.mcap"), name="bench") -> Path:
     if path:
         return Path(path)
     from greybox.data.io import read_log
@@ -69,10 +86,10 @@ def _model(path: str | None, folder: Path) -> Path:
     from greybox.models.gmssvr import GMSSVRModel
     from greybox.persistence import save_model
 
-    train = prepare([read_log(DATA / "X_A.mcap"), read_log(DATA / "X_B.mcap")])
+    runs = prepare([read_log(log) for log in train])
     model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=100), optimize=False, C=0.5, epsilon=0.02, gamma=3.0,
-                        n_subset=2000).fit(train)
-    out = folder / "bench.gbm"
+                        n_subset=2000).fit(runs)
+    out = folder / f"{name}.gbm"
     save_model(model, out)
     return out
 
@@ -80,6 +97,8 @@ def _model(path: str | None, folder: Path) -> Path:
 def _messages(log, batch: int) -> list[str]:
     columns = {"time_s": log.time, "position_mm": log.position, "velocity_mm_s": log.velocity,
                "current_A": log.effort}
+    if log.velocity is None:  # position only: the velocity derived too
+        del columns["velocity_mm_s"]
     return [json.dumps({name: values[k:k + batch].tolist() for name, values in columns.items()} | {"seq": seq})
             for seq, k in enumerate(range(0, len(log), batch))]
 
@@ -202,7 +221,8 @@ def _free_port() -> int:
         return probe.getsockname()[1]
 
 
-def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) -> dict:
+def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float, latency: str = "exact",
+               alarm_limit: float | None = None) -> dict:
     import paho.mqtt.client as mqtt
 
     binary = shutil.which("mosquitto", path=os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin"]))
@@ -226,15 +246,20 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) ->
                     raise RuntimeError("mosquitto did not start") from None
                 time.sleep(0.05)
         arrived: dict = {}
+        alarms: list = []  # (seq of the message that raised or cleared it, arrival)
         ready = threading.Event()
         client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2)
-        client.on_connect = lambda c, u, f, r, p=None: c.subscribe("process/X")
+        client.on_connect = lambda c, u, f, r, p=None: c.subscribe("process/X/#" if alarm_limit else "process/X")
         client.on_subscribe = lambda *args: ready.set()
 
         def on_message(c, u, message):
+            now = time.perf_counter()
             payload = json.loads(message.payload)
-            if "seq" in payload:  # not the tail estimated once the stream went idle, which answers no message
-                arrived[payload["seq"]] = time.perf_counter()
+            if message.topic.startswith("process/X/alarm/"):
+                if payload.get("seq") is not None and not message.retain:
+                    alarms.append((payload["seq"], now))
+            elif message.topic == "process/X" and payload.get("seq") is not None:
+                arrived[payload["seq"]] = now  # not the tail estimated once the stream went idle
 
         client.on_message = on_message
         client.on_socket_open = lambda c, u, sock: sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -243,7 +268,9 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) ->
         ready.wait(10)
         live = subprocess.Popen([sys.executable, "-m", "greybox", "live", str(model_path), "--source",
                                  f"mqtt://127.0.0.1:{port}/axis/X", "--sink", f"mqtt://127.0.0.1:{port}/process/X",
-                                 "--sample-time", str(step_s)], stderr=subprocess.PIPE, text=True)
+                                 "--sample-time", str(step_s), "--latency", latency]
+                                + (["--limit", f"current_process_A={alarm_limit}"] if alarm_limit else []),
+                                stderr=subprocess.PIPE, text=True)
         live.stderr.readline()  # connected
         published = {}
         start = time.perf_counter()
@@ -262,11 +289,68 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float) ->
             live.wait(30)
         broker.terminate()
         broker.wait(10)
-    latency = np.array([arrived[seq] - published[seq] for seq in published if seq in arrived]) * 1e3
-    answered = len(latency)
-    return {"messages": len(published), "answered": answered, "rate_hz": 1 / step_s, "batch": batch,
-            "p50_ms": float(np.percentile(latency, 50)), "p99_ms": float(np.percentile(latency, 99)),
-            "max_ms": float(latency.max())}
+    delays = np.array([arrived[seq] - published[seq] for seq in published if seq in arrived]) * 1e3
+    figures = {"latency": latency, "messages": len(published), "answered": len(delays), "rate_hz": 1 / step_s,
+               "batch": batch, "p50_ms": float(np.percentile(delays, 50)), "p99_ms": float(np.percentile(delays, 99)),
+               "max_ms": float(delays.max())}
+    if alarm_limit:
+        to_alarm = np.array([now - published[seq] for seq, now in alarms if seq in published]) * 1e3
+        figures.update({"alarm_limit_A": alarm_limit, "alarms": len(to_alarm)})
+        if to_alarm.size:
+            figures.update({"alarm_p50_ms": float(np.percentile(to_alarm, 50)),
+                            "alarm_p99_ms": float(np.percentile(to_alarm, 99)), "alarm_max_ms": float(to_alarm.max())})
+    return figures
+
+
+def _live_force(model_path, log, axis_config, batch: int, latency: str) -> np.ndarray:
+    """The process force ``greybox live`` gives for ``log`` streamed in messages of ``batch`` samples."""
+    from greybox.live.run import run_live
+
+    out = io.StringIO()
+    run_live(model_path, source="-", axis_config_path=axis_config, sample_time=log.sample_time, latency=latency,
+             stdin=io.StringIO("\n".join(_messages(log, batch))), stdout=out, say=lambda line: None)
+    rows = [json.loads(line) for line in out.getvalue().splitlines() if line.strip()]
+    time_s = np.concatenate([row["time_s"] for row in rows if "alarm" not in row])
+    force = np.concatenate([row["force_process_N"] for row in rows if "alarm" not in row])
+    if not np.array_equal(time_s, log.time[:time_s.size]) or time_s.size < len(log) - 1:
+        raise RuntimeError(f"{log.source}: the {latency} mode estimated {time_s.size} of {len(log)} samples")
+    return force  # a lone last sample of a message is left (the model steps over two samples at least)
+
+
+def cut_force(model_path, log, truth_n: np.ndarray, axis_config, batch: int) -> dict:
+    """Mean process force over the cutting samples, exact and low-latency mode, and their relative difference."""
+    forces = {latency: _live_force(model_path, log, axis_config, batch, latency) for latency in ("exact", "low")}
+    cutting = truth_n[:min(force.size for force in forces.values())] != 0.0
+    means = {latency: float(force[:cutting.size][cutting].mean()) for latency, force in forces.items()}
+    difference = forces["low"][:cutting.size] - forces["exact"][:cutting.size]
+    return {"log": str(log.source), "velocity_logged": log.velocity is not None, "samples": len(log),
+            "cutting_samples": int(cutting.sum()),
+            "rms_difference_N": float(np.sqrt(np.mean(difference[cutting] ** 2))),
+            "mean_cut_force_exact_N": means["exact"], "mean_cut_force_low_N": means["low"],
+            "mean_cut_force_truth_N": float(truth_n[:cutting.size][cutting].mean()),
+            "relative_difference": abs(means["low"] - means["exact"]) / abs(means["exact"])}
+
+
+def low_latency_force(twin_model, folder: Path, batch: int) -> list[dict]:
+    """:func:`cut_force` on the twin's cutting logs (``twin_model``) and on the independent split's cut."""
+    import pandas as pd
+
+    from greybox.data.io import read_log
+    from greybox.twin import make_dataset
+
+    figures = []
+    for dataset in ("C", "D"):
+        log = make_dataset("X", dataset, 2024, cutting=True)
+        truth = log.extras["truth_process_force_N"]
+        log = log.replace(extras={}, source=f"twin X {dataset} seed 2024, cutting")
+        for given in (log, log.replace(velocity=None)):
+            figures.append(cut_force(twin_model, given, truth, ROOT / "examples" / "axis_x.toml", batch))
+    if INDEPENDENT.is_dir():
+        model = _model(None, folder, [INDEPENDENT / f"aircut_{name}.csv" for name in "ABC"], "independent")
+        log = read_log(INDEPENDENT / "cut_D.csv").replace(source="independent split, axis_dev/cut_D.csv")
+        truth = pd.read_csv(INDEPENDENT / "cut_D_truth.csv")["F_cut_true_N"].to_numpy()
+        figures.append(cut_force(model, log, truth, INDEPENDENT / "axis.toml", batch))
+    return figures
 
 
 def main() -> None:
@@ -281,7 +365,14 @@ def main() -> None:
                         help="passes of the compute run; their least CPU time per message is printed too (default 3)")
     parser.add_argument("--record-minutes", type=float, default=0.0,
                         help="also stream and record a synthetic log of this many minutes (default 0: not)")
+    parser.add_argument("--low-latency", action="store_true",
+                        help="measure the low-latency mode instead: the cut force against the exact mode, and the "
+                        "end-to-end and publish-to-alarm times with --latency low")
+    parser.add_argument("--alarm-limit", type=float, default=0.25,
+                        help="with --low-latency: the limit on |current_process_A| [A] whose alarms are timed "
+                        "(default 0.25)")
     args = parser.parse_args()
+    load_at_start = os.getloadavg()
 
     from threadpoolctl import threadpool_limits
 
@@ -295,6 +386,15 @@ def main() -> None:
         log = read_log(args.log)
         log = trim_log(log, None, float(log.time[0]) + args.seconds - 1e-9)
         messages = _messages(log, args.batch)
+        if args.low_latency:
+            figures = {"end_to_end_low": end_to_end(model_path, messages, Path(folder), args.batch, log.sample_time,
+                                                    latency="low", alarm_limit=args.alarm_limit),
+                       "cut_force": low_latency_force(model_path, Path(folder), args.batch)}
+            figures.update({"model": str(args.model or "GMS+SVR fitted by the benchmark"), "log": args.log,
+                            "seconds": log.duration, "cpu_count": os.cpu_count(), "load_average_start": load_at_start,
+                            "load_average": os.getloadavg()})
+            print(json.dumps(figures))
+            return
         lookahead = derivative_margin(log.sample_time)
         affinity = os.sched_getaffinity(0)
         os.sched_setaffinity(0, {args.core})
@@ -312,7 +412,7 @@ def main() -> None:
     figures.update({"model": str(args.model or "GMS+SVR fitted by the benchmark"), "log": args.log,
                     "seconds": log.duration, "lookahead_samples": lookahead,
                     "lookahead_s": lookahead * log.sample_time, "cpu_count": os.cpu_count(),
-                    "load_average": os.getloadavg()})
+                    "load_average_start": load_at_start, "load_average": os.getloadavg()})
     print(json.dumps(figures))
 
 

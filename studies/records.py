@@ -81,6 +81,11 @@ SPECS = {spec.name: spec for spec in (
                 "scripts/monitor_independent.py"),
                "greybox monitor on the independent simulator's production histories (development split), "
                "scored against their drift truth"),
+    RecordSpec("live-low-latency", ("benchmarks/bench_live.py", "--low-latency"),
+               ("greybox/live", "greybox/predict", "greybox/models", "greybox/data", "greybox/twin",
+                "benchmarks/bench_live.py", "data", "examples/axis_x.toml"),
+               "greybox live --latency low: mean cut force against the exact mode on the twin's and the "
+               "independent split's cutting logs; publish-to-estimate and publish-to-alarm times through Mosquitto"),
 )}
 
 

@@ -188,6 +188,29 @@ def _monitor_independent(record: dict) -> str:
             f"nothing on the stable machine): {met}. `{record['command']}` ({_where(record)}).\n")
 
 
+def _live_cut_force(record: dict) -> str:
+    lines = ["| cutting log | velocity | cutting samples | mean cut force, exact [N] | low latency [N] | difference "
+             "| rms difference per sample [N] | truth [N] |", "|---|---|---|---|---|---|---|---|"]
+    for row in record["figures"]["cut_force"]:
+        velocity = "logged" if row["velocity_logged"] else "derived"
+        lines.append(f"| {row['log']} | {velocity} | {row['cutting_samples']} | "
+                     f"{row['mean_cut_force_exact_N']:.1f} | {row['mean_cut_force_low_N']:.1f} | "
+                     f"{100 * row['relative_difference']:.3f} % | {row['rms_difference_N']:.2f} | "
+                     f"{row['mean_cut_force_truth_N']:.1f} |")
+    return "\n".join(lines) + "\n"
+
+
+def _live_low_latency(record: dict) -> str:
+    end = record["figures"]["end_to_end_low"]
+    return (f"`nice -n 10 {record['command']}`, {record['seconds']:.0f} s ({_where(record)}): through the local "
+            f"Mosquitto at {end['rate_hz']:.0f} Hz in batches of {end['batch']}, with `--latency low`, publish -> "
+            f"estimate p50 {end['p50_ms']:.2f} ms, p99 {end['p99_ms']:.2f} ms, max {end['max_ms']:.1f} ms "
+            f"({end['answered']} of {end['messages']} messages answered); publish -> alarm "
+            f"(`--limit current_process_A={end['alarm_limit_A']:g}`, {end['alarms']} alarm messages raised or "
+            f"cleared) p50 {end['alarm_p50_ms']:.2f} ms, p99 {end['alarm_p99_ms']:.2f} ms, max "
+            f"{end['alarm_max_ms']:.1f} ms.\n")
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -219,6 +242,8 @@ VIEWS = {
     "default-tests-run": View(("default-tests",), _tests_run),
     "monitor-independent": View(("monitor-independent",), _monitor_independent),
     "readme-measured": View(("reproduce", "default-tests", "monitor-independent"), _readme_table),
+    "live-cut-force": View(("live-low-latency",), _live_cut_force),
+    "live-low-latency": View(("live-low-latency",), _live_low_latency),
 }
 
 

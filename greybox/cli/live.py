@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._types import FRACTION, POSITIVE, POSITIVE_INT, NumberRange, positive
+from ._types import FRACTION, GAP_STEPS, POSITIVE, POSITIVE_INT, NumberRange, positive
 
 #: The QoS levels taken.
 QOS = NumberRange(int, low=0, high=1, description="a QoS of 0 or 1")
@@ -13,6 +13,7 @@ QOS = NumberRange(int, low=0, high=1, description="a QoS of 0 or 1")
 
 def add_parser(subparsers) -> None:
     from ..live.broker import PASSWORD_ENV
+    from ..live.lookahead import LATENCIES
     from ..live.messages import MAX_MESSAGE_BYTES, MAX_MESSAGE_DEPTH
     from ..live.report import LINE_INTERVAL_S, LINES_PER_INTERVAL
     from ..live.sources import DEFAULT_IDLE_S
@@ -91,6 +92,15 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--time-tolerance", type=FRACTION, default=0.25, metavar="FRAC",
                         help="allowed deviation of a step from the nominal step (default 0.25): a longer step is a "
                         "gap (a new run, the state re-initialised), a shorter one drops the sample")
+    parser.add_argument("--max-gap", type=GAP_STEPS, metavar="STEPS",
+                        help="bridge glitches as 'greybox predict --resample S --max-gap STEPS' does: resample the "
+                        "stream onto its nominal step (linear interpolation), leave out samples holding NaN, and "
+                        "start a new run only at a step longer than STEPS nominal steps (default: no resampling; "
+                        "--time-tolerance applies)")
+    parser.add_argument("--latency", choices=LATENCIES, default="exact",
+                        help="'exact' (default): the derivatives of 'greybox predict', each estimate after its "
+                        "look-ahead (0.368 s at 2 ms); 'low': causal derivatives, each message's estimates at once, "
+                        "the derived velocity/acceleration delayed by the filter (about 9 ms at 2 ms, 50 Hz)")
     parser.add_argument("--cutoff-hz", type=POSITIVE, metavar="HZ",
                         help="cut-off [Hz] of the derivative filter (default as 'greybox predict')")
     parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
@@ -163,6 +173,7 @@ def run(args: argparse.Namespace) -> int:
         record_s=args.record_s, limits=[parse_limit(text) for text in args.limit],
         hold_s=parse_duration(args.limit_hold), exit_on_alarm=args.exit_on_alarm, stats_path=args.stats,
         sample_time=args.sample_time, tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz, chunk_s=args.chunk_s,
+        max_gap=args.max_gap, latency=args.latency,
         columns=parse_column_mapping(args.columns) if args.columns else None, axis=args.axis,
         broker=broker, status_topic=args.status_topic,
         bounds=MessageBounds(max_bytes=args.max_message_bytes, max_depth=args.max_depth),

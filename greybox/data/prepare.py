@@ -31,8 +31,8 @@ from ..errors import LogError
 from .log import AxisLog, as_log_list
 from .validate import check_finite, check_increasing, check_time, check_time_units, check_velocity_units
 
-__all__ = ["MAX_GAP_STEPS", "default_cutoff", "derivative_filter", "derivative_margin", "derive", "resample",
-           "split_at_gaps", "trim", "prepare"]
+__all__ = ["MAX_GAP_STEPS", "default_cutoff", "derivative_filter", "derivative_margin", "derive", "gap_steps",
+           "resample", "split_at_gaps", "trim", "prepare"]
 
 #: Default cut-off of the derivative filter for fast logs [Hz].
 DEFAULT_CUTOFF_HZ = 50.0
@@ -183,12 +183,13 @@ def derive(log: AxisLog, *, cutoff_hz: float | None = None, order: int = 4, tole
     return log.replace(velocity=velocity, acceleration=acceleration, attrs=attrs)
 
 
-def resample(log: AxisLog, sample_time: float) -> AxisLog:
+def resample(log: AxisLog, sample_time: float, *, origin: float | None = None, first: int = 0) -> AxisLog:
     """Resample all channels to a uniform grid by linear interpolation.
 
-    The grid starts at the first sample and ends at or before the last one.
-    There is no anti-alias filter: downsampling by an integer factor keeps
-    every k-th sample of a uniform log.
+    The grid's points are ``origin + k * sample_time`` for ``k = first, first + 1, ...``, up to the last
+    sample: by default it starts at the first sample. There is no anti-alias filter: downsampling by an
+    integer factor keeps every k-th sample of a uniform log. A stream resampled piece by piece
+    (:mod:`greybox.live.timeline`) gives a piece the grid of its run with ``origin`` and ``first``.
 
     Parameters
     ----------
@@ -196,10 +197,15 @@ def resample(log: AxisLog, sample_time: float) -> AxisLog:
         One run with strictly increasing time.
     sample_time : float
         New sample time [s].
+    origin : float, optional
+        Time of the grid's point 0 [s]; default the first sample's.
+    first : int, default 0
+        The first grid point wanted; ``origin + first * sample_time`` must not precede the first sample.
 
     Returns
     -------
     AxisLog
+        The samples at the grid's points (none when no point lies within the log).
     """
     source = log.source or None
     if not np.isfinite(sample_time) or sample_time <= 0:
@@ -211,9 +217,10 @@ def resample(log: AxisLog, sample_time: float) -> AxisLog:
         k = int(bad[0]) + 1
         raise LogError(source, f"time is not strictly increasing at sample {k} (t = {log.time[k]:.9g} s); "
                                "cannot resample")
-    count = int(np.floor((log.time[-1] - log.time[0]) / sample_time * (1 + 1e-12))) + 1
-    grid = log.time[0] + np.arange(count) * sample_time
-    if count == len(log) and np.allclose(log.time, grid, rtol=0.0, atol=1e-9 * sample_time):
+    origin = float(log.time[0]) if origin is None else float(origin)
+    count = int(np.floor((log.time[-1] - origin) / sample_time * (1 + 1e-12))) + 1
+    grid = origin + np.arange(first, max(first, count)) * sample_time
+    if first == 0 and count == len(log) and np.allclose(log.time, grid, rtol=0.0, atol=1e-9 * sample_time):
         return log  # already on the grid: rounding of the time stamps must not interpolate every channel
 
     def interp(values):
@@ -261,6 +268,26 @@ def trim(log: AxisLog, start_s: float | None = None, stop_s: float | None = None
 MAX_GAP_STEPS = 5.0
 
 
+def gap_steps(steps: np.ndarray, nominal: float, max_gap_steps: float) -> np.ndarray:
+    """Which time steps are gaps: longer than ``max_gap_steps`` nominal steps (shorter ones are interpolated over).
+
+    Parameters
+    ----------
+    steps : ndarray
+        Time steps [s].
+    nominal : float
+        Nominal step [s] (a log's median step; a live stream's nominal step).
+    max_gap_steps : float
+        Longest step that stays inside a run, in nominal steps.
+
+    Returns
+    -------
+    ndarray of int
+        Indices into ``steps`` of the gaps.
+    """
+    return np.flatnonzero(steps > max_gap_steps * nominal)
+
+
 def split_at_gaps(log: AxisLog, max_gap_steps: float = MAX_GAP_STEPS) -> list[AxisLog]:
     """Split one log into runs at every time step longer than ``max_gap_steps`` nominal (median) steps.
 
@@ -286,7 +313,7 @@ def split_at_gaps(log: AxisLog, max_gap_steps: float = MAX_GAP_STEPS) -> list[Ax
         raise ValueError(f"max_gap_steps must be larger than 1, got {max_gap_steps!r}")
     source = log.source or None
     steps = check_increasing(log.time, source=source)
-    cuts = np.flatnonzero(steps > max_gap_steps * float(np.median(steps))) + 1
+    cuts = gap_steps(steps, float(np.median(steps)), max_gap_steps) + 1
     if not cuts.size:
         return [log]
     edges = np.concatenate(([0], cuts, [len(log)]))

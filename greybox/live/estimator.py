@@ -8,7 +8,10 @@ the state the previous ones left, through the same code that ``greybox predict``
 the samples of a log, the estimates equal the table ``greybox predict`` writes for it.
 
 A gap in the time stamps ends the run: the samples waiting are finished as the end of a log, and the
-next run starts from the model's initial state, as the readers split a log at gaps.
+next run starts from the model's initial state, as the readers split a log at gaps. With ``max_gap`` the
+samples are resampled onto the nominal grid and only steps longer than ``max_gap`` steps are gaps, as
+``greybox predict --resample --max-gap`` treats a log. With ``latency="low"`` the derivatives are causal:
+each message's estimates go out with it (:mod:`greybox.live.causal`).
 """
 
 from __future__ import annotations
@@ -63,13 +66,16 @@ class RunStart:
     sample_time : float
         Nominal step [s].
     lookahead : int
-        Samples of look-ahead of the derivatives (0 when the messages carry them).
+        Samples of look-ahead of the derivatives (0 when the messages carry them, or they are causal).
+    delay : float, default 0.0
+        Group delay of the causal derivatives at low frequencies [samples] (0 for the exact ones).
     """
 
     time_s: float
     index: int
     sample_time: float
     lookahead: int
+    delay: float = 0.0
 
 
 @dataclass
@@ -104,9 +110,9 @@ class _Run:
     the blocks' samples were checked as they arrived, so each chunk is not checked again.
     """
 
-    def __init__(self, model, *, index: int, sample_time: float, axis_config, cutoff_hz, chunk_s, tally):
+    def __init__(self, model, *, index: int, sample_time: float, axis_config, cutoff_hz, chunk_s, tally, latency):
         self.index = index
-        self.lookahead = Lookahead(sample_time=sample_time, cutoff_hz=cutoff_hz)
+        self.lookahead = Lookahead(sample_time=sample_time, cutoff_hz=cutoff_hz, latency=latency)
         self.model = model
         self.sample_time = sample_time
         self.axis_config = axis_config
@@ -151,6 +157,12 @@ class LiveEstimator:
     keep_tally : bool, default False
         Keep the running figures of every sample estimated (:attr:`tally`); their sums of squares cost
         about a tenth of a message's time, and the session needs none of them.
+    max_gap : float, optional
+        Bridge steps up to this many nominal steps by resampling onto the nominal grid (as ``greybox predict
+        --resample S --max-gap``); longer ones are gaps. Default: no resampling, ``tolerance`` applies.
+    latency : {"exact", "low"}, default "exact"
+        "exact": the derivatives of ``greybox predict`` (a look-ahead of 0.368 s at 2 ms); "low": causal
+        derivatives, the estimates at once, their derived channels delayed (:mod:`greybox.live.causal`).
 
     Attributes
     ----------
@@ -164,12 +176,13 @@ class LiveEstimator:
 
     def __init__(self, model, *, axis_config: AxisConfig | None = None, sample_time: float | None = None,
                  tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
-                 keep_tally: bool = False):
+                 keep_tally: bool = False, max_gap: float | None = None, latency: str = "exact"):
         self.model = model
         self.axis_config = axis_config
         self.cutoff_hz = cutoff_hz
         self.chunk_s = float(chunk_s)
-        self.timeline = Timeline(sample_time=sample_time, tolerance=tolerance)
+        self.latency = latency
+        self.timeline = Timeline(sample_time=sample_time, tolerance=tolerance, max_gap=max_gap)
         self.tally = ProcessTally() if keep_tally else None
         self.runs = 0
         self.output_columns: tuple | None = None
@@ -202,7 +215,8 @@ class LiveEstimator:
         try:
             step = self.timeline.nominal or float(self.model.sample_time_)
             trial = LiveEstimator(self.model, axis_config=self.axis_config, sample_time=step,
-                                  tolerance=self.timeline.tolerance, cutoff_hz=self.cutoff_hz, chunk_s=self.chunk_s)
+                                  tolerance=self.timeline.tolerance, cutoff_hz=self.cutoff_hz, chunk_s=self.chunk_s,
+                                  max_gap=self.timeline.max_gap, latency=self.latency)
             n = 2 * derivative_margin(step, cutoff_hz=self.cutoff_hz) + 32
             time = step * np.arange(n)
             log = AxisLog(time=time, position=np.sin(2.0 * np.pi * time), effort=np.zeros(n),
@@ -258,10 +272,10 @@ class LiveEstimator:
         if self._run is None:
             self._run = _Run(self.model, index=self.runs, sample_time=self.timeline.nominal,
                              axis_config=self.axis_config, cutoff_hz=self.cutoff_hz, chunk_s=self.chunk_s,
-                             tally=self.tally)
+                             tally=self.tally, latency=self.latency)
             ready = self._run.lookahead.push(samples)
             out.events.append(RunStart(float(samples.time[0]), self.runs, self.timeline.nominal,
-                                       self._run.lookahead.margin))
+                                       self._run.lookahead.margin, self._run.lookahead.delay))
             self.runs += 1
         else:
             ready = self._run.lookahead.push(samples)

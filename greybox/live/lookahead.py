@@ -13,6 +13,10 @@ The forward pass of the filter runs once over each sample as it arrives, its sta
 message to message; per message only the backward pass over the look-ahead runs
 (:class:`~greybox.live.zerophase.ZeroPhaseStream`). At the end of a run (a gap, or the end of the
 stream) the samples still waiting are derived as the end of a log is.
+
+With ``latency="low"`` (``greybox live --latency low``) the derivatives are causal instead
+(:class:`~greybox.live.causal.CausalStream`): no look-ahead, every sample given out as it arrives, its
+derived channels delayed by the filter's group delay.
 """
 
 from __future__ import annotations
@@ -22,9 +26,13 @@ import numpy as np
 from ..data.log import AxisLog
 from ..data.prepare import derivative_filter, derivative_margin
 from ..errors import LogError
+from .causal import CausalStream
 from .zerophase import ZeroPhaseStream
 
-__all__ = ["Lookahead"]
+__all__ = ["LATENCIES", "Lookahead"]
+
+#: The derivative modes: the offline result after a look-ahead, or causal at once.
+LATENCIES = ("exact", "low")
 
 _CHANNELS = ("time", "position", "effort", "velocity", "acceleration")
 
@@ -38,21 +46,31 @@ class Lookahead:
         Nominal step of the run [s].
     cutoff_hz : float, optional
         Derivative-filter cut-off [Hz]; default :func:`~greybox.data.prepare.default_cutoff`.
+    latency : {"exact", "low"}, default "exact"
+        "exact": the zero-phase derivatives of ``greybox predict``, each sample given out once its look-ahead
+        is in; "low": causal derivatives, every sample given out at once.
 
     Attributes
     ----------
     margin : int
         Samples of look-ahead (and of history) a derived sample needs; 0 until a message shows that the
-        stream lacks velocity or acceleration.
+        stream lacks velocity or acceleration, and always with ``latency="low"``.
+    delay : float
+        Group delay of the derived acceleration at low frequencies [samples]; 0 for the exact derivatives
+        and for messages that carry velocity and acceleration.
     """
 
-    def __init__(self, *, sample_time: float, cutoff_hz: float | None = None):
+    def __init__(self, *, sample_time: float, cutoff_hz: float | None = None, latency: str = "exact"):
+        if latency not in LATENCIES:
+            raise ValueError(f"latency must be one of {', '.join(LATENCIES)}, got {latency!r}")
         self.sample_time = float(sample_time)
         self.cutoff_hz = cutoff_hz
+        self.latency = latency
         self.margin = 0
+        self.delay = 0.0
         self._needs: bool | None = None
         self._first: AxisLog | None = None  # the run's first samples: names, units, attrs
-        self._filter: ZeroPhaseStream | None = None
+        self._filter: ZeroPhaseStream | CausalStream | None = None
         self._attrs: dict = {}
         self._pending: dict[str, np.ndarray] = {}  # per channel a buffer; its first _n_pending values wait
         self._n_pending = 0
@@ -111,12 +129,19 @@ class Lookahead:
         self._attrs = dict(log.attrs)
         if not self._needs:
             return
-        self.margin = derivative_margin(self.sample_time, cutoff_hz=self.cutoff_hz)
         sos, cutoff = derivative_filter(self.sample_time, cutoff_hz=self.cutoff_hz, source=log.source or None)
-        self._filter = ZeroPhaseStream(sos, sample_time=self.sample_time, differences=1 + (log.velocity is None))
+        differences = 1 + (log.velocity is None)
+        if self.latency == "low":
+            self._filter = CausalStream(sos, sample_time=self.sample_time, differences=differences)
+            self.delay = self._filter.delay
+        else:
+            self.margin = derivative_margin(self.sample_time, cutoff_hz=self.cutoff_hz)
+            self._filter = ZeroPhaseStream(sos, sample_time=self.sample_time, differences=differences)
         derived = ["acceleration"] if log.velocity is not None else \
             ["velocity"] + (["acceleration"] if log.acceleration is None else [])
         self._attrs["derivative_filter"] = {"cutoff_hz": cutoff, "order": 4, "derived": derived}
+        if self.latency == "low":
+            self._attrs["derivative_filter"].update(causal=True, delay_samples=self.delay)
 
     def _give(self, ready: int, *, final: bool) -> AxisLog:
         columns = {}

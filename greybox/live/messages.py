@@ -31,7 +31,8 @@ from ..errors import GreyboxError, LogError
 
 __all__ = ["MessageError", "SEQUENCE_KEY", "MAX_MESSAGE_SAMPLES", "MAX_MESSAGE_BYTES", "MAX_MESSAGE_DEPTH",
            "MessageBounds", "DEFAULT_BOUNDS", "json_depth", "parse_json",
-           "parse_csv_row", "csv_header", "Decoder", "message_log", "MessageLogs", "estimate_message"]
+           "parse_csv_row", "csv_header", "Decoder", "message_log", "MessageLogs", "estimate_message",
+           "finite_rows"]
 
 #: Key of a message's sequence tag, echoed in the estimates it completes.
 SEQUENCE_KEY = "seq"
@@ -362,6 +363,30 @@ def _check_finite(log: AxisLog) -> None:
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise MessageError(f"channel '{channel}' holds {values[bad[0]]} at sample {bad[0]} of the message")
+
+
+def finite_rows(columns: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], int]:
+    """The samples of a message without those holding NaN or infinity in a number column.
+
+    Parameters
+    ----------
+    columns : mapping of str to ndarray
+        The message's columns, of equal length.
+
+    Returns
+    -------
+    columns : dict of str to ndarray
+        The columns of the finite samples (the same arrays when every sample is finite).
+    dropped : int
+        Samples left out.
+    """
+    numbers = [values for values in columns.values() if values.dtype.kind == "f"]
+    if not numbers or math.isfinite(sum(float(np.add.reduce(values)) for values in numbers)):
+        return dict(columns), 0
+    good = np.logical_and.reduce([np.isfinite(values) for values in numbers])
+    if good.all():  # a sum of finite values overflowing
+        return dict(columns), 0
+    return {name: values[good] for name, values in columns.items()}, int(np.count_nonzero(~good))
 
 
 class MessageLogs:

@@ -202,7 +202,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
              record_s: float = DEFAULT_RECORD_S, limits: list[Limit] = (), hold_s: float = 0.0,
              exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
-             columns: Mapping[str, str] | None = None, axis: str | None = None, broker: BrokerOptions | None = None,
+             max_gap: float | None = None, latency: str = "exact", columns: Mapping[str, str] | None = None,
+             axis: str | None = None, broker: BrokerOptions | None = None,
              status_topic: str | None = None, bounds: MessageBounds = DEFAULT_BOUNDS,
              lines_per_interval: int = LINES_PER_INTERVAL, idle_s: float | None = DEFAULT_IDLE_S,
              say: Callable[[str], None] = print, stdin: TextIO | None = None,
@@ -242,6 +243,12 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         Derivative-filter cut-off [Hz].
     chunk_s : float, default 60.0
         Chunk length [s] of the model.
+    max_gap : float, optional
+        Bridge steps up to this many nominal steps by resampling onto the nominal grid, and leave out samples
+        holding NaN (as ``greybox predict --resample S --max-gap`` treats a log); default: no resampling.
+    latency : {"exact", "low"}, default "exact"
+        The derivatives of ``greybox predict`` after their look-ahead, or causal ones at once
+        (:mod:`greybox.live.causal`).
     columns : mapping of str to str, optional
         ``{canonical_name: column}`` for message columns not named by the convention (over the axis
         file's channels).
@@ -279,7 +286,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     """
     from ..machine_model import is_machine_model
 
-    options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s)
+    options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s,
+                   max_gap=max_gap, latency=latency)
     lines = LineLimiter(say, burst=lines_per_interval)
     if is_machine_model(model_path):
         build, axes = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,

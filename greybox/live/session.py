@@ -16,7 +16,7 @@ import numpy as np
 from ..data.log import AxisLog
 from .estimator import LiveEstimator, Lost, RunStart, StepOutput
 from .limits import LimitWatch
-from .messages import DEFAULT_BOUNDS, Decoder, MessageBounds, MessageError, MessageLogs, estimate_message
+from .messages import DEFAULT_BOUNDS, Decoder, MessageBounds, MessageError, MessageLogs, estimate_message, finite_rows
 from .recording import Recorder
 from .sources import ConnectionChange, Received
 from .stats import LiveStats
@@ -126,6 +126,14 @@ class LiveSession:
             Take the session's ``axis`` from columns named ``<axis>_<quantity>_<unit>``; False for a
             message of this axis alone (its own topic).
         """
+        if self.estimator.timeline.max_gap is not None:
+            columns, bad = finite_rows(columns)
+            if bad:
+                self.stats.samples_received += bad
+                self.stats.drop("not finite", bad)
+                self.say(f"{name}: {bad} sample(s) holding NaN or infinity dropped; the gap is bridged (--max-gap)")
+                if not len(next(iter(columns.values()))):
+                    return
         try:
             log = self._logs.log(columns, name=name, axis=self.axis if select else None)
             signature = _signature(log)
@@ -212,7 +220,7 @@ class LiveSession:
         stats = self.stats
         if stopped:
             unaccounted = stats.samples_received - stats.samples_estimated - stats.skipped
-            if unaccounted:
+            if unaccounted > 0:  # with --max-gap the estimates are the grid's points, not the samples received
                 stats.lose("stopped before their look-ahead arrived", unaccounted)
         stats.waiting = 0 if stopped else self.estimator.waiting
         try:
@@ -253,19 +261,22 @@ class LiveSession:
         columns = parts[0] if len(parts) == 1 else {name: np.concatenate([part[name] for part in parts])
                                                     for name in parts[0]}
         self.stats.samples_estimated += out.n_samples
-        self.sink.estimate(estimate_message(columns, seq, axis=self.subtopic), subtopic=self.subtopic)
-        for run, result, part in zip(out.runs, out.results, parts):
-            if run != self._run:  # the estimates of a new run: a new file, the limits re-armed
+        starts = []  # whether each result starts a new run after the first: a new file
+        for run, part in zip(out.runs, parts):  # the alarms first: they are what a shop floor waits for
+            starts.append(run != self._run and run != 0)
+            if run != self._run:  # the estimates of a new run: the limits re-armed
                 self._run = run
-                if self.recorder is not None and run:
-                    self.recorder.new_run()
                 if self.limits is not None:
                     self._alarms(self.limits.rearm(self._last_s), seq)
-            if self.recorder is not None:
-                self.recorder.add(result)
             if self.limits is not None:
                 self._alarms(self.limits.check(part), seq)
             self._last_s = float(part["time_s"][-1]) if len(part["time_s"]) else self._last_s
+        self.sink.estimate(estimate_message(columns, seq, axis=self.subtopic), subtopic=self.subtopic)
+        if self.recorder is not None:
+            for start, result in zip(starts, out.results):
+                if start:
+                    self.recorder.new_run()
+                self.recorder.add(result)
 
     def _alarms(self, alarms, seq) -> None:
         for alarm in alarms:
@@ -294,4 +305,7 @@ class LiveSession:
                 delay = (f"; each estimate follows its sample by {event.lookahead} samples "
                          f"({event.lookahead * event.sample_time:.3g} s), the look-ahead of the derivatives"
                          if event.lookahead else "")
+                if event.delay:
+                    delay += (f"; causal derivatives (--latency low): the derived channels lag by {event.delay:.3g} "
+                              f"samples ({1e3 * event.delay * event.sample_time:.3g} ms)")
                 self.say(f"stream starts at t = {event.time_s:.9g} s, step {1e3 * event.sample_time:.6g} ms{delay}")

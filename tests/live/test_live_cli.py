@@ -51,6 +51,12 @@ def test_bad_options_give_one_line_and_status_2(model_file, capsys):
         assert run_cli(["live", path, *argv]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and words in err[0] and err[0].startswith("greybox live: error:"), (argv, err)
+    for argv, words in [(["--max-gap", "1"], "argument --max-gap: must be a number of steps above 1"),
+                        (["--latency", "fast"], "argument --latency: invalid choice: 'fast'")]:
+        with pytest.raises(SystemExit) as stop:  # refused while the command line is parsed
+            run_cli(["live", path, "--source", "-", *argv])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert stop.value.code == 2 and len(err) == 1 and words in err[0], (argv, err)
 
 
 def test_an_unreachable_broker_is_one_line(model_file, capsys):

@@ -68,3 +68,32 @@ def test_a_message_within_the_tolerance_is_passed_on_whole_and_one_after_a_gap_i
     events = timeline.push(samples([0.024, 0.0245, 0.026]))  # too soon inside the message
     assert [type(event).__name__ for event in events] == ["AxisLog", "Dropped", "AxisLog"]
     np.testing.assert_array_equal(kept(events), [0.024, 0.026])
+
+
+def test_bridged_pieces_are_the_resampled_log_whatever_the_messages():
+    from greybox.data.prepare import resample
+
+    rng = np.random.default_rng(1)
+    times = 0.002 * np.arange(200) + rng.uniform(-0.6e-3, 0.6e-3, 200)
+    log = AxisLog(time=times, position=np.sin(times * 7.0), effort=np.cos(times * 3.0))
+    whole = resample(log, 0.002)
+    for sizes in ((1,), (10,), (3, 17, 1)):
+        timeline, events, start, k = Timeline(sample_time=0.002, max_gap=5.0), [], 0, 0
+        while start < len(log):
+            stop = min(len(log), start + sizes[k % len(sizes)])
+            events += timeline.push(log.select(slice(start, stop)))
+            start, k = stop, k + 1
+        assert all(isinstance(event, AxisLog) for event in events)
+        np.testing.assert_array_equal(kept(events), whole.time)
+        np.testing.assert_array_equal(np.concatenate([event.position for event in events]), whole.position)
+
+
+def test_bridged_drops_backwards_and_splits_only_beyond_max_gap():
+    timeline = Timeline(sample_time=0.002, max_gap=5.0)
+    events = timeline.push(samples([0.0, 0.002, 0.0015, 0.004, 0.0139, 0.016, 0.0281, 0.030]))
+    kinds = [type(event).__name__ for event in events]
+    assert kinds == ["Dropped", "AxisLog", "Gap", "AxisLog"]
+    assert events[0].count == 1 and events[0].reason == "backwards"
+    np.testing.assert_allclose(events[1].time, 0.002 * np.arange(9))  # 9.9 ms bridged: within 5 steps
+    assert events[2].time_s == 0.0281  # 12.1 ms: a gap
+    np.testing.assert_allclose(events[3].time, [0.0281])  # the new run's grid starts at its first sample
