@@ -19,13 +19,16 @@ def read_options(args: argparse.Namespace) -> dict:
     ----------
     args : argparse.Namespace
         Parsed command-line arguments with the log-reading options (``columns``, ``topic``, ``axis``,
-        ``sample_time``, ``time_tolerance``, ``cutoff_hz``, ``resample``, ``max_gap``).
+        ``sample_time``, ``time_tolerance``, ``cutoff_hz``, ``resample``, ``max_gap``; the last four
+        take their defaults where the command does not offer them).
     """
     from ..data.io import parse_column_mapping
+    from ..data.prepare import MAX_GAP_STEPS
 
     return {"columns": parse_column_mapping(args.columns) if args.columns else None, "topic": args.topic,
-            "axis": args.axis, "sample_time": args.sample_time, "time_tolerance": args.time_tolerance,
-            "cutoff_hz": args.cutoff_hz, "resample": args.resample, "max_gap": args.max_gap}
+            "axis": getattr(args, "axis", None), "sample_time": args.sample_time,
+            "time_tolerance": args.time_tolerance, "cutoff_hz": getattr(args, "cutoff_hz", None),
+            "resample": getattr(args, "resample", None), "max_gap": getattr(args, "max_gap", MAX_GAP_STEPS)}
 
 
 def check_out_dir(out: str, inputs=()) -> Path:

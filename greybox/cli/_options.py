@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from ..data.log import AxisLog
 from ..data.prepare import MAX_GAP_STEPS
@@ -129,8 +128,7 @@ def read_named_runs(args: argparse.Namespace, paths, names, *, prepare: bool = T
     return runs, labels
 
 
-def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = True,
-              axis: str | None = None) -> list[AxisLog]:
+def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = True) -> list[AxisLog]:
     """Read one file and prepare it as the options say: one run, or several when --resample splits it at gaps.
 
     Parameters
@@ -143,28 +141,20 @@ def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = T
         Column mapping (``{canonical_name: name_in_file}``).
     prepare : bool, default True
         Derive velocity and acceleration (and resample when asked).
-    axis : str, optional
-        The axis to read from a log of several (default: ``--axis``).
 
     Returns
     -------
     list of AxisLog
-        The runs of the file, in time order; a note on stderr names the gaps where it was split.
+        The runs of the file, in time order (:func:`greybox.data.reading.read_prepared`); a note on stderr
+        names the gaps where it was split.
     """
     from ..data.io import read_log
-    from ..data.prepare import prepare as prepare_logs
+    from ..data.reading import read_prepared
+    from ._fleet import read_options
 
-    resample = getattr(args, "resample", None) if prepare else None
-    log = read_log(path, columns=columns, topic=args.topic, sample_time=args.sample_time,
-                   time_tolerance=None if resample else args.time_tolerance,
-                   axis=axis if axis is not None else getattr(args, "axis", None))
+    read = read_options(args)
     if not prepare:
-        return [log]
-    runs = prepare_logs([log], cutoff_hz=getattr(args, "cutoff_hz", None), sample_time=resample,
-                        tolerance=args.time_tolerance, max_gap_steps=getattr(args, "max_gap", MAX_GAP_STEPS))
-    if len(runs) > 1:
-        starts = ", ".join(f"{run.attrs['split']['start_s']:.6g}" for run in runs[1:])
-        print(f"note: {Path(path).name}: split into {len(runs)} runs at gaps longer than "
-              f"{args.max_gap:g} steps (--max-gap); the runs after the first start at t = {starts} s",
-              file=sys.stderr)
-    return runs
+        return [read_log(path, columns=columns, topic=read["topic"], sample_time=read["sample_time"],
+                         time_tolerance=read["time_tolerance"], axis=read["axis"])]
+    return read_prepared(path, {**read, "columns": None}, columns=columns,
+                         notify=lambda line: print(line, file=sys.stderr))

@@ -19,6 +19,7 @@ from ..models.effects import EFFECT_NAMES, effect
 from ..models.registry import MODEL_CLASSES
 from ..persistence import save_verified
 from ._build import CommandLineError, add_model_arguments, build_model
+from ._fleet import read_options
 from ._options import add_log_arguments, read_logs
 from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED
 
@@ -174,7 +175,8 @@ def run(args: argparse.Namespace) -> int:
                       n_null=args.null_replicates, seed=args.seed, refit_base=not args.no_refit_base,
                       refine_base=not args.no_refine_base, held_out_blocks=args.held_out_blocks,
                       min_gain=args.min_gain,
-                      progress=say, fit_progress=None if args.quiet else ProgressPrinter(interval=5.0))
+                      progress=say, fit_progress=None if args.quiet else ProgressPrinter(interval=5.0),
+                      read=read_options(args))
     document = result.to_dict()
     document["logs"] = {"train": [str(p) for p in args.train], "test": [str(p) for p in args.test]}
     _print_summary(result)

@@ -40,12 +40,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
-from typing import Callable, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 from sklearn.base import clone
 
-from ..data.log import AxisLog
+from ..data.log import AxisLog, split_runs
 from ..data.quantities import MOTIONS
 from ..errors import GreyboxError
 from ..evaluate.regimes import RegimeThresholds, metrics_by_regime
@@ -55,6 +55,8 @@ from ..models.augmented import AugmentedModel
 from ..models.effects import EFFECT_NAMES, REFINEMENTS, VELOCITY_ONLY, effect
 from ..models.estimator import check_runs
 from ..provenance import provenance
+from ..train.logs import read_training_logs
+from ..train.record import record_training
 from .evidence import StepEvidence, score_step
 from .heldout import DEFAULT_BLOCKS, DEFAULT_MIN_GAIN, HeldOutTest
 from .locate import residual_by_regime, residual_profiles, structure_basis
@@ -257,7 +259,8 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
              candidates: Sequence[str] = EFFECT_NAMES, max_effects: int = 3, alpha: float = 0.05,
              n_null: int = 99, seed: int = 0, refit_base: bool = True, refine_base: bool = True,
              held_out_blocks: int = DEFAULT_BLOCKS, min_gain: float = DEFAULT_MIN_GAIN,
-             progress: Callable[[str], None] | None = None, fit_progress=None) -> DiscoveryResult:
+             progress: Callable[[str], None] | None = None, fit_progress=None,
+             read: Mapping | None = None) -> DiscoveryResult:
     """Find the effects a base model misses, add them, and measure the gap before and after.
 
     Parameters
@@ -295,6 +298,9 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
         Receives one line of text per stage.
     fit_progress : None, bool or callable, optional
         Progress of the base model's identifications (see ``CurrentModel.fit``).
+    read : mapping, optional
+        Options the runs were read and prepared with (:func:`greybox.data.reading.read_prepared`), for the
+        training record the returned model keeps (:func:`greybox.train.record_training`).
 
     Returns
     -------
@@ -395,8 +401,11 @@ def discover(base, train: AxisLog | Sequence[AxisLog], test: AxisLog | Sequence[
         verdict = "base_misfit" if base_misfit and base_misfit["detected"] else "nothing_missing"
     say(f"verdict: {verdict}" + (": " + ", ".join(e["name"] for e in named) if named else ""))
 
-    train_gap, residuals = _gap(train, base_model.predict(train), model.predict(train)), {}
-    residuals["train"] = _residuals(train, base_model.predict(train), model.predict(train))
+    fitted = model.predict(train)
+    train_gap, residuals = _gap(train, base_model.predict(train), fitted), {}
+    residuals["train"] = _residuals(train, base_model.predict(train), fitted)
+    _, run_labels, files = read_training_logs(train)
+    record_training(model, train, split_runs(train, fitted), names=run_labels, files=files, read=read)
     test_gap = {}
     if test:
         before, after = base_model.predict(test), model.predict(test)
