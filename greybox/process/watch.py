@@ -50,13 +50,20 @@ class PartWatch:
         ``{"negative": ..., "positive": ...}``: the re-levelling of a previous part (offsets [signal unit] of a
         raw envelope, factors of the model's current of a model's envelope); ignored without re-levelling,
         none applied when not given.
+    skip_s : float, default 0.0
+        Positions within this time [s] after the reference part's first motion are not compared: a stream's model
+        carries its state from the previous part, while the envelope was taught on parts each computed from the
+        model's initial state, which read otherwise until the model has settled and the smoothing window holds
+        no sample from before the motion.
     """
 
-    def __init__(self, envelope, *, corrections: dict | None = None):
+    def __init__(self, envelope, *, corrections: dict | None = None, skip_s: float = 0.0):
         self.envelope = envelope
         self.corrections = dict(corrections or {})
+        self.skip_s = skip_s
         length = envelope.reference_velocity_.size
         self._reference_start = int(np.argmax(np.abs(envelope.reference_velocity_) > STANDSTILL_MM_S))
+        self._first_compared = self._reference_start + int(round(skip_s / envelope.sample_time_)) if skip_s else 0
         self._velocity: list = []
         self._signal: list = []
         self._extra: dict = {}
@@ -117,7 +124,7 @@ class PartWatch:
         smoothed = moving_mean(self._levelled(grid, convert), self.envelope.width_, complete=True)
         ready = np.flatnonzero(np.isfinite(smoothed))
         last = int(ready[-1]) if ready.size else -1
-        first = max(self._checked + 1, int(ready[0]) if ready.size else 0)
+        first = max(self._checked + 1, int(ready[0]) if ready.size else 0, self._first_compared)
         if last < first:
             return []
         positions = np.arange(first, last + 1)
