@@ -1,13 +1,13 @@
 """A part checked while it is cut: samples in, block by block; the stretches leaving the envelope out at once.
 
-:class:`PartWatch` is what a live stream needs from an envelope (the live command does not call it yet). It is
-fed one part's samples from the part's first one. The part is aligned by its first motion against the
-reference part's (within the envelope's largest shift); every position whose smoothing window is complete is
-compared with the band, as :func:`~greybox.process.check.check_part` compares the whole part, and the start of
-every stretch outside is reported as soon as it is seen: half a smoothing window after it happened. A
-re-levelling envelope is applied with the corrections of a previous part (``corrections``, e.g. the last
-checked part's :attr:`~greybox.process.check.PartCheck.offsets`): the friction changes little from one part to
-the next.
+:class:`PartWatch` is what a live stream needs from an envelope (``greybox live --envelope``,
+:mod:`greybox.live.envelope`). It is fed one part's samples from the part's first one. The part is aligned by
+its first motion against the reference part's (within the envelope's largest shift); every position whose
+smoothing window is complete is compared with the band, as :func:`~greybox.process.check.check_part` compares
+the whole part, and the start of every stretch outside is reported as soon as it is seen: half a smoothing
+window after it happened. A re-levelling envelope is applied with the corrections of a previous part
+(``corrections``, e.g. the last checked part's :attr:`~greybox.process.check.PartCheck.offsets`): the friction
+changes little from one part to the next.
 """
 
 from __future__ import annotations
