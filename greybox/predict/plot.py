@@ -18,6 +18,7 @@ from ..evaluate.plots import (
     window_title,
 )
 from .process import ProcessResult
+from .relevel import moving_mean
 
 __all__ = ["envelope_indices", "moving_mean", "plot_machine_process", "plot_process"]
 
@@ -30,32 +31,6 @@ def _shown(time: np.ndarray, window) -> slice:
     if shown.start >= shown.stop:
         raise ValueError(f"no samples between {window[0]:g} s and {window[1]:g} s")
     return shown
-
-
-def moving_mean(values, window: int) -> np.ndarray:
-    """Centred moving mean over ``window`` samples, the window shortened at both ends of the signal.
-
-    Parameters
-    ----------
-    values : array_like
-        Signal.
-    window : int
-        Window length [samples], at least 1 (1 returns the signal).
-
-    Returns
-    -------
-    ndarray
-        Same length as ``values``; sample ``i`` is the mean of the samples of
-        the window centred on ``i`` that lie inside the signal.
-    """
-    values = np.asarray(values, dtype=float)
-    if window < 1:
-        raise ValueError(f"the window must hold at least one sample, got {window}")
-    sums = np.concatenate(([0.0], np.cumsum(values)))
-    index = np.arange(values.size)
-    start = np.clip(index - window // 2, 0, values.size)
-    stop = np.clip(index - window // 2 + window, 0, values.size)
-    return (sums[stop] - sums[start]) / (stop - start)
 
 
 def _mark_outside(ax, time, outside, max_points: int, label: str, color: str = "tab:orange") -> None:

@@ -49,6 +49,7 @@ from scipy.stats import t as student
 
 from ..atomic import write_text_atomic
 from ..errors import GreyboxError
+from ..predict.relevel import level_direction, relevelled
 from .alignment import STANDSTILL_MM_S, best_shift, shifted
 
 __all__ = ["ENVELOPE_FORMAT", "Envelope", "cut_samples", "level_direction", "moving_mean", "relevelled"]
@@ -83,67 +84,6 @@ def moving_mean(values, width: int, *, complete: bool = False) -> np.ndarray:
     n = counts[high] - counts[low]
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(n >= (int(width) if complete else 1), (sums[high] - sums[low]) / np.maximum(n, 1), np.nan)
-
-
-def level_direction(velocity) -> np.ndarray:
-    """Direction whose friction the axis holds: the sign of the velocity, at standstill the last motion's.
-
-    Parameters
-    ----------
-    velocity : array_like, shape (n,)
-        Axis velocity [mm/s or deg/s]; a rest before the first motion takes the last motion's direction (a part
-        of a series starts where the same program's previous part ended).
-    """
-    v = np.asarray(velocity, dtype=float)
-    sign = np.where(np.abs(v) > STANDSTILL_MM_S, np.sign(v), 0.0)
-    moving = np.flatnonzero(sign)
-    if moving.size == 0:
-        return sign
-    last = np.maximum.accumulate(np.where(sign != 0, np.arange(v.size), -1))
-    return np.where(last >= 0, sign[np.maximum(last, 0)], sign[moving[-1]])
-
-
-def relevelled(signal, direction, air, *, target=None, template=None) -> tuple[np.ndarray, dict]:
-    """A part's signal re-levelled on its air samples, per direction (module docstring).
-
-    Parameters
-    ----------
-    signal : ndarray, shape (L,)
-        The part's signal on the reference grid (NaN where it has no sample).
-    direction : ndarray, shape (L,)
-        Direction whose friction is held per position (:func:`level_direction`): -1 or 1 (0: left alone).
-    air : ndarray of bool, shape (L,)
-        Air samples.
-    target : ndarray, shape (L,), optional
-        Level of the air samples (the centre) for an offset; used without ``template``.
-    template : ndarray, shape (L,), optional
-        The model's current without process: scaled to the air samples, which should read zero.
-
-    Returns
-    -------
-    signal : ndarray
-        Re-levelled.
-    corrections : dict
-        ``{"negative": ..., "positive": ...}``: the factor ``beta`` [signal unit per A] removed with a template,
-        else the offset [signal unit] (0 for a direction without air samples).
-    """
-    out = np.array(signal, dtype=float)
-    corrections = {}
-    for sign, name in ((-1, "negative"), (1, "positive")):
-        side = direction == sign
-        picked = air & side & np.isfinite(out)
-        if template is not None:
-            m = np.asarray(template, dtype=float)
-            picked &= np.isfinite(m)
-            energy = float(np.sum(m[picked] ** 2))
-            beta = float(np.sum(out[picked] * m[picked]) / energy) if energy > 0 else 0.0
-            out[side] -= beta * m[side]
-            corrections[name] = beta
-        else:
-            offset = float(np.median(out[picked] - target[picked])) if picked.any() else 0.0
-            out[side] -= offset
-            corrections[name] = offset
-    return out, corrections
 
 
 def cut_samples(centre, direction, share: float) -> np.ndarray:
