@@ -5,9 +5,10 @@
 (:meth:`~EnvelopeWatch.check_columns`, :meth:`~EnvelopeWatch.check`, :meth:`~EnvelopeWatch.rearm`).
 
 **Parts.** The stream carries no part counter through the model, so a part starts at the first motion after a
-rest of at least the envelope's ``min_rest_s`` seen in the stream (as :func:`~greybox.process.alignment.part_slices`
-splits a long log without a part counter), with half that rest before it; a stream that starts in motion waits
-for the next rest. A part ends where the next one starts, or at a gap in the time stamps (a new run).
+rest of at least the envelope's ``min_rest_s`` seen in the stream, with as much rest before it as the reference
+part has before its first motion (the rest seen, lengthened by repeating its first sample where it was shorter:
+the reference may have been cut from a log by its part counter, at its loading time); a stream that starts in
+motion waits for the next rest. A part ends where the next one starts, or at a gap in the time stamps (a new run).
 
 **While the part is cut.** Each part's samples go to a :class:`~greybox.process.watch.PartWatch` as they are
 estimated; a stretch that leaves the band raises an alarm at once (half a smoothing window after it began plus
@@ -167,6 +168,7 @@ class EnvelopeWatch:
         self._rest = max(1, int(round(min_rest_s / envelope.sample_time_)))
         self._resting = 0  # standstill samples just before the next one (0: in motion, or none seen yet)
         self._recent: dict | None = None  # the last samples, for the rest before a part's first motion
+        self._lead = int(np.argmax(np.abs(envelope.reference_velocity_) > STANDSTILL_MM_S))  # the reference's rest
         self._part: dict | None = None  # the part being cut: its number, start, samples, watch
         self._parts = 0
         self._corrections: dict | None = None
@@ -245,7 +247,7 @@ class EnvelopeWatch:
                 alarms += self._start_part()
             if self._part is not None:
                 alarms += self._feed(piece)
-            self._recent = _tail(self._recent, piece, self._rest // 2)
+            self._recent = _tail(self._recent, piece, self._lead)
         return alarms
 
     def rearm(self, time_s: float = math.nan) -> list[EnvelopeAlarm]:
@@ -270,7 +272,7 @@ class EnvelopeWatch:
         self._parts += 1
         live = not (self.envelope.relevel and self._corrections is None)
         watch = PartWatch(self.envelope, corrections=self._corrections, skip_s=self._skip_s) if live else None
-        lead, self._recent = self._recent, None
+        lead, self._recent = _padded(self._recent, self._lead, self.envelope.sample_time_), None
         self._part = {"number": self._parts, "samples": [], "watch": watch, "start": math.nan}
         return self._feed(lead) if lead is not None and lead["time"].size else []
 
@@ -320,6 +322,22 @@ class EnvelopeWatch:
             alarms.append(EnvelopeAlarm(part["number"], "", part["start"], time_s, state="cleared"))
         self._raised = False
         return alarms
+
+
+def _padded(lead: dict | None, count: int, step: float) -> dict | None:
+    """The rest at the end of ``lead`` (the samples before a part's first motion), lengthened to ``count`` samples by
+    repeating its first one (at standstill: not compared, and the whole part's alignment sees no motion there)."""
+    if lead is None:
+        return lead
+    moving = np.flatnonzero(np.abs(lead["velocity"]) > STANDSTILL_MM_S)
+    if moving.size:  # the rest only, not the end of the motion before it
+        lead = {key: values[moving[-1] + 1:] for key, values in lead.items()}
+    if lead["time"].size >= count or lead["time"].size == 0:
+        return lead
+    missing = count - lead["time"].size
+    out = {key: np.concatenate([np.full(missing, values[0]), values]) for key, values in lead.items()}
+    out["time"][:missing] = lead["time"][0] - step * np.arange(missing, 0, -1)
+    return out
 
 
 def _tail(recent: dict | None, piece: dict, count: int) -> dict:

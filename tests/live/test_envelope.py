@@ -66,6 +66,18 @@ def test_a_breakage_is_raised_while_the_part_is_cut_and_cleared_when_the_next_pa
     assert message["alarm"] == first.column == "envelope" and message["part"] == 4 and message["seq"] == 7
 
 
+def test_a_stream_with_shorter_rests_than_the_taught_parts_is_aligned_by_the_first_motion():
+    rng = np.random.default_rng(12)
+    taught = [make_part(k, rng, wait_s=float(rng.uniform(3.0, 3.1))) for k in range(12)]  # cut at a loading time
+    envelope = Envelope(max_shift_s=0.5).fit(taught, unit="A", signal={"kind": "raw"})
+    parts = [make_part(k, rng, wait_s=1.0) for k in range(3)] + [make_part(3, rng, wait_s=1.0, break_at_s=4.0)]
+    stream = _stream(parts)
+    raised = [a for a in _watched(EnvelopeWatch(envelope, kind="raw", min_rest_s=0.8), stream["columns"])
+              if a.state == "raised"]
+    assert raised and {a.part for a in raised} == {4}  # the stream's parts 1-3 (after rests of 1.5 s) pass
+    assert raised[0].since_s == pytest.approx(stream["starts"][3] + 4.0, abs=0.05)
+
+
 def test_a_stream_that_starts_in_motion_waits_for_the_next_part(raw_envelope):
     rng = np.random.default_rng(5)
     parts = [make_part(1, rng, wait_s=1.05, break_at_s=4.0), *good_parts(1, seed=23)]
