@@ -9,7 +9,8 @@ Steps, all on this machine in one run (its cores stated; ratios carry over, abso
 1. a one-hour 500 Hz cutting log of the twin's X axis (dataset A, seed 21), written as MCAP and as Parquet;
    reading each with :func:`greybox.data.read_log` [samples/s, median of 5 reads], and the MCAP file
    again with its JSON parsed by pyarrow's general reader (greybox's reader before the compiled one);
-2. GMS and GMS+SVR trained as ``greybox train --model gms|gmssvr`` trains them (with an offset) on the shipped ``data/X_A`` + ``X_B``:
+2. GMS and GMS+SVR trained as ``greybox train --model gms|gmssvr`` trains them (with an offset) on the
+   shipped ``data/X_A`` + ``X_B``:
    the GMS stage's time, the SVR stage's time and the ratio of the whole GMS+SVR training to the GMS stage;
    then the GMS+SVR training again with the kernel sums of the code before this benchmark was written
    (every support vector for every sample, one matrix product per block, :func:`dense_expansion` below),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["centred_mean"]
+__all__ = ["centred_mean", "centred_nanmean"]
 
 
 def centred_mean(values, width: int, counts=None) -> np.ndarray:
@@ -28,12 +28,43 @@ def centred_mean(values, width: int, counts=None) -> np.ndarray:
     ndarray, shape (n,)
     """
     values = np.asarray(values, dtype=float)
+    weights = np.ones(values.size) if counts is None else np.asarray(counts, dtype=float)
+    total, number = _window_sums(values * weights, weights, width)
+    return total / np.maximum(number, 1.0)
+
+
+def centred_nanmean(values, width: int, *, complete: bool = False) -> np.ndarray:
+    """Mean over the centred window of ``width`` samples (as :func:`centred_mean`) of the finite samples only.
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        Signal, in any unit; NaN (or infinity) marks a missing sample.
+    width : int
+        Window length [samples], at least 1.
+    complete : bool, default False
+        NaN also where the window holds fewer than ``width`` finite samples (at the ends, next to missing
+        ones); else NaN only where it holds none.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+    """
+    values = np.asarray(values, dtype=float)
+    valid = np.isfinite(values)
+    total, number = _window_sums(np.where(valid, values, 0.0), valid.astype(float), width)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(number >= (int(width) if complete else 1), total / np.maximum(number, 1.0), np.nan)
+
+
+def _window_sums(weighted, weights, width: int):
+    """Sums of ``weighted`` and of ``weights`` over each sample's centred window of ``width`` (running sums)."""
     if width < 1:
         raise ValueError(f"the window must hold at least one sample, got {width}")
-    weights = np.ones(values.size) if counts is None else np.asarray(counts, dtype=float)
-    total = np.concatenate(([0.0], np.cumsum(values * weights)))
+    width = int(width)
+    total = np.concatenate(([0.0], np.cumsum(weighted)))
     number = np.concatenate(([0.0], np.cumsum(weights)))
-    index = np.arange(values.size)
-    start = np.clip(index - width // 2, 0, values.size)
-    stop = np.clip(index - width // 2 + width, 0, values.size)
-    return (total[stop] - total[start]) / np.maximum(number[stop] - number[start], 1.0)
+    index = np.arange(weighted.size)
+    start = np.clip(index - width // 2, 0, weighted.size)
+    stop = np.clip(index - width // 2 + width, 0, weighted.size)
+    return total[stop] - total[start], number[stop] - number[start]

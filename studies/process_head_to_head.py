@@ -29,11 +29,12 @@ import numpy as np
 
 from greybox.process.alignment import shifted
 from greybox.process.check import check_part
-from greybox.process.envelope import Envelope, moving_mean
+from greybox.process.envelope import Envelope
 from greybox.process.parts import PartSignal
 from greybox.twin.cutting import cut_segments
 from greybox.twin.datasets import ESSENTIAL_TRUTH_CHANNELS
 from greybox.twin.part_series import PartSeriesSpec, ToolEvents, WarmUp, make_part_series, synthesize_part_series
+from greybox.windows import centred_nanmean
 
 __all__ = ["PARTS", "TEACH", "RATE", "VARIANTS", "breakage_time", "head_to_head", "seed_series"]
 
@@ -79,7 +80,7 @@ def seed_series(seed: int, out_dir: Path) -> tuple[Path, dict]:
 
 
 def _truth_cut_force(envelope, part, shift: int) -> float:
-    truth = moving_mean(shifted(part.extras["truth_process_force_N"], shift, envelope.centre_.size),
+    truth = centred_nanmean(shifted(part.extras["truth_process_force_N"], shift, envelope.centre_.size),
                         envelope.width_)
     return float(np.nanmean((envelope.direction_ * truth)[envelope.cut_]))
 

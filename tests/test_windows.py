@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from greybox.windows import centred_mean
+from greybox.windows import centred_mean, centred_nanmean
 
 
 def _reference(values, width, counts=None):
@@ -44,3 +44,15 @@ def test_it_is_the_loop_over_each_window_with_and_without_counts(width):
 def test_a_window_of_no_sample_is_refused():
     with pytest.raises(ValueError, match="at least one sample"):
         centred_mean([1.0, 2.0], 0)
+
+
+def test_the_nan_mean_leaves_missing_samples_out_and_says_where_a_window_is_short():
+    values = np.arange(10.0)
+    values[4] = np.nan
+    out = centred_nanmean(values, 3)
+    assert out[1] == pytest.approx(1.0) and out[4] == pytest.approx(4.0)  # (3 + 5) / 2
+    finite = np.isfinite(values)
+    np.testing.assert_allclose(out, _reference(np.where(finite, values, 0.0), 3, finite), rtol=1e-12)
+    complete = centred_nanmean(values, 3, complete=True)
+    assert np.isnan(complete[[0, 3, 4, 5, 9]]).all() and complete[1] == pytest.approx(1.0)
+    assert np.isnan(centred_nanmean(np.full(5, np.nan), 3)).all()

@@ -78,6 +78,10 @@ def add_parser(subparsers) -> None:
                         "force_process_N=1500 (repeatable)")
     parser.add_argument("--limit-hold", default="0", metavar="DURATION",
                         help="how long a limit must be exceeded before the alarm, e.g. 20ms (default 0)")
+    parser.add_argument("--envelope", metavar="ENVELOPE",
+                        help="envelope file of 'greybox process teach' (taught with this model): each part of the "
+                        "stream (starting after a rest) is checked against it while it is cut; a stretch outside "
+                        "raises an alarm at once (docs/process.md)")
     parser.add_argument("--exit-on-alarm", action="store_true",
                         help="stop at the first alarm, exit status 3")
     parser.add_argument("--stats", metavar="JSON",
@@ -169,7 +173,7 @@ def run(args: argparse.Namespace) -> int:
                            connect_timeout=args.connect_timeout)
     outcome = run_live(
         args.model, source=args.source, sink=args.sink, axis_config_path=args.axis_config, machine_path=args.machine,
-        record_dir=args.record,
+        record_dir=args.record, envelope_path=args.envelope,
         record_s=args.record_s, limits=[parse_limit(text) for text in args.limit],
         hold_s=parse_duration(args.limit_hold), exit_on_alarm=args.exit_on_alarm, stats_path=args.stats,
         sample_time=args.sample_time, tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz, chunk_s=args.chunk_s,

@@ -60,6 +60,10 @@ def add_parser(subparsers) -> None:
                         "0.1; 0 draws none)")
     parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
+    parser.add_argument("--relevel", action="store_true",
+                        help="scale the model's current per chunk (--chunk-s) and direction of motion to the log's "
+                        "air moves, found in the log: a friction changed since training (warm-up) leaves the "
+                        "process current (off by default: it adds the scale's noise, docs/predict.md)")
     add_window_argument(parser, "--plot-window")
     parser.add_argument("--force", action="store_true", help="overwrite OUT (and OUT.json) and PNG if they exist")
     parser.add_argument("--quiet", action="store_true", help="no progress display (one line per chunk on stderr)")
@@ -85,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
                         read=read_options(args), force=args.force, scheduler=args.scheduler, workers=args.workers,
                         progress=None if args.quiet else _progress(),
                         fleet_progress=fleet_progress("logs", args.quiet, lambda entry: Path(entry["log"]).name),
-                        notify=lambda line: print(line, file=sys.stderr))
+                        notify=lambda line: print(line, file=sys.stderr), relevel=args.relevel)
     for line in done.summary:
         print(line)
     for heading, figures in done.axes:

@@ -128,7 +128,7 @@ def settled_memory():
 
 
 def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
-                  axis, source, say, bounds):
+                  axis, source, say, bounds, envelope_path=None):
     """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
     from ..data.axis_config import read_axis_config
     from ..models.registry import model_kind
@@ -137,12 +137,19 @@ def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, re
     model = load_model(model_path)
     config = read_axis_config(axis_config_path) if axis_config_path else None
     mapping = {**(config.channels if config else {}), **(columns or {})}
+    envelope, combined = None, None
+    if envelope_path is not None:
+        from .envelope import Watches, read_envelope
+
+        envelope, combined = read_envelope(envelope_path, model_path=model_path, axis_config=config), Watches
 
     def build(out):
         recorder = None if record_dir is None else Recorder(
             record_dir, model=model, axis_config=config, chunk_s=options["chunk_s"], every_s=record_s,
             attrs={"model_file": str(model_path), "source": str(source)})
-        watch = LimitWatch(list(limits), hold_s=hold_s) if limits else None
+        watches = [LimitWatch(list(limits), hold_s=hold_s)] if limits else []
+        watches += [envelope] if envelope is not None else []
+        watch = watches[0] if len(watches) == 1 else combined(watches) if watches else None
         session = LiveSession(LiveEstimator(model, axis_config=config, **options), out, say=say, limits=watch,
                               recorder=recorder, mapping=mapping, axis=axis, bounds=bounds)
         return session, model_kind(model), [recorder] if recorder is not None else []
@@ -198,7 +205,7 @@ def _sink_changes(out, session, say) -> None:
 
 
 def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None, machine_path=None,
-             record_dir=None,
+             record_dir=None, envelope_path=None,
              record_s: float = DEFAULT_RECORD_S, limits: list[Limit] = (), hold_s: float = 0.0,
              exit_on_alarm: bool = False, stats_path=None, sample_time: float | None = None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
@@ -225,6 +232,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         With a machine model: the machine file (TOML) with each axis's channels and mechanics.
     record_dir : path-like, optional
         Folder of the rolling Parquet recording (a sub-folder per axis of a machine).
+    envelope_path : path-like, optional
+        Envelope file (``greybox process teach``) of one axis's model: each part of the stream is checked against
+        it while it is cut (:mod:`greybox.live.envelope`), its alarms on ``<sink topic>/alarm/envelope``.
     record_s : float, default 60.0
         Log seconds per recording file.
     limits : list of Limit
@@ -279,7 +289,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     Raises
     ------
     GreyboxError
-        For a model or axis file that cannot be read, a source or sink that cannot be opened, a limit on a
+        For a model, axis or envelope file that cannot be read, a source or sink that cannot be opened, a limit on a
         column the output lacks, or messages that do not fit the model (units, kind of axis).
     KeyboardInterrupt
         On SIGTERM or Ctrl-C, after the recording, the sink and the stats are closed.
@@ -288,8 +298,15 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
 
     options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s,
                    max_gap=max_gap, latency=latency)
+    watched = [limit.column for limit in limits]
+    if envelope_path is not None:
+        from .envelope import ENVELOPE_COLUMN
+
+        watched.append(ENVELOPE_COLUMN)
     lines = LineLimiter(say, burst=lines_per_interval)
     if is_machine_model(model_path):
+        if envelope_path is not None:
+            raise GreyboxError("--envelope applies to one axis's model; a machine model's axes have none")
         build, axes = _machine_session(model_path, machine_path, options, record_dir=record_dir, record_s=record_s,
                                  limits=limits, hold_s=hold_s, columns=columns, source=source, say=lines,
                                  bounds=bounds)
@@ -299,9 +316,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                                "--axes'); give one axis's mechanics with --axis-config")
         build, axes = _axis_session(model_path, axis_config_path, options, record_dir=record_dir, record_s=record_s,
                               limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=lines,
-                              bounds=bounds), [None]
+                              bounds=bounds, envelope_path=envelope_path), [None]
     ends = open_endpoints(source, sink, options=broker or BrokerOptions(), status_topic=status_topic, axes=axes,
-                          limit_columns=[limit.column for limit in limits], stdin=stdin or sys.stdin,
+                          limit_columns=watched, stdin=stdin or sys.stdin,
                           stdout=stdout or sys.stdout)
     stream, out = ends.stream, ends.out
     try:

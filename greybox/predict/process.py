@@ -70,6 +70,7 @@ from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from ..models.estimator import EXTRAPOLATION_WARNING_SHARE, outside_any
 from ..models.registry import model_kind
 from .interval import ProcessInterval
+from .relevel import Relevel
 
 __all__ = ["ProcessResult", "ProcessTally", "check_process_inputs",
            "extrapolation_summary", "join_results", "predict_process", "process_attrs", "process_blocks"]
@@ -409,7 +410,8 @@ def process_attrs(model, *, axis_config: AxisConfig | None, interval: ProcessInt
 def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
                    axis_config: AxisConfig | None = None, interval: ProcessInterval | None = None,
                    chunk_s: float = DEFAULT_CHUNK_S, tally: ProcessTally | None = None,
-                   progress: Callable[[float], None] | None = None) -> Iterator[ProcessResult]:
+                   progress: Callable[[float], None] | None = None,
+                   relevel: Relevel | None = None) -> Iterator[ProcessResult]:
     """The process result of one run given block by block, one block at a time.
 
     The model runs over each block in chunks of ``chunk_s``, carrying its state (and the state of its
@@ -434,6 +436,9 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
         Counts in every block with its training-region flags.
     progress : callable, optional
         Called after each chunk with the log time [s] reached.
+    relevel : Relevel, optional
+        Scales the model's current of each chunk per direction to the chunk's air moves
+        (:mod:`greybox.predict.relevel`).
 
     Yields
     ------
@@ -449,6 +454,8 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
             chunk = block if samples.stop - samples.start == len(block) else block.select(samples)
             predicted[samples], state, flags, region = model.predict_flag_chunk(
                 chunk, state, region, sample_time=sample_time)
+            if relevel is not None and chunk.effort_unit == "A":
+                predicted[samples] = relevel.model(chunk.time, chunk.effort, predicted[samples], chunk.velocity)
             parts.append(flags)
             if progress is not None:
                 progress(float(block.time[samples.stop - 1]))
@@ -514,7 +521,8 @@ def join_results(parts: Sequence[ProcessResult], attrs: dict) -> ProcessResult:
 
 def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: AxisConfig | None = None,
                     interval: ProcessInterval | None = None, chunk_s: float = DEFAULT_CHUNK_S,
-                    progress: Callable[[int, int, float], None] | None = None) -> ProcessResult:
+                    progress: Callable[[int, int, float], None] | None = None,
+                    relevel: bool = False) -> ProcessResult:
     """Process share of the current of a cutting log, and its force (torque on a rotary axis).
 
     Parameters
@@ -536,6 +544,9 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
     progress : callable, optional
         Called after each chunk as ``progress(done, chunks, time_s)``: chunks
         done, chunks in all, and the log time [s] reached.
+    relevel : bool, default False
+        Scale the model's current per chunk and direction of motion to the chunk's air moves
+        (:mod:`greybox.predict.relevel`); the factors are in ``attrs["relevel"]``.
 
     Returns
     -------
@@ -557,13 +568,16 @@ def predict_process(model, log: AxisLog | Sequence[AxisLog], *, axis_config: Axi
         progress(done[0], n_chunks, time_s)
 
     tally = ProcessTally()
+    levels = [Relevel(sample_time=run.sample_time) if relevel else None for run in runs]
     with threadpool_limits(limits=1, user_api="blas"):  # idle BLAS threads spin, taking the kernels' cores
-        parts = [part for run in runs
+        parts = [part for run, level in zip(runs, levels)
                  for part in process_blocks(model, [run], sample_time=run.sample_time, axis_config=axis_config,
                                             interval=interval, chunk_s=chunk_s, tally=tally,
-                                            progress=None if progress is None else step)]
+                                            progress=None if progress is None else step, relevel=level)]
     attrs = process_attrs(model, axis_config=axis_config, interval=interval, chunk_s=chunk_s,
                           motion=runs[0].motion, effort_unit=runs[0].effort_unit, tally=tally,
                           runs=[{"start_s": float(run.time[0]), "samples": len(run)} for run in runs],
                           effort=effort_quantity(runs[0]))
+    if relevel:
+        attrs["relevel"] = [chunk for level in levels for chunk in level.chunks_]
     return join_results(parts, attrs)

@@ -172,6 +172,8 @@ class Request:
         ``fleet_progress(done, total, entry)`` after each log of a fleet run.
     notify : callable
         ``notify(line)`` with each note or warning line.
+    relevel : bool
+        Scale the model's current per chunk and direction to the log's air moves (:mod:`greybox.predict.relevel`).
     """
 
     out: Path
@@ -190,6 +192,7 @@ class Request:
     progress: Callable | None
     fleet_progress: Callable | None
     notify: Callable[[str], None]
+    relevel: bool = False
 
     def warn(self, line: str | None) -> None:
         """Pass ``line`` (a note or warning, or None for nothing to say) to ``notify``.

@@ -56,7 +56,7 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
                  scheduler: str | None = None, workers: int | None = None,
                  progress: Callable[[ChunkProgress], None] | None = None,
                  fleet_progress: Callable[[int, int, dict], None] | None = None,
-                 notify: Callable[[str], None] | None = None) -> Prediction:
+                 notify: Callable[[str], None] | None = None, relevel: bool = False) -> Prediction:
     """Predict the process current (and force) of cutting logs with a model trained on air cuts, and write it.
 
     Parameters
@@ -101,6 +101,10 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
     notify : callable, optional
         ``notify(line)`` with each ``note:`` or ``warning:`` line while the logs are read and prepared
         (default: dropped).
+    relevel : bool, default False
+        Scale the model's current per chunk (``chunk_s``, the sliding window) and direction of motion to the
+        log's air moves (:mod:`greybox.predict.relevel`): a friction that changed since training (warm-up) leaves
+        the process current. One log with a model file only.
 
     Returns
     -------
@@ -119,11 +123,12 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
                        calibration=None if calibration is None else list(calibration), coverage=coverage, plot=plot,
                        plot_mean_s=plot_mean_s, plot_window=None if plot_window is None else tuple(plot_window),
                        chunk_s=chunk_s, read=dict(read or {}), force=force, scheduler=scheduler, workers=workers,
-                       progress=progress, fleet_progress=fleet_progress, notify=notify or (lambda line: None))
+                       progress=progress, fleet_progress=fleet_progress, notify=notify or (lambda line: None),
+                       relevel=relevel)
     source = open_model(model)
     if is_fleet(logs):
         for setting, value in (("plot", plot), ("plot_window", plot_window), ("calibration", calibration),
-                               ("coverage", coverage), ("machine", machine)):
+                               ("coverage", coverage), ("machine", machine), ("relevel", relevel or None)):
             if value is not None:
                 raise GreyboxError(named(setting), " applies to one log; a fleet run (several logs) writes the "
                                    "process tables")

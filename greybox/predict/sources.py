@@ -125,7 +125,8 @@ class ModelFile:
         interval = calibrated()
         started = time.perf_counter()
         result = predict_process(model, runs, axis_config=config, interval=interval, chunk_s=request.chunk_s,
-                                 progress=request.chunk_progress(lambda: float(runs[-1].time[-1])))
+                                 progress=request.chunk_progress(lambda: float(runs[-1].time[-1])),
+                                 relevel=request.relevel)
         elapsed = time.perf_counter() - started
         result.attrs.update(attrs)
         n_chunks = sum(len(chunk_slices(len(run), samples_per_chunk(run.sample_time, request.chunk_s))) for run in runs)
@@ -150,7 +151,8 @@ class ModelFile:
             done = stream_process(model, log, request.out, axis_config=config, interval=calibrated,
                                   chunk_s=request.chunk_s, tolerance=request.read.get("time_tolerance", 0.25),
                                   cutoff_hz=request.read.get("cutoff_hz"), attrs=attrs, overwrite=request.force,
-                                  protect=inputs, progress=request.chunk_progress(lambda: log.time_span()[1]))
+                                  protect=inputs, progress=request.chunk_progress(lambda: log.time_span()[1]),
+                                  relevel=request.relevel)
         except CannotStream:
             return None
         elapsed = time.perf_counter() - started
@@ -246,6 +248,8 @@ class MachineDirectory:
         request : Request
             The call's options.
         """
+        if request.relevel:
+            raise GreyboxError(named("relevel"), " applies to a model file's log; not to a machine model yet")
         from ..data.machine_config import read_machine_config
         from ..machine_model import load_machine
         from ..persistence import load_model

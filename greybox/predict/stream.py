@@ -25,6 +25,7 @@ from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from .interval import ProcessInterval
 from .output import write_process_blocks
 from .process import ProcessTally, check_process_inputs, process_attrs, process_blocks
+from .relevel import Relevel
 
 __all__ = ["StreamedProcess", "stream_process"]
 
@@ -67,7 +68,8 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
                    interval: ProcessInterval | None = None, chunk_s: float = DEFAULT_CHUNK_S,
                    tolerance: float = 0.25, cutoff_hz: float | None = None, attrs: dict | None = None,
                    overwrite: bool = False, protect=(),
-                   progress: Callable[[int, int, float], None] | None = None) -> StreamedProcess:
+                   progress: Callable[[int, int, float], None] | None = None,
+                   relevel: bool = False) -> StreamedProcess:
     """Predict a log block by block and write its process table (CSV, Parquet or MCAP) atomically.
 
     Parameters
@@ -96,6 +98,9 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
         Files never to replace (the inputs).
     progress : callable, optional
         Called after each chunk as ``progress(done, chunks, time_s)``.
+    relevel : bool, default False
+        Scale the model's current per chunk and direction to the log's air moves (:mod:`greybox.predict.relevel`);
+        the factors go to the table's ``attrs["relevel"]``.
 
     Returns
     -------
@@ -120,9 +125,10 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
         done[0] += 1
         progress(done[0], n_chunks, time_s)
 
+    level = Relevel(sample_time=nominal) if relevel else None
     results = process_blocks(model, chain([first], blocks), sample_time=nominal, axis_config=axis_config,
                              interval=interval, chunk_s=chunk_s, tally=tally,
-                             progress=None if progress is None else step)
+                             progress=None if progress is None else step, relevel=level)
     described: dict = {}
 
     def metadata() -> dict:
@@ -130,6 +136,8 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
                                     motion=first.motion, effort_unit=first.effort_unit, tally=tally,
                                     effort=effort_quantity(first))
         table_attrs.update(attrs or {})
+        if level is not None:
+            table_attrs["relevel"] = level.chunks_
         described.update({"axis": first.axis or (axis_config.name if axis_config is not None else ""),
                           "dataset": first.dataset or "", "effort_unit": first.effort_unit, "attrs": table_attrs})
         return described

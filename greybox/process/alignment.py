@@ -17,13 +17,12 @@ import numpy as np
 from scipy.signal import correlate
 
 from ..errors import GreyboxError
+from ..predict.relevel import STANDSTILL_MM_S
 
 __all__ = ["PART_COLUMN", "STANDSTILL_MM_S", "part_slices", "best_shift", "shifted"]
 
 #: Name of the part counter column of a long log.
 PART_COLUMN = "part"
-#: Speed [mm/s or deg/s] below which the axis is taken to stand still.
-STANDSTILL_MM_S = 0.5
 
 
 def part_slices(velocity, *, counter=None, sample_time: float, min_rest_s: float = 2.0) -> list[slice]:

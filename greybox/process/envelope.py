@@ -49,9 +49,11 @@ from scipy.stats import t as student
 
 from ..atomic import write_text_atomic
 from ..errors import GreyboxError
+from ..predict.relevel import level_direction, relevelled
+from ..windows import centred_nanmean
 from .alignment import STANDSTILL_MM_S, best_shift, shifted
 
-__all__ = ["ENVELOPE_FORMAT", "Envelope", "cut_samples", "level_direction", "moving_mean", "relevelled"]
+__all__ = ["ENVELOPE_FORMAT", "Envelope", "cut_samples", "level_direction", "relevelled"]
 
 #: Format tag of an envelope file.
 ENVELOPE_FORMAT = "greybox-envelope/1"
@@ -59,91 +61,6 @@ ENVELOPE_FORMAT = "greybox-envelope/1"
 AIR_PERCENTILE = 20.0
 #: Pooling window of the spread, in smoothing lengths.
 SPREAD_POOL = 5
-
-
-def moving_mean(values, width: int, *, complete: bool = False) -> np.ndarray:
-    """Centred moving mean over ``width`` samples, ignoring NaN (NaN where a window holds none).
-
-    Parameters
-    ----------
-    values : array_like, shape (n,)
-        Samples; NaN marks missing ones.
-    width : int
-        Window [samples], at least 1.
-    complete : bool, default False
-        NaN also where the window holds fewer than ``width`` valid samples (at the ends, next to missing ones).
-    """
-    v = np.asarray(values, dtype=float)
-    valid = np.isfinite(v)
-    sums = np.concatenate(([0.0], np.cumsum(np.where(valid, v, 0.0))))
-    counts = np.concatenate(([0], np.cumsum(valid)))
-    half = int(width) // 2
-    index = np.arange(v.size)
-    low, high = np.clip(index - half, 0, v.size), np.clip(index - half + int(width), 0, v.size)
-    n = counts[high] - counts[low]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(n >= (int(width) if complete else 1), (sums[high] - sums[low]) / np.maximum(n, 1), np.nan)
-
-
-def level_direction(velocity) -> np.ndarray:
-    """Direction whose friction the axis holds: the sign of the velocity, at standstill the last motion's.
-
-    Parameters
-    ----------
-    velocity : array_like, shape (n,)
-        Axis velocity [mm/s or deg/s]; a rest before the first motion takes the last motion's direction (a part
-        of a series starts where the same program's previous part ended).
-    """
-    v = np.asarray(velocity, dtype=float)
-    sign = np.where(np.abs(v) > STANDSTILL_MM_S, np.sign(v), 0.0)
-    moving = np.flatnonzero(sign)
-    if moving.size == 0:
-        return sign
-    last = np.maximum.accumulate(np.where(sign != 0, np.arange(v.size), -1))
-    return np.where(last >= 0, sign[np.maximum(last, 0)], sign[moving[-1]])
-
-
-def relevelled(signal, direction, air, *, target=None, template=None) -> tuple[np.ndarray, dict]:
-    """A part's signal re-levelled on its air samples, per direction (module docstring).
-
-    Parameters
-    ----------
-    signal : ndarray, shape (L,)
-        The part's signal on the reference grid (NaN where it has no sample).
-    direction : ndarray, shape (L,)
-        Direction whose friction is held per position (:func:`level_direction`): -1 or 1 (0: left alone).
-    air : ndarray of bool, shape (L,)
-        Air samples.
-    target : ndarray, shape (L,), optional
-        Level of the air samples (the centre) for an offset; used without ``template``.
-    template : ndarray, shape (L,), optional
-        The model's current without process: scaled to the air samples, which should read zero.
-
-    Returns
-    -------
-    signal : ndarray
-        Re-levelled.
-    corrections : dict
-        ``{"negative": ..., "positive": ...}``: the factor ``beta`` [signal unit per A] removed with a template,
-        else the offset [signal unit] (0 for a direction without air samples).
-    """
-    out = np.array(signal, dtype=float)
-    corrections = {}
-    for sign, name in ((-1, "negative"), (1, "positive")):
-        side = direction == sign
-        picked = air & side & np.isfinite(out)
-        if template is not None:
-            m = np.asarray(template, dtype=float)
-            picked &= np.isfinite(m)
-            energy = float(np.sum(m[picked] ** 2))
-            beta = float(np.sum(out[picked] * m[picked]) / energy) if energy > 0 else 0.0
-            out[side] -= beta * m[side]
-            corrections[name] = beta
-        else:
-            offset = float(np.median(out[picked] - target[picked])) if picked.any() else 0.0
-            out[side] -= offset
-            corrections[name] = offset
-    return out, corrections
 
 
 def cut_samples(centre, direction, share: float) -> np.ndarray:
@@ -172,7 +89,7 @@ def cut_samples(centre, direction, share: float) -> np.ndarray:
 
 
 def _dilated(mask: np.ndarray, width: int) -> np.ndarray:
-    return moving_mean(mask.astype(float), 2 * int(width) + 1) > 0
+    return centred_nanmean(mask.astype(float), 2 * int(width) + 1) > 0
 
 
 class Envelope:
@@ -244,18 +161,18 @@ class Envelope:
         self.held_direction_ = level_direction(self.reference_velocity_)
         self.scaled_ = all(part.level is not None for part in parts)
         raw = [self._aligned(part) for part in parts]
-        first = np.vstack([moving_mean(row, self.width_) for row, _, _ in raw])
+        first = np.vstack([centred_nanmean(row, self.width_) for row, _, _ in raw])
         centre = np.nanmean(first, axis=0)
         self.cut_ = cut_samples(centre, self.direction_, self.cut_share)
         self.air_ = (self.direction_ != 0) & ~_dilated(self.cut_, self.width_)
         aligned = first
         if self.relevel:
-            aligned = np.vstack([moving_mean(self._relevelled(part, row, template, shift, centre)[0], self.width_)
+            aligned = np.vstack([centred_nanmean(self._relevelled(part, row, template, shift, centre)[0], self.width_)
                                  for part, (row, template, shift) in zip(parts, raw)])
             centre = np.nanmean(aligned, axis=0)
         self.centre_ = centre
         spread = np.nanstd(aligned, axis=0, ddof=1)
-        pooled = np.sqrt(moving_mean(spread ** 2, SPREAD_POOL * self.width_))
+        pooled = np.sqrt(centred_nanmean(spread ** 2, SPREAD_POOL * self.width_))
         self.spread_ = np.maximum(pooled, 0.5 * float(np.nanmedian(pooled)))
         n = len(parts)
         independent = max(1.0, length / self.width_)
@@ -328,7 +245,7 @@ class Envelope:
         offsets: dict = {}
         if self.relevel:
             aligned, offsets = self._relevelled(part, aligned, template, shift, self.centre_)
-        return moving_mean(aligned, self.width_, complete=True), shift, offsets
+        return centred_nanmean(aligned, self.width_, complete=True), shift, offsets
 
     @property
     def band_(self) -> np.ndarray:

@@ -4,7 +4,8 @@
 load, stretches); ``stretches.csv`` one row per stretch (part, kind, start and end [s] since the part's first
 sample, peak in band half-widths, mean load deviation); ``report.json`` both with the envelope's settings;
 ``part_<file>_<NNN>.png`` the part's signal over the envelope, for the flagged parts (the worst first, at most
-``figures``) or, when none is flagged, the first part.
+``figures``) or, when none is flagged, the first part; ``report.html`` the tables and those parts as interactive
+charts (:mod:`greybox.process.html`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import numpy as np
 from ..atomic import write_text_atomic
 from ..evaluate.plots import finish_figure, import_pyplot, legend_outside
 from ..json_values import jsonable
+from .html import write_html_report
 
 __all__ = ["PART_FIELDS", "STRETCH_FIELDS", "part_rows", "stretch_rows", "plot_part", "write_report"]
 
@@ -137,7 +139,9 @@ def write_report(envelope, checks: Sequence, out_dir: str | PathLike, *, figures
     flagged = [c for c in checks if c.flagged]
     worst = sorted(flagged, key=lambda c: -max([abs(c.deviation) / max(c.deviation_limit, 1e-300)]
                                                + [s.peak for s in c.stretches]))
-    for check in (worst[:figures] if flagged else list(checks[:1])):
+    figured = worst[:figures] if flagged else list(checks[:1])
+    for check in figured:
         stem = re.sub(r"[^A-Za-z0-9_.-]", "_", Path(check.source).stem)
         written.append(plot_part(envelope, check, out / f"part_{stem}_{check.number:03d}.png"))
+    written.append(write_html_report(envelope, checks, figured, out / "report.html"))
     return written

@@ -1,13 +1,13 @@
 """A part checked while it is cut: samples in, block by block; the stretches leaving the envelope out at once.
 
-:class:`PartWatch` is what a live stream needs from an envelope (the live command does not call it yet). It is
-fed one part's samples from the part's first one. The part is aligned by its first motion against the
-reference part's (within the envelope's largest shift); every position whose smoothing window is complete is
-compared with the band, as :func:`~greybox.process.check.check_part` compares the whole part, and the start of
-every stretch outside is reported as soon as it is seen: half a smoothing window after it happened. A
-re-levelling envelope is applied with the corrections of a previous part (``corrections``, e.g. the last
-checked part's :attr:`~greybox.process.check.PartCheck.offsets`): the friction changes little from one part to
-the next.
+:class:`PartWatch` is what a live stream needs from an envelope (``greybox live --envelope``,
+:mod:`greybox.live.envelope`). It is fed one part's samples from the part's first one. The part is aligned by
+its first motion against the reference part's (within the envelope's largest shift); every position whose
+smoothing window is complete is compared with the band, as :func:`~greybox.process.check.check_part` compares
+the whole part, and the start of every stretch outside is reported as soon as it is seen: half a smoothing
+window after it happened. A re-levelling envelope is applied with the corrections of a previous part
+(``corrections``, e.g. the last checked part's :attr:`~greybox.process.check.PartCheck.offsets`): the friction
+changes little from one part to the next.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..windows import centred_nanmean
 from .alignment import STANDSTILL_MM_S, shifted
 from .check import stretch_kind
-from .envelope import moving_mean
 
 __all__ = ["Breach", "PartWatch"]
 
@@ -50,13 +50,20 @@ class PartWatch:
         ``{"negative": ..., "positive": ...}``: the re-levelling of a previous part (offsets [signal unit] of a
         raw envelope, factors of the model's current of a model's envelope); ignored without re-levelling,
         none applied when not given.
+    skip_s : float, default 0.0
+        Positions within this time [s] after the reference part's first motion are not compared: a stream's model
+        carries its state from the previous part, while the envelope was taught on parts each computed from the
+        model's initial state, which read otherwise until the model has settled and the smoothing window holds
+        no sample from before the motion.
     """
 
-    def __init__(self, envelope, *, corrections: dict | None = None):
+    def __init__(self, envelope, *, corrections: dict | None = None, skip_s: float = 0.0):
         self.envelope = envelope
         self.corrections = dict(corrections or {})
+        self.skip_s = skip_s
         length = envelope.reference_velocity_.size
         self._reference_start = int(np.argmax(np.abs(envelope.reference_velocity_) > STANDSTILL_MM_S))
+        self._first_compared = self._reference_start + int(round(skip_s / envelope.sample_time_)) if skip_s else 0
         self._velocity: list = []
         self._signal: list = []
         self._extra: dict = {}
@@ -114,10 +121,10 @@ class PartWatch:
                   **{name: np.concatenate(parts) if len(parts) == len(self._signal) else None
                      for name, parts in self._extra.items()}}
         grid = {name: None if values is None else shifted(values, shift, length) for name, values in arrays.items()}
-        smoothed = moving_mean(self._levelled(grid, convert), self.envelope.width_, complete=True)
+        smoothed = centred_nanmean(self._levelled(grid, convert), self.envelope.width_, complete=True)
         ready = np.flatnonzero(np.isfinite(smoothed))
         last = int(ready[-1]) if ready.size else -1
-        first = max(self._checked + 1, int(ready[0]) if ready.size else 0)
+        first = max(self._checked + 1, int(ready[0]) if ready.size else 0, self._first_compared)
         if last < first:
             return []
         positions = np.arange(first, last + 1)

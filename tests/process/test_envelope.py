@@ -11,15 +11,7 @@ from process_parts import good_parts, make_part
 from scipy.stats import t as student
 
 from greybox.errors import GreyboxError
-from greybox.process.envelope import Envelope, level_direction, moving_mean, relevelled
-
-
-def test_moving_mean_ignores_nan_and_matches_a_plain_mean():
-    values = np.arange(10.0)
-    values[4] = np.nan
-    out = moving_mean(values, 3)
-    assert out[1] == pytest.approx(1.0) and out[4] == pytest.approx(4.0)  # (3 + 5) / 2
-    assert np.isnan(moving_mean(np.full(5, np.nan), 3)).all()
+from greybox.process.envelope import Envelope, level_direction, relevelled
 
 
 def test_level_direction_holds_the_last_motion_at_rest():

@@ -19,7 +19,7 @@ def test_report_tables_and_figure(tmp_path):
     checks.append(check_part(envelope, make_part(4, np.random.default_rng(0), break_at_s=4.0)))
     written = write_report(envelope, checks, tmp_path / "report", figures=2)
     names = sorted(path.name for path in written)
-    assert names == ["part_series_004.png", "parts.csv", "report.json", "stretches.csv"]
+    assert names == ["part_series_004.png", "parts.csv", "report.html", "report.json", "stretches.csv"]
     rows = list(csv.DictReader((tmp_path / "report" / "parts.csv").open()))
     assert tuple(rows[0]) == PART_FIELDS and len(rows) == 4
     assert [row["flagged"] for row in rows] == [str(c.flagged) for c in checks]

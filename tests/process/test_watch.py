@@ -51,3 +51,13 @@ def test_good_parts_raise_nothing_and_a_relevelled_watch_sees_what_the_whole_che
     previous = check_part(envelope, make_part(20, rng, friction=0.8)).offsets
     without, with_previous = _watch(envelope, warm), _watch(envelope, warm, corrections=previous)
     assert without and len(with_previous) < len(without)  # the warmer machine leaves the band unless re-levelled
+
+
+def test_positions_right_after_the_first_motion_are_skipped_when_asked(envelope):
+    part = make_part(4, np.random.default_rng(6), wait_s=1.05)
+    first = int(np.argmax(np.abs(part.velocity) > 0.5))
+    spoiled = part.signal.copy()
+    spoiled[first:first + 15] += 5.0  # 0.03 s off after the first motion, as a model started at rest reads
+    part = type(part)(part.source, part.number, part.start_s, part.time, part.velocity, spoiled)
+    assert _watch(envelope, part)
+    assert _watch(envelope, part, skip_s=0.03 + envelope.width_ // 2 * envelope.sample_time_ + 0.01) == []
