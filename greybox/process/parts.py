@@ -10,7 +10,6 @@ its initial state, so that a part reads the same in a file of its own and in a l
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
@@ -18,6 +17,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from ..errors import GreyboxError
+from ..provenance import file_sha256
 from .alignment import PART_COLUMN, part_slices
 
 __all__ = ["Part", "PartSignal"]
@@ -71,14 +71,6 @@ class Part:
         return float(np.median(np.diff(self.time))) if len(self.time) > 1 else 0.0
 
 
-def _digest(path: str) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 class PartSignal:
     """How the watched signal of a part is computed.
 
@@ -115,7 +107,7 @@ class PartSignal:
 
     def describe(self) -> dict:
         """JSON-able description: the kind, the model and axis files with their SHA-256."""
-        return {"kind": self.kind, "model": self.model, "model_sha256": _digest(self.model) if self.model else None,
+        return {"kind": self.kind, "model": self.model, "model_sha256": file_sha256(self.model) if self.model else None,
                 "axis_config": self.axis_config, "min_rest_s": self.min_rest_s, "read": self.read}
 
     def _model(self):
