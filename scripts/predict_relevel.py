@@ -16,7 +16,7 @@ import warnings
 import numpy as np
 
 from greybox.data.axis_config import read_axis_config
-from greybox.fleet import read_prepared
+from greybox.data.reading import read_prepared
 from greybox.persistence import load_model
 from greybox.predict.process import predict_process
 

@@ -9,8 +9,6 @@ This package imports only its engine: the workflows import the engine without im
 training.
 """
 
-# the one reader of logs (greybox.data.reading), named here too for its callers of before (greybox.process.parts)
-from ..data.reading import read_prepared
 from .engine import (
     LOG_SUFFIXES,
     MANIFEST,
@@ -53,7 +51,6 @@ __all__ = [
     "machine_of",
     "out_dir_of",
     "partition",
-    "read_prepared",
     "read_manifest",
     "run_tasks",
 ]

@@ -81,7 +81,7 @@ class PartSignal:
     axis_config : str, optional
         Axis file of the model's axis: the signal is then the process force (torque).
     read : mapping, optional
-        Options of reading and preparing the logs (:func:`greybox.fleet.read_prepared`).
+        Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`).
     min_rest_s : float, default 2.0
         Shortest standstill [s] between two parts of a long log without a part counter.
     """
@@ -162,7 +162,7 @@ class PartSignal:
         GreyboxError
             For a log that cannot be read or holds no motion.
         """
-        from ..fleet import read_prepared
+        from ..data.reading import read_prepared
 
         runs = read_prepared(str(path), self.read)
         parts, unit = [], ""

@@ -60,8 +60,8 @@ def test_a_chunk_without_enough_air_carries_the_previous_factor():
 def test_predict_relevels_a_streamed_log_as_a_whole_one_and_refuses_a_fleet(tmp_path):
     from greybox.data.io import write_log
     from greybox.data.prepare import prepare
+    from greybox.data.reading import read_prepared
     from greybox.errors import GreyboxError
-    from greybox.fleet import read_prepared
     from greybox.models.friction import CoulombModel
     from greybox.persistence import save_model
     from greybox.predict import predict_logs
