@@ -197,7 +197,7 @@ def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[
                          f"(RE {behind.re:.2f} against {without.re:.2f} %), so {', '.join(gap_tried)} were tried too")
             extra = [(spec, build_candidate(spec, inertia=inertia)) for spec in gap_tried]
             models += extra
-            scores += score_candidates(_screened(extra), folds, workers=workers, progress=progress)
+            scores += score_candidates(_screened(extra), folds, workers=workers, progress=progress, rivals=scores)
     notes += [f"{score.label} disqualified: {score.error}" for score in scores
               if score.error is not None and score.fold_re]
     speed = speed_fold(folds)
