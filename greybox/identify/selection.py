@@ -137,6 +137,8 @@ class CandidateScore:
         Wall time of the fits and predictions [s].
     error : str or None
         Why the candidate could not be scored (a fit or prediction failed), else None.
+    raced : bool
+        Out by the racing rule (:data:`RACE_FACTOR`): ``fold_re`` holds its lead fold's RE only.
     """
 
     label: str
@@ -145,6 +147,7 @@ class CandidateScore:
     n_params: int = 0
     seconds: float = 0.0
     error: str | None = None
+    raced: bool = False
 
     @property
     def re(self) -> float:
@@ -413,6 +416,7 @@ def score_candidates(candidates: Sequence[tuple[str, object]], folds: Sequence[F
                                f"{EXPLODING_FACTOR:g} times the {floors[f]:.4g} % of predicting zero)")
                 break
         if score.error is None and c in raced:
+            score.raced = True
             score.error = (f"{folds[lead].name}: held-out RE {figures[c][lead][0]:.4g} % beyond {RACE_FACTOR:g} times "
                            f"the best candidate's {best:.4g} % there: raced out, not fitted on the other folds")
     return scores
@@ -427,8 +431,9 @@ def choose(scores: Sequence[CandidateScore], speed: int | None = None) -> int:
         Scored candidates; failed (or exploded) ones are never chosen.
     speed : int, optional
         Index of the fold that tests speed (:func:`speed_fold`): candidates that predict it worse than the
-        simplest candidate (fewest parameters, then the first) by more than that one's standard error are
-        not chosen.
+        simplest candidate (fewest parameters, then the first; scored or raced out) by more than that one's
+        standard error are not chosen. A raced-out simplest candidate sets no ceiling: the speed fold is then
+        the lead fold, where every candidate left predicted better than it.
 
     Returns
     -------
@@ -444,10 +449,14 @@ def choose(scores: Sequence[CandidateScore], speed: int | None = None) -> int:
         reasons = "; ".join(f"{score.label}: {score.error}" for score in scores)
         raise GreyboxError(f"no candidate model could be scored on the held-out runs ({reasons})")
     if speed is not None:
-        simplest = scores[min(scored, key=lambda i: scores[i].n_params)]
-        spread = simplest.re_se
-        ceiling = simplest.fold_re[speed] + (spread if math.isfinite(spread) else 0.0)
-        scored = [i for i in scored if scores[i].fold_re[speed] <= ceiling]
+        # the simplest among those scored and those raced out: a raced-out simplest candidate was out on the
+        # speed fold (the lead fold), beyond the factor of the best, and every candidate left beats it there
+        reference = [i for i, score in enumerate(scores) if i in scored or score.raced]
+        simplest = scores[min(reference, key=lambda i: scores[i].n_params)]
+        if not simplest.raced:
+            spread = simplest.re_se
+            ceiling = simplest.fold_re[speed] + (spread if math.isfinite(spread) else 0.0)
+            scored = [i for i in scored if scores[i].fold_re[speed] <= ceiling]
     best = min(scored, key=lambda i: scores[i].re)
     spread = scores[best].re_se
     limit = scores[best].re + (spread if math.isfinite(spread) else 0.0)

@@ -288,7 +288,7 @@ def test_a_candidate_far_behind_on_the_lead_fold_is_not_fitted_on_the_others():
     behind = _Scaled(factors={runs[0].source: 2.0})  # far behind on the lead fold only
     _FITS.clear()
     scores = score_candidates([("coulomb", CoulombModel(fit_offset=True)), ("behind", behind)], folds)
-    assert len(_FITS) == 1 and scores[1].error is not None and "raced out" in scores[1].error
+    assert len(_FITS) == 1 and scores[1].raced and "raced out" in scores[1].error
     assert len(scores[1].fold_re) == 1 and scores[1].fold_re[0] > RACE_FACTOR * scores[0].fold_re[0]
     everything = score_candidates([("coulomb", CoulombModel(fit_offset=True)), ("behind", behind)], folds,
                                   race=False)
@@ -334,3 +334,15 @@ def test_the_real_two_stage_candidates_share_the_gms_candidate_of_their_own_opti
     assert shared_stages(models) == [None, None, 0, 1, None]
     other = [build_candidate("gms:offset,elements=3").held_out_search(), models[2]]
     assert shared_stages(other) == [None, None]  # another GMS: the stage is fitted with its own settings
+
+
+def test_a_raced_out_simplest_candidate_sets_no_speed_ceiling_on_the_others():
+    # the speed fold is the lead fold: coulomb was raced out there, beyond 1.5 times the best, so every candidate
+    # left beats it on the fastest runs; the next simplest one (lugre) must not take its place as the ceiling
+    raced = CandidateScore("coulomb:offset", fold_re=[30.0], fold_rmse=[0.3], n_params=4, error="raced out",
+                           raced=True)
+    lugre = _score("lugre:offset", [10.0, 10.0, 10.0], 8)
+    gms = _score("gms:asymmetric", [10.5, 8.0, 8.0], 14)  # mean 8.83 +- 0.83: the best, beyond lugre's reach
+    assert choose([raced, lugre, gms], speed=0) == 2
+    failed = CandidateScore("coulomb:offset", error="fold x: diverged", n_params=4)  # not raced: no figure at all
+    assert choose([failed, lugre, gms], speed=0) == 1  # the simplest scored one sets the ceiling, as before
