@@ -346,3 +346,15 @@ def test_a_raced_out_simplest_candidate_sets_no_speed_ceiling_on_the_others():
     assert choose([raced, lugre, gms], speed=0) == 2
     failed = CandidateScore("coulomb:offset", error="fold x: diverged", n_params=4)  # not raced: no figure at all
     assert choose([failed, lugre, gms], speed=0) == 1  # the simplest scored one sets the ceiling, as before
+
+
+def test_a_gap_shows_on_the_lead_fold_when_the_model_without_it_was_raced_out():
+    from greybox.model_choice import gap_shown
+
+    without = CandidateScore("stribeck:asymmetric", fold_re=[80.0], fold_rmse=[1.0], n_params=9, error="raced out",
+                             raced=True)
+    behind = _score("stribeck:asymmetric,backlash", [20.0, 50.0, 30.0], 10)  # lead fold 1 here: 50 < 80
+    assert gap_shown(without, behind, lead=1) == (80.0, 50.0, " on the lead fold")
+    assert gap_shown(without, _score("b", [20.0, 90.0, 30.0], 10), lead=1) is None  # worse on the lead fold
+    assert gap_shown(_score("a", [9.0, 9.0, 9.0], 9), _score("b", [8.0, 8.0, 8.0], 10), lead=0)[:2] == (9.0, 8.0)
+    assert gap_shown(_score("a", [9.0] * 3, 9, error="fold x: diverged"), behind, lead=1) is None
