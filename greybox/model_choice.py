@@ -33,11 +33,18 @@ from typing import Callable, Sequence
 
 from .errors import GreyboxError
 from .identify.inertia import SPRING_SHARE_LIMIT, spring_share
-from .identify.selection import choose, held_out_folds, score_candidates, selection_record, speed_fold
+from .identify.selection import (
+    choose,
+    held_out_folds,
+    lead_fold,
+    score_candidates,
+    selection_record,
+    speed_fold,
+)
 from .models.friction.backlash import BacklashModel
 from .models.registry import MODEL_CLASSES
 
-__all__ = ["DEFAULT_CANDIDATES", "GAP_CANDIDATES", "GAP_EVIDENCE", "build_candidate", "choose_model"]
+__all__ = ["DEFAULT_CANDIDATES", "GAP_CANDIDATES", "GAP_EVIDENCE", "build_candidate", "choose_model", "gap_shown"]
 
 #: The candidates of ``--model auto``, simplest first: each kind's symmetric form with an offset and its
 #: direction-dependent form, a static model behind a backlash, and the grey-box model.
@@ -129,6 +136,37 @@ def build_candidate(spec: str, *, inertia: float | None = None):
     return BacklashModel(base=model) if backlash else model
 
 
+def gap_shown(without, behind, lead: int):
+    """Whether the model behind a backlash predicts the held-out runs better than the same model without it.
+
+    Parameters
+    ----------
+    without, behind : CandidateScore
+        The scores of the two candidates of :data:`GAP_EVIDENCE`.
+    lead : int
+        The lead fold (:func:`~greybox.identify.selection.lead_fold`).
+
+    Returns
+    -------
+    tuple or None
+        ``(RE without, RE behind, what was compared)`` [%] when ``behind`` is better: their mean RE when both
+        were scored on every fold, their lead fold's when either was raced out there; None otherwise (or
+        when either failed).
+    """
+    def lead_re(score):
+        if score.raced:
+            return score.fold_re[0]
+        return score.fold_re[lead] if score.error is None and score.fold_re else None
+
+    if without.error is None and behind.error is None:
+        pair, what = (without.re, behind.re), ""
+    else:
+        pair, what = (lead_re(without), lead_re(behind)), " on the lead fold"
+    if None in pair or not pair[1] < pair[0]:
+        return None
+    return pair[0], pair[1], what
+
+
 def _screened(models):
     """The candidates as the folds fit them: each one's held-out search (``held_out_search``: fewer starts or
     Bayesian calls); the chosen one is refitted with its full search."""
@@ -192,12 +230,14 @@ def choose_model(runs: Sequence, groups: Sequence[str], *, candidates: Sequence[
     gap_tried = [spec for spec in gap_candidates if spec not in labels]
     if gap_tried and all(spec in labels for spec in GAP_EVIDENCE):
         without, behind = (scores[labels.index(spec)] for spec in GAP_EVIDENCE)
-        if behind.error is None and without.error is None and behind.re < without.re:
+        shown = gap_shown(without, behind, lead_fold(folds))
+        if shown is not None:
             notes.append(f"a gap: {GAP_EVIDENCE[1]} predicts the held-out runs better than {GAP_EVIDENCE[0]} "
-                         f"(RE {behind.re:.2f} against {without.re:.2f} %), so {', '.join(gap_tried)} were tried too")
+                         f"(RE {shown[1]:.2f} against {shown[0]:.2f} %{shown[2]}), so {', '.join(gap_tried)} were "
+                         "tried too")
             extra = [(spec, build_candidate(spec, inertia=inertia)) for spec in gap_tried]
             models += extra
-            scores += score_candidates(_screened(extra), folds, workers=workers, progress=progress)
+            scores += score_candidates(_screened(extra), folds, workers=workers, progress=progress, rivals=scores)
     notes += [f"{score.label} disqualified: {score.error}" for score in scores
               if score.error is not None and score.fold_re]
     speed = speed_fold(folds)

@@ -28,32 +28,44 @@ from __future__ import annotations
 import math
 import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Callable, Sequence
 
 import numpy as np
 from sklearn.base import clone
+from threadpoolctl import threadpool_limits
 
 from ..errors import GreyboxError, ParameterError
 from ..json_values import jsonable
 from ..metrics import relative_error, rmse
 
 __all__ = ["Fold", "CandidateScore", "held_out_folds", "score_candidates", "choose", "selection_record",
-           "check_selection_record", "speed_fold", "RULE", "EXPLODING_FACTOR", "SPEED_MARGIN"]
-
-#: The choice rule, as recorded with the result.
-RULE = ("lowest mean held-out RE; among candidates within one standard error of it, the fewest parameters; "
-        "a fold's RE beyond 2 times that of predicting zero disqualifies; on the fold that holds out the fastest "
-        "runs, no worse than the simplest candidate by more than its standard error")
+           "check_selection_record", "speed_fold", "lead_fold", "shared_stages", "RULE", "EXPLODING_FACTOR",
+           "SPEED_MARGIN", "RACE_FACTOR"]
 
 #: A held-out RE above this multiple of the RE of predicting zero effort on the same fold disqualifies [-]:
 #: predicting nothing is the floor every model must beat; twice its error is a prediction that ran away.
 EXPLODING_FACTOR = 2.0
 
+#: A candidate whose held-out RE on the lead fold (:func:`lead_fold`) exceeds this multiple of the best
+#: candidate's there is raced out: not fitted on the other folds, not chosen [-]. To have had the lowest mean
+#: over ``k`` folds it would have had to beat that best candidate on the other folds by ``(RACE_FACTOR - 1) /
+#: (k - 1)`` times the best's lead-fold RE on average (half of it with 2 folds). A rule of thumb that saves the
+#: other folds of the slow candidates, not a bound: ``race=False`` (:func:`score_candidates`) scores every fold.
+RACE_FACTOR = 1.5
+
 #: A fold tests speed when its held-out runs are faster than its training runs by this factor [-] (99th
 #: percentiles of ``|v|``): a fifth beyond the fastest training speed is a regime the training runs did not show.
 SPEED_MARGIN = 1.2
+
+#: The choice rule, as recorded with the result.
+RULE = ("lowest mean held-out RE; among candidates within one standard error of it, the fewest parameters; "
+        f"a fold's RE beyond {EXPLODING_FACTOR:g} times that of predicting zero disqualifies; on the fold that "
+        "holds out the fastest runs, no worse than the simplest candidate by more than its standard error; a "
+        "candidate whose RE on the first fold scored (the fastest runs' if one tests speed) is beyond "
+        f"{RACE_FACTOR:g} times the best there is not fitted on the others")
 
 #: Samples a held-out stretch needs at least (one second at 2 ms), so that it holds motion and reversals.
 MIN_FOLD_SAMPLES = 500
@@ -125,6 +137,8 @@ class CandidateScore:
         Wall time of the fits and predictions [s].
     error : str or None
         Why the candidate could not be scored (a fit or prediction failed), else None.
+    raced : bool
+        Out by the racing rule (:data:`RACE_FACTOR`): ``fold_re`` holds its lead fold's RE only.
     """
 
     label: str
@@ -133,6 +147,7 @@ class CandidateScore:
     n_params: int = 0
     seconds: float = 0.0
     error: str | None = None
+    raced: bool = False
 
     @property
     def re(self) -> float:
@@ -196,10 +211,42 @@ def held_out_folds(runs: Sequence, groups: Sequence[str], *, n_blocks: int = 3) 
                  [run_pieces[j] for run_pieces in pieces]) for j in range(n_blocks)]
 
 
-def _score_fold(model, fold: Fold) -> tuple[float, float, int, float]:
-    """Fit a clone of ``model`` on the fold's training runs; its held-out RE [%], RMSE, parameters, seconds."""
-    started = time.perf_counter()
-    fitted = clone(model).fit(fold.train)
+def _same_settings(model, other) -> bool:
+    """Whether two unfitted estimators are the same class with the same settings (their fits agree)."""
+    if type(model) is not type(other):
+        return False
+    return repr(sorted(model.get_params(deep=True).items())) == repr(sorted(other.get_params(deep=True).items()))
+
+
+def shared_stages(models: Sequence) -> list[int | None]:
+    """For each candidate, the candidate whose fit is its first stage, if any.
+
+    A two-stage candidate (``first_stage()`` not None) whose unfitted first stage has the settings of another
+    candidate freezes that candidate's fit on each fold (``fit_staged(..., first_stage=...)``) instead of
+    fitting the same stage again: the fit is deterministic, so the figures are the same.
+
+    Parameters
+    ----------
+    models : sequence of estimator
+        The unfitted candidates.
+
+    Returns
+    -------
+    list of int or None
+        Index of the candidate that is its first stage, or None.
+    """
+    out: list[int | None] = []
+    for model in models:
+        stage = getattr(model, "first_stage", lambda: None)()
+        owner = None if stage is None else next(
+            (i for i, other in enumerate(models) if getattr(other, "first_stage", lambda: None)() is None
+             and _same_settings(stage, other)), None)
+        out.append(owner)
+    return out
+
+
+def _figures(fitted, fold: Fold, started: float) -> tuple[float, float, int, float]:
+    """Held-out RE [%], RMSE, parameters and seconds since ``started`` of a fitted candidate on ``fold``."""
     prediction = fitted.predict(fold.test)
     effort = np.concatenate([run.effort for run in fold.test])
     if not np.all(np.isfinite(prediction)):
@@ -208,20 +255,73 @@ def _score_fold(model, fold: Fold) -> tuple[float, float, int, float]:
             time.perf_counter() - started)
 
 
-def _job(arguments):
-    """One (candidate, fold) fit in a worker process: the figures, or the error's text."""
-    model, fold = arguments
+def _score_fold(model, fold: Fold, first_stage=None):
+    """Fit a clone of ``model`` on the fold's training runs (its first stage frozen to ``first_stage`` if given).
+
+    Returns the figures of :func:`_figures` and the fitted model.
+    """
+    started = time.perf_counter()
+    fitted = clone(model).fit(fold.train) if first_stage is None else \
+        clone(model).fit_staged(fold.train, first_stage=first_stage)
+    return _figures(fitted, fold, started), fitted
+
+
+def _guarded(call):
+    """``(call(), None)``, or ``(None, the error's text)`` for a failure of one fit."""
     try:
-        return _score_fold(model, fold), None
+        return call(), None
     except GreyboxError as error:
         return None, str(error)
     except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:  # a numerical failure of one fit
         return None, f"{type(error).__name__}: {error}"
 
 
+def _job(arguments):
+    """One fold of one candidate and of the candidates that freeze its fit as their first stage.
+
+    ``arguments``: the owner's model, the dependants' models and the fold. Returns one outcome per model,
+    owner first: the figures, or the error's text. In a worker process the linear algebra runs on one thread
+    (the workers already fill the cores).
+    """
+    model, dependants, fold = arguments
+    with threadpool_limits(limits=1, user_api="blas"):
+        outcome, error = _guarded(partial(_score_fold, model, fold))
+        outcomes = [(None if outcome is None else outcome[0], error)]
+        for dependant in dependants:
+            if outcome is None:
+                outcomes.append((None, error))
+            else:
+                scored, own_error = _guarded(partial(_score_fold, dependant, fold, first_stage=outcome[1]))
+                outcomes.append((None if scored is None else scored[0], own_error))
+    return outcomes
+
+
+def lead_fold(folds: Sequence[Fold]) -> int:
+    """The fold every candidate is scored on first: the one that tests speed (:func:`speed_fold`), else the first.
+
+    Parameters
+    ----------
+    folds : sequence of Fold
+        From :func:`held_out_folds`.
+
+    Returns
+    -------
+    int
+    """
+    speed = speed_fold(folds)
+    return 0 if speed is None else speed
+
+
 def score_candidates(candidates: Sequence[tuple[str, object]], folds: Sequence[Fold], *, workers: int = 1,
-                     progress: Callable[[str], None] | None = None) -> list[CandidateScore]:
+                     progress: Callable[[str], None] | None = None, race: bool = True,
+                     rivals: Sequence[CandidateScore] = ()) -> list[CandidateScore]:
     """Fit every candidate on every fold's training runs and score it on the runs held out.
+
+    Every candidate is first scored on the lead fold (:func:`lead_fold`). A candidate whose fit failed or
+    exploded there (:data:`EXPLODING_FACTOR`) is out; with ``race``, so is one whose held-out RE there
+    exceeds :data:`RACE_FACTOR` times the best candidate's (of these and of ``rivals``): it is not fitted
+    on the other folds (:data:`RACE_FACTOR` says what that costs). A two-stage candidate whose first stage
+    is another candidate (:func:`shared_stages`) freezes that candidate's fit of each fold.
 
     Parameters
     ----------
@@ -233,52 +333,92 @@ def score_candidates(candidates: Sequence[tuple[str, object]], folds: Sequence[F
         Processes fitting in parallel (1: in this process).
     progress : callable, optional
         Called with one line of text per finished fit.
+    race : bool, default True
+        Drop candidates far behind the best on the lead fold before fitting them on the others.
+    rivals : sequence of CandidateScore, optional
+        Candidates scored before on the same folds, whose lead-fold RE counts for the best.
 
     Returns
     -------
     list of CandidateScore
-        In the order of ``candidates``; a candidate one of whose fits failed carries the error.
+        In the order of ``candidates``; a candidate one of whose fits failed carries the error, one that
+        exploded or was raced out its held-out RE so far and why it is out.
     """
-    jobs = [(c, f) for c in range(len(candidates)) for f in range(len(folds))]
+    models = [model for _, model in candidates]
+    owners = shared_stages(models)
+    dependants = {c: [d for d, owner in enumerate(owners) if owner == c] for c in range(len(models))}
+    roots = [c for c, owner in enumerate(owners) if owner is None]
     scores = [CandidateScore(label) for label, _ in candidates]
-    fits: list[list[int]] = [[] for _ in candidates]
-    arguments = [(candidates[c][1], folds[f]) for c, f in jobs]
+    figures: list[dict[int, tuple]] = [{} for _ in candidates]
+    errors: list[dict[int, str]] = [{} for _ in candidates]
+    floors = [fold.zero_re() for fold in folds]
+    lead = lead_fold(folds)
 
-    def record(job, outcome) -> None:
-        (c, f), (figures, error) = job, outcome
-        score = scores[c]
+    def record(c: int, f: int, outcome) -> None:
+        values, error = outcome
         if error is not None:
-            score.error = score.error or f"{folds[f].name}: {error}"
+            errors[c][f] = error
         else:
-            re, error_rms, n_params, seconds = figures
-            score.fold_re.append(re)
-            score.fold_rmse.append(error_rms)
-            fits[c].append(n_params)
-            score.seconds += seconds
+            figures[c][f] = values
         if progress is not None:
-            figure = f"RE {figures[0]:.2f} % ({figures[3]:.1f} s)" if error is None else "failed"
+            figure = f"RE {values[0]:.2f} % ({values[3]:.1f} s)" if error is None else "failed"
             progress(f"{candidates[c][0]} without {folds[f].name}: {figure}")
 
-    if workers <= 1 or len(jobs) <= 1:
-        for job, argument in zip(jobs, arguments):
-            record(job, _job(argument))
-    else:
+    def run(jobs) -> None:
+        """Fit the jobs ``(owner, fold, members)``, the most complex owners first (the list runs simplest first)."""
+        jobs = sorted(jobs, key=lambda job: (-job[0], job[1]))
+        arguments = [(models[c], [models[d] for d in members if d != c], folds[f]) for c, f, members in jobs]
+        if workers <= 1 or len(jobs) <= 1:
+            outcomes = map(_job, arguments)
+            for (c, f, members), outcome in zip(jobs, outcomes):
+                for member, result in zip([c] + [d for d in members if d != c], outcome):
+                    if member in members:
+                        record(member, f, result)
+            return
         # fresh interpreters, not forks: a fork of a process whose compiled kernels run threads may deadlock
         context = multiprocessing.get_context("spawn")
         with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=context) as pool:
-            for job, outcome in zip(jobs, pool.map(_job, arguments)):
-                record(job, outcome)
-    floors = [fold.zero_re() for fold in folds]
-    for score, n_params in zip(scores, fits):
-        score.n_params = int(np.median(n_params)) if n_params else 0
-        if score.error is not None:
+            futures = {pool.submit(_job, argument): job for job, argument in zip(jobs, arguments)}
+            for future in as_completed(futures):
+                c, f, members = futures[future]
+                for member, result in zip([c] + [d for d in members if d != c], future.result()):
+                    if member in members:
+                        record(member, f, result)
+
+    run([(c, lead, [c] + dependants[c]) for c in roots])
+    alive = [c for c in range(len(models)) if lead in figures[c]
+             and figures[c][lead][0] <= EXPLODING_FACTOR * floors[lead]]
+    leads = [figures[c][lead][0] for c in alive] + [s.fold_re[lead] for s in rivals
+                                                      if s.error is None and len(s.fold_re) == len(folds)]
+    best = min(leads, default=math.inf)
+    raced = set()
+    if race:
+        raced = {c for c in alive if figures[c][lead][0] > RACE_FACTOR * best}
+        alive = [c for c in alive if c not in raced]
+    rest = [f for f in range(len(folds)) if f != lead]
+    run([(c, f, [m for m in [c] + dependants[c] if m in alive]) for c in roots for f in rest
+         if any(m in alive for m in [c] + dependants[c])])
+
+    for c, score in enumerate(scores):
+        done = sorted(figures[c])
+        score.fold_re = [figures[c][f][0] for f in done]
+        score.fold_rmse = [figures[c][f][1] for f in done]
+        score.seconds = float(sum(figures[c][f][3] for f in done))
+        score.n_params = int(np.median([figures[c][f][2] for f in done])) if done else 0
+        if errors[c]:
+            f = min(errors[c])
+            score.error = f"{folds[f].name}: {errors[c][f]}"
             score.fold_re, score.fold_rmse = [], []
             continue
-        for fold, re, floor in zip(folds, score.fold_re, floors):
-            if not re <= EXPLODING_FACTOR * floor:
-                score.error = (f"{fold.name}: held-out RE {re:.4g} % exploded (beyond {EXPLODING_FACTOR:g} times the "
-                               f"{floor:.4g} % of predicting zero)")
+        for f in done:
+            if not figures[c][f][0] <= EXPLODING_FACTOR * floors[f]:
+                score.error = (f"{folds[f].name}: held-out RE {figures[c][f][0]:.4g} % exploded (beyond "
+                               f"{EXPLODING_FACTOR:g} times the {floors[f]:.4g} % of predicting zero)")
                 break
+        if score.error is None and c in raced:
+            score.raced = True
+            score.error = (f"{folds[lead].name}: held-out RE {figures[c][lead][0]:.4g} % beyond {RACE_FACTOR:g} times "
+                           f"the best candidate's {best:.4g} % there: raced out, not fitted on the other folds")
     return scores
 
 
@@ -291,8 +431,9 @@ def choose(scores: Sequence[CandidateScore], speed: int | None = None) -> int:
         Scored candidates; failed (or exploded) ones are never chosen.
     speed : int, optional
         Index of the fold that tests speed (:func:`speed_fold`): candidates that predict it worse than the
-        simplest candidate (fewest parameters, then the first) by more than that one's standard error are
-        not chosen.
+        simplest candidate (fewest parameters, then the first; scored or raced out) by more than that one's
+        standard error are not chosen. A raced-out simplest candidate sets no ceiling: the speed fold is then
+        the lead fold, where every candidate left predicted better than it.
 
     Returns
     -------
@@ -308,10 +449,14 @@ def choose(scores: Sequence[CandidateScore], speed: int | None = None) -> int:
         reasons = "; ".join(f"{score.label}: {score.error}" for score in scores)
         raise GreyboxError(f"no candidate model could be scored on the held-out runs ({reasons})")
     if speed is not None:
-        simplest = scores[min(scored, key=lambda i: scores[i].n_params)]
-        spread = simplest.re_se
-        ceiling = simplest.fold_re[speed] + (spread if math.isfinite(spread) else 0.0)
-        scored = [i for i in scored if scores[i].fold_re[speed] <= ceiling]
+        # the simplest among those scored and those raced out: a raced-out simplest candidate was out on the
+        # speed fold (the lead fold), beyond the factor of the best, and every candidate left beats it there
+        reference = [i for i, score in enumerate(scores) if i in scored or score.raced]
+        simplest = scores[min(reference, key=lambda i: scores[i].n_params)]
+        if not simplest.raced:
+            spread = simplest.re_se
+            ceiling = simplest.fold_re[speed] + (spread if math.isfinite(spread) else 0.0)
+            scored = [i for i in scored if scores[i].fold_re[speed] <= ceiling]
     best = min(scored, key=lambda i: scores[i].re)
     spread = scores[best].re_se
     limit = scores[best].re + (spread if math.isfinite(spread) else 0.0)

@@ -257,6 +257,41 @@ def stribeck_regressors(velocity, acceleration, v_s, fit_offset: bool) -> np.nda
     return np.column_stack(columns)
 
 
+class _StribeckColumns:
+    """The matrix of :func:`stribeck_regressors`, kept between trial Stribeck velocities of one fit.
+
+    Only the columns of a direction whose ``v_s`` changed are written again, with the same operations as
+    :func:`stribeck_regressors` (so the same values to the last bit): the coordinate search of the asymmetric
+    fit moves one direction at a time, and neither the other direction's columns nor the motion columns are
+    built again for each of its some 200 trials.
+    """
+
+    def __init__(self, velocity, acceleration, asymmetric: bool, fit_offset: bool):
+        v = np.asarray(velocity, dtype=float)
+        if asymmetric:
+            positive, negative = (v > 0.0).astype(float), (v < 0.0).astype(float)
+            self.signs, viscous = [positive, -negative], [v * positive, v * negative]
+        else:
+            self.signs, viscous = [np.sign(v)], [v]
+        self.speed = np.abs(v)
+        fixed = viscous + ([np.ones_like(v)] if fit_offset else [])
+        self.matrix = np.empty((v.size, 1 + 2 * len(self.signs) + len(fixed)))
+        self.matrix[:, 0] = acceleration
+        for j, column in enumerate(fixed):
+            self.matrix[:, 1 + 2 * len(self.signs) + j] = column
+        self.scales = [None] * len(self.signs)
+
+    def at(self, v_s) -> np.ndarray:
+        """The regressors at ``v_s`` (a float, or the pair of an asymmetric fit); the array is reused."""
+        for d, scale in enumerate([v_s] if np.ndim(v_s) == 0 else list(v_s)):
+            if self.scales[d] != scale:
+                e = np.exp(-self.speed / scale)
+                self.matrix[:, 1 + 2 * d] = self.signs[d] * (1.0 - e)
+                self.matrix[:, 2 + 2 * d] = self.signs[d] * e
+                self.scales[d] = scale
+        return self.matrix
+
+
 def _stribeck_bounds(asymmetric: bool, fit_offset: bool):
     lower = [0.0] * (7 if asymmetric else 4) + ([-np.inf] if fit_offset else [])
     return np.array(lower), np.full(len(lower), np.inf)
@@ -347,10 +382,11 @@ def fit_stribeck(velocity, acceleration, effort, *, asymmetric: bool = False, fi
     lo, hi = velocity_range(velocity) if v_s_range is None else v_s_range
     lower, upper = _stribeck_bounds(asymmetric, fit_offset)
 
+    columns = _StribeckColumns(velocity, acceleration, asymmetric, fit_offset)
+
     def sse(log_v_s):
         v_s = tuple(np.exp(log_v_s)) if asymmetric else float(np.exp(log_v_s))
-        a = stribeck_regressors(velocity, acceleration, v_s, fit_offset)
-        residual = bounded_lstsq(a, effort, lower, upper)[1]
+        residual = bounded_lstsq(columns.at(v_s), effort, lower, upper)[1]
         return float(residual @ residual)
 
     grid = np.linspace(np.log(lo), np.log(hi), _N_GRID)

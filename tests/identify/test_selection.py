@@ -8,17 +8,20 @@ import numpy as np
 import pytest
 from axis_dev_data import axis_dev
 from friction_signals import motion_log, velocity_profile
-from sklearn.base import BaseEstimator
+from sklearn.base import BaseEstimator, clone
 
 from greybox.errors import GreyboxError, ParameterError
 from greybox.identify.selection import (
     EXPLODING_FACTOR,
+    RACE_FACTOR,
     CandidateScore,
     check_selection_record,
     choose,
     held_out_folds,
+    lead_fold,
     score_candidates,
     selection_record,
+    shared_stages,
     speed_fold,
 )
 from greybox.model_choice import build_candidate, choose_model
@@ -85,7 +88,7 @@ def test_the_choice_follows_held_out_error_not_training_error():
     runs = [_coulomb_run(s) for s in range(3)]
     np.testing.assert_array_equal(_Memoriser().fit(runs).predict(runs), np.concatenate([r.effort for r in runs]))
     folds = held_out_folds(runs, ["r0", "r1", "r2"])
-    scores = score_candidates([("memoriser", _Memoriser()), ("coulomb", CoulombModel())], folds)
+    scores = score_candidates([("memoriser", _Memoriser()), ("coulomb", CoulombModel())], folds, race=False)
     assert [s.label for s in scores] == ["memoriser", "coulomb"]
     assert scores[1].re < scores[0].re
     assert choose(scores) == 1
@@ -202,7 +205,8 @@ def test_an_exploding_fold_disqualifies_a_candidate_with_a_note():
     coulomb, runaway = scores
     assert coulomb.error is None and all(re < EXPLODING_FACTOR * f for re, f in zip(coulomb.fold_re, floors))
     assert runaway.error is not None and "exploded" in runaway.error and "predicting zero" in runaway.error
-    assert math.isnan(runaway.re) and len(runaway.fold_re) == 2  # out, not averaged, its figures kept
+    assert math.isnan(runaway.re) and len(runaway.fold_re) == 1  # out, not averaged, its figure kept
+    assert runaway.error.startswith(folds[0].name)  # out on the lead fold: not fitted on the other
     assert choose(scores) == 0
     record = selection_record(scores, folds, 0)
     check_selection_record(record)
@@ -237,3 +241,120 @@ def test_the_folds_fit_each_candidate_with_a_smaller_search_of_the_same_model():
         # only the size of the search differs: no option of the candidate
         assert changed and all(name.split("__")[-1] in ("n_starts", "n_calls", "refine") for name in changed)
         assert all(reduced[name] < settings[name] for name in changed)
+
+
+#: Fits of ``_Scaled`` models: (factors, runs) per fit (the folds run in this process).
+_FITS = []
+
+
+class _Scaled(BaseEstimator):
+    """A Coulomb model whose prediction of a run is scaled by ``factors.get(run.source, 1)``; with a ``stage``,
+    a two-stage model whose first stage is that model (its fit frozen, nothing fitted after it)."""
+
+    def __init__(self, factors=None, stage=None):
+        self.factors = factors
+        self.stage = stage
+
+    def first_stage(self):
+        return None if self.stage is None else clone(self.stage)
+
+    def fit(self, runs):
+        _FITS.append((self.factors, len(runs)))
+        self.model_ = CoulombModel(fit_offset=True).fit(runs)
+        return self
+
+    def fit_staged(self, runs, *, first_stage):
+        self.model_ = first_stage.model_
+        return self
+
+    @property
+    def n_params(self):
+        return 4
+
+    def predict(self, runs):
+        runs = runs if isinstance(runs, list) else [runs]
+        return np.concatenate([self.model_.predict(run) * (self.factors or {}).get(run.source, 1.0) for run in runs])
+
+
+def _three_runs():
+    """Three runs of about one speed (no fold tests speed: the lead fold is the first)."""
+    runs = [_coulomb_run(s, noise=0.2) for s in (2, 3, 7)]
+    return runs, held_out_folds(runs, [run.source for run in runs])
+
+
+def test_a_candidate_far_behind_on_the_lead_fold_is_not_fitted_on_the_others():
+    runs, folds = _three_runs()
+    assert lead_fold(folds) == 0  # no fold tests speed: the first
+    behind = _Scaled(factors={runs[0].source: 2.0})  # far behind on the lead fold only
+    _FITS.clear()
+    scores = score_candidates([("coulomb", CoulombModel(fit_offset=True)), ("behind", behind)], folds)
+    assert len(_FITS) == 1 and scores[1].raced and "raced out" in scores[1].error
+    assert len(scores[1].fold_re) == 1 and scores[1].fold_re[0] > RACE_FACTOR * scores[0].fold_re[0]
+    everything = score_candidates([("coulomb", CoulombModel(fit_offset=True)), ("behind", behind)], folds,
+                                  race=False)
+    assert everything[1].error is None and len(everything[1].fold_re) == 3
+    assert choose(scores) == choose(everything) == 0
+
+
+def test_racing_keeps_a_candidate_behind_on_the_lead_fold_that_wins_the_mean():
+    # behind by less than RACE_FACTOR on the lead fold, better on the two others: the best on the mean. A rule
+    # that dropped every candidate behind on the lead fold would lose it.
+    runs = [_coulomb_run(s) for s in (2, 3, 7)]
+    folds = held_out_folds(runs, [run.source for run in runs])
+    high = _Scaled(factors={run.source: 1.2 for run in runs})  # a fifth too high on every run
+    mixed = _Scaled(factors={runs[0].source: 1.25})  # worse than that on the lead fold, right on the others
+    scores = score_candidates([("high", high), ("mixed", mixed)], folds)
+    assert scores[1].error is None and len(scores[1].fold_re) == 3
+    assert scores[0].fold_re[0] < scores[1].fold_re[0] < RACE_FACTOR * scores[0].fold_re[0]
+    assert scores[1].re < scores[0].re - scores[1].re_se
+    assert choose(scores) == 1
+
+
+def test_the_lead_fold_is_the_one_that_tests_speed():
+    slow, fast, other = _coulomb_run(2), _coulomb_run(1), _coulomb_run(3)
+    folds = held_out_folds([slow, fast, other], ["slow.csv", "fast.csv", "other.csv"])
+    assert lead_fold(folds) == speed_fold(folds) == 1
+
+
+def test_a_two_stage_candidate_freezes_the_fit_of_the_candidate_that_is_its_first_stage():
+    runs, folds = _three_runs()
+    stage = _Scaled()
+    two = _Scaled(stage=stage)
+    assert shared_stages([stage, two, _Scaled(factors={"x": 3.0})]) == [None, 0, None]
+    _FITS.clear()
+    shared = score_candidates([("stage", stage), ("two", two)], folds)
+    assert _FITS == [(None, 2)] * 3  # the stage, once per fold on its two training runs; the second never fits
+    alone = score_candidates([("two", two)], folds)  # no candidate is its stage: it fits its own
+    assert shared[1].fold_re == alone[0].fold_re == shared[0].fold_re
+
+
+def test_the_real_two_stage_candidates_share_the_gms_candidate_of_their_own_options():
+    labels = ["gms:offset", "gms:asymmetric", "gmssvr:offset", "gmssvr:asymmetric", "lugre:offset"]
+    models = [build_candidate(label).held_out_search() for label in labels]
+    assert shared_stages(models) == [None, None, 0, 1, None]
+    other = [build_candidate("gms:offset,elements=3").held_out_search(), models[2]]
+    assert shared_stages(other) == [None, None]  # another GMS: the stage is fitted with its own settings
+
+
+def test_a_raced_out_simplest_candidate_sets_no_speed_ceiling_on_the_others():
+    # the speed fold is the lead fold: coulomb was raced out there, beyond 1.5 times the best, so every candidate
+    # left beats it on the fastest runs; the next simplest one (lugre) must not take its place as the ceiling
+    raced = CandidateScore("coulomb:offset", fold_re=[30.0], fold_rmse=[0.3], n_params=4, error="raced out",
+                           raced=True)
+    lugre = _score("lugre:offset", [10.0, 10.0, 10.0], 8)
+    gms = _score("gms:asymmetric", [10.5, 8.0, 8.0], 14)  # mean 8.83 +- 0.83: the best, beyond lugre's reach
+    assert choose([raced, lugre, gms], speed=0) == 2
+    failed = CandidateScore("coulomb:offset", error="fold x: diverged", n_params=4)  # not raced: no figure at all
+    assert choose([failed, lugre, gms], speed=0) == 1  # the simplest scored one sets the ceiling, as before
+
+
+def test_a_gap_shows_on_the_lead_fold_when_the_model_without_it_was_raced_out():
+    from greybox.model_choice import gap_shown
+
+    without = CandidateScore("stribeck:asymmetric", fold_re=[80.0], fold_rmse=[1.0], n_params=9, error="raced out",
+                             raced=True)
+    behind = _score("stribeck:asymmetric,backlash", [20.0, 50.0, 30.0], 10)  # lead fold 1 here: 50 < 80
+    assert gap_shown(without, behind, lead=1) == (80.0, 50.0, " on the lead fold")
+    assert gap_shown(without, _score("b", [20.0, 90.0, 30.0], 10), lead=1) is None  # worse on the lead fold
+    assert gap_shown(_score("a", [9.0, 9.0, 9.0], 9), _score("b", [8.0, 8.0, 8.0], 10), lead=0)[:2] == (9.0, 8.0)
+    assert gap_shown(_score("a", [9.0] * 3, 9, error="fold x: diverged"), behind, lead=1) is None

@@ -233,3 +233,17 @@ def test_coulomb_model_is_the_emps_idim_ls_estimator(real_data):
     assert asym.coulomb_pos_ == pytest.approx(20.1440, rel=0.02)
     assert 1e3 * asym.viscous_neg_ == pytest.approx(240.4236, rel=0.02)
     assert asym.coulomb_neg_ == pytest.approx(20.6277, rel=0.02)
+
+
+@pytest.mark.parametrize("asymmetric, fit_offset", [(False, False), (False, True), (True, False)])
+def test_the_kept_stribeck_columns_are_the_regressors_to_the_last_bit(asymmetric, fit_offset):
+    from greybox.identify.static import _StribeckColumns, stribeck_regressors
+
+    rng = np.random.default_rng(3)
+    velocity = 20.0 * rng.standard_normal(2000)
+    velocity[::9] = 0.0
+    acceleration = rng.standard_normal(2000)
+    columns = _StribeckColumns(velocity, acceleration, asymmetric, fit_offset)
+    trials = [(3.0, 1.0), (3.0, 0.2), (0.7, 0.2), (3.0, 1.0)] if asymmetric else [3.0, 0.2, 3.0]
+    for v_s in trials:  # one direction moved at a time, both, and back
+        np.testing.assert_array_equal(columns.at(v_s), stribeck_regressors(velocity, acceleration, v_s, fit_offset))
