@@ -211,6 +211,46 @@ def _live_low_latency(record: dict) -> str:
             f"{end['alarm_max_ms']:.1f} ms.\n")
 
 
+def _predict_hour(record: dict) -> str:
+    f = record["figures"]
+    lines = ["| one-hour log | figure | target |", "|---|---|---|"]
+    for fmt, label in (("mcap", "MCAP"), ("parquet", "Parquet")):
+        runs = f["predict"][fmt]
+        gms, svr = runs["gms"], runs["gmssvr"]
+        peak = max(gms["peak_rss_mb"], svr["peak_rss_mb"])
+        lines.append(f"| `greybox predict` to Parquet, {label} log streamed: GMS / GMS+SVR | {gms['seconds']:.2f} s / "
+                     f"{svr['seconds']:.2f} s wall, ratio **{runs['ratio']:.2f}**; peak {gms['peak_rss_mb']:.0f} / "
+                     f"{svr['peak_rss_mb']:.0f} MB | ratio <= 1.5, peak <= 600 MB: "
+                     f"{_met(runs['ratio'] <= 1.5 and peak <= 600)} |")
+    long = f["long"]
+    lines.append(f"| GMS+SVR on a Parquet log three times as long | {long['seconds']:.2f} s, peak "
+                 f"{long['peak_rss_mb']:.0f} MB ({long['memory_ratio']:.2f}x the hour's) | memory independent of the "
+                 f"length (within 10 %): {_met(long['memory_ratio'] <= 1.1)} |")
+    k = f["kernel"]
+    lines.append(f"| kernel sums of the hour's SVR inputs ({k['samples']} samples, {k['n_support']} support vectors) | "
+                 f"former dense {k['former_s']:.2f} s; compiled {k['compiled_1_thread_s']:.2f} s on 1 thread "
+                 f"({k['speedup_1_thread']:.2f}x), {k['compiled_threads_s']:.2f} s on all "
+                 f"({k['speedup_threads']:.2f}x); "
+                 f"largest difference {k['max_abs_difference_A']:.1e} A | |")
+    t = f["train"]
+    change = abs(t["test_re_percent"] - t["former_test_re_percent"])
+    lines.append(f"| training on X_A + X_B: GMS stage / SVR stage of GMS+SVR | {t['gmssvr_gms_stage_s']:.1f} s / "
+                 f"{t['gmssvr_svr_stage_s']:.1f} s: the whole **{t['gmssvr_over_gms_stage']:.2f}x** the GMS stage "
+                 f"(SVR stage with the former kernel sums {t['former_svr_stage_s']:.1f} s); test RE on X_C "
+                 f"{t['test_re_percent']:.2f} % ({t['former_test_re_percent']:.2f} % with the former sums); "
+                 f"{t['n_support']} support vectors | <= 2x, test RE within 0.1 pp: "
+                 f"{_met(t['gmssvr_over_gms_stage'] <= 2.0 and change <= 0.1)} |")
+    read = f["read"]
+    lines.append(f"| reading the hour whole (`read_log`), median of 5 reads | Parquet "
+                 f"{read['parquet']['samples_per_s'] / 1e6:.2f} M samples/s; MCAP "
+                 f"**{read['mcap']['samples_per_s'] / 1e6:.2f} M samples/s** ({read['mcap']['min_s']:.2f}-"
+                 f"{read['mcap']['max_s']:.2f} s), with pyarrow's general JSON reader "
+                 f"{read['mcap, general JSON reader']['samples_per_s'] / 1e6:.2f} M samples/s | >= 1 M samples/s: "
+                 f"{_met(min(read['parquet']['samples_per_s'], read['mcap']['samples_per_s']) >= 1e6)} |")
+    return ("\n".join(lines) + f"\n\n`{record['command']}`, {f['duration_s']:.0f} s of log, all in one run "
+            f"({_where(record)}).\n")
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -241,6 +281,7 @@ VIEWS = {
     "reproduce-summary": View(("reproduce",), _reproduce_summary),
     "default-tests-run": View(("default-tests",), _tests_run),
     "monitor-independent": View(("monitor-independent",), _monitor_independent),
+    "predict-hour": View(("predict-hour",), _predict_hour),
     "readme-measured": View(("reproduce", "default-tests", "monitor-independent"), _readme_table),
     "live-cut-force": View(("live-low-latency",), _live_cut_force),
     "live-low-latency": View(("live-low-latency",), _live_low_latency),
