@@ -111,3 +111,14 @@ def certificates(tmp_path) -> Certificates:
     folder = tmp_path / "pki"
     folder.mkdir()
     return Certificates(folder)
+
+
+@pytest.fixture(scope="session")
+def opcua_server():
+    """An asyncua OPC UA server in the test process, shared by the tests (its start takes seconds); each test makes
+    its own axis of variables (:meth:`opcua_helpers.OpcUaServer.axis`)."""
+    from opcua_helpers import OpcUaServer
+
+    running = OpcUaServer().start()
+    yield running
+    running.close()

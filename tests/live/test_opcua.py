@@ -1,0 +1,193 @@
+"""``greybox live --source opc.tcp://...`` against a real asyncua server in the test process: the estimates equal
+``greybox predict`` on the same samples; the log-in, the variables and the server are checked at the start (one
+line, exit 2); a malformed value is one line and the stream goes on; a server restart is survived and counted."""
+
+from __future__ import annotations
+
+import _thread
+import io
+import threading
+
+import numpy as np
+import pytest
+from live_helpers import EXAMPLE_AXIS, free_port, joined, run_cli, wait_until
+
+from greybox.errors import GreyboxError
+from greybox.live.opcua import OpcUaOptions, parse_nodes, parse_opcua_address
+from greybox.live.run import run_live
+
+
+def live_until(model_path, source: str, options: OpcUaOptions, *, act, until, timeout_s: float = 20.0, **kwargs):
+    """Run ``run_live`` here (the main thread) on an OPC UA source; a helper thread does ``act()`` once it has
+    started and stops it, as Ctrl-C does, once ``until(output, lines)`` holds. Returns (output, lines)."""
+    out, said, failed = io.StringIO(), [], []
+    finished = threading.Event()
+
+    def drive():
+        try:
+            wait_until(lambda: finished.is_set() or any(line.startswith("greybox live:") for line in said), "start",
+                       timeout_s)
+            if finished.is_set():
+                return
+            act()
+            wait_until(lambda: finished.is_set() or until(out.getvalue(), said), "the estimates", timeout_s)
+        except BaseException as exc:  # re-raised in the test
+            failed.append(exc)
+        if not finished.is_set():
+            _thread.interrupt_main()
+
+    helper = threading.Thread(target=drive, daemon=True)
+    helper.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_live(model_path, source=source, opcua=options, axis_config_path=EXAMPLE_AXIS, stdout=out,
+                     say=said.append, **kwargs)
+    finally:
+        finished.set()
+        helper.join(5.0)
+    if failed:
+        raise AssertionError(f"{failed[0]!r}; the lines said: {said}") from failed[0]
+    return out.getvalue(), said
+
+
+def estimated(output: str) -> int:
+    rows = [line for line in output.splitlines() if line.strip() and '"alarm"' not in line]
+    return len(joined(rows)["time_s"]) if rows else 0
+
+
+def test_estimates_equal_predict(opcua_server, model_file, offline, cut_raw):
+    """Each sample written to the server's variables, one at a time, comes out as ``greybox predict`` has it."""
+    path = model_file("gmssvr")
+    expected = offline(path)
+    axis = opcua_server.axis()
+    axis.publish(cut_raw, 0, 1)  # the values the subscription starts with: the log's first sample
+    output, said = live_until(path, opcua_server.url, OpcUaOptions(nodes=axis.node_ids()),
+                              act=lambda: axis.publish(cut_raw, 1),
+                              until=lambda out, _: estimated(out) >= len(cut_raw))
+    live = joined(output.splitlines())
+    assert list(live) == list(expected.columns)
+    for name in expected.columns:  # the tolerance of the other sources' tests: rounding only
+        np.testing.assert_allclose(live[name], expected[name].to_numpy(), rtol=0, atol=1e-9, err_msg=name)
+    assert f"reading {opcua_server.url}" in said[0]
+    assert f"0 rejected), {len(cut_raw)} samples received, {len(cut_raw)} estimated, 0 dropped" in said[-1], said
+    assert "0 gap(s), 0 disconnection(s)" in said[-1], said
+
+
+def test_a_user_logs_in_with_a_password(opcua_server, model_file, cut_raw, tmp_path, capsys, monkeypatch):
+    axis = opcua_server.axis()
+    axis.publish(cut_raw, 0, 1)
+    source = opcua_server.url.replace("opc.tcp://", "opc.tcp://user@")
+    output, said = live_until(model_file("coulomb"), source, OpcUaOptions(nodes=axis.node_ids(), password="secret"),
+                              act=lambda: axis.publish(cut_raw, 1, 200),
+                              until=lambda out, _: estimated(out) >= 199)
+    assert estimated(output) == 199 + 1 - 0  # the first sample and the 199 after it, the tail at the idle time
+    wrong = tmp_path / "password"
+    wrong.write_text("guess\n")
+    capsys.readouterr()
+    status = run_cli(["live", model_file("coulomb"), "--source", source, *axis.node_options(),
+                      "--opcua-password-file", wrong, "--connect-timeout", "5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1, err
+    assert "refused the connection" in err[0] and "guess" not in err[0], err
+
+
+def test_a_node_the_server_lacks_is_refused_at_the_start(opcua_server, model_file, tmp_path, capsys):
+    axis = opcua_server.axis()
+    config = tmp_path / "live.toml"  # the options in the configuration file, as the command line takes them
+    nodes = [f"{column}={node}" for column, node in axis.node_ids().items() if column != "current_A"]
+    config.write_text(f'source = "{opcua_server.url}"\nnode = {nodes + ["current_A=ns=2;s=No.Such.Node"]!r}\n'
+                      'sampling_ms = 2\npublishing_ms = 10\n'.replace("'", '"'))
+    status = run_cli(["live", model_file("coulomb"), "--config", config])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1, err
+    assert err[0].endswith(f"error: --node current_A=ns=2;s=No.Such.Node: no such variable on {opcua_server.url} "
+                      "(BadNodeIdUnknown)"), err
+
+
+def test_a_server_that_does_not_answer_is_one_line(model_file, capsys):
+    status = run_cli(["live", model_file("coulomb"), "--source", f"opc.tcp://127.0.0.1:{free_port()}", "--node",
+                      "time_s=ns=2;s=T", "--node", "position_mm=ns=2;s=P", "--connect-timeout", "2"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1, err
+    assert "no OPC UA server answered within 2 s" in err[0], err
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["--source", "-", "--node", "time_s=ns=2;s=T"], "--node applies to an opc.tcp:// source"),
+    (["--source", "opc.tcp://localhost:4840"], "needs --node COLUMN=NODEID"),
+    (["--source", "opc.tcp://u:pw@localhost:4840", "--node", "time_s=ns=2;s=T"], "a password in the address"),
+    (["--source", "opc.tcp://localhost:4840", "--node", "time_s"], "give COLUMN=NODEID"),
+    (["--source", "opc.tcp://localhost:4840", "--node", "time_s=ns=2;s=T", "--opcua-security", "Basic128,Sign"],
+     "give POLICY,MODE"),
+    (["--source", "opc.tcp://localhost:4840", "--node", "time_s=ns=2;s=T", "--opcua-security",
+      "Basic256Sha256,SignAndEncrypt"], "needs the client certificate and its key"),
+])
+def test_options_are_checked_before_connecting(argv, says, model_file, capsys):
+    status = run_cli(["live", model_file("coulomb"), *argv])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and says in err[0], err
+    assert "pw" not in err[0]
+
+
+def test_a_malformed_value_is_one_line_and_the_stream_goes_on(opcua_server, model_file, cut_raw):
+    axis = opcua_server.axis()
+    axis.publish(cut_raw, 0, 1)
+
+    def act():
+        axis.publish(cut_raw, 1, 100)
+        axis.write({"time_s": float(cut_raw.time[100]), "position_mm": float(cut_raw.position[100]),
+                    "velocity_mm_s": float(cut_raw.velocity[100]), "current_A": "overload"})
+        axis.publish(cut_raw, 101, 200)
+        axis.write({"time_s": float(cut_raw.time[200]), "position_mm": float("nan"),
+                    "velocity_mm_s": float(cut_raw.velocity[200]), "current_A": float(cut_raw.effort[200])})
+        axis.publish(cut_raw, 201, 300)
+
+    output, said = live_until(model_file("coulomb"), opcua_server.url, OpcUaOptions(nodes=axis.node_ids()), act=act,
+                              until=lambda out, _: estimated(out) >= 297)
+    skipped = [line for line in said if "skipped" in line]
+    assert len(skipped) == 2, said
+    assert "column 'current_A' holds 'overload', not a number" in skipped[0]
+    assert "channel 'position_mm' holds nan" in skipped[1], skipped
+    live = joined(output.splitlines())
+    assert live["time_s"][-1] == pytest.approx(cut_raw.time[299])  # the stream went on past both
+
+
+def test_a_server_restart_is_survived_and_counted(opcua_server, model_file, cut_raw, tmp_path):
+    import json
+
+    axis = opcua_server.axis()
+    axis.publish(cut_raw, 0, 1)
+    stats = tmp_path / "stats.json"
+
+    def act():
+        axis.publish(cut_raw, 1, 200)
+        opcua_server.restart()
+        axis.publish(cut_raw, 200, 201)
+
+    resumed = []
+
+    def until(out, said):
+        if not resumed and any("OPC UA server connection back" in line for line in said):
+            resumed.append(True)
+            axis.publish(cut_raw, 201, 400)
+        return estimated(out) >= 300
+
+    output, said = live_until(model_file("coulomb"), opcua_server.url, OpcUaOptions(nodes=axis.node_ids()), act=act,
+                              until=until, stats_path=stats)
+    assert sum("OPC UA server connection lost; reconnecting" in line for line in said) == 1, said
+    assert not any("Traceback" in line for line in said)
+    counters = json.loads(stats.read_text())
+    assert counters["disconnections"] == 1
+    live = joined(output.splitlines())
+    assert live["time_s"][-1] >= cut_raw.time[300]
+
+
+def test_addresses_and_nodes_are_read():
+    address = parse_opcua_address("opc.tcp://plc@cnc.plant:4841/UA/Server")
+    assert (address.host, address.port, address.path, address.username) == ("cnc.plant", 4841, "UA/Server", "plc")
+    assert address.url == "opc.tcp://cnc.plant:4841/UA/Server" and parse_opcua_address("opc.tcp://h").port == 4840
+    assert parse_nodes(["position_mm=ns=2;s=X.Pos"]) == {"position_mm": "ns=2;s=X.Pos"}
+    with pytest.raises(GreyboxError, match="given twice"):
+        parse_nodes(["a=ns=2;s=1", "a=ns=2;s=2"])
+    with pytest.raises(GreyboxError, match="same node id"):
+        OpcUaOptions(nodes={"a": "ns=2;s=1", "b": "ns=2;s=1"})
