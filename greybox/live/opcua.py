@@ -226,6 +226,20 @@ def _status_name(exc: BaseException) -> str:
     return str(exc) or type(exc).__name__
 
 
+async def _application_uri(path) -> str | None:
+    """The application URI a certificate names (its subject alternative name URI), which the client must give."""
+    from asyncua.crypto import uacrypto
+    from cryptography import x509
+
+    certificate = await uacrypto.load_certificate(path)
+    try:
+        names = certificate.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+    except x509.ExtensionNotFound:
+        return None
+    uris = names.get_values_for_type(x509.UniformResourceIdentifier)
+    return uris[0] if uris else None
+
+
 class _Handler:
     """The subscription's callbacks: each value, with its variable's column and source time stamp, to the queue."""
 
@@ -291,16 +305,14 @@ class OpcUaSource(Source):
         if username:
             client.set_user(username)
             client.set_password(options.password or "")
-        if options.security:
-            files = [options.cert_file, options.key_file] + ([options.server_cert_file] if options.server_cert_file
-                                                             else [])
-            try:
-                await client.set_security_string(",".join([options.security, *files]))
-            except (OSError, ValueError) as exc:
-                raise GreyboxError(f"--opcua-security {options.security}: cannot load the certificates "
-                                   f"({exc})") from None
         try:
+            if options.server_cert_file:  # before the security is set: the endpoints are read without it
+                await self._check_server_certificate(client)
+            await self._secure(client)
             await asyncio.wait_for(client.connect(), options.connect_timeout)
+        except GreyboxError:
+            await self._abandon(client)
+            raise
         except (OSError, asyncio.TimeoutError) as exc:
             await self._abandon(client)
             raise GreyboxError(f"{where}: no OPC UA server answered within {options.connect_timeout:g} s "
@@ -339,6 +351,32 @@ class OpcUaSource(Source):
                 raise GreyboxError(f"--node {column}={options.nodes[column]}: the server refused to watch it "
                                    f"({result.name})")
         self._watch = asyncio.ensure_future(self._watch_state())
+
+    async def _secure(self, client) -> None:
+        """Set the security policy with the client's certificate (and the server's, when pinned)."""
+        options = self.options
+        if not options.security:
+            return
+        files = [options.cert_file, options.key_file] + ([options.server_cert_file] if options.server_cert_file
+                                                         else [])
+        try:
+            client.application_uri = await _application_uri(options.cert_file) or client.application_uri
+            await client.set_security_string(",".join([options.security, *files]))
+        except (OSError, ValueError) as exc:
+            raise GreyboxError(f"--opcua-security {options.security}: cannot load the certificates ({exc})") from None
+
+    async def _check_server_certificate(self, client) -> None:
+        """Refuse a server whose endpoints do not show the certificate of ``--opcua-server-cert`` (a server that
+        cannot decrypt what is sent for another certificate would otherwise just not answer)."""
+        from asyncua.crypto import uacrypto
+        from cryptography.hazmat.primitives.serialization import Encoding
+
+        options = self.options
+        pinned = (await uacrypto.load_certificate(options.server_cert_file)).public_bytes(Encoding.DER)
+        endpoints = await asyncio.wait_for(client.connect_and_get_server_endpoints(), options.connect_timeout)
+        if not any(bytes(endpoint.ServerCertificate or b"").startswith(pinned) for endpoint in endpoints):
+            raise GreyboxError(f"--source {self.address}: the server's certificate is not the one of "
+                               f"--opcua-server-cert {options.server_cert_file}; refused")
 
     @staticmethod
     async def _abandon(client) -> None:

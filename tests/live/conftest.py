@@ -114,11 +114,11 @@ def certificates(tmp_path) -> Certificates:
 
 
 @pytest.fixture(scope="session")
-def opcua_server():
+def opcua_server(tmp_path_factory):
     """An asyncua OPC UA server in the test process, shared by the tests (its start takes seconds); each test makes
     its own axis of variables (:meth:`opcua_helpers.OpcUaServer.axis`)."""
     from opcua_helpers import OpcUaServer
 
-    running = OpcUaServer().start()
+    running = OpcUaServer(tmp_path_factory.mktemp("opcua")).start()
     yield running
     running.close()

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import asyncio
 import datetime
+import ipaddress
 import logging
 import threading
+from pathlib import Path
 
 from live_helpers import free_port
 
@@ -79,15 +81,19 @@ class Axis:
 
 
 class OpcUaServer:
-    """A running asyncua server (anonymous log-ins, and ``user``/``secret``), in a thread of its own.
+    """A running asyncua server (anonymous log-ins, and ``user``/``secret``; no security, or Basic256Sha256 with
+    SignAndEncrypt and the certificates it makes in ``folder``), in a thread of its own.
 
     Parameters
     ----------
+    folder : path-like
+        Where the certificates go.
     port : int, optional
         Default a free one.
     """
 
-    def __init__(self, port: int | None = None):
+    def __init__(self, folder, port: int | None = None):
+        self.folder = Path(folder)
         self.port = port or free_port()
         self.loop = asyncio.new_event_loop()
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
@@ -104,17 +110,40 @@ class OpcUaServer:
         return asyncio.run_coroutine_threadsafe(coroutine, self.loop).result(timeout)
 
     async def _init(self):
-        from asyncua import Server
+        from asyncua import Server, ua
 
         server = Server(user_manager=_Users())
         await server.init()
         server.set_endpoint(self.url)
-        server.set_security_IDs(["Anonymous", "Username"])
+        server.set_identity_tokens([ua.AnonymousIdentityToken, ua.UserNameIdentityToken])
+        server.set_security_policy([ua.SecurityPolicyType.NoSecurity,
+                                    ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
+        await server.load_certificate(str(self.server_cert))
+        await server.load_private_key(str(self.server_key))
         assert await server.register_namespace("urn:greybox:test") == 2
         await server.start()
         self.server = server
 
+    def _certificates(self) -> None:
+        """A certificate and key of the server and of a client (self-signed, as OPC UA applications use)."""
+        from asyncua.crypto import cert_gen
+        from cryptography import x509
+        from cryptography.hazmat.primitives import serialization
+        from cryptography.x509.oid import ExtendedKeyUsageOID
+
+        for role, uri, use in (("server", "urn:greybox:test:server", ExtendedKeyUsageOID.SERVER_AUTH),
+                               ("client", "urn:greybox:test:client", ExtendedKeyUsageOID.CLIENT_AUTH)):
+            key = cert_gen.generate_private_key()
+            names = [x509.UniformResourceIdentifier(uri), x509.DNSName("localhost"),
+                     x509.IPAddress(ipaddress.ip_address("127.0.0.1"))]
+            certificate = cert_gen.generate_self_signed_app_certificate(key, f"greybox test {role}", {}, names, [use])
+            (self.folder / f"{role}.pem").write_bytes(certificate.public_bytes(serialization.Encoding.PEM))
+            (self.folder / f"{role}-key.pem").write_bytes(cert_gen.dump_private_key_as_pem(key))
+        self.server_cert, self.server_key = self.folder / "server.pem", self.folder / "server-key.pem"
+        self.client_cert, self.client_key = self.folder / "client.pem", self.folder / "client-key.pem"
+
     def start(self) -> "OpcUaServer":
+        self._certificates()
         self.run(self._init(), timeout=120.0)
         return self
 

@@ -55,9 +55,10 @@ def estimated(output: str) -> int:
     return len(joined(rows)["time_s"]) if rows else 0
 
 
-def test_estimates_equal_predict(opcua_server, model_file, offline, cut_raw):
+@pytest.mark.parametrize("kind", ["coulomb", pytest.param("gmssvr", marks=pytest.mark.slow)])
+def test_estimates_equal_predict(kind, opcua_server, model_file, offline, cut_raw):
     """Each sample written to the server's variables, one at a time, comes out as ``greybox predict`` has it."""
-    path = model_file("gmssvr")
+    path = model_file(kind)
     expected = offline(path)
     axis = opcua_server.axis()
     axis.publish(cut_raw, 0, 1)  # the values the subscription starts with: the log's first sample
@@ -89,6 +90,29 @@ def test_a_user_logs_in_with_a_password(opcua_server, model_file, cut_raw, tmp_p
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1, err
     assert "refused the connection" in err[0] and "guess" not in err[0], err
+
+
+def test_a_secured_connection_with_a_certificate(opcua_server, model_file, cut_raw):
+    """Basic256Sha256, signed and encrypted, with the client's certificate and the server's one pinned."""
+    axis = opcua_server.axis()
+    axis.publish(cut_raw, 0, 1)
+    options = OpcUaOptions(nodes=axis.node_ids(), security="Basic256Sha256,SignAndEncrypt",
+                           cert_file=str(opcua_server.client_cert), key_file=str(opcua_server.client_key),
+                           server_cert_file=str(opcua_server.server_cert))
+    output, said = live_until(model_file("coulomb"), opcua_server.url, options,
+                              act=lambda: axis.publish(cut_raw, 1, 100), until=lambda out, _: estimated(out) >= 100)
+    assert estimated(output) == 100
+
+
+def test_a_server_other_than_the_pinned_one_is_refused(opcua_server, model_file, capsys):
+    axis = opcua_server.axis()
+    status = run_cli(["live", model_file("coulomb"), "--source", opcua_server.url, *axis.node_options(),
+                      "--opcua-security", "Basic256Sha256,SignAndEncrypt", "--opcua-cert", opcua_server.client_cert,
+                      "--opcua-key", opcua_server.client_key, "--opcua-server-cert", opcua_server.client_cert,
+                      "--connect-timeout", "5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1, err
+    assert f"--source {opcua_server.url}: the server's certificate is not the one of --opcua-server-cert" in err[0]
 
 
 def test_a_node_the_server_lacks_is_refused_at_the_start(opcua_server, model_file, tmp_path, capsys):
@@ -152,6 +176,7 @@ def test_a_malformed_value_is_one_line_and_the_stream_goes_on(opcua_server, mode
     assert live["time_s"][-1] == pytest.approx(cut_raw.time[299])  # the stream went on past both
 
 
+@pytest.mark.slow  # the client finds the server back after 1 s at the earliest: 3-4 s
 def test_a_server_restart_is_survived_and_counted(opcua_server, model_file, cut_raw, tmp_path):
     import json
 
