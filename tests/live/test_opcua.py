@@ -216,3 +216,77 @@ def test_addresses_and_nodes_are_read():
         parse_nodes(["a=ns=2;s=1", "a=ns=2;s=2"])
     with pytest.raises(GreyboxError, match="same node id"):
         OpcUaOptions(nodes={"a": "ns=2;s=1", "b": "ns=2;s=1"})
+
+
+@pytest.mark.slow  # a greybox process of its own (its start takes seconds) and a restart of the server
+def test_the_command_survives_a_server_restart_in_lines_of_its_own(opcua_server, model_file, cut_raw, tmp_path):
+    """The command as a service runs it: a restart of the server is one line out and one back, counted; the client
+    library's own reports (warnings, tracebacks of the reconnection attempts) do not reach stderr."""
+    import json
+
+    from live_helpers import LiveProcess
+
+    axis = opcua_server.axis()
+    axis.publish(cut_raw, 0, 1)
+    stats = tmp_path / "stats.json"
+    live = LiveProcess(model_file("coulomb"), "--source", opcua_server.url, *axis.node_options(),
+                       "--axis-config", EXAMPLE_AXIS, "--stats", stats)
+    estimates = []
+    reader = threading.Thread(target=lambda: estimates.extend(live.process.stdout), daemon=True)
+    reader.start()
+    try:
+        wait_until(lambda: live.said("reading opc.tcp://") or live.process.poll() is not None, "the start", 60)
+        axis.publish(cut_raw, 1, 200)
+        opcua_server.restart(down_s=1.5)
+        wait_until(lambda: live.said("OPC UA server connection back"), "the reconnection", 30)
+        axis.publish(cut_raw, 200, 400)
+        wait_until(lambda: sum("estimated as the end of a run" in line for line in live.lines) >= 2,
+                   "the estimates", 30)
+    except AssertionError as exc:
+        raise AssertionError(f"{exc}: {live.lines}") from None
+    finally:
+        status = live.stop()
+    reader.join(5)
+    assert status == 143, live.lines
+    assert sum("OPC UA server connection lost; reconnecting" in line for line in live.lines) == 1, live.lines
+    assert sum("OPC UA server connection back after" in line for line in live.lines) == 1, live.lines
+    assert not [line for line in live.lines if "Traceback" in line or "asyncua" in line or "WARNING" in line]
+    counters = json.loads(stats.read_text())
+    assert counters["disconnections"] == 1 and counters["rejected"] == 0
+    assert joined(estimates)["time_s"][-1] == pytest.approx(cut_raw.time[399])
+
+
+def test_the_configuration_of_the_docs_runs(opcua_server, model_file, cut_raw, tmp_path, capsys):
+    """The TOML example of docs/live.md, its server and axis those of the test server, as the configuration of the
+    command; stopped by an alarm at the first estimate (exit status 3) while the test writes samples."""
+    import re
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "live.md").read_text(encoding="utf-8")
+    section = page[page.index("## From an OPC UA server"):page.index("## Speed")]
+    example = re.search(r"```toml\n(.*?)```", section, re.DOTALL).group(1)
+    axis = opcua_server.axis()
+    config = tmp_path / "opcua.toml"
+    config.write_text(example.replace("opc.tcp://cnc1.plant:4840", opcua_server.url)
+                      .replace("Axis.X.", f"{axis.name}.")
+                      .replace('"examples/axis_x.toml"', f'"{EXAMPLE_AXIS.as_posix()}"'))
+    axis.publish(cut_raw, 0, 1)
+    finished = threading.Event()
+
+    def write():
+        for start in range(1, len(cut_raw) - 10, 10):
+            if finished.is_set():
+                return
+            axis.publish(cut_raw, start, start + 10)
+
+    writer = threading.Thread(target=write, daemon=True)
+    writer.start()
+    try:
+        status = run_cli(["live", model_file("coulomb"), "--config", config, "--limit", "current_process_A=1e-12",
+                          "--exit-on-alarm"])
+    finally:
+        finished.set()
+        writer.join(30)
+    captured = capsys.readouterr()
+    assert status == 3, captured.err
+    assert f"reading {opcua_server.url}" in captured.err and "force_process_N" in captured.out
