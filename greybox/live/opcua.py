@@ -16,6 +16,7 @@ every 1 to 2 s and re-creates the subscription on the server, and says when it i
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import json
 import logging
 import queue
@@ -27,7 +28,7 @@ from urllib.parse import urlsplit
 
 from ..errors import GreyboxError
 from .opcua_samples import SampleAssembler
-from .source_base import ConnectionChange, Idle, Received, Source
+from .source_base import ConnectionChange, Idle, Received, Source, polled
 
 __all__ = ["DEFAULT_PORT", "OPCUA_PASSWORD_ENV", "SECURITY_MODES", "SECURITY_POLICIES", "OpcUaAddress",
            "OpcUaOptions", "is_opcua_address", "parse_opcua_address", "parse_nodes", "OpcUaSource"]
@@ -287,7 +288,12 @@ class OpcUaSource(Source):
         self._thread = threading.Thread(target=self._loop.run_forever, name="greybox-opcua", daemon=True)
         self._thread.start()
         try:
-            self._call(self._open(), options.connect_timeout + 5.0)
+            try:  # each step of the start is bounded by the connect timeout: this bound is the last resort
+                self._call(self._open(), 3 * options.connect_timeout + 10.0)
+            except concurrent.futures.TimeoutError:
+                raise GreyboxError(f"--source {address}: the server did not complete the start (log-in, checking "
+                                   f"the variables, subscribing) within {3 * options.connect_timeout + 10.0:g} s") \
+                    from None
         except BaseException:
             self.close()
             raise
@@ -399,13 +405,11 @@ class OpcUaSource(Source):
                                                  peer="OPC UA server", after=_RESUMED if now else ""))
 
     def __iter__(self) -> Iterator[Received | ConnectionChange | Idle]:
-        while True:
-            try:
-                item = self._queue.get(timeout=self.poll_s)
-            except queue.Empty:
-                yield Idle(time.time())
+        for item in polled(self._queue, self.poll_s):
+            if isinstance(item, Idle):
+                yield item
                 continue
-            changes = []
+            changes = []  # the values that came meanwhile taken at once, their samples given first
             while True:
                 if isinstance(item, ConnectionChange):
                     changes.append(item)

@@ -9,10 +9,12 @@ transports are interchangeable. This module imports nothing else of the package.
 from __future__ import annotations
 
 import abc
+import queue
+import time
 from dataclasses import dataclass
 from typing import Iterator
 
-__all__ = ["Received", "ConnectionChange", "Idle", "Source"]
+__all__ = ["Received", "ConnectionChange", "Idle", "Source", "polled"]
 
 
 @dataclass(frozen=True)
@@ -28,7 +30,7 @@ class Received:
     arrived_s : float
         Arrival time, ``time.time()`` [s].
     topic : str
-        The MQTT topic, or the axis a message of an OPC UA server belongs to ("" for a line of a text stream).
+        The MQTT topic ("" for a line of a text stream or a sample of an OPC UA server).
     """
 
     payload: str | bytes
@@ -93,3 +95,22 @@ class Source(abc.ABC):
     @abc.abstractmethod
     def close(self) -> None:
         """Release the transport (idempotent)."""
+
+
+def polled(items: queue.Queue, poll_s: float) -> Iterator[object]:
+    """The items of a queue as they come (put there by a transport's thread), and an :class:`Idle` each time
+    none came for ``poll_s`` seconds (so that the command stays responsive to signals and does what is due
+    while the stream is quiet).
+
+    Parameters
+    ----------
+    items : queue.Queue
+        The queue.
+    poll_s : float
+        Seconds to wait for an item [s].
+    """
+    while True:
+        try:
+            yield items.get(timeout=poll_s)
+        except queue.Empty:
+            yield Idle(time.time())

@@ -14,7 +14,7 @@ import time
 from typing import Iterator, TextIO
 
 from .broker import BrokerAddress, BrokerOptions, Connection
-from .source_base import ConnectionChange, Idle, Received, Source
+from .source_base import ConnectionChange, Idle, Received, Source, polled
 
 __all__ = ["DEFAULT_IDLE_S", "Received", "ConnectionChange", "Idle", "LineSource", "MqttSource"]
 
@@ -88,13 +88,8 @@ class MqttSource(Source):
         self._queue.put(ConnectionChange(connected, time_s, reason, after=_RESUMED if connected else ""))
 
     def __iter__(self) -> Iterator[Received | ConnectionChange | Idle]:
-        while True:
-            try:
-                item = self._queue.get(timeout=self.poll_s)
-            except queue.Empty:
-                yield Idle(time.time())
-                continue
-            if isinstance(item, ConnectionChange):
+        for item in polled(self._queue, self.poll_s):
+            if isinstance(item, (Idle, ConnectionChange)):
                 yield item
                 continue
             topic, payload, arrived_s = item

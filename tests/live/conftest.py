@@ -122,3 +122,14 @@ def opcua_server(tmp_path_factory):
     running = OpcUaServer(tmp_path_factory.mktemp("opcua")).start()
     yield running
     running.close()
+
+
+@pytest.fixture
+def own_opcua_server(tmp_path):
+    """An asyncua OPC UA server of the test's own, for tests that stop and restart it (a server that others' clients
+    were connected to can take long to stop)."""
+    from opcua_helpers import OpcUaServer
+
+    running = OpcUaServer(tmp_path / "opcua").start()
+    yield running
+    running.close()

@@ -126,6 +126,7 @@ class OpcUaServer:
 
     def _certificates(self) -> None:
         """A certificate and key of the server and of a client (self-signed, as OPC UA applications use)."""
+        self.folder.mkdir(parents=True, exist_ok=True)
         from asyncua.crypto import cert_gen
         from cryptography import x509
         from cryptography.hazmat.primitives import serialization

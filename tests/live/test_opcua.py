@@ -55,22 +55,24 @@ def estimated(output: str) -> int:
     return len(joined(rows)["time_s"]) if rows else 0
 
 
-@pytest.mark.parametrize("kind", ["coulomb", pytest.param("gmssvr", marks=pytest.mark.slow)])
-def test_estimates_equal_predict(kind, opcua_server, model_file, offline, cut_raw):
-    """Each sample written to the server's variables, one at a time, comes out as ``greybox predict`` has it."""
+@pytest.mark.parametrize("kind, seconds", [("coulomb", 1.0), pytest.param("gmssvr", None, marks=pytest.mark.slow)])
+def test_estimates_equal_predict(kind, seconds, opcua_server, model_file, offline, cut_raw):
+    """Each sample written to the server's variables, one at a time, comes out as ``greybox predict`` has it (the
+    first second of the cutting log in the default run, all of it in the slow one)."""
     path = model_file(kind)
-    expected = offline(path)
+    log = cut_raw if seconds is None else cut_raw.select(slice(0, int(round(seconds / cut_raw.sample_time))))
+    expected = offline(path) if seconds is None else offline(path, log, name=f"cut-{seconds:g}s")
     axis = opcua_server.axis()
-    axis.publish(cut_raw, 0, 1)  # the values the subscription starts with: the log's first sample
+    axis.publish(log, 0, 1)  # the values the subscription starts with: the log's first sample
     output, said = live_until(path, opcua_server.url, OpcUaOptions(nodes=axis.node_ids()),
-                              act=lambda: axis.publish(cut_raw, 1),
-                              until=lambda out, _: estimated(out) >= len(cut_raw))
+                              act=lambda: axis.publish(log, 1, every=25),
+                              until=lambda out, _: estimated(out) >= len(log))
     live = joined(output.splitlines())
-    assert list(live) == list(expected.columns)
+    assert list(live) == list(expected.columns) and len(expected) == len(log)
     for name in expected.columns:  # the tolerance of the other sources' tests: rounding only
         np.testing.assert_allclose(live[name], expected[name].to_numpy(), rtol=0, atol=1e-9, err_msg=name)
     assert f"reading {opcua_server.url}" in said[0]
-    assert f"0 rejected), {len(cut_raw)} samples received, {len(cut_raw)} estimated, 0 dropped" in said[-1], said
+    assert f"0 rejected), {len(log)} samples received, {len(log)} estimated, 0 dropped" in said[-1], said
     assert "0 gap(s), 0 disconnection(s)" in said[-1], said
 
 
@@ -177,16 +179,16 @@ def test_a_malformed_value_is_one_line_and_the_stream_goes_on(opcua_server, mode
 
 
 @pytest.mark.slow  # the client finds the server back after 1 s at the earliest: 3-4 s
-def test_a_server_restart_is_survived_and_counted(opcua_server, model_file, cut_raw, tmp_path):
+def test_a_server_restart_is_survived_and_counted(own_opcua_server, model_file, cut_raw, tmp_path):
     import json
 
-    axis = opcua_server.axis()
+    axis = own_opcua_server.axis()
     axis.publish(cut_raw, 0, 1)
     stats = tmp_path / "stats.json"
 
     def act():
         axis.publish(cut_raw, 1, 200)
-        opcua_server.restart()
+        own_opcua_server.restart()
         axis.publish(cut_raw, 200, 201)
 
     resumed = []
@@ -197,7 +199,7 @@ def test_a_server_restart_is_survived_and_counted(opcua_server, model_file, cut_
             axis.publish(cut_raw, 201, 400)
         return estimated(out) >= 300
 
-    output, said = live_until(model_file("coulomb"), opcua_server.url, OpcUaOptions(nodes=axis.node_ids()), act=act,
+    output, said = live_until(model_file("coulomb"), own_opcua_server.url, OpcUaOptions(nodes=axis.node_ids()), act=act,
                               until=until, stats_path=stats)
     assert sum("OPC UA server connection lost; reconnecting" in line for line in said) == 1, said
     assert not any("Traceback" in line for line in said)
@@ -219,17 +221,17 @@ def test_addresses_and_nodes_are_read():
 
 
 @pytest.mark.slow  # a greybox process of its own (its start takes seconds) and a restart of the server
-def test_the_command_survives_a_server_restart_in_lines_of_its_own(opcua_server, model_file, cut_raw, tmp_path):
+def test_the_command_survives_a_server_restart_in_lines_of_its_own(own_opcua_server, model_file, cut_raw, tmp_path):
     """The command as a service runs it: a restart of the server is one line out and one back, counted; the client
     library's own reports (warnings, tracebacks of the reconnection attempts) do not reach stderr."""
     import json
 
     from live_helpers import LiveProcess
 
-    axis = opcua_server.axis()
+    axis = own_opcua_server.axis()
     axis.publish(cut_raw, 0, 1)
     stats = tmp_path / "stats.json"
-    live = LiveProcess(model_file("coulomb"), "--source", opcua_server.url, *axis.node_options(),
+    live = LiveProcess(model_file("coulomb"), "--source", own_opcua_server.url, *axis.node_options(),
                        "--axis-config", EXAMPLE_AXIS, "--stats", stats)
     estimates = []
     reader = threading.Thread(target=lambda: estimates.extend(live.process.stdout), daemon=True)
@@ -237,7 +239,7 @@ def test_the_command_survives_a_server_restart_in_lines_of_its_own(opcua_server,
     try:
         wait_until(lambda: live.said("reading opc.tcp://") or live.process.poll() is not None, "the start", 60)
         axis.publish(cut_raw, 1, 200)
-        opcua_server.restart(down_s=1.5)
+        own_opcua_server.restart(down_s=1.5)
         wait_until(lambda: live.said("OPC UA server connection back"), "the reconnection", 30)
         axis.publish(cut_raw, 200, 400)
         wait_until(lambda: sum("estimated as the end of a run" in line for line in live.lines) >= 2,
