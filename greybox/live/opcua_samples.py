@@ -7,6 +7,9 @@ time stamp are one sample (a variable holding an array holds a batch: the arrays
 columns, ``{column: value}``, for the decoder every source's messages go through: a value that is not a number
 (text, null, NaN) is then refused there in one line, as in a message of any other source.
 
+A value whose stamp is not later than that of the last sample given is that sample again (a subscription made
+anew after a reconnection starts with the variables' current values) and is left out.
+
 A sample some of whose variables never deliver its stamp (every such variable has delivered a later one) is
 given as it is, without them: the decoder refuses it for the columns it lacks, in one line.
 """
@@ -42,6 +45,7 @@ class SampleAssembler:
         self.max_pending = int(max_pending)
         self._pending: dict[Hashable, dict[str, object]] = {}
         self._latest: dict[str, Hashable] = {}
+        self._given: Hashable | None = None  # the stamp of the last sample given
 
     @property
     def pending(self) -> int:
@@ -60,6 +64,8 @@ class SampleAssembler:
         value : object
             The value as the server gave it (a number, an array of numbers, or anything else).
         """
+        if self._given is not None and not stamp > self._given:
+            return
         self._pending.setdefault(stamp, {})[column] = value
         if column not in self._latest or stamp > self._latest[column]:
             self._latest[column] = stamp
@@ -85,6 +91,7 @@ class SampleAssembler:
             if not (complete or self._dead(stamp, values) or len(self._pending) > self.max_pending):
                 break
             del self._pending[stamp]
+            self._given = stamp
             ready.append((stamp, values, complete and all(map(_plain_number, values.values()))))
         out: list[tuple[Hashable, dict[str, object]]] = []
         batch = None

@@ -168,13 +168,21 @@ class OpcUaServer:
         """Stop the server (every connection closed, the sessions and subscriptions gone) and start it again."""
         import time
 
-        self.run(self.server.stop())
+        self.run(self._stop())
         time.sleep(down_s)
         self.run(self.server.start())
 
+    async def _stop(self):
+        # asyncua closes the clients' connections before its listening socket: a client that connects again in
+        # between keeps the stop waiting for its connection; refuse new ones first
+        listening = getattr(self.server.bserver, "_server", None)
+        if listening is not None:
+            listening.close()
+        await self.server.stop()
+
     def close(self) -> None:
         if self.server is not None:
-            self.run(self.server.stop())
+            self.run(self._stop())
             self.server = None
         self.loop.call_soon_threadsafe(self.loop.stop)
         self.thread.join(5.0)

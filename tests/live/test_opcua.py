@@ -242,8 +242,8 @@ def test_the_command_survives_a_server_restart_in_lines_of_its_own(own_opcua_ser
         own_opcua_server.restart(down_s=1.5)
         wait_until(lambda: live.said("OPC UA server connection back"), "the reconnection", 30)
         axis.publish(cut_raw, 200, 400)
-        wait_until(lambda: sum("estimated as the end of a run" in line for line in live.lines) >= 2,
-                   "the estimates", 30)
+        wait_until(lambda: sum("the 184 sample(s) waiting are estimated" in line for line in live.lines) >= 2,
+                   "the tails of both runs", 30)  # 184: the look-ahead at 2 ms
     except AssertionError as exc:
         raise AssertionError(f"{exc}: {live.lines}") from None
     finally:

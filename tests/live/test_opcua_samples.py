@@ -55,3 +55,16 @@ def test_the_samples_held_are_bounded():
         add_sample(assembler, stamp, (0.002 * stamp, 1.0), COLUMNS[:2])
     taken = assembler.take()
     assert [stamp for stamp, _ in taken] == [0, 1] and assembler.pending == 3
+
+
+def test_a_sample_given_again_is_left_out():
+    """After a reconnection the subscription starts with the current values: the last sample again."""
+    assembler = SampleAssembler(COLUMNS)
+    add_sample(assembler, 1, (0.002, 1.0, 0.5))
+    add_sample(assembler, 2, (0.004, 1.1, 0.6))
+    assert len(assembler.take()) == 1
+    add_sample(assembler, 2, (0.004, 1.1, 0.6))  # the current values again
+    add_sample(assembler, 1, (0.002, 1.0, 0.5))
+    assert assembler.take() == [] and assembler.pending == 0
+    add_sample(assembler, 3, (0.006, 1.2, 0.7))
+    assert assembler.take() == [(3, {"time_s": [0.006], "position_mm": [1.2], "current_A": [0.7]})]
