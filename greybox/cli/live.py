@@ -1,11 +1,11 @@
-"""``greybox live``: the process current and force of a live stream (MQTT or stdin), as it comes."""
+"""``greybox live``: the process current and force of a live stream (MQTT, OPC UA or stdin), as it comes."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-from ._types import FRACTION, GAP_STEPS, POSITIVE, POSITIVE_INT, NumberRange, positive
+from ._types import FRACTION, GAP_STEPS, POSITIVE, POSITIVE_INT, NumberRange, non_negative, positive
 
 #: The QoS levels taken.
 QOS = NumberRange(int, low=0, high=1, description="a QoS of 0 or 1")
@@ -15,6 +15,7 @@ def add_parser(subparsers) -> None:
     from ..live.broker import PASSWORD_ENV
     from ..live.lookahead import LATENCIES
     from ..live.messages import MAX_MESSAGE_BYTES, MAX_MESSAGE_DEPTH
+    from ..live.opcua import OPCUA_PASSWORD_ENV, SECURITY_MODES, SECURITY_POLICIES
     from ..live.report import LINE_INTERVAL_S, LINES_PER_INTERVAL
     from ..live.sources import DEFAULT_IDLE_S
     from ..models.chunked import DEFAULT_CHUNK_S
@@ -35,8 +36,9 @@ def add_parser(subparsers) -> None:
                         help="read options from this file: keys are the option names (record_s = 60, limit = "
                         "['force_process_N=1500'], tls_ca = 'ca.pem', ...); the command line overrides them")
     parser.add_argument("--source", metavar="SOURCE",
-                        help="'-' (JSON or CSV lines on stdin) or mqtt[s]://[USER@]HOST[:PORT]/TOPIC (wildcards + "
-                        "and #; mqtts for TLS); required, here or in --config")
+                        help="'-' (JSON or CSV lines on stdin), mqtt[s]://[USER@]HOST[:PORT]/TOPIC (wildcards + "
+                        "and #; mqtts for TLS) or opc.tcp://[USER@]HOST[:PORT] (an OPC UA server's variables, named "
+                        "by --node); required, here or in --config")
     parser.add_argument("--sink", default="-", metavar="SINK",
                         help="'-' (JSON lines on stdout, the default) or mqtt[s]://[USER@]HOST[:PORT]/TOPIC (alarms "
                         "retained on TOPIC/alarm/COLUMN, the status on TOPIC/status)")
@@ -63,6 +65,27 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--status-topic", metavar="TOPIC",
                         help="retained status (online/offline, the counters every 10 s) on this topic; default "
                         "SINK_TOPIC/status with an MQTT sink")
+    parser.add_argument("--node", action="append", default=[], metavar="COLUMN=NODEID",
+                        help="with an opc.tcp:// source: the variable giving a column, e.g. "
+                        "'position_mm=ns=2;s=Axis.X.Position' (repeatable: time, position, velocity, current, ...; "
+                        "X_position_mm, ... for the axes of a machine model)")
+    parser.add_argument("--opcua-password-file", metavar="FILE",
+                        help=f"file whose first line is the OPC UA user's password (the user in the address, "
+                        f"opc.tcp://USER@HOST; default: the environment variable {OPCUA_PASSWORD_ENV})")
+    parser.add_argument("--opcua-security", metavar="POLICY,MODE",
+                        help=f"OPC UA message security, POLICY one of {', '.join(SECURITY_POLICIES)}, MODE one of "
+                        f"{', '.join(SECURITY_MODES)} (e.g. Basic256Sha256,SignAndEncrypt); with --opcua-cert and "
+                        "--opcua-key")
+    parser.add_argument("--opcua-cert", metavar="PEM", help="the client's application certificate (PEM or DER)")
+    parser.add_argument("--opcua-key", metavar="PEM", help="the key of the client's certificate")
+    parser.add_argument("--opcua-server-cert", metavar="PEM",
+                        help="the server's certificate: accept that server only")
+    parser.add_argument("--sampling-ms", type=non_negative("milliseconds"), default=0.0, metavar="MS",
+                        help="OPC UA sampling interval of each variable (default 0: as fast as the server samples)")
+    parser.add_argument("--publishing-ms", type=positive("milliseconds"), default=20.0, metavar="MS",
+                        help="OPC UA publishing interval of the subscription (default 20)")
+    parser.add_argument("--opcua-queue-size", type=POSITIVE_INT, default=1000, metavar="N",
+                        help="values the server holds per variable between two publishes (default 1000)")
     parser.add_argument("--axis-config", metavar="TOML",
                         help="axis metadata: adds force_process_N (torque_process_Nm), channel names")
     parser.add_argument("--machine", metavar="TOML",
@@ -164,9 +187,18 @@ def run(args: argparse.Namespace) -> int:
     from ..live.broker import BrokerOptions, read_password
     from ..live.limits import parse_duration, parse_limit
     from ..live.messages import MessageBounds
+    from ..live.opcua import OPCUA_PASSWORD_ENV, OpcUaOptions, is_opcua_address, parse_nodes
     from ..live.run import run_live
 
     args = _configured(args)
+    opcua = None
+    if args.node or is_opcua_address(args.source):
+        opcua = OpcUaOptions(
+            nodes=parse_nodes(args.node), password=read_password(args.opcua_password_file, variable=OPCUA_PASSWORD_ENV,
+                                                                 option="--opcua-password-file"),
+            security=args.opcua_security, cert_file=args.opcua_cert, key_file=args.opcua_key,
+            server_cert_file=args.opcua_server_cert, sampling_ms=args.sampling_ms, publishing_ms=args.publishing_ms,
+            queue_size=args.opcua_queue_size, connect_timeout=args.connect_timeout)
     broker = BrokerOptions(username=args.username, password=read_password(args.password_file), ca_file=args.tls_ca,
                            cert_file=args.tls_cert, key_file=args.tls_key, client_id=args.client_id, qos=args.qos,
                            session_expiry_s=args.session_expiry, queue_size=args.queue_size,
@@ -179,7 +211,7 @@ def run(args: argparse.Namespace) -> int:
         sample_time=args.sample_time, tolerance=args.time_tolerance, cutoff_hz=args.cutoff_hz, chunk_s=args.chunk_s,
         max_gap=args.max_gap, latency=args.latency,
         columns=parse_column_mapping(args.columns) if args.columns else None, axis=args.axis,
-        broker=broker, status_topic=args.status_topic,
+        broker=broker, status_topic=args.status_topic, opcua=opcua,
         bounds=MessageBounds(max_bytes=args.max_message_bytes, max_depth=args.max_depth),
         lines_per_interval=args.lines_per_interval, idle_s=args.idle_s, say=_say)
     for path in outcome.recorded:

@@ -192,8 +192,9 @@ def parse_address(text: str, option: str, *, wildcards: bool = True) -> BrokerAd
     return BrokerAddress(parts.hostname, port, topic, tls=tls, username=username)
 
 
-def read_password(path=None, *, environ=None) -> str | None:
-    """The broker password: the first line of ``path``, else the environment variable :data:`PASSWORD_ENV`.
+def read_password(path=None, *, environ=None, variable: str = PASSWORD_ENV,
+                  option: str = "--password-file") -> str | None:
+    """A password: the first line of ``path``, else the environment variable ``variable``.
 
     Parameters
     ----------
@@ -201,6 +202,10 @@ def read_password(path=None, *, environ=None) -> str | None:
         A file holding the password on its first line (readable by the service's user alone).
     environ : mapping, optional
         The environment (default ``os.environ``).
+    variable : str, default :data:`PASSWORD_ENV`
+        The environment variable read without ``path`` (the broker's by default).
+    option : str, default "--password-file"
+        The option that gave ``path``, named in errors.
 
     Returns
     -------
@@ -213,16 +218,16 @@ def read_password(path=None, *, environ=None) -> str | None:
         When the file cannot be read or its first line is empty.
     """
     if path is None:
-        value = (os.environ if environ is None else environ).get(PASSWORD_ENV)
+        value = (os.environ if environ is None else environ).get(variable)
         return value or None
     try:
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise GreyboxError(f"--password-file {path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") \
+        raise GreyboxError(f"{option} {path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") \
             from None
     lines = text.splitlines()
     if not lines or not lines[0]:
-        raise GreyboxError(f"--password-file {path}: the first line (the password) is empty")
+        raise GreyboxError(f"{option} {path}: the first line (the password) is empty")
     return lines[0]
 
 

@@ -1,5 +1,8 @@
 """The source, the sink and the status topic of ``greybox live``, opened and checked together.
 
+The source is stdin, an MQTT topic or an OPC UA server's variables (:mod:`greybox.live.opcua`); the sink
+stdout or an MQTT topic.
+
 The source and the sink are opened with one client id (``<id>-in``, ``<id>-out``). The status topic
 (``<sink topic>/status`` by default with an MQTT sink) goes out through the sink's connection, or through
 the source's when the estimates go to stdout; that connection's will is the ``offline`` status. A sink on
@@ -14,6 +17,7 @@ from typing import Sequence, TextIO
 
 from ..errors import GreyboxError
 from .broker import BrokerOptions, default_client_id, is_address, parse_address, topic_matches
+from .opcua import OpcUaOptions, OpcUaSource, is_opcua_address, parse_opcua_address
 from .sinks import LineSink, MqttSink
 from .sources import LineSource, MqttSource
 from .status import StatusTopic, will_message
@@ -27,8 +31,8 @@ class Endpoints:
 
     Attributes
     ----------
-    stream : LineSource or MqttSource
-        The source.
+    stream : Source
+        The source (:class:`~greybox.live.source_base.Source`: stdin lines, MQTT or OPC UA).
     out : LineSink or MqttSink
         The sink.
     status : StatusTopic or None
@@ -57,13 +61,13 @@ def _output_topics(sink_topic: str, axes: Sequence[str | None], columns: Sequenc
 
 def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_topic: str | None = None,
                    axes: Sequence[str | None] = (None,), limit_columns: Sequence[str] = (),
-                   stdin: TextIO, stdout: TextIO) -> Endpoints:
+                   opcua: OpcUaOptions | None = None, stdin: TextIO, stdout: TextIO) -> Endpoints:
     """Open the source and the sink (and the status topic), after checking that they do not loop.
 
     Parameters
     ----------
     source : str
-        ``-`` or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC`` (wildcards allowed).
+        ``-``, ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC`` (wildcards allowed) or ``opc.tcp://[USER@]HOST[:PORT]``.
     sink : str
         ``-`` or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC``.
     options : BrokerOptions
@@ -74,6 +78,8 @@ def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_top
         The axes of a machine (their estimates go to ``<sink topic>/<axis>``), or ``(None,)``.
     limit_columns : sequence of str, default ()
         The columns with limits (their alarms go to ``.../alarm/<column>``).
+    opcua : OpcUaOptions, optional
+        The variables, log-in and subscription of an ``opc.tcp://`` source (needed with one, refused otherwise).
     stdin, stdout : text file
         The streams of ``-``.
 
@@ -83,11 +89,16 @@ def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_top
         For an address that cannot be read, a sink whose topics the source would receive, a status topic
         without a broker, or a broker that cannot be reached or refuses the connection.
     """
-    if source != "-" and not is_address(source):
-        raise GreyboxError(f"--source {source}: give '-' (lines on stdin) or mqtt://HOST[:PORT]/TOPIC")
+    server_at = parse_opcua_address(source) if is_opcua_address(source) else None
+    if source != "-" and not is_address(source) and server_at is None:
+        raise GreyboxError(f"--source {source}: give '-' (lines on stdin), mqtt://HOST[:PORT]/TOPIC or "
+                           "opc.tcp://HOST[:PORT]")
     if sink != "-" and not is_address(sink):
         raise GreyboxError(f"--sink {sink}: give '-' (lines on stdout) or mqtt://HOST[:PORT]/TOPIC")
-    source_at = parse_address(source, "--source") if source != "-" else None
+    if (server_at is None) != (opcua is None):
+        raise GreyboxError("--node applies to an opc.tcp:// source" if server_at is None else
+                           f"--source {server_at}: give the variables to read, --node COLUMN=NODEID each")
+    source_at = parse_address(source, "--source") if source != "-" and server_at is None else None
     sink_at = parse_address(sink, "--sink", wildcards=False) if sink != "-" else None
     if status_topic is None and sink_at is not None:
         status_topic = f"{sink_at.topic}/status"
@@ -107,8 +118,12 @@ def open_endpoints(source: str, sink: str, *, options: BrokerOptions, status_top
                                "give the sink a topic outside the filter")
     options = _completed(options, [address for address in (source_at, sink_at) if address is not None])
     will = (status_topic, will_message(options.client_id)) if status_topic is not None else None
-    stream = LineSource(stdin) if source_at is None else MqttSource(
-        source_at, options, will=will if sink_at is None else None)
+    if server_at is not None:
+        stream = OpcUaSource(server_at, opcua)
+    elif source_at is None:
+        stream = LineSource(stdin)
+    else:
+        stream = MqttSource(source_at, options, will=will if sink_at is None else None)
     try:
         out = LineSink(stdout) if sink_at is None else MqttSink(sink_at, options, will=will)
     except BaseException:

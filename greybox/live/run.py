@@ -25,6 +25,7 @@ from .estimator import LiveEstimator
 from .limits import Limit, LimitWatch
 from .machine import MachineSession
 from .messages import DEFAULT_BOUNDS, MessageBounds
+from .opcua import OpcUaOptions
 from .recording import DEFAULT_RECORD_S, Recorder
 from .report import LINES_PER_INTERVAL, LineLimiter
 from .session import LiveSession
@@ -211,7 +212,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
              tolerance: float = 0.25, cutoff_hz: float | None = None, chunk_s: float = DEFAULT_CHUNK_S,
              max_gap: float | None = None, latency: str = "exact", columns: Mapping[str, str] | None = None,
              axis: str | None = None, broker: BrokerOptions | None = None,
-             status_topic: str | None = None, bounds: MessageBounds = DEFAULT_BOUNDS,
+             status_topic: str | None = None, opcua: OpcUaOptions | None = None,
+             bounds: MessageBounds = DEFAULT_BOUNDS,
              lines_per_interval: int = LINES_PER_INTERVAL, idle_s: float | None = DEFAULT_IDLE_S,
              say: Callable[[str], None] = print, stdin: TextIO | None = None,
              stdout: TextIO | None = None) -> LiveOutcome:
@@ -223,7 +225,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         Model file written by ``greybox train``, or a machine model (a directory written by ``greybox train
         --axes``): then one session per axis (:mod:`greybox.live.machine`).
     source : str
-        ``-`` (JSON or CSV lines on ``stdin``) or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC`` (wildcards allowed).
+        ``-`` (JSON or CSV lines on ``stdin``), ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC`` (wildcards allowed) or
+        ``opc.tcp://[USER@]HOST[:PORT]`` (the variables in ``opcua``).
     sink : str, default "-"
         ``-`` (JSON lines on ``stdout``) or ``mqtt[s]://[USER@]HOST[:PORT]/TOPIC``.
     axis_config_path : path-like, optional
@@ -269,6 +272,9 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     status_topic : str, optional
         Topic of the retained status (online/offline, the counters every 10 s); default
         ``<sink topic>/status`` with an MQTT sink.
+    opcua : OpcUaOptions, optional
+        With an ``opc.tcp://`` source: the variables (``{column: node id}``), the log-in, the security and the
+        subscription's intervals.
     bounds : MessageBounds, optional
         The largest message taken (bytes, JSON nesting, samples); a larger one is refused in one line.
     lines_per_interval : int, default 20
@@ -318,7 +324,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                               limits=limits, hold_s=hold_s, columns=columns, axis=axis, source=source, say=lines,
                               bounds=bounds, envelope_path=envelope_path), [None]
     ends = open_endpoints(source, sink, options=broker or BrokerOptions(), status_topic=status_topic, axes=axes,
-                          limit_columns=watched, stdin=stdin or sys.stdin,
+                          limit_columns=watched, opcua=opcua, stdin=stdin or sys.stdin,
                           stdout=stdout or sys.stdout)
     stream, out = ends.stream, ends.out
     try:

@@ -231,7 +231,7 @@ class LiveSession:
             self.stats.outputs_lost, self.stats.outputs_queued = self.sink.lost, self.sink.queued
 
     def connection(self, change: ConnectionChange, *, quiet: bool = False) -> None:
-        """Count a loss or return of the broker connection, and say it.
+        """Count a loss or return of the source's connection (broker or server), and say it.
 
         Parameters
         ----------
@@ -244,13 +244,12 @@ class LiveSession:
         if not change.connected:
             self.stats.disconnections += 1
             self._offline_since = change.time_s
-            say("broker connection lost; reconnecting")
+            say(f"{change.peer} connection lost; reconnecting")
         else:
             away = change.time_s - self._offline_since if self._offline_since is not None else 0.0
             self.stats.offline_s += away
             self._offline_since = None
-            say(f"broker connection back after {away:.1f} s; the messages the broker kept for the session (QoS 1) "
-                "come now, any missing make a gap in the time stamps (the model's state re-initialised)")
+            say(f"{change.peer} connection back after {away:.1f} s" + (f"; {change.after}" if change.after else ""))
 
     def _publish(self, out: StepOutput, seq) -> None:
         for event in out.events:

@@ -1,6 +1,7 @@
 """Where the messages of a live stream come from: lines of a text stream (stdin) or an MQTT topic.
 
-A source is an iterable of :class:`Received` messages and :class:`ConnectionChange` events, in the order
+(An OPC UA server's variables: :mod:`greybox.live.opcua`.) A source (:class:`~greybox.live.source_base.Source`)
+is an iterable of :class:`Received` messages and :class:`ConnectionChange` events, in the order
 they happened; it ends when the stream does (end of the text stream; an MQTT source runs until the
 command is stopped). An MQTT source also gives an :class:`Idle` each time no message came for its poll
 interval, so that the command can do what is due while the stream is quiet.
@@ -10,10 +11,10 @@ from __future__ import annotations
 
 import queue
 import time
-from dataclasses import dataclass
 from typing import Iterator, TextIO
 
 from .broker import BrokerAddress, BrokerOptions, Connection
+from .source_base import ConnectionChange, Idle, Received, Source, polled
 
 __all__ = ["DEFAULT_IDLE_S", "Received", "ConnectionChange", "Idle", "LineSource", "MqttSource"]
 
@@ -21,61 +22,12 @@ __all__ = ["DEFAULT_IDLE_S", "Received", "ConnectionChange", "Idle", "LineSource
 DEFAULT_IDLE_S = 0.5
 
 
-@dataclass(frozen=True)
-class Received:
-    """One message as it arrived.
-
-    Attributes
-    ----------
-    payload : str or bytes
-        The message text.
-    name : str
-        How errors name it, e.g. "line 12" or "message 12 on axis/X".
-    arrived_s : float
-        Arrival time, ``time.time()`` [s].
-    topic : str
-        The MQTT topic ("" for a line of a text stream).
-    """
-
-    payload: str | bytes
-    name: str
-    arrived_s: float
-    topic: str = ""
+#: What the return of the broker means for the stream (said after it).
+_RESUMED = ("the messages the broker kept for the session (QoS 1) come now, any missing make a gap in the time "
+            "stamps (the model's state re-initialised)")
 
 
-@dataclass(frozen=True)
-class ConnectionChange:
-    """The connection to the broker was lost (``connected`` False) or is back.
-
-    Attributes
-    ----------
-    connected : bool
-        The new state.
-    time_s : float
-        When, ``time.time()`` [s].
-    reason : str
-        Why, in the broker's or paho's words ("" for a return).
-    """
-
-    connected: bool
-    time_s: float
-    reason: str = ""
-
-
-@dataclass(frozen=True)
-class Idle:
-    """No message came for the source's poll interval.
-
-    Attributes
-    ----------
-    time_s : float
-        When, ``time.time()`` [s].
-    """
-
-    time_s: float
-
-
-class LineSource:
+class LineSource(Source):
     """Messages as lines of a text stream: JSON lines, or CSV lines after a header line.
 
     Parameters
@@ -99,7 +51,7 @@ class LineSource:
         """Nothing to release (the stream is the caller's)."""
 
 
-class MqttSource:
+class MqttSource(Source):
     """Messages of an MQTT topic, taken in arrival order; connection losses and returns in between.
 
     Parameters
@@ -133,16 +85,11 @@ class MqttSource:
         self._queue.put((topic, payload, arrived_s))
 
     def _state(self, connected: bool, time_s: float, reason: str) -> None:
-        self._queue.put(ConnectionChange(connected, time_s, reason))
+        self._queue.put(ConnectionChange(connected, time_s, reason, after=_RESUMED if connected else ""))
 
     def __iter__(self) -> Iterator[Received | ConnectionChange | Idle]:
-        while True:
-            try:
-                item = self._queue.get(timeout=self.poll_s)
-            except queue.Empty:
-                yield Idle(time.time())
-                continue
-            if isinstance(item, ConnectionChange):
+        for item in polled(self._queue, self.poll_s):
+            if isinstance(item, (Idle, ConnectionChange)):
                 yield item
                 continue
             topic, payload, arrived_s = item

@@ -111,3 +111,25 @@ def certificates(tmp_path) -> Certificates:
     folder = tmp_path / "pki"
     folder.mkdir()
     return Certificates(folder)
+
+
+@pytest.fixture(scope="session")
+def opcua_server(tmp_path_factory):
+    """An asyncua OPC UA server in the test process, shared by the tests (its start takes seconds); each test makes
+    its own axis of variables (:meth:`opcua_helpers.OpcUaServer.axis`)."""
+    from opcua_helpers import OpcUaServer
+
+    running = OpcUaServer(tmp_path_factory.mktemp("opcua")).start()
+    yield running
+    running.close()
+
+
+@pytest.fixture
+def own_opcua_server(tmp_path):
+    """An asyncua OPC UA server of the test's own, for tests that stop and restart it (a server that others' clients
+    were connected to can take long to stop)."""
+    from opcua_helpers import OpcUaServer
+
+    running = OpcUaServer(tmp_path / "opcua").start()
+    yield running
+    running.close()
