@@ -70,6 +70,10 @@ class RecordSpec:
 
 #: Every record the pages cite.
 SPECS = {spec.name: spec for spec in (
+    RecordSpec("live-speed", ("benchmarks/bench_live.py", "--seconds", "20"),
+               ("greybox/live", "greybox/models", "greybox/data", "greybox/predict", "greybox/persistence.py",
+                "benchmarks/bench_live.py", "data"),
+               "greybox live's speed: compute per sample, 16 axes' CPU share, publish to estimate through Mosquitto"),
     RecordSpec("predict-hour", ("benchmarks/bench_predict_hour.py", "--json"),
                ("data", "greybox/data", "greybox/models", "greybox/predict", "greybox/persistence.py",
                 "greybox/threads.py", "greybox/cli/predict.py", "benchmarks/bench_predict_hour.py"),

@@ -251,6 +251,30 @@ def _predict_hour(record: dict) -> str:
             f"({_where(record)}).\n")
 
 
+def _live_speed(record: dict) -> str:
+    f = record["figures"]
+    c, share, ends = f["compute"], f["cpu_share"], f["end_to_end"]
+    least = c.get("least_cpu_p99_us_per_sample")
+    rows = ["| figure | target | measured |", "|---|---|---|",
+            f"| compute per sample, CPU time of the thread, one pass ({c['messages']} messages of {c['batch']}) | | "
+            f"p50 {c['cpu_p50_us_per_sample']:.1f} us, p99 {c['cpu_p99_us_per_sample']:.1f} us |",
+            f"| the same, each message's least CPU time over {c.get('repeats', 1)} passes (the code's own cost) | "
+            f"p99 <= 50 us: {_met(least is not None and least <= 50.0)} | "
+            + ("–" if least is None else f"p50 {c['least_cpu_p50_us_per_sample']:.1f} us, p99 {least:.1f} us") + " |",
+            f"| CPU of {share['axes']} axes at 500 Hz | <= 25 % of one core: "
+            f"{_met(share['share_of_one_core'] <= 0.25)} | "
+            f"{100 * share['share_of_one_core']:.1f} % ({share['cpu_s']:.1f} CPU s for {share['stream_s']:.1f} s) |"]
+    if "p99_ms" in ends:
+        rows.append(f"| publish -> arrival of the estimate through the local Mosquitto, 500 Hz in batches of "
+                    f"{ends['batch']} | p99 <= 5 ms: {_met(ends['p99_ms'] <= 5.0)} | p50 {ends['p50_ms']:.2f} ms, "
+                    f"p99 {ends['p99_ms']:.2f} ms, max {ends['max_ms']:.2f} ms |")
+    else:
+        rows.append(f"| publish -> arrival of the estimate through the local Mosquitto | p99 <= 5 ms | "
+                    f"{ends.get('skipped', 'not measured')} |")
+    return ("\n".join(rows) + f"\n\n`{record['command']}` ({f['seconds']:.0f} s of `{Path(f['log']).name}`, "
+            f"{f['model']}; {_where(record)}).\n")
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -282,6 +306,7 @@ VIEWS = {
     "default-tests-run": View(("default-tests",), _tests_run),
     "monitor-independent": View(("monitor-independent",), _monitor_independent),
     "predict-hour": View(("predict-hour",), _predict_hour),
+    "live-speed": View(("live-speed",), _live_speed),
     "readme-measured": View(("reproduce", "default-tests", "monitor-independent"), _readme_table),
     "live-cut-force": View(("live-low-latency",), _live_cut_force),
     "live-low-latency": View(("live-low-latency",), _live_low_latency),
