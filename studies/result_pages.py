@@ -202,7 +202,7 @@ def _live_cut_force(record: dict) -> str:
 
 def _live_low_latency(record: dict) -> str:
     end = record["figures"]["end_to_end_low"]
-    return (f"`nice -n 10 {record['command']}`, {record['seconds']:.0f} s ({_where(record)}): through the local "
+    return (f"`{record['command']}`, {record['seconds']:.0f} s ({_where(record)}): through the local "
             f"Mosquitto at {end['rate_hz']:.0f} Hz in batches of {end['batch']}, with `--latency low`, publish -> "
             f"estimate p50 {end['p50_ms']:.2f} ms, p99 {end['p99_ms']:.2f} ms, max {end['max_ms']:.1f} ms "
             f"({end['answered']} of {end['messages']} messages answered); publish -> alarm "
