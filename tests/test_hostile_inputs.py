@@ -126,6 +126,7 @@ def test_mutated_logs_read_or_fail_clearly(tmp_path, suffix, mutation):
         assert len(result) >= 2 and np.all(np.isfinite(result.position))
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 @seed(2026)
 @settings(FUZZ, max_examples=60)
 @given(kind=st.sampled_from(["gms", "gmssvr"]), mutation=MUTATIONS)
@@ -212,6 +213,7 @@ def test_a_member_stored_twice_is_refused(tmp_path):
         load_model(path)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_a_zip_bomb_is_refused_before_it_is_expanded(tmp_path):
     path = tmp_path / "bomb.gbm"
     members = _members()
@@ -239,6 +241,7 @@ def long_prediction(tmp_path_factory):
     return root
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 @pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGKILL])
 def test_a_run_stopped_mid_write_keeps_the_previous_output(long_prediction, tmp_path, stop):
     out = tmp_path / "process.csv"

@@ -59,6 +59,7 @@ def test_help_lists_every_command_and_loads_no_command_module():
     assert not {"numpy", "greybox.models.friction", "greybox.models", "greybox.data"} & set(modules)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_a_commands_help_loads_that_command_only_and_shows_its_options():
     code, out, modules = loaded_by("train", "--help")
     assert code == 0

@@ -71,6 +71,7 @@ def test_corrupt_and_truncated_mcap(tmp_path, capsys, make_log):
     assert not (tmp_path / "x.png").exists()
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_console_script_exits_2_without_traceback(tmp_path):
     path = bad_csv(tmp_path, "gap.csv", CASES["gap.csv"][0])
     result = subprocess.run(

@@ -43,6 +43,7 @@ def _pages(path) -> int:
     return len(re.findall(rb"/Type /Page\b", path.read_bytes()))
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_evaluate_writes_one_pdf_of_tables_and_figures(fitted, capsys):
     directory, _ = fitted
     report = directory / "report.pdf"

@@ -174,6 +174,7 @@ def test_friction_feedforward_helps_in_gross_sliding(comparison, sliding_compari
     assert rms["lugre"] < 0.7 * rms["coulomb"]
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_the_exact_dynamic_model_as_feedforward_of_itself_as_plant(plant_runs):
     """A GMS model controlled with its own feed-forward: only the discretisation of the model is left."""
     gms = GMSModel(n_starts=1, max_iter=100).fit(plant_runs)

@@ -92,6 +92,7 @@ def test_leave_one_out_quantiles_match_quantiles_of_the_others(n):
         np.testing.assert_allclose(_leave_one_out_quantile(values[order], rank, level), expected, atol=1e-15)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_on_pure_noise_the_family_wise_p_values_are_not_too_small():
     # exchangeable observed and null residuals: P(p <= 0.2) must stay near 0.2 over many noise draws
     rejections = 0

@@ -52,6 +52,7 @@ def test_inputs_are_position_gms_current_and_states(fitted):
     np.testing.assert_allclose(model.input_mean_, X.mean(0), rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_stages_on_different_data_keep_the_gms_frozen():
     first, second = gms_run(4, n=8000), gms_run(5, n=8000)
     model = GMSSVRModel(gms=quick_gms(), **SVR_FIXED).fit_gms(first)

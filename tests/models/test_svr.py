@@ -115,6 +115,7 @@ def test_bad_settings_are_refused_with_a_clear_error():
         SVRCurrentModel(random_state=None, optimize=False).fit(run)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_velocity_weight_is_an_anisotropic_kernel_in_the_standardised_plane():
     from sklearn.svm import SVR
 

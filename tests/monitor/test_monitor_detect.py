@@ -86,6 +86,7 @@ def test_one_odd_day_is_no_alarm():
     assert not ChangeDetector(baseline_days=14, h=5.0).fit(_table({"noise": x}, default=_alternating(40))).alarms_
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_calibrated_threshold_holds_its_false_alarm_rate():
     rng = np.random.default_rng(2024)  # stable axes drawn apart from the calibration's own seed
     axes = [_table({name: rng.normal(1.0, 0.02, 28 + 365) for name in FEATURES}, axis=f"A{i}") for i in range(60)]
@@ -119,6 +120,7 @@ def _false_alarms_per_axis_year(x, h, n_features, baseline_days=28, k=1.0, clip=
     return n_features * (crossed_up.mean() + crossed_low.mean())
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_calibration_on_skewed_days_holds_the_rate_the_normal_one_misses():
     # stable days skewed to high values (not normal); the baselines estimated from 28 of them; drawn apart
     # from the calibration's seed

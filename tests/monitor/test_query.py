@@ -31,6 +31,7 @@ def _history(tmp_path, shifts: dict, days: int = 60):
     return tmp_path
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_axes_ranked_by_their_largest_change(tmp_path):
     history = _history(tmp_path, {("m2", "X"): ("backlash", 0.2), ("m1", "Y"): ("sliding_neg", -0.05)})
     table = changed_most(history, days=20)
@@ -69,6 +70,7 @@ def test_bad_options_and_histories(tmp_path):
         changed_most(history)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_a_row_file_wins_over_its_compacted_row(tmp_path):
     history = _history(tmp_path, {})
     compact_history(history)

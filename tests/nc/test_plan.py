@@ -117,6 +117,7 @@ def test_the_twin_runs_a_program_at_its_feeds_and_stops_at_its_reversals():
         program_trajectory(Program("Y", (Move(-250.0, None),)), axis_geometry("X"))
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_plan_to_log_to_model_to_process_force(tmp_path, capsys):
     program = tmp_path / "aircuts.mpf"
     assert cli.main(["plan", "--axis", "X", "--travel", "-510:0", "--window", "-275:-225", "--feed", "100:2000",

@@ -43,6 +43,7 @@ def test_the_region_is_the_range_of_the_training_runs_and_the_flags_follow_it(lo
     assert far["position"].mean() > 0.8
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_gms_svr_adds_its_input_space_and_covers_both_stages(logs):
     model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=60), **SMALL_SVR).fit_staged(logs["A"], logs["C"])
     both = np.concatenate([logs["A"].position, logs["C"].position])
@@ -112,6 +113,7 @@ def test_a_model_file_without_a_region_still_predicts_and_says_so(logs, tmp_path
     assert "outside_training" not in result.columns()
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_gms_svr_flags_its_inputs_in_chunks_equal_to_the_whole_run(logs):
     model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=60), **SMALL_SVR).fit(logs["A"])
     long_log = prepare([make_dataset("X", "C", seed=35, duration_s=130)])[0]
@@ -127,6 +129,7 @@ def test_gms_svr_flags_its_inputs_in_chunks_equal_to_the_whole_run(logs):
     np.testing.assert_array_equal(np.concatenate(parts), expected)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_gms_svr_predicts_and_flags_a_chunk_with_one_gms_pass_as_it_does_apart(logs):
     model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=60), **SMALL_SVR).fit(logs["A"])
     run = prepare([make_dataset("X", "C", seed=36, duration_s=20)])[0]

@@ -285,6 +285,7 @@ def test_single_element_without_stages():
     assert model.n_params == 8
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_staged_identification_gives_the_same_model_for_every_seed():
     # the perturbed starts come from a fixed design: the seed does not change the staged search
     log = synthetic_log(6.0, seed=3, noise=0.01)

@@ -35,6 +35,7 @@ def fine_reference(velocity, sigma0):
     return np.array(out)
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_stiff_bristles_at_2ms_match_a_fine_implicit_reference():
     sigma0 = 1e3  # A/mm: sigma0 |v| T / g reaches ~300, far beyond forward Euler's limit of 2
     t = np.arange(150) * STEP

@@ -7,9 +7,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import greybox
 
 
+@pytest.mark.slow  # 2-11 s, the longest of the default run (300 s in all in session 18): in the slow run
 def test_numba_cache_is_kept_out_of_the_package_directory(tmp_path):
     package = Path(greybox.__file__).resolve().parent
     env = {key: value for key, value in os.environ.items() if key != "NUMBA_CACHE_DIR"}
