@@ -15,9 +15,9 @@ from greybox.data.machine_config import parse_machine_config, read_machine_confi
 from greybox.data.prepare import prepare
 from greybox.data.units import axes_in_columns
 from greybox.errors import GreyboxError, LogError, ModelFileError
-from greybox.machine_model import MANIFEST, MachineModel, load_machine, save_machine
+from greybox.models.files import load_model
 from greybox.models.friction import StribeckModel
-from greybox.persistence import load_model
+from greybox.models.machine import MANIFEST, MachineModel, load_machine, save_machine
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 

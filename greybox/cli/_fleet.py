@@ -5,10 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from pathlib import Path
 from typing import Callable
 
-__all__ = ["check_out_dir", "fleet_progress", "read_options", "report_fleet"]
+__all__ = ["fleet_progress", "read_options", "report_fleet"]
 
 
 def read_options(args: argparse.Namespace) -> dict:
@@ -29,21 +28,6 @@ def read_options(args: argparse.Namespace) -> dict:
             "axis": getattr(args, "axis", None), "sample_time": args.sample_time,
             "time_tolerance": args.time_tolerance, "cutoff_hz": getattr(args, "cutoff_hz", None),
             "resample": getattr(args, "resample", None), "max_gap": getattr(args, "max_gap", MAX_GAP_STEPS)}
-
-
-def check_out_dir(out: str, inputs=()) -> Path:
-    """``--out`` of a fleet run, resolved (:func:`greybox.fleet.check_out_dir`).
-
-    Parameters
-    ----------
-    out : str
-        The ``--out`` path given on the command line.
-    inputs : iterable of str or Path, default ()
-        Input paths of the run; the output directory must not be one of them.
-    """
-    from ..fleet import check_out_dir as checked
-
-    return checked(out, inputs)
 
 
 def fleet_progress(noun: str, quiet: bool, label: Callable[[dict], str]) -> Callable[[int, int, dict], None]:
