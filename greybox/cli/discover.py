@@ -19,8 +19,7 @@ from ..models.effects import EFFECT_NAMES, effect
 from ..models.files import save_verified
 from ..models.registry import MODEL_CLASSES
 from ._build import CommandLineError, add_model_arguments, build_model
-from ._fleet import read_options
-from ._options import add_log_arguments, read_logs
+from ._options import add_log_arguments, read_logs, read_options
 from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED
 
 

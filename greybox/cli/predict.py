@@ -83,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
     from ..fleet.predict import predict_fleet
     from ..predict import predict_logs
     from ..predict.run import is_fleet
-    from ._fleet import fleet_progress, read_options
+    from ._fleet import fleet_progress
+    from ._options import read_options
 
     run_started = getattr(args, "started_s", None) or time.perf_counter()
     options = dict(out=args.out, axis_config=args.axis_config, machine=args.machine, calibration=args.calibration,

@@ -15,9 +15,8 @@ from ..identify.intervals import METHODS as INTERVAL_METHODS
 from ..models.registry import MODEL_CLASSES
 from ..train.candidates import DEFAULT_CANDIDATES
 from ._build import add_model_arguments, build_model
-from ._fleet import read_options
 from ._model_text import model_lines
-from ._options import add_log_arguments
+from ._options import add_log_arguments, read_options
 from ._types import POSITIVE_INT
 
 
