@@ -7,7 +7,7 @@ Usage::
 
 Synthesises ``--logs`` cutting logs of the twin's X axis (dataset A of ``--duration`` seconds each, MCAP,
 different seeds) in two machine folders, trains ``--model`` on a short air cut, and runs the fleet
-command (the library call behind it, :func:`greybox.predict.fleet.run_fleet`) twice from scratch: a local
+command (the library call behind it, :func:`greybox.fleet.predict.run_fleet`) twice from scratch: a local
 cluster of 1 worker, then of 2. With ``--train`` the fleet trains instead a ``--model`` per machine on
 its logs (:func:`greybox.fleet.train.run_training`, two tasks; short logs, ``--duration 60``, keep it
 quick). Printed, measured in one run on this machine (its cores stated):
@@ -33,10 +33,10 @@ from pathlib import Path
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.fleet import expand_logs
+from greybox.fleet.predict import fleet_jobs, run_fleet
 from greybox.fleet.train import run_training, train_jobs
+from greybox.models.files import save_model
 from greybox.models.registry import model_class
-from greybox.persistence import save_model
-from greybox.predict.fleet import fleet_jobs, run_fleet
 from greybox.twin import make_dataset
 
 

@@ -82,9 +82,9 @@ def _model(path: str | None, folder: Path, train=(DATA / "X_A.mcap", DATA / "X_B
         return Path(path)
     from greybox.data.io import read_log
     from greybox.data.prepare import prepare
+    from greybox.models.files import save_model
     from greybox.models.friction.gms import GMSModel
     from greybox.models.gmssvr import GMSSVRModel
-    from greybox.persistence import save_model
 
     runs = prepare([read_log(log) for log in train])
     model = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=100), optimize=False, C=0.5, epsilon=0.02, gamma=3.0,
@@ -112,7 +112,7 @@ def _session(model_path, step_s: float):
     from greybox.live.estimator import LiveEstimator
     from greybox.live.session import LiveSession
     from greybox.live.sinks import LineSink
-    from greybox.persistence import load_model
+    from greybox.models.files import load_model
 
     estimator = LiveEstimator(load_model(model_path), sample_time=step_s)
     return LiveSession(estimator, LineSink(_Null()), say=lambda line: None)
@@ -179,7 +179,7 @@ def recording(model_path, minutes: float, batch: int, folder: Path) -> dict:
     from greybox.live.session import LiveSession
     from greybox.live.sinks import LineSink
     from greybox.live.sources import Received
-    from greybox.persistence import load_model
+    from greybox.models.files import load_model
     from greybox.twin import make_dataset
 
     log = make_dataset("X", "C", 7, duration_s=60.0 * minutes, cutting=True).replace(extras={})

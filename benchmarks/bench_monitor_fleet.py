@@ -10,9 +10,9 @@ default cutting: 5795 samples of 2 ms each, with their spindle-load column; the 
 model trained on one air-move day, then, each from scratch on a local cluster of ``--workers`` processes
 (cluster start included):
 
-- ``greybox predict`` of the logs (:func:`greybox.predict.fleet.run_fleet`),
+- ``greybox predict`` of the logs (:func:`greybox.fleet.predict.run_fleet`),
 - ``greybox monitor`` of the logs: fingerprints by their spindle load, into a new history
-  (:func:`greybox.monitor.workflow.run_monitor` with ``workers``), the change detection and the dashboard
+  (:func:`greybox.fleet.monitor.monitor_fleet` with ``workers``), the change detection and the dashboard
   included.
 
 Printed: samples per second of wall time of each and their ratio (monitor over predict), and the ratio
@@ -37,10 +37,11 @@ from greybox.data.blocks import concatenate
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.fleet import expand_logs
+from greybox.fleet.monitor import monitor_fleet
+from greybox.fleet.predict import fleet_jobs, run_fleet
+from greybox.models.files import save_model
 from greybox.models.registry import model_class
 from greybox.monitor.workflow import run_monitor
-from greybox.persistence import save_model
-from greybox.predict.fleet import fleet_jobs, run_fleet
 from greybox.twin.ageing import SPINDLE_COLUMN, aged_log
 from greybox.twin.cutting import CuttingSpec
 
@@ -76,8 +77,8 @@ def main() -> None:
         predict_s = time.perf_counter() - started
         samples = sum(entry.get("samples", 0) for entry in manifest["logs"])
         started = time.perf_counter()
-        result = run_monitor(logs, root / "history", root / "report", spindle_column=SPINDLE_COLUMN,
-                             baseline_days=3, workers=args.workers)
+        result = monitor_fleet(logs, root / "history", root / "report", spindle_column=SPINDLE_COLUMN,
+                               baseline_days=3, workers=args.workers)
         monitor_s = time.perf_counter() - started
         started = time.perf_counter()  # the per-history part alone: detection and dashboard, no log to file
         run_monitor([], root / "history", root / "report2", baseline_days=3)

@@ -42,11 +42,11 @@ from greybox.data import mcap_io
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.metrics import relative_error
+from greybox.models.files import save_model
 from greybox.models.friction.gms import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
 from greybox.models.kernel import expansion as kernel_engine
 from greybox.models.kernel.rbf import rbf_expansion
-from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 DATA = Path(__file__).resolve().parents[1] / "data"
@@ -179,7 +179,7 @@ def predict_cli(model: Path, log: Path, out: Path) -> dict:
 
 def kernel_sums(root: Path) -> dict:
     """The hour's SVR inputs summed by the compiled kernel (1 and all threads) and by the former code."""
-    from greybox.persistence import load_model
+    from greybox.models.files import load_model
 
     model = load_model(root / "gmssvr.gbm")
     (log,) = prepare([read_log(root / "hour.parquet")])

@@ -2,7 +2,7 @@
 
 :func:`provenance`: greybox and library versions, Python, machine, cores.
 :func:`training_record`: the training files (name, size, SHA-256), their preparation, the training
-errors and ranges, stored in every model file :mod:`greybox.persistence` writes for ``greybox train``.
+errors and ranges, stored in every model file :mod:`greybox.models.files` writes for ``greybox train``.
 
 Every report greybox writes records this, so a figure can be traced to the
 versions and the machine that printed it (results of the Bayesian search and
@@ -75,10 +75,10 @@ def provenance_line(info: dict | None = None) -> str:
 
 
 # ------------------------------------------------------------------ how a model was made
-#: Name of the training record in a model file's records (:func:`greybox.persistence.save_model`).
+#: Name of the training record in a model file's records (:func:`greybox.models.files.save_model`).
 TRAINING_RECORD = "training"
 #: The learned attribute a trained model keeps its training record in (:func:`greybox.train.record_training`);
-#: :mod:`greybox.persistence` writes it as the file's :data:`TRAINING_RECORD` and sets it again on loading.
+#: :mod:`greybox.models.files` writes it as the file's :data:`TRAINING_RECORD` and sets it again on loading.
 TRAINING_ATTRIBUTE = "training_record_"
 #: Version of the training record's layout.
 TRAINING_RECORD_VERSION = 1

@@ -1,10 +1,11 @@
-"""The centred moving window over a signal: one copy for every moving mean and moving RMS of greybox."""
+"""The centred moving window over a signal: one copy for every moving mean and moving RMS of greybox, and for
+flags widened on either side."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["centred_mean", "centred_nanmean"]
+__all__ = ["centred_mean", "centred_nanmean", "widened"]
 
 
 def centred_mean(values, width: int, counts=None) -> np.ndarray:
@@ -55,6 +56,26 @@ def centred_nanmean(values, width: int, *, complete: bool = False) -> np.ndarray
     total, number = _window_sums(np.where(valid, values, 0.0), valid.astype(float), width)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(number >= (int(width) if complete else 1), total / np.maximum(number, 1.0), np.nan)
+
+
+def widened(flags, pad: int) -> np.ndarray:
+    """``flags`` widened by ``pad`` samples on either side: true where a flag lies within ``pad`` samples.
+
+    Parameters
+    ----------
+    flags : array_like of bool, shape (n,)
+        The samples flagged.
+    pad : int
+        Samples added on either side of each flag [samples], at least 0.
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+    """
+    flags = np.asarray(flags, dtype=bool)
+    if not pad or not flags.any():
+        return flags
+    return np.convolve(flags.astype(float), np.ones(2 * int(pad) + 1), mode="same") > 0.5
 
 
 def _window_sums(weighted, weights, width: int):

@@ -17,7 +17,7 @@ import numpy as np
 
 from greybox.data.axis_config import read_axis_config
 from greybox.data.reading import read_prepared
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 from greybox.predict.process import predict_process
 
 

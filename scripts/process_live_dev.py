@@ -20,7 +20,7 @@ import numpy as np
 from greybox.data.axis_config import read_axis_config
 from greybox.data.reading import read_prepared
 from greybox.live.envelope import EnvelopeWatch
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 from greybox.predict.process import predict_process
 from greybox.process.alignment import part_slices
 from greybox.process.envelope import Envelope

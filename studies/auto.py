@@ -2,7 +2,7 @@
 
 The protocols construct every model from its seed and call its ``fit`` on the
 training runs; this stand-in's ``fit`` returns the model that
-:func:`greybox.model_choice.choose_model` chooses on those runs, each
+:func:`greybox.train.candidates.choose_model` chooses on those runs, each
 training file held out in turn (one file: three stretches of it), fitted
 on all of them and carrying the table it was chosen from in ``selection_``.
 """
@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 
 from greybox.data.log import as_log_list
-from greybox.model_choice import choose_model
+from greybox.train.candidates import choose_model
 
 __all__ = ["HeldOutChoice"]
 

@@ -41,8 +41,8 @@ RESULTS = ROOT / "docs" / "results"
 #: What the paper's experiments depend on: the shipped data, the models and everything that fits, tests
 #: and reports them.
 _REPRODUCTION = ("data", "greybox/data", "greybox/identify", "greybox/models", "greybox/evaluate",
-                 "greybox/reproduce", "greybox/base.py", "greybox/metrics.py", "greybox/persistence.py",
-                 "greybox/threads.py", "greybox/provenance.py", "benchmarks/bench_reproduce.py")
+                 "greybox/reproduce", "greybox/base.py", "greybox/metrics.py", "greybox/threads.py",
+                 "greybox/provenance.py", "benchmarks/bench_reproduce.py")
 
 
 @dataclass(frozen=True)
@@ -71,12 +71,12 @@ class RecordSpec:
 #: Every record the pages cite.
 SPECS = {spec.name: spec for spec in (
     RecordSpec("live-speed", ("benchmarks/bench_live.py", "--seconds", "20"),
-               ("greybox/live", "greybox/models", "greybox/data", "greybox/predict", "greybox/persistence.py",
-                "benchmarks/bench_live.py", "data"),
+               ("greybox/live", "greybox/models", "greybox/data", "greybox/predict", "benchmarks/bench_live.py",
+                "data"),
                "greybox live's speed: compute per sample, 16 axes' CPU share, publish to estimate through Mosquitto"),
     RecordSpec("predict-hour", ("benchmarks/bench_predict_hour.py", "--json"),
-               ("data", "greybox/data", "greybox/models", "greybox/predict", "greybox/persistence.py",
-                "greybox/threads.py", "greybox/cli/predict.py", "benchmarks/bench_predict_hour.py"),
+               ("data", "greybox/data", "greybox/models", "greybox/predict", "greybox/threads.py",
+                "greybox/cli/predict.py", "benchmarks/bench_predict_hour.py"),
                "GMS+SVR against GMS on a one-hour log: predict, read, train and the kernel sums, in one run"),
     RecordSpec("reproduce", ("benchmarks/bench_reproduce.py", "--records"), _REPRODUCTION,
                "both experiments of the paper on the shipped twin (greybox reproduce), with its wall time"),

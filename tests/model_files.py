@@ -1,6 +1,6 @@
 """Model files rewritten by tests as a forger would: members changed and the digest recomputed to match.
 
-The digest (``digest.json``, :func:`greybox.persistence.digest_document`) catches a member changed by
+The digest (``digest.json``, :func:`greybox.models.files.digest_document`) catches a member changed by
 hand; one who knows the format recomputes it, and then the checks behind it must still refuse what is
 hostile. Tests of those checks write their files with :func:`write_members`.
 """
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import zipfile
 
-from greybox.persistence import DIGEST_MEMBER, digest_document
+from greybox.models.files import DIGEST_MEMBER, digest_document
 
 
 def write_members(path, members: dict, *, duplicates=(), compression=zipfile.ZIP_STORED, key=None):

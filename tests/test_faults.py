@@ -1,8 +1,8 @@
 """Fault suite of issue 41 (and the two small items of issue 40): each fault, reproduced, gives its documented outcome.
 
 Fast cases run by default; the fleet, concurrency and history cases are beside their modules
-(``tests/fleet/test_engine.py``, ``tests/predict/test_fleet.py``, ``tests/monitor/test_monitor_history.py``,
-``tests/test_persistence.py``).
+(``tests/fleet/test_engine.py``, ``tests/fleet/test_predict.py``, ``tests/monitor/test_monitor_history.py``,
+``tests/models/test_files.py``).
 """
 
 from __future__ import annotations
@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 
 import greybox.cli as cli
-from greybox import atomic, persistence
+from greybox import atomic
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
+from greybox.models import files
 
 
 def _log(axis: str, seed: int = 0, n: int = 1500, dt: float = 0.002) -> AxisLog:
@@ -55,7 +56,7 @@ def test_training_refuses_logs_of_two_axes_and_records_the_axis(logs, tmp_path, 
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "xy.gbm").exists()
     status, _, err = _train(capsys, tmp_path / "x.gbm", logs["x1"], logs["x2"])
     assert status == 0, err
-    assert persistence.load_model(tmp_path / "x.gbm", records=True)[1]["training"]["axis"] == "X"
+    assert files.load_model(tmp_path / "x.gbm", records=True)[1]["training"]["axis"] == "X"
     status, out, _ = _main(capsys, "info", tmp_path / "x.gbm")
     assert "  axis           = X" in out
 
@@ -96,7 +97,7 @@ def test_an_unexpected_error_is_one_line_and_its_traceback_only_with_debug(logs,
     def bug(*args, **kwargs):
         raise ZeroDivisionError("a bug")
 
-    monkeypatch.setattr(persistence, "_check_digest", bug)
+    monkeypatch.setattr(files, "_check_digest", bug)
     status, _, err = _main(capsys, "info", tmp_path / "x.gbm")
     assert status == 2 and err.strip().splitlines() == [
         "greybox info: internal error: ZeroDivisionError: a bug (a bug: please report it with the output of "
@@ -106,14 +107,14 @@ def test_an_unexpected_error_is_one_line_and_its_traceback_only_with_debug(logs,
 
 
 def test_a_plant_key_file_signs_and_checks_model_files(logs, tmp_path, capsys, monkeypatch):
-    monkeypatch.delenv(persistence.KEY_ENV, raising=False)
-    monkeypatch.delenv(persistence.KEY_FILE_ENV, raising=False)
+    monkeypatch.delenv(files.KEY_ENV, raising=False)
+    monkeypatch.delenv(files.KEY_FILE_ENV, raising=False)
     key = tmp_path / "plant.key"
     key.write_text("a secret of the plant\n")
     assert _train(capsys, tmp_path / "unsigned.gbm", logs["x1"])[0] == 0
     assert _main(capsys, "--key-file", key, "train", "--model", "coulomb", "--train", logs["x1"], "--out",
                  tmp_path / "signed.gbm", "--quiet")[0] == 0
-    assert os.environ.get(persistence.KEY_FILE_ENV) is None  # the option holds for its command only
+    assert os.environ.get(files.KEY_FILE_ENV) is None  # the option holds for its command only
     assert _main(capsys, "--key-file", key, "info", tmp_path / "signed.gbm")[0] == 0
     status, _, err = _main(capsys, "--key-file", key, "info", tmp_path / "unsigned.gbm")
     assert status == 2 and "unsigned.gbm: not signed, and the plant's key is set" in err
@@ -134,7 +135,7 @@ def test_warnings_reach_the_terminal_as_one_note_line(logs, tmp_path, capsys):
     path = tmp_path / "x.gbm"
     assert _train(capsys, path, logs["x1"])[0] == 0
     with zipfile.ZipFile(path) as archive:  # a file of before the digest: loads with a warning
-        members = {name: archive.read(name) for name in archive.namelist() if name != persistence.DIGEST_MEMBER}
+        members = {name: archive.read(name) for name in archive.namelist() if name != files.DIGEST_MEMBER}
     with zipfile.ZipFile(path, "w") as archive:
         for name, data in members.items():
             archive.writestr(name, data)
@@ -199,7 +200,7 @@ def test_the_staging_file_of_a_killed_parquet_writer_is_removed_by_the_next_writ
 def test_a_fleet_output_of_the_earlier_naming_is_refused_before_any_work(tmp_path):
     # its outputs (log=<file stem>) would stay beside the new ones and be read twice as one dataset
     from greybox.errors import GreyboxError
-    from greybox.predict.fleet import FleetJob, run_fleet
+    from greybox.fleet.predict import FleetJob, run_fleet
 
     out = tmp_path / "results"
     out.mkdir()

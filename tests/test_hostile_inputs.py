@@ -29,9 +29,9 @@ from greybox.data.io import LOG_FORMATS, read_log, write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError, ModelFileError
+from greybox.models.files import MAX_MEMBER_BYTES, check_fitted, load_model, save_model
 from greybox.models.friction import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
-from greybox.persistence import MAX_MEMBER_BYTES, check_fitted, load_model, save_model
 from greybox.twin import make_dataset
 
 #: The first extension of every registered log format: a new format is fuzzed here without an edit.

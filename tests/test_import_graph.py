@@ -15,22 +15,29 @@ rules (docs/layout.md, "Layer rules"):
   truth laws' base class) import nothing of greybox, and the twin imports no
   model (``greybox.models``): a truth plant built from the models it tests
   would flatter them;
-- the model kinds (``greybox.models``: physical friction, kernel, augmented)
-  import nothing of the layers above them: ``evaluate``, ``predict``,
-  ``discover``, ``reproduce``, ``control``, ``cli``;
-- training (``greybox.train``) sits above the models, the model files and the
-  choice of a model, and below its users, which it imports nothing of: the
+- the model kinds (``greybox.models``: physical friction, kernel, augmented,
+  with their files and machine models) import nothing of the layers above
+  them: ``evaluate``, ``predict``, ``discover``, ``reproduce``, ``control``, ``cli``;
+- identification (``greybox.identify``: searches, cross-validation, the
+  scoring of candidates) imports no model kind: the models stand on it, so the
+  choice among the model kinds (``greybox.train.candidates``), which needs
+  their registry, sits above them in ``train``;
+- training (``greybox.train``, with the choice of a model) sits above the
+  models and their files, and below its users, which it imports nothing of: the
   fleet, ``predict``, ``evaluate``, ``live``, ``monitor``, ``process``,
   ``discover``, ``control``, ``reproduce``, ``cli``;
 - the fleet's engine (``greybox.fleet`` and ``greybox.fleet.engine``) imports
-  no workflow that runs on it (the fleet's training, ``train``, ``predict``,
+  no workflow that runs on it (the fleet's runs ``fleet.train``,
+  ``fleet.predict``, ``fleet.monitor``, and ``train``, ``predict``,
   ``monitor``, ...);
 - prediction (``greybox.predict``) sits above the models, the data and
   ``evaluate`` (metrics, regimes, figures), which import nothing of it, and
-  below its users, which it imports nothing of: ``live``, ``monitor``,
-  ``process``, ``discover``, ``control``, ``reproduce``, ``cli``;
+  below its users, which it imports nothing of: the fleet, ``live``,
+  ``monitor``, ``process``, ``discover``, ``control``, ``reproduce``, ``cli``;
+- the monitor (``greybox.monitor``) imports nothing of the fleet, whose
+  ``fleet.monitor`` runs it on a cluster;
 - the model layer as a whole (:data:`MODEL_LAYER`: the model kinds in
-  ``models`` with their registry, the file format, the
+  ``models`` with their registry, their file format and machine models, the
   identification and data layers they stand on) imports nothing outside it:
   no import runs back up the layers (the registry of model kinds imports no
   workflow: the augmented kind of ``greybox discover`` lives in ``models``).
@@ -61,7 +68,7 @@ TWIN_USERS = ("greybox.control", "greybox.reproduce", "greybox.cli")
 #: The model kinds and everything they stand on: importing nothing outside this set.
 MODEL_LAYER = ("greybox.base", "greybox.errors", "greybox.threads", "greybox.atomic", "greybox.json_values",
                "greybox.provenance", "greybox.metrics", "greybox.data", "greybox.identify", "greybox.models",
-               "greybox.persistence")
+               "greybox.models.files")
 ABOVE_MODELS = ("greybox.evaluate", "greybox.predict", "greybox.discover", "greybox.reproduce", "greybox.control",
                 "greybox.cli")
 #: Layers training (``greybox.train``) must not depend on: its users (the fleet, the compensation study, the
@@ -70,8 +77,8 @@ ABOVE_TRAIN = ("greybox.fleet", "greybox.predict", "greybox.evaluate", "greybox.
                "greybox.monitor", "greybox.process", "greybox.discover", "greybox.control", "greybox.reproduce",
                "greybox.cli")
 #: Layers prediction must not depend on (they use it, or stand beside it).
-ABOVE_PREDICT = ("greybox.live", "greybox.monitor", "greybox.process", "greybox.discover", "greybox.control",
-                 "greybox.reproduce", "greybox.cli")
+ABOVE_PREDICT = ("greybox.fleet", "greybox.live", "greybox.monitor", "greybox.process", "greybox.discover",
+                 "greybox.control", "greybox.reproduce", "greybox.cli")
 
 
 def _within(module: str, package: str) -> bool:
@@ -283,11 +290,27 @@ def test_the_models_import_nothing_of_the_layers_above_them(graph):
     assert not found, "models/ depends on a layer above it:\n" + "\n".join(found)
 
 
+def test_identification_imports_no_model_kind(graph):
+    assert "greybox.identify.selection" in graph  # the scoring of candidates by held-out runs
+    found = forbidden(graph, lambda m: _within(m, "greybox.identify"), lambda t: _within(t, "greybox.models"))
+    assert not found, "greybox/identify/ imports the models that stand on it:\n" + "\n".join(found)
+
+
 def test_the_fleet_engine_imports_no_workflow(graph):
     assert "greybox.fleet.engine" in graph  # every fleet run's engine: predict and monitor import it
+    runs = ("greybox.fleet.train", "greybox.fleet.predict", "greybox.fleet.monitor")
+    assert all(run in graph for run in runs)
     found = forbidden(graph, lambda m: m in ("greybox.fleet", "greybox.fleet.engine"),
-                      lambda t: any(_within(t, p) for p in ("greybox.fleet.train", "greybox.train", *ABOVE_TRAIN[1:])))
+                      lambda t: any(_within(t, p) for p in (*runs, "greybox.train", *ABOVE_TRAIN[1:])))
     assert not found, "the fleet engine depends on a workflow that runs on it:\n" + "\n".join(found)
+
+
+def test_the_workflows_the_fleet_runs_import_nothing_of_it(graph):
+    found = forbidden(graph, lambda m: any(_within(m, p) for p in ("greybox.train", "greybox.predict",
+                                                                   "greybox.monitor")),
+                      lambda t: _within(t, "greybox.fleet"))
+    assert not found, "a workflow imports the fleet that runs it (the command line picks the fleet run):\n" + \
+        "\n".join(found)
 
 
 def test_training_imports_nothing_of_its_users(graph):

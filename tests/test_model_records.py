@@ -16,8 +16,8 @@ from greybox.cli import main
 from greybox.data.io import read_log
 from greybox.data.prepare import prepare
 from greybox.errors import ModelFileError
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel
-from greybox.persistence import load_model, save_model
 from greybox.provenance import check_training_record, preparation_differences
 
 

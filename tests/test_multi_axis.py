@@ -1,8 +1,8 @@
-"""Several axes in one log: axis-prefixed columns, MCAP channels and TDMS groups; machine files and machine models."""
+"""Several axes in one log: axis-prefixed columns, MCAP channels and TDMS groups; machine files; machine models
+trained, predicted and refused on the command line (the machine model file itself: tests/models/test_machine.py)."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -14,10 +14,10 @@ from greybox.data.io import read_log, write_log
 from greybox.data.machine_config import parse_machine_config, read_machine_config
 from greybox.data.prepare import prepare
 from greybox.data.units import axes_in_columns
-from greybox.errors import GreyboxError, LogError, ModelFileError
-from greybox.machine_model import MANIFEST, MachineModel, load_machine, save_machine
+from greybox.errors import GreyboxError, LogError
+from greybox.models.files import load_model
 from greybox.models.friction import StribeckModel
-from greybox.persistence import load_model
+from greybox.models.machine import MachineModel, save_machine
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset
 
@@ -116,37 +116,6 @@ def test_an_axis_with_channels_only_and_shared_channels():
 def fitted():
     runs = {log.axis: prepare([log])[0] for log in _machine_logs(duration_s=10)}
     return {axis: StribeckModel().fit(run) for axis, run in runs.items()}
-
-
-def test_machine_model_round_trip_and_refusals(tmp_path, fitted):
-    directory = tmp_path / "machine"
-    written = save_machine(MachineModel(models=fitted, name="m"), directory)
-    assert [path.name for path in written] == ["X.gbm", "Y.gbm", "C.gbm", MANIFEST]
-    loaded = load_machine(directory)
-    assert loaded.axes == ["X", "Y", "C"] and loaded.name == "m"
-    assert loaded.models["C"].motion_ == "rotary"
-    with pytest.raises(ModelFileError, match="file exists"):
-        save_machine(MachineModel(models=fitted), directory)
-    manifest = json.loads((directory / MANIFEST).read_text())
-
-    def broken(change):
-        document = json.loads(json.dumps(manifest))
-        change(document)
-        (directory / MANIFEST).write_text(json.dumps(document))
-        with pytest.raises(ModelFileError) as error:
-            load_machine(directory)
-        return str(error.value)
-
-    assert "keeps it as X.gbm" in broken(lambda d: d["axes"]["X"].update(model="../X.gbm"))
-    assert "the manifest says 'gms'" in broken(lambda d: d["axes"]["Y"].update(kind="gms"))
-    assert "'linear' axis" in broken(lambda d: d["axes"]["C"].update(motion="linear"))
-    assert "newer greybox" in broken(lambda d: d.update(format_version=99))
-    assert "letters and digits" in broken(lambda d: d["axes"].update({"../Z": d["axes"]["X"]}))
-    (directory / MANIFEST).write_text("{not json")
-    with pytest.raises(ModelFileError, match="not a JSON manifest"):
-        load_machine(directory)
-    with pytest.raises(ModelFileError, match="holding a machine model"):
-        load_model(directory)
 
 
 @pytest.fixture(scope="module")

@@ -20,8 +20,8 @@ from greybox.data.prepare import prepare
 from greybox.data.validate import check_velocity_units
 from greybox.errors import GreyboxError, LogError, ParameterError
 from greybox.evaluate.plots import plot_log
+from greybox.models.files import check_fitted, load_model, save_model
 from greybox.models.friction import StribeckModel
-from greybox.persistence import check_fitted, load_model, save_model
 from greybox.predict.plot import plot_process
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from greybox.windows import centred_mean, centred_nanmean
+from greybox.windows import centred_mean, centred_nanmean, widened
 
 
 def _reference(values, width, counts=None):
@@ -56,3 +56,12 @@ def test_the_nan_mean_leaves_missing_samples_out_and_says_where_a_window_is_shor
     complete = centred_nanmean(values, 3, complete=True)
     assert np.isnan(complete[[0, 3, 4, 5, 9]]).all() and complete[1] == pytest.approx(1.0)
     assert np.isnan(centred_nanmean(np.full(5, np.nan), 3)).all()
+
+
+@pytest.mark.parametrize("pad", [0, 1, 3])
+def test_widened_flags_are_the_loop_over_each_sample_within_pad(pad):
+    flags = np.random.default_rng(pad).random(40) < 0.1
+    flags[0] = flags[-1] = True  # flags at both ends: the widening stops at the signal's edges
+    expected = [bool(flags[max(0, i - pad):i + pad + 1].any()) for i in range(flags.size)]
+    assert widened(flags, pad).tolist() == expected
+    assert widened(np.zeros(5, dtype=bool), 2).tolist() == [False] * 5

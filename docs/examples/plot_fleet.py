@@ -22,9 +22,9 @@ import pyarrow.dataset
 from distributed import LocalCluster
 
 from greybox.data import prepare, read_log
+from greybox.fleet.predict import predict_fleet
+from greybox.models.files import save_model
 from greybox.models.friction.stribeck import StribeckModel
-from greybox.persistence import save_model
-from greybox.predict import predict_logs
 
 root = Path("../..")  # the repository (the gallery runs from docs/examples)
 work = Path(tempfile.mkdtemp())
@@ -45,8 +45,8 @@ save_model(model, work / "x_stribeck.gbm")
 # A folder of logs makes a fleet run: one task per log on Dask, the results a Parquet dataset
 # partitioned by machine, axis and log.
 with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
-    done = predict_logs(work / "x_stribeck.gbm", [str(work / "plant")], out=work / "results",
-                        axis_config=str(root / "examples" / "axis_x.toml"), scheduler=cluster.scheduler_address)
+    done = predict_fleet(work / "x_stribeck.gbm", [str(work / "plant")], out=work / "results",
+                         axis_config=str(root / "examples" / "axis_x.toml"), scheduler=cluster.scheduler_address)
 for entry in done.manifest["logs"]:
     print(entry["status"], Path(entry["log"]).relative_to(work), entry.get("samples"), "samples")
 

@@ -218,7 +218,7 @@ def _key_file(path: str | None):
     if path is None:
         yield
         return
-    from ..persistence import KEY_FILE_ENV
+    from ..models.files import KEY_FILE_ENV
 
     before = os.environ.get(KEY_FILE_ENV)
     os.environ[KEY_FILE_ENV] = path

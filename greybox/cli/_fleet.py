@@ -1,49 +1,12 @@
-"""What ``greybox predict`` and ``greybox train --per-machine`` share on the command line about fleet runs."""
+"""What ``greybox predict``, ``greybox train --per-machine`` print of a fleet run: its progress and its summary."""
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
-from pathlib import Path
 from typing import Callable
 
-__all__ = ["check_out_dir", "fleet_progress", "read_options", "report_fleet"]
-
-
-def read_options(args: argparse.Namespace) -> dict:
-    """The options of reading and preparing logs (:func:`greybox.data.reading.read_prepared`) as given on the command
-    line.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        Parsed command-line arguments with the log-reading options (``columns``, ``topic``, ``axis``,
-        ``sample_time``, ``time_tolerance``, ``cutoff_hz``, ``resample``, ``max_gap``; the last four
-        take their defaults where the command does not offer them).
-    """
-    from ..data.io import parse_column_mapping
-    from ..data.prepare import MAX_GAP_STEPS
-
-    return {"columns": parse_column_mapping(args.columns) if args.columns else None, "topic": args.topic,
-            "axis": getattr(args, "axis", None), "sample_time": args.sample_time,
-            "time_tolerance": args.time_tolerance, "cutoff_hz": getattr(args, "cutoff_hz", None),
-            "resample": getattr(args, "resample", None), "max_gap": getattr(args, "max_gap", MAX_GAP_STEPS)}
-
-
-def check_out_dir(out: str, inputs=()) -> Path:
-    """``--out`` of a fleet run, resolved (:func:`greybox.fleet.check_out_dir`).
-
-    Parameters
-    ----------
-    out : str
-        The ``--out`` path given on the command line.
-    inputs : iterable of str or Path, default ()
-        Input paths of the run; the output directory must not be one of them.
-    """
-    from ..fleet import check_out_dir as checked
-
-    return checked(out, inputs)
+__all__ = ["fleet_progress", "report_fleet"]
 
 
 def fleet_progress(noun: str, quiet: bool, label: Callable[[dict], str]) -> Callable[[int, int, dict], None]:

@@ -9,7 +9,7 @@ from ..data.log import AxisLog
 from ..data.prepare import MAX_GAP_STEPS
 from ._types import FRACTION, GAP_STEPS, POSITIVE, positive
 
-__all__ = ["add_log_arguments", "read_logs", "read_named_runs", "read_runs"]
+__all__ = ["add_log_arguments", "read_logs", "read_named_runs", "read_options", "read_runs"]
 
 
 def add_log_arguments(parser: argparse.ArgumentParser, *, prepare: bool = True) -> None:
@@ -150,11 +150,28 @@ def read_runs(args: argparse.Namespace, path, *, columns=None, prepare: bool = T
     """
     from ..data.io import read_log
     from ..data.reading import read_prepared
-    from ._fleet import read_options
-
     read = read_options(args)
     if not prepare:
         return [read_log(path, columns=columns, topic=read["topic"], sample_time=read["sample_time"],
                          time_tolerance=read["time_tolerance"], axis=read["axis"])]
     return read_prepared(path, {**read, "columns": None}, columns=columns,
                          notify=lambda line: print(line, file=sys.stderr))
+
+
+def read_options(args: argparse.Namespace) -> dict:
+    """The options of reading and preparing logs (:func:`greybox.data.reading.read_prepared`) as given on the command
+    line.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed command-line arguments with the log-reading options (``columns``, ``topic``, ``axis``,
+        ``sample_time``, ``time_tolerance``, ``cutoff_hz``, ``resample``, ``max_gap``; the last four
+        take their defaults where the command does not offer them).
+    """
+    from ..data.io import parse_column_mapping
+
+    return {"columns": parse_column_mapping(args.columns) if args.columns else None, "topic": args.topic,
+            "axis": getattr(args, "axis", None), "sample_time": args.sample_time,
+            "time_tolerance": args.time_tolerance, "cutoff_hz": getattr(args, "cutoff_hz", None),
+            "resample": getattr(args, "resample", None), "max_gap": getattr(args, "max_gap", MAX_GAP_STEPS)}

@@ -96,7 +96,7 @@ def _say(args, text: str) -> None:
 
 def _plant(args):
     from ..control.plants import ModelPlant, TwinPlant
-    from ..persistence import load_model
+    from ..models.files import load_model
 
     key = args.plant.strip().lower()
     if key in TWIN_PLANTS:

@@ -16,11 +16,10 @@ from ..discover.workflow import discover
 from ..errors import GreyboxError, ModelFileError
 from ..identify.progress import ProgressPrinter
 from ..models.effects import EFFECT_NAMES, effect
+from ..models.files import save_verified
 from ..models.registry import MODEL_CLASSES
-from ..persistence import save_verified
 from ._build import CommandLineError, add_model_arguments, build_model
-from ._fleet import read_options
-from ._options import add_log_arguments, read_logs
+from ._options import add_log_arguments, read_logs, read_options
 from ._types import FRACTION, NON_NEGATIVE_INT, POSITIVE_INT, SEED
 
 

@@ -11,7 +11,7 @@ from ..errors import GreyboxError
 from ..evaluate.records import evaluate_models, write_evaluation_pdf, write_evaluation_report
 from ..evaluate.regimes import REGIME_NAMES, TRAINING_REGION_NAMES
 from ..evaluate.report import RE_NOTE, check_output_dir, records_json
-from ..persistence import load_model
+from ..models.files import load_model
 from ..provenance import model_quantity
 from ._options import add_log_arguments, read_named_runs
 from ._provenance import warn_preparation

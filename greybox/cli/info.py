@@ -12,8 +12,8 @@ import numpy as np
 from ..data.effort import EFFORT_UNITS, effort_quantity, effort_text
 from ..data.log import AxisLog
 from ..json_values import jsonable
+from ..models.files import load_model
 from ..models.registry import model_kind
-from ..persistence import load_model
 from ..provenance import model_quantity
 from ._model_text import model_lines
 from ._options import add_log_arguments, read_named_runs

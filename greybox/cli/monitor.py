@@ -46,14 +46,17 @@ def add_parser(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..fleet.monitor import monitor_fleet
     from ..monitor.report import baseline_note
     from ..monitor.workflow import run_monitor
 
-    result = run_monitor(args.logs, args.history, args.out, machine=args.machine, axis=args.axis,
-                         model_path=args.model, spindle_column=args.spindle_load,
-                         find_cuts=args.find_cuts,
-                         baseline_days=args.baseline_days, scheduler=args.scheduler, workers=args.workers,
-                         progress=print, force=args.force)
+    options = dict(machine=args.machine, axis=args.axis, model_path=args.model, spindle_column=args.spindle_load,
+                   find_cuts=args.find_cuts, baseline_days=args.baseline_days, progress=print, force=args.force)
+    if args.scheduler is not None or args.workers is not None:  # the logs fingerprinted on a Dask cluster
+        result = monitor_fleet(args.logs, args.history, args.out, **options, scheduler=args.scheduler,
+                               workers=args.workers)
+    else:
+        result = run_monitor(args.logs, args.history, args.out, **options)
     trends = result.detector.trends_
     copies = f", {len(result.duplicates)} copies of logs filed under another day (not filed)" \
         if result.duplicates else ""

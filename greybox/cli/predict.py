@@ -78,18 +78,26 @@ def add_parser(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """``greybox predict``: :func:`greybox.predict.predict_logs` with the options, its report printed."""
+    """``greybox predict``: :func:`greybox.predict.predict_logs` with the options (a fleet run:
+    :func:`greybox.fleet.predict.predict_fleet`), its report printed."""
+    from ..fleet.predict import predict_fleet
     from ..predict import predict_logs
-    from ._fleet import fleet_progress, read_options
+    from ..predict.run import is_fleet
+    from ._fleet import fleet_progress
+    from ._options import read_options
 
     run_started = getattr(args, "started_s", None) or time.perf_counter()
-    done = predict_logs(args.model, args.logs, out=args.out, axis_config=args.axis_config, machine=args.machine,
-                        calibration=args.calibration, coverage=args.interval, plot=args.plot,
-                        plot_mean_s=args.plot_mean_s, plot_window=args.plot_window, chunk_s=args.chunk_s,
-                        read=read_options(args), force=args.force, scheduler=args.scheduler, workers=args.workers,
-                        progress=None if args.quiet else _progress(),
-                        fleet_progress=fleet_progress("logs", args.quiet, lambda entry: Path(entry["log"]).name),
-                        notify=lambda line: print(line, file=sys.stderr), relevel=args.relevel)
+    options = dict(out=args.out, axis_config=args.axis_config, machine=args.machine, calibration=args.calibration,
+                   coverage=args.interval, plot=args.plot, plot_window=args.plot_window, chunk_s=args.chunk_s,
+                   read=read_options(args), force=args.force, scheduler=args.scheduler, workers=args.workers,
+                   relevel=args.relevel)
+    if is_fleet(args.logs):
+        done = predict_fleet(args.model, args.logs, **options,
+                             progress=fleet_progress("logs", args.quiet, lambda entry: Path(entry["log"]).name))
+    else:
+        done = predict_logs(args.model, args.logs, **options, plot_mean_s=args.plot_mean_s,
+                            progress=None if args.quiet else _progress(),
+                            notify=lambda line: print(line, file=sys.stderr))
     for line in done.summary:
         print(line)
     for heading, figures in done.axes:

@@ -12,12 +12,11 @@ from ..atomic import check_output_path
 from ..data.effort import effort_text
 from ..errors import GreyboxError, ModelFileError
 from ..identify.intervals import METHODS as INTERVAL_METHODS
-from ..model_choice import DEFAULT_CANDIDATES
 from ..models.registry import MODEL_CLASSES
+from ..train.candidates import DEFAULT_CANDIDATES
 from ._build import add_model_arguments, build_model
-from ._fleet import read_options
 from ._model_text import model_lines
-from ._options import add_log_arguments
+from ._options import add_log_arguments, read_options
 from ._types import POSITIVE_INT
 
 
@@ -154,7 +153,7 @@ def _print_fit(model, elapsed: float, label: str) -> None:
 
 
 def _run_machine(args: argparse.Namespace) -> int:
-    from ..machine_model import MANIFEST
+    from ..models.machine import MANIFEST
     from ..train import train_machine_logs
 
     name, axes = _machine_axes(args)
@@ -177,9 +176,9 @@ def _label(entry: dict) -> str:
 
 def _run_per_machine(args: argparse.Namespace) -> int:
     """``greybox train --per-machine``: a model per machine and axis on Dask (:mod:`greybox.fleet.train`)."""
-    from ..fleet import MANIFEST, expand_logs
-    from ..fleet.train import run_training, train_jobs
-    from ._fleet import check_out_dir, fleet_progress, report_fleet
+    from ..fleet.train import train_fleet
+    from ..models.plant import MANIFEST
+    from ._fleet import fleet_progress, report_fleet
 
     if args.intervals != "sandwich" or args.bootstrap is not None:
         raise GreyboxError("--intervals and --bootstrap do not apply with --per-machine: a fleet's models get the "
@@ -189,12 +188,10 @@ def _run_per_machine(args: argparse.Namespace) -> int:
             raise GreyboxError(f"{option} does not apply with --per-machine: every machine's model is fitted on "
                                "its logs in --train (give the axes of logs of several with --axes)")
     axes = [axis.name for axis in _machine_axes(args)[1]] if args.axes is not None else None
-    out = check_out_dir(args.out, args.train)
-    logs = expand_logs(args.train, exclude=[out])
     model = build_model(args.model, args)  # a bad option is one error before any cluster starts
-    jobs = train_jobs(logs, model, str(out), axes=axes, read=read_options(args))
-    manifest = run_training(jobs, scheduler=args.scheduler, workers=args.workers, force=args.force,
-                            progress=fleet_progress("models", args.quiet, _label))
+    out, manifest = train_fleet(model, args.train, out=args.out, axes=axes, read=read_options(args),
+                                scheduler=args.scheduler, workers=args.workers, force=args.force,
+                                progress=fleet_progress("models", args.quiet, _label))
     status = report_fleet(manifest, "models", "trained", lambda entry: f"{_label(entry)}: {entry['error']}")
     for entry in manifest["models"]:
         if entry["status"] != "failed":

@@ -16,8 +16,8 @@ from typing import Callable, Mapping, Sequence
 from ..data.log import AxisLog
 from ..data.prepare import prepare
 from ..errors import GreyboxError
+from ..models.files import load_model
 from ..models.registry import model_kind
-from ..persistence import load_model
 from ..train import train_logs
 from ..twin import CurrentNoise, axis_geometry, make_dataset
 from .feedforward import InertiaFeedForward, ModelFeedForward

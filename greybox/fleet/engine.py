@@ -2,7 +2,7 @@
 
 :func:`expand_logs` turns files, directories (searched recursively for log files) and glob patterns
 into the list of logs. :func:`run_tasks` is the one engine of every fleet run (``greybox predict`` over
-many logs in :mod:`greybox.predict.fleet`, ``greybox train --per-machine`` in :mod:`greybox.fleet.train`):
+many logs in :mod:`greybox.fleet.predict`, ``greybox train --per-machine`` in :mod:`greybox.fleet.train`):
 it runs one task per job on a Dask cluster, by default a local cluster of processes, one per core and one
 thread each, or the cluster of a scheduler address, so that the same command runs on a laptop and on a
 cluster; it skips the jobs complete from an earlier run, reports a job that fails and goes on, and writes
@@ -27,17 +27,11 @@ from urllib.parse import quote, unquote
 from ..atomic import write_text_atomic
 from ..data.io import LOG_SUFFIXES
 from ..errors import GreyboxError, Setting
+from ..models.plant import MANIFEST, load_manifest, machine_of, read_manifest
 
-__all__ = ["LOG_SUFFIXES", "MANIFEST", "MAX_NAME_BYTES", "MODELS_FORMAT", "SAVE_EVERY_S", "attempt", "check_machines",
-           "check_names", "check_out_dir", "decode_name", "encode_name", "expand_logs", "fleet_summary",
-           "log_names", "log_stamp", "machine_of", "out_dir_of", "partition", "read_manifest",
-           "run_tasks"]
-
-#: Name of the manifest in the output directory (a leading "_": dataset readers skip it).
-MANIFEST = "_manifest.json"
-
-#: ``format`` of the manifest of a directory of models written by ``greybox train --per-machine``.
-MODELS_FORMAT = "greybox-fleet-models"
+__all__ = ["LOG_SUFFIXES", "MAX_NAME_BYTES", "SAVE_EVERY_S", "attempt", "check_machines", "check_names",
+           "check_out_dir", "decode_name", "encode_name", "expand_logs", "fleet_summary", "log_names", "log_stamp",
+           "out_dir_of", "run_tasks"]
 
 #: Least time between two saves of the manifest while a fleet runs [s]: the jobs finished so far are kept
 #: for a re-run when a run is killed.
@@ -194,28 +188,6 @@ def check_names(logs: Sequence[str], names: Sequence[str]) -> None:
         seen[key] = log
 
 
-def partition(value: str) -> str:
-    """A partition value safe in a path: letters, digits, ``-``, ``_`` and ``.``.
-
-    Parameters
-    ----------
-    value : str
-        Name to make safe; every other character becomes ``_``, and an empty name ``_``.
-    """
-    return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in value) or "_"
-
-
-def machine_of(log: str | os.PathLike) -> str:
-    """The machine a log belongs to: the name of its folder, made safe for a path (:func:`partition`).
-
-    Parameters
-    ----------
-    log : str or path-like
-        Log file.
-    """
-    return partition(Path(log).parent.name)
-
-
 def check_machines(logs: Sequence[str | os.PathLike]) -> None:
     """Refuse logs whose different folder names give one machine name (:func:`machine_of`: ``run 1``, ``run_1``).
 
@@ -312,32 +284,6 @@ def _canonical(value) -> str:
     return json.dumps(value, sort_keys=True)
 
 
-def _load_manifest(directory: str | os.PathLike) -> dict:
-    """The manifest in ``directory`` of any format, or ``{}`` when there is none or it is unreadable."""
-    path = Path(directory) / MANIFEST
-    if not path.is_file():
-        return {}
-    try:
-        document = json.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, ValueError, RecursionError):
-        return {}
-    return document if isinstance(document, dict) else {}
-
-
-def read_manifest(directory: str | os.PathLike, fmt: str) -> dict:
-    """The manifest of ``fmt`` in ``directory``, or ``{}`` when there is none, it is unreadable or of another format.
-
-    Parameters
-    ----------
-    directory : str or path-like
-        Output directory holding :data:`MANIFEST`.
-    fmt : str
-        The ``format`` the manifest must have (:data:`MODELS_FORMAT`, or that of a fleet prediction).
-    """
-    document = _load_manifest(directory)
-    return document if document.get("format") == fmt else {}
-
-
 def _complete(document: dict, items: str, out_dir: Path, fields: Sequence[str]) -> dict:
     """Entries of an earlier manifest a re-run may keep, by their ``fields``: ok, output still there."""
     kept = {}
@@ -407,7 +353,7 @@ def run_tasks(task: Callable, jobs: Sequence, fingerprints: Sequence[dict], *, o
         When ``out_dir`` holds the manifest of another kind of fleet run, or the scheduler cannot be reached.
     """
     out_dir = Path(out_dir)
-    other = _load_manifest(out_dir).get("format", header["format"])
+    other = load_manifest(out_dir).get("format", header["format"])
     if other != header["format"]:
         raise GreyboxError(f"{out_dir}: holds the {MANIFEST} of another kind of run ({other}); choose another "
                            "output directory")
@@ -455,7 +401,7 @@ def out_dir_of(jobs: Sequence, nothing: str) -> str:
     Parameters
     ----------
     jobs : sequence
-        Jobs with an ``out_dir`` attribute (:class:`greybox.predict.fleet.FleetJob`, or those of
+        Jobs with an ``out_dir`` attribute (:class:`greybox.fleet.predict.FleetJob`, or those of
         ``greybox train --per-machine``).
     nothing : str
         Error message for no job at all.

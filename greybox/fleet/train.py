@@ -19,7 +19,7 @@ With axes to read from logs of several (``--axes``) there is one task per machin
 per machine, whose logs must all be of one axis, the model named after it (``-`` where the logs name
 none). A re-run skips every model whose entry is ``ok`` for the same logs (size and modification time),
 kind, hyperparameters and reading options, its file still there. ``greybox predict OUT LOG... --out DIR``
-predicts each log with its machine's model (:func:`greybox.predict.fleet.fleet_jobs`).
+predicts each log with its machine's model (:func:`greybox.models.plant.model_of_log`).
 """
 
 from __future__ import annotations
@@ -30,18 +30,10 @@ from typing import Callable, Sequence
 
 from ..data.reading import read_prepared
 from ..errors import GreyboxError
-from .engine import (
-    MODELS_FORMAT,
-    attempt,
-    check_machines,
-    log_stamp,
-    machine_of,
-    out_dir_of,
-    partition,
-    run_tasks,
-)
+from ..models.plant import MODELS_FORMAT, machine_of, partition
+from .engine import attempt, check_machines, check_out_dir, expand_logs, log_stamp, out_dir_of, run_tasks
 
-__all__ = ["TrainJob", "run_training", "train_jobs", "train_model"]
+__all__ = ["TrainJob", "run_training", "train_fleet", "train_jobs", "train_model"]
 
 
 @dataclass(frozen=True)
@@ -187,3 +179,35 @@ def run_training(jobs: Sequence[TrainJob], *, scheduler: str | None = None, work
     return run_tasks(train_model, jobs, fingerprints, out_dir=out_dir,
                      header={"format": MODELS_FORMAT, "format_version": 1}, items="models", scheduler=scheduler,
                      workers=workers, force=force, progress=progress)
+
+
+def train_fleet(model, logs: Sequence[str], *, out: str | Path, axes: Sequence[str] | None = None,
+                read: dict | None = None, scheduler: str | None = None, workers: int | None = None,
+                force: bool = False, progress: Callable[[int, int, dict], None] | None = None) -> tuple[Path, dict]:
+    """``greybox train --per-machine``: a model per machine (and axis) of the logs, trained on Dask.
+
+    Parameters
+    ----------
+    model : estimator
+        Unfitted model, the same kind and hyperparameters for every machine.
+    logs : sequence of str
+        Log files, directories searched recursively, glob patterns (:func:`greybox.fleet.expand_logs`); the
+        folder of a log names its machine.
+    out : str or path
+        Directory of the models (not one of ``logs``).
+    axes : sequence of str, optional
+        Axes to read from logs of several, a model each.
+    read : dict, optional
+        Options of reading and preparing the logs.
+    scheduler, workers, force, progress
+        The cluster, whether to train again the models complete from an earlier run, and the progress
+        callback, as in :func:`greybox.fleet.run_tasks`.
+
+    Returns
+    -------
+    (Path, dict)
+        The models directory (resolved) and its manifest (:func:`run_training`).
+    """
+    out = check_out_dir(out, logs)
+    jobs = train_jobs(expand_logs(logs, exclude=[out]), model, str(out), axes=axes, read=read)
+    return out, run_training(jobs, scheduler=scheduler, workers=workers, force=force, progress=progress)

@@ -106,6 +106,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import t as student_t
 
+from ..data.log import split_runs
 from ..errors import GreyboxError, ParameterError
 from .cv import time_blocks
 
@@ -564,13 +565,12 @@ def _bootstrap(stage, runs, fitted, residuals, labels, result_rows, names, stage
     from sklearn.base import clone
 
     rng = np.random.default_rng(random_state)
-    edges = np.concatenate(([0], np.cumsum([len(run) for run in runs])))
     n_clusters = int(labels.max()) + 1
     draws = {name: [] for name in stage_rows if name not in notes}
     for replicate in range(n_bootstrap):
         signs = rng.choice((-1.0, 1.0), size=n_clusters)
         effort = fitted + signs[labels] * residuals
-        replicate_runs = [run.replace(effort=effort[a:b]) for run, a, b in zip(runs, edges[:-1], edges[1:])]
+        replicate_runs = [run.replace(effort=part) for run, part in zip(runs, split_runs(runs, effort))]
         try:
             refit = clone(stage).fit(replicate_runs)
         except GreyboxError:  # a replicate the model refuses (e.g. an unstable search) is left out

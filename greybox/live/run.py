@@ -132,8 +132,8 @@ def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, re
                   axis, source, say, bounds, envelope_path=None):
     """A function of the sink that builds the session of one axis's model: (session, kind, recorders)."""
     from ..data.axis_config import read_axis_config
+    from ..models.files import load_model
     from ..models.registry import model_kind
-    from ..persistence import load_model
 
     model = load_model(model_path)
     config = read_axis_config(axis_config_path) if axis_config_path else None
@@ -164,7 +164,7 @@ def _machine_session(model_path, machine_path, options: dict, *, record_dir, rec
     from pathlib import Path
 
     from ..data.machine_config import read_machine_config
-    from ..machine_model import load_machine
+    from ..models.machine import load_machine
     from ..models.registry import model_kind
 
     if columns:
@@ -300,7 +300,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
     KeyboardInterrupt
         On SIGTERM or Ctrl-C, after the recording, the sink and the stats are closed.
     """
-    from ..machine_model import is_machine_model
+    from ..models.machine import is_machine_model
 
     options = dict(sample_time=sample_time, tolerance=tolerance, cutoff_hz=cutoff_hz, chunk_s=chunk_s,
                    max_gap=max_gap, latency=latency)

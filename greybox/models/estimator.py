@@ -341,7 +341,7 @@ class CurrentModel(ModelProtocol):
         """An unfitted copy whose identification searches less, for scoring on held-out runs.
 
         ``greybox train --model auto`` fits every candidate once per fold only to score it on runs it did not
-        see, and refits the chosen one with the full search (:mod:`greybox.model_choice`). Models whose
+        see, and refits the chosen one with the full search (:mod:`greybox.train.candidates`). Models whose
         identification is a multi-start or Bayesian search return a copy with fewer starts or calls; the
         others (default) a plain copy.
 

@@ -27,16 +27,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..identify.static import coulomb_regressors
-from ..windows import centred_mean
+from ..windows import centred_mean, widened
 
 __all__ = ["uncut_samples"]
-
-
-def _widen(flags: np.ndarray, pad: int) -> np.ndarray:
-    """``flags`` widened by ``pad`` samples on either side."""
-    if not pad or not flags.any():
-        return flags
-    return np.convolve(flags.astype(float), np.ones(2 * pad + 1), mode="same") > 0.5
 
 
 def uncut_samples(velocity, acceleration, effort, *, share: float = 0.5, min_speed: float = 2.0,
@@ -93,6 +86,6 @@ def uncut_samples(velocity, acceleration, effort, *, share: float = 0.5, min_spe
         departure = centred_mean(residual, int(window), counts=fast)
         level = np.where(v > 0.0, abs(theta[1]), abs(theta[2]))
         loaded = fast & (np.abs(departure) > tolerance * level)
-        unloaded = ~_widen(loaded, int(pad))
+        unloaded = ~widened(loaded, int(pad))
         keep = fast & unloaded
     return unloaded

@@ -52,7 +52,7 @@ from scipy import sparse
 from ..data.log import AxisLog, as_log_list
 from ..errors import LogError, ParameterError
 from ..identify.static import coulomb_from_normal_equations, coulomb_regressors
-from ..windows import centred_mean
+from ..windows import centred_mean, widened
 
 __all__ = ["FEATURES", "FEATURE_UNITS", "FrictionFingerprint", "reversal_widths", "spindle_idle_samples",
            "unloaded_samples"]
@@ -143,10 +143,7 @@ def spindle_idle_samples(load, *, threshold: float | None = None, pad: int = 100
         threshold = low + 0.2 * (high - low)
     if not np.isfinite(threshold) or isinstance(pad, bool) or not isinstance(pad, (int, np.integer)) or pad < 0:
         raise ParameterError(f"spindle load: need a finite threshold and a non-negative pad, got {threshold}, {pad}")
-    cutting = (values > threshold).astype(float)
-    if pad:
-        cutting = np.convolve(cutting, np.ones(2 * int(pad) + 1), mode="same")
-    return cutting == 0.0
+    return ~widened(values > threshold, int(pad))
 
 
 def _block_counts(n_blocks: int, n_boot: int, rng: np.random.Generator) -> np.ndarray:

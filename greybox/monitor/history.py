@@ -49,11 +49,10 @@ import pyarrow.parquet as pq
 
 from ..atomic import atomic_output
 from ..errors import GreyboxError
-from ..provenance import file_sha256
 from .fingerprint import FEATURE_UNITS, FEATURES
 
 __all__ = ["COMPACTED_NAME", "HistoryError", "LOCK_NAME", "LOCK_TIMEOUT_S", "MAX_MAP_BINS", "MAX_ROWS", "SCHEMA",
-           "SCHEMA_VERSION", "append_fingerprint", "check_history", "compact_history", "file_sha256", "find_log",
+           "SCHEMA_VERSION", "append_fingerprint", "by_precedence", "check_history", "compact_history", "find_log",
            "has_log", "history_lock", "read_history", "row_path"]
 
 #: File name of the compacted rows of one machine and axis.
@@ -547,17 +546,13 @@ def read_history(history, *, machine: str | None = None, axis: str | None = None
     if root.exists() and not root.is_dir():
         raise HistoryError(f"{root}: history is a file, not a directory")
     with history_lock(root, shared=True):
-        layout = _scan(root, machine, axis)
+        paths = [path for _, rows, compacted in _scan(root, machine, axis) for path in [*rows, compacted]
+                 if path is not None and (since is None or path.name == COMPACTED_NAME
+                                          or path.parent.name[len("date="):] >= since.isoformat())]
         tables = []
-        for _, rows, _ in layout:
-            for path in rows:
-                if since is None or path.parent.name[len("date="):] >= since.isoformat():
-                    tables.append(_read_row_file(path, one_row=True))
-        for _, _, path in layout:
-            if path is None:
-                continue
-            rows = _read_row_file(path)
-            if since is not None:
+        for path in by_precedence(paths):
+            rows = _read_row_file(path, one_row=path.name != COMPACTED_NAME)
+            if since is not None and path.name == COMPACTED_NAME:
                 rows = rows.filter(pa.array([d >= since for d in rows.column("date").to_pylist()], pa.bool_()))
             tables.append(rows)
     if not tables:
@@ -567,8 +562,29 @@ def read_history(history, *, machine: str | None = None, axis: str | None = None
                           ("log_sha256", "ascending")])
 
 
+def by_precedence(paths) -> list[Path]:
+    """The history's files in the order a log's row is taken from them: the first file holding it wins.
+
+    A log's row file comes before every compacted file: a row file is the newer, written by a writer killed
+    before it removed the log's older row from a compacted file (:func:`append_fingerprint`); files of one
+    kind come by path. :func:`read_history` and :func:`compact_history` (in Python) and
+    :func:`greybox.monitor.query.changed_most` (in SQL, by the position of a file in this list) both keep
+    a log's row from its first file in this order.
+
+    Parameters
+    ----------
+    paths : iterable of path-like
+        Files of the history (:func:`check_history`).
+
+    Returns
+    -------
+    list of Path
+    """
+    return sorted((Path(path) for path in paths), key=lambda path: (path.name == COMPACTED_NAME, str(path)))
+
+
 def _first_per_log(table: pa.Table) -> pa.Table:
-    """The first row of every log (row files come before compacted files, so they win)."""
+    """The first row of every log, the files read in :func:`by_precedence` order."""
     seen, keep = set(), []
     for key in table.column("log_sha256").to_pylist():
         keep.append(key not in seen)
@@ -620,9 +636,8 @@ def compact_history(history) -> int:
         for axis_dir, files, target in layout:
             if not files:
                 continue
-            tables = [_read_row_file(path, one_row=True) for path in files]
-            if target is not None:
-                tables.append(_read_row_file(target))
+            tables = [_read_row_file(path, one_row=path.name != COMPACTED_NAME)
+                      for path in by_precedence([*files, *([target] if target is not None else [])])]
             table = _first_per_log(pa.concat_tables(tables)).sort_by([("date", "ascending"),
                                                                      ("log_sha256", "ascending")])
             _write(axis_dir / COMPACTED_NAME, table)

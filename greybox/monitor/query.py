@@ -4,8 +4,9 @@
 of the last ``days`` days (up to the history's latest day, or ``until``) against the baseline (the first
 ``baseline_days`` days of that axis with a fingerprint, mean and sample standard deviation, as the change
 detector takes it), in baseline standard deviations; per axis the feature with the largest absolute change.
-Every Parquet file of the history is read (row files and compacted files, a log's row file winning over its
-row in a compacted file, as :func:`~greybox.monitor.history.read_history` does); a history of one file per
+Every Parquet file of the history is read (row files and compacted files, a log's row taken from its first
+file in :func:`~greybox.monitor.history.by_precedence` order, as :func:`~greybox.monitor.history.read_history`
+takes it: :func:`load_rows`); a history of one file per
 log is slow to read (milliseconds per file): ``greybox monitor`` compacts the history
 (:func:`~greybox.monitor.history.compact_history`) after filing its logs.
 """
@@ -19,9 +20,9 @@ import pyarrow as pa
 
 from ..errors import ParameterError
 from .fingerprint import FEATURES
-from .history import COMPACTED_NAME, SCHEMA_VERSION, HistoryError, check_history, history_lock
+from .history import COMPACTED_NAME, SCHEMA_VERSION, HistoryError, by_precedence, check_history, history_lock
 
-__all__ = ["changed_most"]
+__all__ = ["changed_most", "load_rows"]
 
 
 def _sql_text(value: str) -> str:
@@ -84,7 +85,6 @@ def _query(root: Path, paths: list, chosen: tuple, days: int, until: dt.date | N
 
     if not paths:
         raise HistoryError(f"{root}: the history holds no fingerprints")
-    files = "[" + ", ".join(_sql_text(str(path)) for path in paths) + "]"
     columns = ", ".join(f'avg("{f}") AS "{f}"' for f in chosen)
     names = ", ".join(f'"{f}"' for f in chosen)
     end = "(SELECT max(date) FROM daily)" if until is None else f"DATE {_sql_text(until.isoformat())}"
@@ -118,28 +118,53 @@ def _query(root: Path, paths: list, chosen: tuple, days: int, until: dt.date | N
             FROM change GROUP BY machine, axis)
         ORDER BY abs(change_sd) DESC, machine, axis
         LIMIT {int(limit)}"""
-    needed = ", ".join(["schema_version", "machine", "axis", "date", "log_sha256", *(f'"{f}"' for f in chosen)])
     with duckdb.connect() as connection:
         connection.execute("SET threads TO 1")
-        # the files are read once, only the columns needed; a log's row file wins over a compacted row (a
-        # history of compacted files only, as greybox monitor leaves it, holds every log once)
-        row_files = any(path.name != COMPACTED_NAME for path in paths)
-        unique = (f"QUALIFY row_number() OVER (PARTITION BY log_sha256 ORDER BY filename LIKE '%{COMPACTED_NAME}', "
-                  f"filename) = 1") if row_files else ""
         try:
-            connection.execute(f"""
-                CREATE TEMP TABLE rows AS
-                SELECT {needed}
-                FROM read_parquet({files}, hive_partitioning = false, union_by_name = false,
-                                  filename = {str(row_files).lower()})
-                {unique}""")
-            versions = connection.execute("SELECT DISTINCT schema_version FROM rows").fetchall()
-            if sorted(v for (v,) in versions) != [SCHEMA_VERSION]:
-                found = ", ".join(str(v) for (v,) in versions)
-                raise HistoryError(f"{root}: history rows of schema version {found}; this greybox reads "
-                                   f"version {SCHEMA_VERSION}")
+            load_rows(connection, root, paths, ["machine", "axis", "date", *chosen])
             relation = connection.sql(query)
             to_table = getattr(relation, "to_arrow_table", None) or relation.arrow  # DuckDB 2 / DuckDB 1
             return to_table()
         except duckdb.Error as error:
             raise HistoryError(f"{root}: not a readable fingerprint history ({str(error).splitlines()[0]})") from None
+
+
+def load_rows(connection, root: Path, paths, columns) -> None:
+    """Create the temporary table ``rows`` of the history's files: a log's row from its first file in
+    :func:`~greybox.monitor.history.by_precedence` order, the rule :func:`~greybox.monitor.history.read_history`
+    follows.
+
+    Parameters
+    ----------
+    connection : duckdb.DuckDBPyConnection
+        The connection the table is created in.
+    root : Path
+        The history directory, named in the messages.
+    paths : sequence of Path
+        The history's files (:func:`~greybox.monitor.history.check_history`).
+    columns : sequence of str
+        Columns of the table besides ``schema_version`` and ``log_sha256`` (each file is read once, only
+        these columns).
+
+    Raises
+    ------
+    HistoryError
+        For rows of another schema version.
+    """
+    ordered = by_precedence(paths)
+    files = "[" + ", ".join(_sql_text(str(path)) for path in ordered) + "]"
+    needed = ", ".join(f'"{name}"' for name in dict.fromkeys(["schema_version", "log_sha256", *columns]))
+    # a history of compacted files only (as greybox monitor leaves it) holds every log once: nothing to choose
+    choose = any(path.name != COMPACTED_NAME for path in ordered)
+    unique = (f"QUALIFY row_number() OVER (PARTITION BY log_sha256 ORDER BY list_position({files}, filename)) = 1"
+              if choose else "")
+    connection.execute(f"""
+        CREATE TEMP TABLE rows AS
+        SELECT {needed}
+        FROM read_parquet({files}, hive_partitioning = false, union_by_name = false, filename = {str(choose).lower()})
+        {unique}""")
+    versions = connection.execute("SELECT DISTINCT schema_version FROM rows").fetchall()
+    if sorted(v for (v,) in versions) != [SCHEMA_VERSION]:
+        found = ", ".join(str(v) for (v,) in versions)
+        raise HistoryError(f"{root}: history rows of schema version {found}; this greybox reads version "
+                           f"{SCHEMA_VERSION}")

@@ -13,17 +13,15 @@ import numpy as np
 from ..data.io import read_log
 from ..data.prepare import prepare
 from ..errors import GreyboxError, LogError
+from ..provenance import file_sha256
 from .cutting import uncut_samples
 from .detect import ChangeDetector
 from .fingerprint import FrictionFingerprint, spindle_idle_samples, unloaded_samples
-from .history import append_fingerprint, compact_history, file_sha256, find_log, read_history, row_path
+from .history import append_fingerprint, compact_history, find_log, read_history, row_path
 from .report import write_report
 
-__all__ = ["DuplicateLogError", "FingerprintJob", "MonitorResult", "fingerprint_file", "fingerprint_job", "log_date",
-           "run_monitor"]
-
-#: ``format`` of the manifest a fleet run of the fingerprints leaves in the history (``_manifest.json``).
-MONITOR_FORMAT = "greybox-monitor"
+__all__ = ["DuplicateLogError", "MonitorResult", "finish_run", "fingerprint_file", "log_date", "run_monitor",
+           "start_run"]
 
 #: Axis name of a log of one axis that names none, without ``--axis``.
 DEFAULT_AXIS = "axis"
@@ -174,98 +172,6 @@ def fingerprint_file(path, history, *, machine: str | None = None, axis: str | N
     return written, True
 
 
-@dataclass(frozen=True)
-class FingerprintJob:
-    """One log of a fleet run of ``greybox monitor``: what to read and where its fingerprint goes.
-
-    Parameters
-    ----------
-    path : str
-        Log file.
-    history : str
-        History directory.
-    machine, axis : str or None
-        As :func:`fingerprint_file` takes them.
-    model_path : str or None
-        Reference model file, loaded by the worker.
-    spindle_column : str or None
-        Spindle-load column.
-    find_cuts : bool
-        Find the cutting stretches from the current.
-    """
-
-    path: str
-    history: str
-    machine: str | None = None
-    axis: str | None = None
-    model_path: str | None = None
-    spindle_column: str | None = None
-    find_cuts: bool = False
-
-
-def fingerprint_job(job: FingerprintJob) -> dict:
-    """Fingerprint one log on a fleet worker (:func:`greybox.fleet.run_tasks`); never raises for bad input.
-
-    Parameters
-    ----------
-    job : FingerprintJob
-        The log and its settings.
-
-    Returns
-    -------
-    dict
-        The manifest entry (:func:`greybox.fleet.attempt`): ``output``, the history file of the log's row,
-        and ``fitted``, whether it was fitted now.
-    """
-    from ..fleet import attempt
-
-    def work() -> dict:
-        model = None
-        if job.model_path is not None:
-            from ..persistence import load_model
-
-            model = load_model(job.model_path)
-        try:
-            row, new = fingerprint_file(job.path, job.history, machine=job.machine, axis=job.axis, model=model,
-                                        spindle_column=job.spindle_column, find_cuts=job.find_cuts)
-        except DuplicateLogError as copy:
-            return {"output": None, "fitted": False, "duplicate": str(copy)}
-        return {"output": str(row), "fitted": bool(new)}
-
-    return attempt(str(job.path), work)
-
-
-def _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column, find_cuts, scheduler, workers,
-                       progress) -> tuple[int, int, list]:
-    """Fingerprint ``logs`` on a Dask cluster (:func:`greybox.fleet.run_tasks`); the logs fitted, known, and the
-    copies found (one line each)."""
-    from ..fleet import log_stamp, run_tasks
-
-    jobs = [FingerprintJob(str(path), str(history), machine, axis, None if model_path is None else str(model_path),
-                           spindle_column, find_cuts) for path in logs]
-    for job in jobs:
-        if not Path(job.path).is_file():
-            raise LogError(job.path, "no such log file")
-    stamps = [{"log": job.path, **log_stamp(job.path), "machine": machine, "axis": axis,
-               "model": job.model_path, "spindle_column": spindle_column, "find_cuts": find_cuts} for job in jobs]
-
-    def report(done: int, total: int, entry: dict) -> None:
-        if progress is not None:
-            state = entry.get("error") or entry.get("duplicate") or (
-                "fingerprinted" if entry.get("fitted") else "already in the history")
-            progress(f"[{done}/{total}] {entry['log']}: {state}")
-
-    manifest = run_tasks(fingerprint_job, jobs, stamps, out_dir=history, header={"format": MONITOR_FORMAT},
-                         items="logs", scheduler=scheduler, workers=workers, progress=report)
-    failed = [entry for entry in manifest["logs"] if entry["status"] == "failed"]
-    if failed:
-        raise GreyboxError(f"{len(failed)} of {len(jobs)} logs failed (listed in {Path(history) / '_manifest.json'});"
-                           f" the first: {failed[0]['error']}")
-    fitted = sum(bool(entry.get("fitted")) and entry["status"] == "ok" for entry in manifest["logs"])
-    copies = [entry["duplicate"] for entry in manifest["logs"] if entry.get("duplicate")]
-    return fitted, len(jobs) - fitted - len(copies), copies
-
-
 @dataclass
 class MonitorResult:
     """What ``greybox monitor`` did.
@@ -292,16 +198,79 @@ class MonitorResult:
     duplicates: list = field(default_factory=list)
 
 
-def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
-                model_path=None, spindle_column: str | None = None, find_cuts: bool = False,
-                baseline_days: int = 28,
-                scheduler: str | None = None, workers: int | None = None,
-                progress: Callable[[str], None] | None = None, force: bool = False) -> MonitorResult:
-    """Fingerprint ``logs`` into ``history``, compact it, detect changes over the whole history, write the dashboard.
+def start_run(history, out_dir, *, baseline_days: int = 28, force: bool = False) -> ChangeDetector:
+    """Refuse the options and outputs of a run of ``greybox monitor`` before any work; its change detector.
+
+    Parameters
+    ----------
+    history : path-like
+        History directory (created if missing).
+    out_dir : path-like
+        Directory of the dashboard ``index.html``.
+    baseline_days : int, default 28
+        Days that set each feature's baseline.
+    force : bool, default False
+        Replace the dashboard of an earlier run in ``out_dir``; otherwise it is an error.
+
+    Returns
+    -------
+    ChangeDetector
+        Not fitted yet.
+    """
+    page = Path(out_dir) / "index.html"
+    if page.exists() and not force:
+        raise GreyboxError(f"{page}: exists; give --force to replace the dashboard (or another --out)")
+    detector = ChangeDetector(baseline_days=baseline_days)
+    detector._check_params()  # refuse bad options before any work
+    if Path(history).exists() and not Path(history).is_dir():
+        raise GreyboxError(f"{history}: history is a file, not a directory")
+    return detector
+
+
+def finish_run(history, out_dir, detector: ChangeDetector, *, fitted: int = 0, known: int = 0,
+               duplicates: Sequence[str] = ()) -> MonitorResult:
+    """Compact the history, detect changes over all of it and write the dashboard: the end of every run.
 
     The history is compacted (:func:`~greybox.monitor.history.compact_history`) after the logs are filed:
     every machine and axis keeps one file, which its query (:func:`~greybox.monitor.query.changed_most`)
     reads quickly. Compacting is atomic per axis and idempotent.
+
+    Parameters
+    ----------
+    history : path-like
+        History directory.
+    out_dir : path-like
+        Directory of the dashboard ``index.html``.
+    detector : ChangeDetector
+        Of :func:`start_run`; fitted here on the whole history.
+    fitted, known : int, default 0
+        Logs fingerprinted now, and logs already in the history.
+    duplicates : sequence of str, default ()
+        One line per log not filed because the history holds the same bytes under another day.
+
+    Returns
+    -------
+    MonitorResult
+    """
+    if Path(history).is_dir():
+        compact_history(history)  # one file per machine and axis: the history stays quick to query
+    table = read_history(history)
+    if table.num_rows == 0:
+        raise GreyboxError(f"{history}: the history holds no fingerprints; give logs to fingerprint")
+    detector.fit(table)
+    page = write_report(detector, out_dir)
+    return MonitorResult(fitted, known, detector, page, list(duplicates))
+
+
+def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None, axis: str | None = None,
+                model_path=None, spindle_column: str | None = None, find_cuts: bool = False,
+                baseline_days: int = 28, progress: Callable[[str], None] | None = None,
+                force: bool = False) -> MonitorResult:
+    """Fingerprint ``logs`` into ``history`` one after the other, then detect changes and write the dashboard.
+
+    The logs are fingerprinted in this process; :func:`greybox.fleet.monitor.monitor_fleet` fingerprints them
+    on a Dask cluster instead. Both end in :func:`finish_run`: the history compacted, the change detection
+    fitted on all of it, the dashboard written.
 
     Parameters
     ----------
@@ -324,12 +293,6 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         current (:func:`~greybox.monitor.cutting.uncut_samples`).
     baseline_days : int, default 28
         Days that set each feature's baseline.
-    scheduler : str, optional
-        Address of a Dask scheduler: the logs are fingerprinted on that cluster (:mod:`greybox.fleet`).
-    workers : int, optional
-        Fingerprint the logs on a local Dask cluster of this many processes (:mod:`greybox.fleet`); without
-        it and ``scheduler`` one after the other in this process. A fleet run leaves its manifest
-        ``_manifest.json`` in the history and skips the logs it lists as done, unchanged.
     progress : callable, optional
         Called with one line per log.
     force : bool, default False
@@ -339,25 +302,12 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
     -------
     MonitorResult
     """
-    page = Path(out_dir) / "index.html"
-    if page.exists() and not force:
-        raise GreyboxError(f"{page}: exists; give --force to replace the dashboard (or another --out)")
-    detector = ChangeDetector(baseline_days=baseline_days)
-    detector._check_params()  # refuse bad options before any work
-    if Path(history).exists() and not Path(history).is_dir():
-        raise GreyboxError(f"{history}: history is a file, not a directory")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise GreyboxError(f"workers must be a positive whole number, got {workers!r}")
-    if logs and (scheduler is not None or workers is not None):
-        fitted, known, duplicates = _fingerprint_fleet(logs, history, machine, axis, model_path, spindle_column,
-                                                       find_cuts, scheduler, workers, progress)
-        logs = []
-    else:
-        fitted = known = 0
-        duplicates = []
+    detector = start_run(history, out_dir, baseline_days=baseline_days, force=force)
+    fitted = known = 0
+    duplicates = []
     model = None
     if model_path is not None and logs:
-        from ..persistence import load_model
+        from ..models.files import load_model
 
         model = load_model(model_path)
     for path in logs:
@@ -370,11 +320,4 @@ def run_monitor(logs: Sequence, history, out_dir, *, machine: str | None = None,
         fitted, known = fitted + new, known + (not new)
         if progress is not None:
             progress(f"{path}: {'fingerprinted' if new else 'already in the history'} -> {row}")
-    if Path(history).is_dir():
-        compact_history(history)  # one file per machine and axis: the history stays quick to query
-    table = read_history(history)
-    if table.num_rows == 0:
-        raise GreyboxError(f"{history}: the history holds no fingerprints; give logs to fingerprint")
-    detector.fit(table)
-    page = write_report(detector, out_dir)
-    return MonitorResult(fitted, known, detector, page, duplicates)
+    return finish_run(history, out_dir, detector, fitted=fitted, known=known, duplicates=duplicates)

@@ -1,6 +1,6 @@
 """The process share of every axis of a machine, and the resultant process force of its linear axes.
 
-``greybox predict`` with a machine model (:mod:`greybox.machine_model`) runs
+``greybox predict`` with a machine model (:mod:`greybox.models.machine`) runs
 :func:`~greybox.predict.process.predict_process` on each axis and joins the
 results on one time base: the first axis's time stamps. Axes logged on the
 same clock (one CSV, a TDMS group) share them already; channels with their
@@ -117,7 +117,7 @@ def predict_machine(models: Mapping[str, object], runs: Mapping[str, Sequence[Ax
     Parameters
     ----------
     models : mapping of str to CurrentModel
-        A fitted model per axis (:class:`greybox.machine_model.MachineModel`'s ``models``).
+        A fitted model per axis (:class:`greybox.models.machine.MachineModel`'s ``models``).
     runs : mapping of str to sequence of AxisLog
         Each axis's prepared run(s) of the log.
     axis_configs : mapping of str to AxisConfig or None, optional

@@ -1,10 +1,10 @@
 """What one :func:`~greybox.predict.run.predict_logs` call asks for and what it gives back.
 
 :class:`Request` holds the call's options as given and does what every model source needs of them:
-checking the outputs before any work, calibrating the interval, reporting progress, writing the table
-and running a fleet. :class:`Prediction` is the result: the lines to show, the figures of each axis
-(:class:`AxisFigures`) and what was written; :class:`ChunkProgress` is what the progress callback
-receives after each chunk.
+checking the outputs before any work, calibrating the interval, reporting progress and writing the
+table. :class:`Prediction` is the result (also of a fleet run, :func:`greybox.fleet.predict.predict_fleet`):
+the lines to show, the figures of each axis (:class:`AxisFigures`) and what was written;
+:class:`ChunkProgress` is what the progress callback receives after each chunk.
 """
 
 from __future__ import annotations
@@ -12,10 +12,9 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable
 
 from ..errors import GreyboxError, Setting
-from ..fleet import check_out_dir, fleet_summary
 from ..provenance import training_file_warning
 from .interval import DEFAULT_COVERAGE, ProcessInterval, calibrate_interval
 from .output import check_output_path, output_paths, write_process
@@ -143,7 +142,7 @@ class Request:
     Parameters
     ----------
     out : Path
-        The process table of one log, or the dataset directory of a fleet run.
+        The process table of the log.
     axis_config, machine : str or None
         Axis file of a model file's axis; machine file of a machine model (TOML).
     calibration : list of str or None
@@ -162,14 +161,8 @@ class Request:
         Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`).
     force : bool
         Replace outputs that exist (never an input).
-    scheduler : str or None
-        Address of a dask.distributed scheduler for a fleet run.
-    workers : int or None
-        Processes of the local cluster of a fleet run.
     progress : callable or None
         ``progress(ChunkProgress)`` after each chunk.
-    fleet_progress : callable or None
-        ``fleet_progress(done, total, entry)`` after each log of a fleet run.
     notify : callable
         ``notify(line)`` with each note or warning line.
     relevel : bool
@@ -187,10 +180,7 @@ class Request:
     chunk_s: float
     read: dict
     force: bool
-    scheduler: str | None
-    workers: int | None
     progress: Callable | None
-    fleet_progress: Callable | None
     notify: Callable[[str], None]
     relevel: bool = False
 
@@ -308,35 +298,6 @@ class Request:
             draw(result, self.plot, mean_s=self.plot_mean_s, window=window)
             written.append(str(self.plot))
         return written
-
-    def fleet(self, model: str, logs: Sequence[str]) -> Prediction:
-        """Predict every log as a task on Dask, each with ``model``; the run's summary.
-
-        Parameters
-        ----------
-        model : str
-            A model file, or a directory of per-machine models.
-        logs : sequence of str
-            Log files, directories searched recursively, glob patterns.
-        """
-        from ..fleet import MANIFEST, expand_logs
-        from ..persistence import load_model
-        from .fleet import fleet_jobs, run_fleet
-
-        out = check_out_dir(self.out)
-        jobs = fleet_jobs(expand_logs(logs, exclude=[out]), str(Path(model).resolve()), str(out),
-                          axis_config=str(Path(self.axis_config).resolve()) if self.axis_config else None,
-                          read=self.read, chunk_s=self.chunk_s)
-        for path in sorted({job.model for job in jobs}):
-            load_model(path)  # a bad model file is one error before any cluster starts
-        manifest = run_fleet(jobs, scheduler=self.scheduler, workers=self.workers, force=self.force,
-                             progress=self.fleet_progress)
-        lines, status = fleet_summary(manifest, "logs", "predicted", lambda entry: entry["error"])
-        if manifest["counts"]["ok"] + manifest["counts"]["skipped"]:
-            lines.append(f"wrote {out / MANIFEST} and the dataset {out}/machine=*/axis=*/log=*/part-0.parquet")
-        else:
-            lines.append(f"wrote {out / MANIFEST} (every log failed: no output)")
-        return Prediction(closing=lines, status=status, manifest=manifest)
 
 
 def named(name: str) -> Setting:

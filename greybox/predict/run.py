@@ -6,9 +6,10 @@ What it does follows from what it is given:
   every axis of the log, and the resultant force, :mod:`greybox.predict.machine`), or a directory of
   models of ``greybox train --per-machine`` (each log predicted with its machine's model). The kind of
   model source carries what it can do (:func:`~greybox.predict.sources.open_model`): a machine model
-  predicts one log of several axes and refuses a fleet;
-* the logs: one log file is predicted in this process, several logs, a directory or a glob pattern
-  make a fleet run (one task per log on Dask, a partitioned Parquet dataset, :mod:`greybox.predict.fleet`);
+  predicts one log of several axes;
+* the logs: one log file, predicted in this process. Several logs, a directory or a glob pattern make a
+  fleet run (:func:`is_fleet`: one task per log on Dask, a partitioned Parquet dataset), which
+  :func:`greybox.fleet.predict.predict_fleet` runs on top of this package; this function refuses it;
 * how a log is read: a Parquet or MCAP log of a linear axis, without a picture, resampling or a sample
   time, is read, predicted and written block by block (:mod:`greybox.predict.stream`), so that its
   length does not bound the memory; any other log, or one that turns out not to stream
@@ -55,7 +56,6 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
                  chunk_s: float = DEFAULT_CHUNK_S, read: Mapping | None = None, force: bool = False,
                  scheduler: str | None = None, workers: int | None = None,
                  progress: Callable[[ChunkProgress], None] | None = None,
-                 fleet_progress: Callable[[int, int, dict], None] | None = None,
                  notify: Callable[[str], None] | None = None, relevel: bool = False) -> Prediction:
     """Predict the process current (and force) of cutting logs with a model trained on air cuts, and write it.
 
@@ -64,11 +64,11 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
     model : str or path-like
         A model file, a machine model directory, or the models directory of ``greybox train
         --per-machine`` (:func:`~greybox.predict.sources.open_model`).
-    logs : str, path-like or sequence of them
-        One cutting log, or (a fleet run, :func:`is_fleet`) several logs, directories searched
-        recursively, glob patterns.
+    logs : str, path-like or sequence of one
+        One cutting log (several, a directory or a glob pattern make a fleet run, :func:`is_fleet`: refused,
+        :func:`greybox.fleet.predict.predict_fleet` runs it).
     out : str or path-like
-        The process table (.csv, .parquet, .mcap) of one log; the dataset directory of a fleet run.
+        The process table (.csv, .parquet, .mcap).
     axis_config : str, optional
         Axis file (TOML) of a model file's axis: adds the process force (torque on a rotary axis).
     machine : str, optional
@@ -90,14 +90,11 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
         Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`).
     force : bool, default False
         Replace outputs that exist (never an input).
-    scheduler : str, optional
-        Address of a dask.distributed scheduler for a fleet run (default a local cluster).
-    workers : int, optional
-        Processes of the local cluster of a fleet run.
+    scheduler, workers : None
+        Options of a fleet run (:func:`greybox.fleet.predict.predict_fleet`, which takes the options of this
+        function): refused here, one log is predicted in this process.
     progress : callable, optional
-        ``progress(ChunkProgress)`` after each chunk of a log predicted here.
-    fleet_progress : callable, optional
-        ``fleet_progress(done, total, entry)`` after each log of a fleet run.
+        ``progress(ChunkProgress)`` after each chunk.
     notify : callable, optional
         ``notify(line)`` with each ``note:`` or ``warning:`` line while the logs are read and prepared
         (default: dropped).
@@ -122,17 +119,12 @@ def predict_logs(model: str | os.PathLike, logs: str | os.PathLike | Sequence[st
     request = Request(out=Path(out), axis_config=axis_config, machine=machine,
                        calibration=None if calibration is None else list(calibration), coverage=coverage, plot=plot,
                        plot_mean_s=plot_mean_s, plot_window=None if plot_window is None else tuple(plot_window),
-                       chunk_s=chunk_s, read=dict(read or {}), force=force, scheduler=scheduler, workers=workers,
-                       progress=progress, fleet_progress=fleet_progress, notify=notify or (lambda line: None),
-                       relevel=relevel)
+                       chunk_s=chunk_s, read=dict(read or {}), force=force, progress=progress,
+                       notify=notify or (lambda line: None), relevel=relevel)
     source = open_model(model)
     if is_fleet(logs):
-        for setting, value in (("plot", plot), ("plot_window", plot_window), ("calibration", calibration),
-                               ("coverage", coverage), ("machine", machine), ("relevel", relevel or None)):
-            if value is not None:
-                raise GreyboxError(named(setting), " applies to one log; a fleet run (several logs) writes the "
-                                   "process tables")
-        return source.predict_fleet([str(item) for item in logs], request)
+        raise GreyboxError(f"{logs[0]}: several logs, a directory or a pattern make a fleet run; "
+                           "greybox.fleet.predict.predict_fleet runs it")
     if scheduler or workers:
         raise GreyboxError(named("scheduler"), " and ", named("workers"),
                            " apply to fleet runs (several logs, a directory or a pattern)")

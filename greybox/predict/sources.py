@@ -1,7 +1,6 @@
 """The model sources prediction takes: a model file, a directory of per-machine models, a machine model.
 
-:func:`open_model` tells them apart; each source carries what it can do: predict one log
-(``predict_log``) and a fleet of logs (``predict_fleet``), or refuse it with a message naming why.
+:func:`open_model` tells them apart; each source carries how it predicts one log (``predict_log``).
 """
 
 from __future__ import annotations
@@ -10,7 +9,7 @@ import os
 import time
 from dataclasses import replace
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable
 
 import numpy as np
 
@@ -36,7 +35,7 @@ def _window(request: Request, runs, log: str):
 
 
 class ModelFile:
-    """A model file (``greybox train``): one log predicted in this process, or a fleet of logs.
+    """A model file (``greybox train``): one log predicted in this process.
 
     Parameters
     ----------
@@ -46,18 +45,6 @@ class ModelFile:
 
     def __init__(self, path):
         self.path = str(path)
-
-    def predict_fleet(self, logs: Sequence[str], request: Request) -> Prediction:
-        """Predict every log on Dask with this model (see :func:`~greybox.predict.run.predict_logs`).
-
-        Parameters
-        ----------
-        logs : sequence of str
-            Log files, directories searched recursively, glob patterns.
-        request : Request
-            The call's options.
-        """
-        return request.fleet(self.path, logs)
 
     def predict_log(self, log: str, request: Request) -> Prediction:
         """Predict one log, streamed where it can be (see :func:`~greybox.predict.run.predict_logs`).
@@ -71,7 +58,7 @@ class ModelFile:
         """
         from ..data.axis_config import read_axis_config
         from ..data.stream import open_stream
-        from ..persistence import load_model
+        from ..models.files import load_model
 
         if request.machine:
             raise GreyboxError(named("machine"), " applies to a machine model (a directory written by 'greybox train "
@@ -205,7 +192,7 @@ class ModelsDirectory(ModelFile):
         request : Request
             The call's options.
         """
-        from .fleet import model_of_log
+        from ..models.plant import model_of_log
 
         chosen = model_of_log(self.path, log, request.read.get("axis"))
         done = ModelFile(chosen).predict_log(log, request)
@@ -225,19 +212,6 @@ class MachineDirectory:
     def __init__(self, path):
         self.path = str(path)
 
-    def predict_fleet(self, logs: Sequence[str], request: Request) -> Prediction:
-        """Refused: a fleet run takes one model file.
-
-        Parameters
-        ----------
-        logs : sequence of str
-            Log files, directories searched recursively, glob patterns.
-        request : Request
-            The call's options.
-        """
-        raise GreyboxError(f"{self.path}: a fleet run takes one model file; run one fleet per axis of the machine "
-                           "model with its file and ", named("axis"))
-
     def predict_log(self, log: str, request: Request) -> Prediction:
         """Predict every axis of one log (see :func:`~greybox.predict.run.predict_logs`).
 
@@ -251,8 +225,8 @@ class MachineDirectory:
         if request.relevel:
             raise GreyboxError(named("relevel"), " applies to a model file's log; not to a machine model yet")
         from ..data.machine_config import read_machine_config
-        from ..machine_model import load_machine
-        from ..persistence import load_model
+        from ..models.files import load_model
+        from ..models.machine import load_machine
         from .machine import RESULTANT_COLUMN, predict_machine
         from .plot import plot_machine_process
 
@@ -328,9 +302,9 @@ def open_model(path: str | os.PathLike) -> ModelFile | ModelsDirectory | Machine
     Returns
     -------
     ModelFile or ModelsDirectory or MachineDirectory
-        Each with ``predict_log(log, request)`` and ``predict_fleet(logs, request)``.
+        Each with ``predict_log(log, request)``.
     """
-    from ..machine_model import is_machine_model
+    from ..models.machine import is_machine_model
 
     if is_machine_model(path):
         return MachineDirectory(path)

@@ -113,7 +113,7 @@ class PartSignal:
     def _model(self):
         if self._loaded is None:
             from ..data.axis_config import read_axis_config
-            from ..persistence import load_model
+            from ..models.files import load_model
 
             config = read_axis_config(self.axis_config) if self.axis_config else None
             self._loaded = (load_model(self.model), config)

@@ -728,7 +728,7 @@ def reproduce(
     Reproduction
     """
     from ..evaluate.report import report_tables, write_report
-    from ..persistence import save_model
+    from ..models.files import save_model
 
     started = time.perf_counter()
     out_dir = Path(out_dir)

@@ -8,8 +8,8 @@ from typing import Callable, Mapping, Sequence
 from ..atomic import check_output_path
 from ..data.effort import check_effort_measured, check_one_axis, check_one_effort
 from ..errors import ModelFileError
-from ..model_choice import DEFAULT_CANDIDATES, choose_model
-from ..persistence import save_verified
+from ..models.files import save_verified
+from .candidates import DEFAULT_CANDIDATES, choose_model
 from .logs import axis_file_inertia, check_intervals, intervals_line, read_training_logs
 from .record import record_training
 
@@ -21,13 +21,13 @@ def train_auto_logs(logs, *, candidates: Sequence[str] = DEFAULT_CANDIDATES, rea
                     intervals: str = "sandwich", n_bootstrap: int | None = None, out=None, overwrite: bool = False,
                     progress: Callable[[str], None] | None = None, report: Callable[[str], None] | None = None,
                     notify: Callable[[str], None] | None = None):
-    """Choose the model by held-out runs (:func:`greybox.model_choice.choose_model`), record it, return it.
+    """Choose the model by held-out runs (:func:`greybox.train.candidates.choose_model`), record it, return it.
 
     Parameters
     ----------
     logs : sequence of (str, path-like or AxisLog)
         Training logs; a log's runs are held out together.
-    candidates : sequence of str, default :data:`~greybox.model_choice.DEFAULT_CANDIDATES`
+    candidates : sequence of str, default :data:`~greybox.train.candidates.DEFAULT_CANDIDATES`
         Candidate specifications (``KIND[:OPTION,...]``).
     read : mapping, optional
         Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`).

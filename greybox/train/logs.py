@@ -3,7 +3,7 @@
 :func:`train_logs` is the one entry point of training one model, beside :func:`greybox.predict.predict_logs`;
 ``greybox train``, the fleet (:mod:`greybox.fleet.train`) and Python callers all go through it, so every
 model it returns carries the same training record (:func:`~greybox.train.record.record_training`), which
-:func:`greybox.persistence.save_model` writes into its file.
+:func:`greybox.models.files.save_model` writes into its file.
 """
 
 from __future__ import annotations
@@ -23,8 +23,8 @@ from ..data.reading import read_prepared
 from ..errors import GreyboxError, ModelFileError
 from ..identify.intervals import METHODS as INTERVAL_METHODS
 from ..identify.intervals import attach_intervals
+from ..models.files import save_verified
 from ..models.registry import model_class, model_kind
-from ..persistence import save_verified
 from .advice import offset_note, takes_hyperparameter
 from .record import record_training, run_names
 

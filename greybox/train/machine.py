@@ -6,7 +6,7 @@ import time
 from typing import Callable, Mapping, Sequence
 
 from ..data.effort import check_effort_measured, check_one_axis, check_one_effort
-from ..machine_model import MachineModel, check_machine_output, save_machine
+from ..models.machine import MachineModel, check_machine_output, save_machine
 from .logs import axis_file_inertia, check_intervals, fit_runs, read_training_logs, unfitted
 from .record import record_training
 

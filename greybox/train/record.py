@@ -1,7 +1,7 @@
 """The training record of a model: the files, their preparation, the training errors and ranges.
 
 :func:`record_training` builds it from the runs a model was fitted on and keeps it on the model as the
-learned attribute ``training_record_``; :func:`greybox.persistence.save_model` writes it as the file's
+learned attribute ``training_record_``; :func:`greybox.models.files.save_model` writes it as the file's
 ``training`` record, however the model was trained (``greybox train``, the fleet, Python).
 """
 

@@ -12,8 +12,8 @@ from greybox.cli import compensate
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
+from greybox.models.files import save_model
 from greybox.models.friction import CoulombModel, GMSModel
-from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 

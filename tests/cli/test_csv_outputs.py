@@ -23,8 +23,8 @@ from greybox.data.file_metadata import sidecar_path
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare, trim
 from greybox.evaluate.report import CSV_COLUMNS
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel, GMSModel
-from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
 PROCESS_COLUMNS = ["time_s", "current_measured_A", "current_model_A", "current_process_A", "position_mm",

@@ -16,7 +16,7 @@ from greybox.data.io import write_log
 from greybox.errors import GreyboxError
 from greybox.models import registry
 from greybox.models.augmented import AugmentedModel
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 from studies.discovery import StudyCase, case_logs
 
 

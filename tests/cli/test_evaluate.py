@@ -15,8 +15,8 @@ from greybox.data.prepare import prepare, trim
 from greybox.evaluate.regimes import REGIME_NAMES, TRAINING_REGION_NAMES
 from greybox.evaluate.report import CSV_COLUMNS
 from greybox.metrics import rmse
+from greybox.models.files import save_model
 from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
-from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 #: The tests on the twin's logs take long together (model fits, end-to-end runs): left out of the default run;
@@ -56,7 +56,7 @@ def test_evaluate_prints_regimes_and_writes_json_and_report(files, tmp_path, cap
     assert "stribeck" in printed and "gms" in printed and "noise_floor" in printed
     records = {r["model"]: r for r in json.loads(records_file.read_text())}
     assert set(records) == {"stribeck", "gms", "noise_floor"}
-    from greybox.persistence import load_model
+    from greybox.models.files import load_model
 
     runs = prepare([trim(make_dataset("X", d, seed=11, duration_s=6.0), stop_s=6.0) for d in "CD"])
     measured = np.concatenate([run.effort for run in runs])

@@ -10,8 +10,8 @@ from svr_runs import FIXED, sweep_run
 
 from greybox.cli import main
 from greybox.data.io import write_log
+from greybox.models.files import save_model
 from greybox.models.svr import SVRCurrentModel
-from greybox.persistence import save_model
 
 
 @pytest.fixture(scope="module")

@@ -13,8 +13,8 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
+from greybox.models.files import save_model
 from greybox.models.friction import GMSModel
-from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"

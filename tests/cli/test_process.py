@@ -9,8 +9,8 @@ import pytest
 
 from greybox.cli import main
 from greybox.data.prepare import prepare
+from greybox.models.files import save_model
 from greybox.models.friction import GMSModel
-from greybox.persistence import save_model
 from greybox.twin import make_dataset
 from greybox.twin.part_series import PartSeriesSpec, ToolEvents, part_program, synthesize_part_series
 

@@ -16,8 +16,8 @@ from greybox.data.io import write_log  # noqa: E402
 from greybox.data.log import AxisLog  # noqa: E402
 from greybox.data.prepare import prepare  # noqa: E402
 from greybox.evaluate.figures import residual_vs_position, time_comparison  # noqa: E402
+from greybox.models.files import save_model  # noqa: E402
 from greybox.models.friction import CoulombModel  # noqa: E402
-from greybox.persistence import save_model  # noqa: E402
 from greybox.predict.plot import plot_process  # noqa: E402
 from greybox.predict.process import predict_process  # noqa: E402
 

@@ -11,7 +11,7 @@ import greybox.cli as cli
 from greybox.cli._spelling import OPTIONS, command_notes, error_message, spell, spelt
 from greybox.data.io import write_log
 from greybox.errors import GreyboxError, LogError, ParameterError, Setting, SettingWarning
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 from greybox.twin import make_dataset
 
 

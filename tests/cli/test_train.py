@@ -9,9 +9,9 @@ import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
+from greybox.models.files import load_model
 from greybox.models.friction import CoulombModel
 from greybox.models.friction.backlash import BacklashModel
-from greybox.persistence import load_model
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.

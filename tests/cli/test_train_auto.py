@@ -11,7 +11,7 @@ from scipy.io import savemat
 
 import greybox.cli as cli
 from greybox.data.io import write_log
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 
 
 def _log(seed: int, duration: float = 5.0):

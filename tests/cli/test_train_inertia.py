@@ -12,7 +12,7 @@ from friction_signals import motion_log, velocity_profile
 import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.identify.inertia import AXIS_INERTIA_FACTOR
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 
 #: Inertia of the runs [A s^2/mm] and the axis: k_t = 1.35 Nm/A, a 10 mm screw coupled directly.
 J_TRUE = 0.002
@@ -89,7 +89,7 @@ def test_an_axis_file_without_inertia_is_refused_before_the_fit(logs, tmp_path, 
 
 
 def test_a_machine_files_axis_inertia_checks_that_axis_model(tmp_path, capsys):
-    from greybox.machine_model import load_machine
+    from greybox.models.machine import load_machine
 
     velocity = velocity_profile(5.0, seed=4, v_max=60.0)
     log = motion_log(velocity)

@@ -118,8 +118,8 @@ def _force_log(dataset: str, seed: int, duration_s: float):
 def force_files(tmp_path_factory):
     """A Stribeck model fitted on a force log, two force test logs and one current log (MCAP)."""
     from greybox.data.prepare import prepare
+    from greybox.models.files import save_model
     from greybox.models.friction import StribeckModel
-    from greybox.persistence import save_model
 
     root = tmp_path_factory.mktemp("force")
     model = save_model(StribeckModel().fit(prepare([_force_log("A", 1, 4.0)])), root / "stribeck.gbm")
@@ -173,7 +173,7 @@ def test_evaluate_prints_a_row_per_test_log_before_the_pooled_rows(force_files, 
     from greybox.data.io import read_log
     from greybox.data.prepare import prepare
     from greybox.metrics import rmse
-    from greybox.persistence import load_model
+    from greybox.models.files import load_model
 
     records_file = tmp_path / "m.json"
     out = tmp_path / "report"
@@ -288,8 +288,8 @@ def test_plot_window_option(short_log, tmp_path, capsys):
 def predict_files(tmp_path_factory):
     """A Stribeck model file and a 6 s cutting log of dataset C (MCAP)."""
     from greybox.data.prepare import prepare
+    from greybox.models.files import save_model
     from greybox.models.friction import StribeckModel
-    from greybox.persistence import save_model
 
     root = tmp_path_factory.mktemp("predict")
     model = save_model(StribeckModel().fit(prepare([make_dataset("X", "A", seed=1, duration_s=4.0)])),
@@ -326,7 +326,7 @@ def test_process_picture_title_names_the_dataset(predict_files):
     matplotlib.use("Agg")
     from greybox.data.io import read_log
     from greybox.data.prepare import prepare
-    from greybox.persistence import load_model
+    from greybox.models.files import load_model
     from greybox.predict.plot import plot_process
     from greybox.predict.process import predict_process
 

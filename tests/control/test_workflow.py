@@ -7,8 +7,8 @@ import pytest
 from greybox.control.plants import ModelPlant, TwinPlant
 from greybox.control.workflow import feedforward_models, synthesises_training
 from greybox.errors import GreyboxError, ModelFileError
+from greybox.models.files import save_model
 from greybox.models.friction import CoulombModel
-from greybox.persistence import save_model
 
 
 @pytest.fixture(scope="module")

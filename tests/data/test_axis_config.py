@@ -14,8 +14,8 @@ from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
+from greybox.models.files import save_model
 from greybox.models.friction import CoulombModel
-from greybox.persistence import save_model
 
 BASE = {"torque_constant_Nm_per_A": 1.2, "screw_lead_mm": 10.0, "efficiency_backdriven": 0.85}
 

@@ -17,9 +17,9 @@ from greybox.data.mcap_io import McapLog
 from greybox.data.prepare import derivative_margin, prepare
 from greybox.data.stream import ParquetLog, median_step, open_stream, prepared_blocks
 from greybox.errors import LogError
+from greybox.models.files import save_model
 from greybox.models.friction import GMSModel
 from greybox.models.gmssvr import GMSSVRModel
-from greybox.persistence import save_model
 from greybox.twin import make_dataset
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "axis_x.toml"

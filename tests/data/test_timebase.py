@@ -94,8 +94,8 @@ def test_the_command_line_resamples_splits_with_a_note_and_names_resample_otherw
 def test_predict_writes_the_runs_of_a_split_log_one_after_the_other(uniform, tmp_path, capsys):
     import json
 
+    from greybox.models.files import save_model
     from greybox.models.friction import StribeckModel
-    from greybox.persistence import save_model
 
     raw, reference = uniform
     save_model(StribeckModel().fit(reference), tmp_path / "m.gbm")

@@ -9,8 +9,8 @@ from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
 from greybox.models.augmented import AugmentedModel
 from greybox.models.effects import effect
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel, StribeckModel
-from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
 

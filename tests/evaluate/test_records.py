@@ -21,8 +21,8 @@ from greybox.evaluate.report import training_region_table  # noqa: E402
 from greybox.evaluate.table import Table  # noqa: E402
 from greybox.metrics import rmse  # noqa: E402
 from greybox.models.estimator import EXTRAPOLATION_WARNING_SHARE, outside_any  # noqa: E402
+from greybox.models.files import load_model, save_model  # noqa: E402
 from greybox.models.friction import CoulombModel  # noqa: E402
-from greybox.persistence import load_model, save_model  # noqa: E402
 
 
 def _log(seed: int) -> AxisLog:

@@ -14,11 +14,12 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
-from greybox.fleet import MANIFEST, expand_logs
+from greybox.fleet import expand_logs
 from greybox.fleet.train import train_jobs, train_model
 from greybox.metrics import metrics_table
+from greybox.models.files import load_model
 from greybox.models.friction import CoulombModel
-from greybox.persistence import load_model
+from greybox.models.plant import MANIFEST
 from greybox.twin import make_dataset
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;

@@ -9,9 +9,9 @@ from friction_signals import motion_log, velocity_profile
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
 from greybox.identify.inertia import SPRING_SHARE_LIMIT, inertia_note, spring_share
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.models.gmssvr import GMSSVRModel
-from greybox.persistence import load_model, save_model
 
 STEP = 0.002
 

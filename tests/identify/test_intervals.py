@@ -22,9 +22,9 @@ from greybox.identify.intervals import attach_intervals, cluster_covariance, clu
 from greybox.models import registry
 from greybox.models.augmented import AugmentedModel
 from greybox.models.estimator import CurrentModel
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel, GMSModel, LuGreModel, StribeckModel
 from greybox.models.friction.backlash import BacklashModel
-from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;

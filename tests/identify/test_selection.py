@@ -1,4 +1,4 @@
-"""Model choice by held-out runs (greybox.identify.selection, greybox.model_choice)."""
+"""Model choice by held-out runs (greybox.identify.selection, greybox.train.candidates)."""
 
 from __future__ import annotations
 
@@ -24,11 +24,11 @@ from greybox.identify.selection import (
     shared_stages,
     speed_fold,
 )
-from greybox.model_choice import build_candidate, choose_model
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.models.friction.backlash import BacklashModel
 from greybox.models.gmssvr import GMSSVRModel
-from greybox.persistence import load_model, save_model
+from greybox.train.candidates import build_candidate, choose_model
 
 
 def _coulomb_run(seed: int, duration: float = 6.0, noise: float = 0.02):
@@ -349,7 +349,7 @@ def test_a_raced_out_simplest_candidate_sets_no_speed_ceiling_on_the_others():
 
 
 def test_a_gap_shows_on_the_lead_fold_when_the_model_without_it_was_raced_out():
-    from greybox.model_choice import gap_shown
+    from greybox.train.candidates import gap_shown
 
     without = CandidateScore("stribeck:asymmetric", fold_re=[80.0], fold_rmse=[1.0], n_params=9, error="raced out",
                              raced=True)

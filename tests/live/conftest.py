@@ -12,7 +12,7 @@ from live_helpers import EXAMPLE_AXIS, QUICK, Broker, Certificates, run_cli
 
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
-from greybox.persistence import save_model
+from greybox.models.files import save_model
 from greybox.twin import make_dataset
 
 

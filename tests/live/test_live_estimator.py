@@ -10,7 +10,7 @@ from live_helpers import QUICK
 
 from greybox.live.estimator import LiveEstimator
 from greybox.live.run import settled_memory
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 
 
 def _estimates(estimator, log, size=10) -> np.ndarray:

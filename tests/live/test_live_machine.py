@@ -18,8 +18,8 @@ from greybox.live.run import run_live
 from greybox.live.session import LiveSession
 from greybox.live.sinks import LineSink
 from greybox.live.sources import Received
-from greybox.machine_model import MachineModel, save_machine
 from greybox.models.friction import CoulombModel, GMSModel
+from greybox.models.machine import MachineModel, save_machine
 from greybox.twin import make_dataset
 
 
@@ -71,7 +71,7 @@ def test_messages_of_every_axis_feed_every_axis(machine):
 
 def test_one_topic_per_axis(machine):
     """Messages on topics ending in the axis name hold that axis's plain columns."""
-    from greybox.persistence import load_model
+    from greybox.models.files import load_model
 
     root, logs, expected = machine
     out = io.StringIO()

@@ -12,7 +12,7 @@ import pytest
 from greybox.errors import GreyboxError
 from greybox.live.estimator import LiveEstimator
 from greybox.live.recording import Recorder
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 
 
 def _results(model, log, size=10):

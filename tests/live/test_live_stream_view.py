@@ -9,7 +9,7 @@ from live_helpers import QUICK
 
 from greybox.data.prepare import prepare
 from greybox.errors import LogError
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 
 
 @pytest.mark.parametrize("kind", sorted(QUICK))

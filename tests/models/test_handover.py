@@ -9,9 +9,8 @@ import pytest
 from model_files import write_members
 from svr_runs import FIXED, sweep_run
 
-from greybox import persistence
 from greybox.errors import ParameterError
-from greybox.models import registry
+from greybox.models import files, registry
 from greybox.models.handover import HANDOVER_LENGTHS, hand_over, handover_weight, handover_width
 from greybox.models.svr import SVRCurrentModel
 
@@ -131,13 +130,13 @@ def test_the_hand_over_round_trips_and_a_file_from_before_it_predicts_as_fitted(
     model, plain = svr_pair
     test = sweep_run(4, n=2000)
     test = test.replace(velocity=test.velocity * 2.0)  # partly beyond the training speeds
-    loaded = persistence.load_model(persistence.save_model(model, tmp_path / "new.gbm"))
+    loaded = files.load_model(files.save_model(model, tmp_path / "new.gbm"))
     np.testing.assert_array_equal(loaded.predict(test), model.predict(test))
     assert {"handover_width", "proxy_coulomb", "proxy_viscous"} <= {row.name for row in loaded.parameter_table()}
     # a file written before the hand-over has neither the setting nor its attribute
     old = copy.deepcopy(plain)
     del old.handover_width_
-    saved = persistence.save_model(old, tmp_path / "saved.gbm")
+    saved = files.save_model(old, tmp_path / "saved.gbm")
     with zipfile.ZipFile(saved) as archive:
         members = {name: archive.read(name) for name in archive.namelist()}
     document = json.loads(members["model.json"])
@@ -145,7 +144,7 @@ def test_the_hand_over_round_trips_and_a_file_from_before_it_predicts_as_fitted(
     members["model.json"] = json.dumps(document).encode()
     path = tmp_path / "old.gbm"
     write_members(path, members)
-    loaded_old = persistence.load_model(path)
+    loaded_old = files.load_model(path)
     assert loaded_old.handover  # the setting's default ...
     np.testing.assert_array_equal(loaded_old.predict(test), plain.predict(test))  # ... yet predicts as fitted
     assert not np.allclose(loaded_old.predict(test), model.predict(test))
@@ -159,6 +158,6 @@ def test_a_file_with_a_bad_hand_over_width_is_refused(svr_pair, tmp_path, monkey
     monkeypatch.setitem(registry.MODEL_CLASSES, "svr", SVRCurrentModel)
     hostile = copy.deepcopy(svr_pair[0])
     hostile.handover_width_ = -1.0
-    path = persistence.save_model(hostile, tmp_path / "hostile.gbm")
+    path = files.save_model(hostile, tmp_path / "hostile.gbm")
     with pytest.raises(ModelFileError, match="handover_width_"):
-        persistence.load_model(path)
+        files.load_model(path)

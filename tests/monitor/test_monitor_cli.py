@@ -11,10 +11,10 @@ import pytest
 
 from greybox.cli import main
 from greybox.data.io import read_log
+from greybox.models.files import load_model
 from greybox.monitor.fingerprint import FEATURES
 from greybox.monitor.history import read_history
 from greybox.monitor.workflow import fingerprint_file
-from greybox.persistence import load_model
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;
 #: `pytest -m slow` runs them, as .ci/run does.
@@ -160,8 +160,8 @@ def test_reference_model_leaves_out_a_process_load(twin_days, tmp_path, capsys):
     """With --model, a process current added to part of a log is left out: the levels stay those of the air cut."""
     from greybox.data.io import write_log
     from greybox.data.prepare import prepare
+    from greybox.models.files import save_model
     from greybox.models.friction import CoulombModel
-    from greybox.persistence import save_model
 
     source = sorted(twin_days.iterdir())[0]
     log = read_log(source)

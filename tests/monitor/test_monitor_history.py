@@ -15,7 +15,6 @@ from greybox.monitor.history import (
     HistoryError,
     append_fingerprint,
     compact_history,
-    file_sha256,
     find_log,
     has_log,
     read_history,
@@ -57,14 +56,6 @@ def test_rerun_is_idempotent(tmp_path):
     table = read_history(tmp_path)
     assert table.num_rows == 1 and table.column("date").to_pylist() == [dt.date(2026, 3, 5)]
     assert has_log(tmp_path, SHA_A) == row_path(tmp_path, "mill1", "X", dt.date(2026, 3, 5), SHA_A)
-
-
-def test_file_sha256_is_of_the_bytes(tmp_path):
-    one, two = tmp_path / "one", tmp_path / "two"
-    one.write_bytes(b"abc")
-    two.write_bytes(b"abd")
-    assert file_sha256(one) == "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
-    assert file_sha256(two) != file_sha256(one)
 
 
 def test_corrupt_file_is_named(tmp_path):

@@ -85,3 +85,40 @@ def test_a_row_file_wins_over_its_compacted_row(tmp_path):
     assert (rows[0]["machine"], rows[0]["axis"], rows[0]["feature"]) == ("m1", "X", "backlash")
     assert rows[0]["recent"] == pytest.approx(1.5) and rows[0]["recent_days"] == 20
     assert first[0]["feature"] != "backlash" or abs(first[0]["change_sd"]) < 5
+
+
+def test_both_readers_take_a_logs_row_from_the_same_file(tmp_path, monkeypatch):
+    """A writer killed before it removed a log's older rows leaves them beside its row file: read_history (pyarrow)
+    and the DuckDB reader of changed_most take the row of one file, the first in by_precedence order."""
+    import duckdb
+
+    from greybox.monitor import history as history_module
+    from greybox.monitor.history import by_precedence, check_history, read_history
+    from greybox.monitor.query import load_rows
+
+    root = tmp_path / "h"
+
+    def file(day: int, sha: str, level: float) -> None:
+        values = {f: level for f in FEATURES}
+        append_fingerprint(root, machine="m1", axis="X", date=DAY0 + dt.timedelta(days=day), sha256=sha,
+                           source="log", n_samples=1, values=values, lower=values, upper=values)
+
+    for day in range(4):
+        file(day, f"{day:064x}", 1.0)
+    compact_history(root)
+    monkeypatch.setattr(history_module, "_forget", lambda *args, **kwargs: None)  # killed before forgetting
+    file(1, f"{1:064x}", 2.0)  # a row file over the compacted row of the same log
+    file(3, f"{2:064x}", 3.0)  # log 2 under a later day too: two row files and a compacted row
+    file(2, f"{2:064x}", 4.0)
+    paths = check_history(root)
+    ordered = by_precedence(paths)
+    assert [path.name == "compacted.parquet" for path in ordered] == [False, False, False, True]
+    assert ordered[:3] == sorted(ordered[:3], key=str)
+    table = read_history(root)
+    with duckdb.connect() as connection:
+        load_rows(connection, root, paths, ["machine", "axis", "date", *FEATURES])
+        sql = connection.execute('SELECT log_sha256, date, "backlash" FROM rows ORDER BY log_sha256').fetchall()
+    python = sorted(zip(table.column("log_sha256").to_pylist(), table.column("date").to_pylist(),
+                        table.column("backlash").to_pylist()))
+    assert sql == python
+    assert [level for _, _, level in python] == [1.0, 2.0, 4.0, 1.0]  # log 1's row file, log 2's earlier path

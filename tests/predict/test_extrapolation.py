@@ -12,9 +12,9 @@ import pytest
 import greybox.cli as cli
 from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import GMSModel, StribeckModel
 from greybox.models.gmssvr import GMSSVRModel
-from greybox.persistence import load_model, save_model
 from greybox.predict.process import EXTRAPOLATION_WARNING_SHARE, predict_process
 from greybox.twin import make_dataset
 

@@ -15,8 +15,8 @@ from greybox.data.io import read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
 from greybox.evaluate.regimes import RegimeThresholds, regime_masks
+from greybox.models.files import save_model
 from greybox.models.friction import LuGreModel
-from greybox.persistence import save_model
 from greybox.predict.interval import INTERVAL_CLASSES, _conformal_half_width, calibrate_interval, interval_classes
 from greybox.predict.process import predict_process
 from greybox.twin import make_dataset

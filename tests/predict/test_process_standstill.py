@@ -11,8 +11,8 @@ from greybox.data.axis_config import AxisConfig
 from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
+from greybox.models.files import save_model
 from greybox.models.friction import StribeckModel
-from greybox.persistence import save_model
 from greybox.predict.plot import plot_process
 from greybox.predict.process import ProcessTally, predict_process
 

@@ -62,8 +62,8 @@ def test_predict_relevels_a_streamed_log_as_a_whole_one_and_refuses_a_fleet(tmp_
     from greybox.data.prepare import prepare
     from greybox.data.reading import read_prepared
     from greybox.errors import GreyboxError
+    from greybox.models.files import save_model
     from greybox.models.friction import CoulombModel
-    from greybox.persistence import save_model
     from greybox.predict import predict_logs
     from greybox.predict.process import predict_process
     from greybox.twin import make_dataset

@@ -13,10 +13,12 @@ import pytest
 from greybox.data.io import FORMATS, LOG_SUFFIXES, read_log, write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError, Setting
-from greybox.fleet import MANIFEST, MODELS_FORMAT, expand_logs, machine_of
-from greybox.machine_model import MachineModel, save_machine
+from greybox.fleet import expand_logs
+from greybox.fleet.predict import predict_fleet
+from greybox.models.files import save_model
 from greybox.models.friction import CoulombModel
-from greybox.persistence import save_model
+from greybox.models.machine import MachineModel, save_machine
+from greybox.models.plant import MANIFEST, MODELS_FORMAT, machine_of
 from greybox.predict import ChunkProgress, Prediction, predict_logs
 from greybox.predict.output import write_process
 from greybox.predict.process import predict_process
@@ -89,7 +91,7 @@ def test_a_machine_model_predicts_every_axis_and_refuses_a_fleet(files, tmp_path
     assert "with the machine model machine (X: coulomb, Y: coulomb)" in done.summary[0]
     assert {"X_current_process_A", "Y_current_process_A"} <= set(_table(tmp_path / "m.csv").columns)
     with pytest.raises(GreyboxError, match="a fleet run takes one model file"):
-        predict_logs(files["machine"], [files["csv"], files["parquet"]], out=tmp_path / "fleet")
+        predict_fleet(files["machine"], [files["csv"], files["parquet"]], out=tmp_path / "fleet")
     with pytest.raises(GreyboxError, match="^axis does not apply to a machine model"):
         predict_logs(files["machine"], files["csv"], out=tmp_path / "m2.csv", read={"axis": "X"})
     assert not (tmp_path / "fleet").exists() and not (tmp_path / "m2.csv").exists()
@@ -102,7 +104,13 @@ def test_a_machine_model_predicts_every_axis_and_refuses_a_fleet(files, tmp_path
 ])
 def test_options_of_one_log_are_refused_for_a_fleet_before_any_work(files, tmp_path, options, message):
     with pytest.raises(GreyboxError, match=message):
-        predict_logs(files["model_path"], [files["csv"], files["parquet"]], out=tmp_path / "fleet", **options)
+        predict_fleet(files["model_path"], [files["csv"], files["parquet"]], out=tmp_path / "fleet", **options)
+    assert not (tmp_path / "fleet").exists()
+
+
+def test_several_logs_are_refused_with_the_fleet_run_named(files, tmp_path):
+    with pytest.raises(GreyboxError, match="make a fleet run; greybox.fleet.predict.predict_fleet runs it"):
+        predict_logs(files["model_path"], [files["csv"], files["parquet"]], out=tmp_path / "fleet")
     assert not (tmp_path / "fleet").exists()
 
 

@@ -12,8 +12,8 @@ from greybox.data.io import write_log
 from greybox.data.log import AxisLog
 from greybox.data.prepare import prepare
 from greybox.models.estimator import STANDSTILL_SHARE
+from greybox.models.files import save_model
 from greybox.models.friction import GMSModel, StribeckModel
-from greybox.persistence import save_model
 from greybox.predict.process import predict_process
 
 HELD_A = 0.7

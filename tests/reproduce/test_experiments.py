@@ -11,7 +11,7 @@ from greybox.errors import GreyboxError, Setting, SettingWarning
 from greybox.evaluate.records import NOISE_FLOOR
 from greybox.evaluate.report import svr_generalisation
 from greybox.metrics import rmse
-from greybox.persistence import load_model
+from greybox.models.files import load_model
 from greybox.reproduce.experiments import (
     EXPERIMENTS,
     MODEL_SETTINGS,

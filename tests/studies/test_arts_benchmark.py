@@ -19,9 +19,9 @@ import pytest
 from scipy.signal import butter, sosfiltfilt
 
 from greybox.errors import GreyboxError, LogError
-from greybox.model_choice import choose_model
 from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
 from greybox.models.friction.backlash import BacklashModel
+from greybox.train.candidates import choose_model
 from studies import arts as bench
 from studies import auto
 from studies.arts_data import read_arts

@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 from greybox.errors import GreyboxError
-from greybox.model_choice import choose_model
 from greybox.models.friction import CoulombModel
+from greybox.train.candidates import choose_model
 from studies import auto
 from studies import emps as bench
 

@@ -14,8 +14,8 @@ from greybox.data.io import read_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
 from greybox.fleet.train import train_jobs, train_model
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel
-from greybox.persistence import load_model, save_model
 from greybox.train import train_logs
 
 

@@ -15,9 +15,9 @@ from greybox.control.plants import ModelPlant, fine_stride
 from greybox.control.references import filtered_random_reference
 from greybox.control.tuning import default_bandwidth_hz, pole_placement_gains
 from greybox.errors import LogError, ParameterError
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import LuGreModel, stribeck_curve
 from greybox.models.friction.lugre import check_lugre_parameters, simulate_lugre
-from greybox.persistence import load_model, save_model
 
 PARAMS = {"sigma1": 0.02, "sigma2": 0.004, "coulomb": 0.6, "static": 0.9, "v_s": 3.0}
 

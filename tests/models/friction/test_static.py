@@ -15,9 +15,9 @@ from model_files import write_members
 from greybox.data.log import AxisLog
 from greybox.errors import ParameterError
 from greybox.identify.static import fit_stribeck
+from greybox.models.files import load_model, save_model
 from greybox.models.friction import CoulombModel, StribeckModel, stribeck_curve
 from greybox.models.friction.coulomb import coulomb_friction
-from greybox.persistence import load_model, save_model
 
 
 def log_with(current_of):

@@ -71,19 +71,19 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from .atomic import atomic_output
-from .data.log import AxisLog
-from .data.quantities import MOTIONS
-from .errors import GreyboxError, ModelFileError, ParameterError
-from .identify.intervals import check_intervals
-from .identify.selection import check_selection_record
-from .models import registry
-from .models.estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
-from .provenance import TRAINING_ATTRIBUTE, TRAINING_RECORD, check_training_record
+from ..atomic import atomic_output
+from ..data.log import AxisLog
+from ..data.quantities import MOTIONS
+from ..errors import GreyboxError, ModelFileError, ParameterError
+from ..identify.intervals import check_intervals
+from ..identify.selection import check_selection_record
+from ..provenance import TRAINING_ATTRIBUTE, TRAINING_RECORD, check_training_record
+from . import registry
+from .estimator import MAX_PARAMETER_MAGNITUDE, check_inertia
 
 __all__ = ["DIGEST_MEMBER", "FORMAT_NAME", "FORMAT_VERSION", "KEY_ENV", "KEY_FILE_ENV", "RECORD_CHECKS",
            "RENAMED_ATTRIBUTES", "digest_document", "model_key", "save_model", "save_verified", "load_model",
-           "check_fitted", "check_reproduces"]
+           "check_fitted", "check_format", "check_reproduces"]
 
 #: Check of each record a model file may hold, by name: returns the record or raises ValueError.
 RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
@@ -339,7 +339,7 @@ def save_model(model, path: str | PathLike, *, overwrite: bool = False, records:
         If the file exists and ``overwrite`` is false, the model is not
         registered, or a value cannot be saved without pickle.
     """
-    from . import __version__
+    from .. import __version__
 
     path = Path(path)
     if path.exists() and not overwrite:
@@ -551,6 +551,44 @@ def _check_members(archive: zipfile.ZipFile, path: Path) -> None:
         raise ModelFileError(f"{path}: members of {total} bytes in all, more than {MAX_TOTAL_BYTES}")
 
 
+def check_format(document, path, *, name: str, newest: int, what: str) -> int:
+    """The format version of a greybox document (a model file's ``model.json``, a machine manifest), checked.
+
+    Parameters
+    ----------
+    document : object
+        The parsed JSON document.
+    path : path-like
+        Its file, named in the messages.
+    name : str
+        The ``format`` it must have.
+    newest : int
+        The newest ``format_version`` this greybox reads.
+    what : str
+        What the document is, in the messages (``"model file"``, ``"machine manifest"``).
+
+    Returns
+    -------
+    int
+        The format version, from 1 to ``newest``.
+
+    Raises
+    ------
+    ModelFileError
+        For another format, an invalid version, or one written by a newer greybox.
+    """
+    if not isinstance(document, dict) or document.get("format") != name:
+        raise ModelFileError(f"{path}: not a greybox {what} (format is not {name!r})")
+    version = document.get("format_version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise ModelFileError(f"{path}: invalid format version {version!r}")
+    if version > newest:
+        raise ModelFileError(f"{path}: {what} format version {version} was written by a newer greybox "
+                             f"({document.get('greybox_version', 'unknown version')}); this greybox reads versions "
+                             f"up to {newest}: upgrade greybox")
+    return version
+
+
 def load_model(path: str | PathLike, *, records: bool = False, key: bytes | None = None):
     """Load a model saved by :func:`save_model`.
 
@@ -598,17 +636,7 @@ def load_model(path: str | PathLike, *, records: bool = False, key: bytes | None
                 raise
             except (UnicodeDecodeError, ValueError, RecursionError) as error:  # ValueError: also too long a number
                 raise ModelFileError(f"{path}: {_JSON_MEMBER} is not valid JSON: {error}") from None
-            if not isinstance(document, dict) or document.get("format") != FORMAT_NAME:
-                raise ModelFileError(f"{path}: not a greybox model file (format is not {FORMAT_NAME!r})")
-            version = document.get("format_version")
-            if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-                raise ModelFileError(f"{path}: invalid format version {version!r}")
-            if version > FORMAT_VERSION:
-                raise ModelFileError(
-                    f"{path}: model file format version {version} was written by a newer greybox "
-                    f"({document.get('greybox_version', 'unknown version')}); this greybox reads versions "
-                    f"up to {FORMAT_VERSION}: upgrade greybox"
-                )
+            version = check_format(document, path, name=FORMAT_NAME, newest=FORMAT_VERSION, what="model file")
             held = _checked_records(document.get("records"), path, "load")
             decoder = _Decoder(path, archive, version)
             try:

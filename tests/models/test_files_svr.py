@@ -7,16 +7,15 @@ import pytest
 from model_files import write_members
 from svr_runs import FIXED, sweep_run
 
-from greybox import persistence
-from greybox.models import registry
+from greybox.models import files, registry
 from greybox.models.svr import SVRCurrentModel
 
 
 def test_saved_and_loaded_model_predicts_identically(tmp_path, monkeypatch):
     monkeypatch.setitem(registry.MODEL_CLASSES, "svr", SVRCurrentModel)
     model = SVRCurrentModel(**FIXED).fit(sweep_run(1))
-    path = persistence.save_model(model, tmp_path / "svr.gbm")
-    loaded = persistence.load_model(path)
+    path = files.save_model(model, tmp_path / "svr.gbm")
+    loaded = files.load_model(path)
     test = sweep_run(3, n=1000)
     np.testing.assert_array_equal(loaded.predict(test), model.predict(test))
     table, loaded_table = model.hyperparameters_table(), loaded.hyperparameters_table()
@@ -34,7 +33,7 @@ def test_grey_box_model_with_nested_gms_stage_round_trips(tmp_path, monkeypatch,
     monkeypatch.setitem(registry.MODEL_CLASSES, "gms", GMSModel)
     monkeypatch.setitem(registry.MODEL_CLASSES, "gmssvr", GMSSVRModel)
     model = GMSSVRModel(gms=quick_gms(), target=target, **SVR_FIXED).fit(gms_run(1, n=6000))
-    loaded = persistence.load_model(persistence.save_model(model, tmp_path / "gmssvr.gbm"))
+    loaded = files.load_model(files.save_model(model, tmp_path / "gmssvr.gbm"))
     assert loaded.target == target
     test = gms_run(2, n=2000)
     np.testing.assert_array_equal(loaded.predict(test), model.predict(test))
@@ -49,8 +48,8 @@ def test_the_kernel_weights_round_trip_and_a_file_with_bad_ones_is_refused(tmp_p
 
     monkeypatch.setitem(registry.MODEL_CLASSES, "svr", SVRCurrentModel)
     model = SVRCurrentModel(**FIXED, velocity_weight=9.0).fit(sweep_run(1))
-    path = persistence.save_model(model, tmp_path / "svr.gbm")
-    loaded = persistence.load_model(path)
+    path = files.save_model(model, tmp_path / "svr.gbm")
+    loaded = files.load_model(path)
     np.testing.assert_array_equal(loaded.input_weights_, [1.0, 9.0])
     test = sweep_run(3, n=1000)
     np.testing.assert_array_equal(loaded.predict(test), model.predict(test))
@@ -64,7 +63,7 @@ def test_the_kernel_weights_round_trip_and_a_file_with_bad_ones_is_refused(tmp_p
         hostile = tmp_path / f"hostile_{len(bad)}_{bad[1]:g}.gbm"
         write_members(hostile, {**members, member: buffer.getvalue()})
         with pytest.raises(ModelFileError, match="input_weights_ must hold one positive weight per input"):
-            persistence.load_model(hostile)
+            files.load_model(hostile)
 
 
 def test_a_file_from_before_the_kernel_weights_predicts_with_the_isotropic_kernel(tmp_path, monkeypatch):
@@ -73,7 +72,7 @@ def test_a_file_from_before_the_kernel_weights_predicts_with_the_isotropic_kerne
     test = sweep_run(3, n=1000)
     expected = model.predict(test)
     del model.input_weights_
-    loaded = persistence.load_model(persistence.save_model(model, tmp_path / "old.gbm"))
+    loaded = files.load_model(files.save_model(model, tmp_path / "old.gbm"))
     assert not hasattr(loaded, "input_weights_")
     np.testing.assert_array_equal(loaded.predict(test), expected)
     assert loaded.hyperparameters_table()["velocity_weight"] == 1.0

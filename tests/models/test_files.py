@@ -12,10 +12,10 @@ import pytest
 from model_files import write_members
 from sklearn.base import BaseEstimator
 
-from greybox import atomic, persistence
+from greybox import atomic
 from greybox.errors import ModelFileError, ParameterError
-from greybox.models import registry
-from greybox.persistence import FORMAT_VERSION, load_model, save_model
+from greybox.models import files, registry
+from greybox.models.files import FORMAT_VERSION, load_model, save_model
 
 
 class ToyModel(BaseEstimator):
@@ -55,8 +55,8 @@ def _check_toy(model):
 @pytest.fixture(autouse=True)
 def toy_registered(monkeypatch):
     monkeypatch.setitem(registry.MODEL_CLASSES, "toy", ToyModel)
-    real_check = persistence.check_fitted
-    monkeypatch.setattr(persistence, "check_fitted",
+    real_check = files.check_fitted
+    monkeypatch.setattr(files, "check_fitted",
                         lambda model: _check_toy(model) if isinstance(model, ToyModel) else real_check(model))
 
 
@@ -397,8 +397,8 @@ def test_every_single_flipped_byte_is_one_model_file_error(tmp_path, gms_file):
 
 
 def test_save_verified_writes_a_file_that_predicts_what_the_model_did(tmp_path):
+    from greybox.models.files import save_verified
     from greybox.models.friction import CoulombModel
-    from greybox.persistence import save_verified
 
     runs = [_axis_run(1), _axis_run(2)]
     model = CoulombModel().fit(runs)
@@ -412,8 +412,8 @@ def test_save_verified_writes_a_file_that_predicts_what_the_model_did(tmp_path):
 
 def test_a_saved_model_that_predicts_otherwise_is_refused_naming_the_file(tmp_path):
     """The comparison is bit for bit: predictions off by one ulp on one run are refused."""
+    from greybox.models.files import save_verified
     from greybox.models.friction import CoulombModel
-    from greybox.persistence import save_verified
 
     runs = [_axis_run(1), _axis_run(2)]
     model = CoulombModel().fit(runs)
@@ -424,7 +424,7 @@ def test_a_saved_model_that_predicts_otherwise_is_refused_naming_the_file(tmp_pa
 
 
 def test_check_fitted_refuses_an_implausible_parameter_and_a_state_that_streams_otherwise(gms_file):
-    from greybox.persistence import check_fitted
+    from greybox.models.files import check_fitted
 
     model = load_model(gms_file)
     check_fitted(model)
@@ -461,8 +461,8 @@ def _write_raw(path, members) -> None:
 def test_a_member_changed_added_or_removed_after_saving_is_refused_naming_it(tmp_path, data):
     path = save_model(ToyModel().fit(*data), tmp_path / "m.gbm")
     members = _members_of(path)
-    assert json.loads(members[persistence.DIGEST_MEMBER])["members"].keys() == set(members) - {
-        persistence.DIGEST_MEMBER}
+    assert json.loads(members[files.DIGEST_MEMBER])["members"].keys() == set(members) - {
+        files.DIGEST_MEMBER}
     edited = dict(members, **{"model.json": members["model.json"].replace(b'"gain": 1.5', b'"gain": 2.0')})
     assert edited["model.json"] != members["model.json"]
     _write_raw(path, edited)
@@ -480,19 +480,19 @@ def test_a_member_changed_added_or_removed_after_saving_is_refused_naming_it(tmp
 def test_a_file_without_a_digest_loads_with_a_warning(tmp_path, data):
     path = save_model(ToyModel().fit(*data), tmp_path / "old.gbm")
     _write_raw(path, {name: content for name, content in _members_of(path).items()
-                      if name != persistence.DIGEST_MEMBER})
+                      if name != files.DIGEST_MEMBER})
     with pytest.warns(UserWarning, match="written before model files carried a digest"):
         load_model(path)
 
 
 def test_a_signed_file_is_checked_with_the_plants_key(tmp_path, data, monkeypatch):
     model = ToyModel().fit(*data)
-    monkeypatch.delenv(persistence.KEY_ENV, raising=False)
-    monkeypatch.delenv(persistence.KEY_FILE_ENV, raising=False)
+    monkeypatch.delenv(files.KEY_ENV, raising=False)
+    monkeypatch.delenv(files.KEY_FILE_ENV, raising=False)
     unsigned = save_model(model, tmp_path / "unsigned.gbm")
-    monkeypatch.setenv(persistence.KEY_ENV, "plant secret")
+    monkeypatch.setenv(files.KEY_ENV, "plant secret")
     signed = save_model(model, tmp_path / "signed.gbm")
-    assert json.loads(_members_of(signed)[persistence.DIGEST_MEMBER])["hmac_sha256"]
+    assert json.loads(_members_of(signed)[files.DIGEST_MEMBER])["hmac_sha256"]
     load_model(signed)
     with pytest.raises(ModelFileError, match="unsigned.gbm: not signed, and the plant's key is set"):
         load_model(unsigned)
@@ -505,11 +505,11 @@ def test_a_signed_file_is_checked_with_the_plants_key(tmp_path, data, monkeypatc
     write_members(signed, forged)
     with pytest.raises(ModelFileError, match="not signed"):
         load_model(signed)
-    monkeypatch.delenv(persistence.KEY_ENV)
+    monkeypatch.delenv(files.KEY_ENV)
     assert load_model(signed).gain == 2.0  # without the key a consistent digest is all that is checked
     key_file = tmp_path / "key"
     key_file.write_bytes(b"plant secret\n")
-    monkeypatch.setenv(persistence.KEY_FILE_ENV, str(key_file))
+    monkeypatch.setenv(files.KEY_FILE_ENV, str(key_file))
     write_members(signed, members, key=b"plant secret")  # the key file holds the same key
     load_model(signed)
     key_file.write_bytes(b"")

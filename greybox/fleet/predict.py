@@ -1,6 +1,8 @@
 """``greybox predict`` over many logs: one task per log on Dask, a Parquet dataset partitioned like the plant.
 
-:func:`run_fleet` predicts each log (:func:`predict_log`, on a worker of :func:`greybox.fleet.run_tasks`)
+:func:`predict_fleet` is the entry point (``greybox predict`` with several logs, a directory or a pattern:
+:func:`greybox.predict.run.is_fleet`); :func:`run_fleet` predicts each log (:func:`predict_log`, on a worker
+of :func:`greybox.fleet.run_tasks`) with what :mod:`greybox.predict` predicts one log with,
 and writes its process table to a Parquet dataset partitioned like the plant::
 
     OUT/machine=<folder of the log>/axis=<axis>/log=<name>/part-0.parquet
@@ -17,7 +19,7 @@ time. A re-run skips every log whose output is complete: listed ``ok`` in the ma
 output name for the same model file (hash) and the same log file (size and modification time), its output
 still there, also after a run that was killed. The
 model is one model file, or a directory of models written by ``greybox train --per-machine``, from which
-each log gets its machine's model (:func:`machine_models`).
+each log gets its machine's model (:func:`greybox.models.plant.machine_models`).
 """
 
 from __future__ import annotations
@@ -29,25 +31,26 @@ from typing import Callable, Sequence
 
 from ..data.reading import read_prepared
 from ..errors import GreyboxError
-from ..fleet import (
-    MANIFEST,
-    MODELS_FORMAT,
+from ..models.chunked import DEFAULT_CHUNK_S
+from ..models.plant import MANIFEST, machine_models, machine_of, model_for, partition, read_manifest
+from ..predict.request import Prediction, named
+from ..provenance import file_sha256
+from .engine import (
     attempt,
     check_machines,
     check_names,
+    check_out_dir,
     encode_name,
+    expand_logs,
+    fleet_summary,
     log_names,
     log_stamp,
-    machine_of,
     out_dir_of,
-    partition,
-    read_manifest,
     run_tasks,
 )
-from ..provenance import file_sha256
 
-__all__ = ["FORMAT_VERSION", "PREDICT_FORMAT", "FleetJob", "fleet_jobs", "machine_models", "model_of_log",
-           "predict_log", "run_fleet"]
+__all__ = ["FORMAT_VERSION", "PREDICT_FORMAT", "FleetJob", "fleet_jobs", "predict_fleet", "predict_log",
+           "run_fleet"]
 
 #: ``format`` of the manifest of a fleet prediction.
 PREDICT_FORMAT = "greybox-fleet"
@@ -92,72 +95,6 @@ class FleetJob:
     chunk_s: float = 60.0
 
 
-def machine_models(directory: str | os.PathLike) -> dict[str, dict[str, str]]:
-    """The models of a directory written by ``greybox train --per-machine``: ``{machine: {axis: model file}}``.
-
-    Only the models its manifest lists as trained (``ok`` or ``skipped``) whose file is there count.
-
-    Parameters
-    ----------
-    directory : str or path-like
-        Output directory of ``greybox train --per-machine``, with its manifest.
-
-    Raises
-    ------
-    GreyboxError
-        For a directory without such a manifest.
-    """
-    directory = Path(directory)
-    document = read_manifest(directory, MODELS_FORMAT)
-    if not document:
-        raise GreyboxError(f"{directory}: a directory without the {MANIFEST} of 'greybox train --per-machine'; "
-                           "give a model file or a directory of models it wrote")
-    table: dict[str, dict[str, str]] = {}
-    for entry in document.get("models", []):
-        if isinstance(entry, dict) and entry.get("status") in ("ok", "skipped") and \
-                isinstance(entry.get("output"), str) and (directory / entry["output"]).is_file():
-            table.setdefault(str(entry.get("machine")), {})[str(entry.get("axis"))] = str(directory / entry["output"])
-    return table
-
-
-def model_of_log(directory: str | os.PathLike, log: str | os.PathLike, axis: str | None = None) -> str:
-    """The model file of ``log``'s machine (the name of its folder) in a directory of ``greybox train --per-machine``.
-
-    Parameters
-    ----------
-    directory : str or path-like
-        Output directory of ``greybox train --per-machine``, with its manifest.
-    log : str or path-like
-        Log file; its folder names its machine.
-    axis : str, optional
-        The axis whose model to take where the machine has models of several.
-
-    Raises
-    ------
-    GreyboxError
-        For a directory without that manifest, a machine without a model, or (without ``axis``) a machine
-        with models of several axes.
-    """
-    return _model_for(Path(log), machine_of(Path(log)), machine_models(directory), str(directory), axis)
-
-
-def _model_for(log: Path, machine: str, models: dict[str, dict[str, str]], directory: str, axis: str | None) -> str:
-    """The model file of ``log``'s machine in a models directory (of ``axis`` where it has several)."""
-    by_axis = models.get(machine)
-    if not by_axis:
-        known = ", ".join(sorted(models)) or "none"
-        raise GreyboxError(f"{log}: no trained model of machine {machine} in {directory} (machines: {known})")
-    if axis is not None:
-        if axis not in by_axis:
-            raise GreyboxError(f"{log}: --axis {axis}: machine {machine} has models of axes "
-                               f"{', '.join(sorted(by_axis))}")
-        return by_axis[axis]
-    if len(by_axis) > 1:
-        raise GreyboxError(f"{log}: machine {machine} has models of axes {', '.join(sorted(by_axis))} in {directory}; "
-                           "give --axis NAME (one fleet per axis)")
-    return next(iter(by_axis.values()))
-
-
 def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: str | None = None,
                read: dict | None = None, chunk_s: float = 60.0) -> list[FleetJob]:
     """One job per log; the machine is the name of the log's folder, the output name its relative path.
@@ -193,7 +130,7 @@ def fleet_jobs(logs: Sequence[Path], model: str, out_dir: str, *, axis_config: s
     check_machines(logs)
     if os.path.isdir(model):
         models = machine_models(model)
-        chosen = [_model_for(Path(log), machine_of(log), models, model, read.get("axis")) for log in logs]
+        chosen = [model_for(Path(log), machine_of(log), models, model, read.get("axis")) for log in logs]
     else:
         chosen = [str(model)] * len(logs)
     return [FleetJob(str(log), machine_of(log), path, str(out_dir), name, axis_config, read, float(chunk_s))
@@ -221,9 +158,9 @@ def predict_log(job: FleetJob) -> dict:
 def _predict_and_write(job: FleetJob) -> dict:
     """The table ``greybox predict`` writes for the job's log, streamed where ``predict`` streams it."""
     from ..data.axis_config import read_axis_config
-    from ..persistence import load_model
-    from .output import write_process
-    from .process import predict_process
+    from ..models.files import load_model
+    from ..predict.output import write_process
+    from ..predict.process import predict_process
 
     config = read_axis_config(job.axis_config) if job.axis_config else None
     model = load_model(job.model)
@@ -252,7 +189,7 @@ def _stream_and_write(job: FleetJob, model, config, attrs: dict) -> dict | None:
     """Predict and write the log block by block (:mod:`greybox.data.stream`); None if it is to be read whole."""
     from ..data.blocks import CannotStream
     from ..data.stream import open_stream
-    from .stream import stream_process
+    from ..predict.stream import stream_process
 
     read = job.read
     columns = {**(config.channels if config else {}), **(read.get("columns") or {})} or None
@@ -308,3 +245,79 @@ def run_fleet(jobs: Sequence[FleetJob], *, scheduler: str | None = None, workers
               "read": jobs[0].read, "chunk_s": jobs[0].chunk_s}
     return run_tasks(predict_log, jobs, fingerprints, out_dir=out_dir, header=header, items="logs",
                      scheduler=scheduler, workers=workers, force=force, progress=progress)
+
+
+def predict_fleet(model: str | os.PathLike, logs: Sequence[str | os.PathLike], *, out: str | os.PathLike,
+                  axis_config: str | None = None, chunk_s: float = DEFAULT_CHUNK_S, read: dict | None = None,
+                  force: bool = False, scheduler: str | None = None, workers: int | None = None,
+                  progress: Callable[[int, int, dict], None] | None = None, machine: str | None = None,
+                  calibration: Sequence[str] | None = None, coverage: float | None = None, plot: str | None = None,
+                  plot_window: tuple[float, float] | None = None, relevel: bool = False) -> Prediction:
+    """Predict every log as a task on Dask and write the partitioned dataset and its manifest; the run's summary.
+
+    It takes the options of :func:`greybox.predict.predict_logs` (the one-log entry point) by the same names,
+    so that a caller switches between the two on :func:`greybox.predict.run.is_fleet`.
+
+    Parameters
+    ----------
+    model : str or path-like
+        A model file for every log, or the models directory of ``greybox train --per-machine`` (each log
+        predicted with its machine's model). A machine model (``greybox train --axes``) is refused.
+    logs : sequence of str or path-like
+        Log files, directories searched recursively, glob patterns (:func:`greybox.fleet.expand_logs`).
+    out : str or path-like
+        The dataset directory (not one of the inputs).
+    axis_config : str, optional
+        Axis file (TOML) of every log's axis: adds the process force.
+    chunk_s : float, default 60.0
+        Chunk length of the model [s].
+    read : dict, optional
+        Options of reading and preparing the logs (:func:`greybox.data.reading.read_prepared`).
+    force : bool, default False
+        Predict again the logs complete from an earlier run.
+    scheduler : str, optional
+        Address of a dask.distributed scheduler (default a local cluster).
+    workers : int, optional
+        Processes of the local cluster.
+    progress : callable, optional
+        ``progress(done, total, entry)`` after each log.
+    machine, calibration, coverage, plot, plot_window : None
+        Options of one log: refused (a fleet run writes the process tables).
+    relevel : bool, default False
+        An option of one log: refused when true.
+
+    Returns
+    -------
+    Prediction
+        The summary and failure lines in ``closing``, the manifest, the exit status (2 when a log failed).
+
+    Raises
+    ------
+    GreyboxError
+        For an option of one log, a machine model, a bad model file, an output directory that is a file or
+        an input, or a scheduler that cannot be reached.
+    """
+    for setting, value in (("plot", plot), ("plot_window", plot_window), ("calibration", calibration),
+                           ("coverage", coverage), ("machine", machine), ("relevel", relevel or None)):
+        if value is not None:
+            raise GreyboxError(named(setting), " applies to one log; a fleet run (several logs) writes the "
+                               "process tables")
+    from ..models.files import load_model
+    from ..models.machine import is_machine_model
+
+    if is_machine_model(model):
+        raise GreyboxError(f"{model}: a fleet run takes one model file; run one fleet per axis of the machine "
+                           "model with its file and ", named("axis"))
+    out = check_out_dir(out)
+    jobs = fleet_jobs(expand_logs([str(log) for log in logs], exclude=[out]), str(Path(model).resolve()), str(out),
+                      axis_config=str(Path(axis_config).resolve()) if axis_config else None, read=dict(read or {}),
+                      chunk_s=chunk_s)
+    for path in sorted({job.model for job in jobs}):
+        load_model(path)  # a bad model file is one error before any cluster starts
+    manifest = run_fleet(jobs, scheduler=scheduler, workers=workers, force=force, progress=progress)
+    lines, status = fleet_summary(manifest, "logs", "predicted", lambda entry: entry["error"])
+    if manifest["counts"]["ok"] + manifest["counts"]["skipped"]:
+        lines.append(f"wrote {out / MANIFEST} and the dataset {out}/machine=*/axis=*/log=*/part-0.parquet")
+    else:
+        lines.append(f"wrote {out / MANIFEST} (every log failed: no output)")
+    return Prediction(closing=lines, status=status, manifest=manifest)

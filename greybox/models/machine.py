@@ -6,7 +6,7 @@ Layout (format name ``greybox-machine``, version 1)::
         machine.json      {"format": "greybox-machine", "format_version": 1, "greybox_version": "...",
                            "name": "five-axis mill",
                            "axes": {"X": {"model": "X.gbm", "kind": "gmssvr", "motion": "linear"}, ...}}
-        X.gbm             the X axis's model file (greybox.persistence)
+        X.gbm             the X axis's model file (greybox.models.files)
         Y.gbm
         C.gbm
 
@@ -16,7 +16,7 @@ written last and atomically: a directory whose training was interrupted has
 no manifest of the new run. Reading validates the manifest fully (format,
 version, axis names, a model file per axis named ``<axis>.gbm`` inside the
 directory, its kind and kind of axis against the manifest) and loads each
-model file with :func:`greybox.persistence.load_model`, which executes nothing.
+model file with :func:`greybox.models.files.load_model`, which executes nothing.
 """
 
 from __future__ import annotations
@@ -27,10 +27,10 @@ from os import PathLike
 from pathlib import Path
 from typing import Mapping
 
-from .atomic import write_text_atomic
-from .errors import ModelFileError
-from .models.registry import model_kind
-from .persistence import check_reproduces, load_model, save_model
+from ..atomic import write_text_atomic
+from ..errors import ModelFileError
+from .files import check_format, check_reproduces, load_model, save_model
+from .registry import model_kind
 
 __all__ = ["MACHINE_FORMAT", "MACHINE_FORMAT_VERSION", "MANIFEST", "MachineModel", "is_machine_model",
            "check_machine_output", "save_machine", "load_machine"]
@@ -141,10 +141,10 @@ def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite:
     overwrite : bool, default False
         Replace the files of an existing machine model in ``directory``.
     records : dict, optional
-        ``{axis: records}``: the records of each axis's model file (:func:`greybox.persistence.save_model`).
+        ``{axis: records}``: the records of each axis's model file (:func:`greybox.models.files.save_model`).
     verify : mapping, optional
         ``{axis: (runs, predictions)}``: read the machine model back and check that each axis's model
-        predicts these runs exactly as the fitted one did (:func:`greybox.persistence.check_reproduces`).
+        predicts these runs exactly as the fitted one did (:func:`greybox.models.files.check_reproduces`).
 
     Returns
     -------
@@ -158,7 +158,7 @@ def save_machine(machine: MachineModel, directory: str | PathLike, *, overwrite:
         without ``overwrite``, an invalid axis name, a model that cannot be saved, or (with ``verify``)
         a saved model that does not reproduce the fitted one's predictions.
     """
-    from . import __version__
+    from .. import __version__
 
     directory = Path(directory)
     targets = check_machine_output(directory, list(machine.models), overwrite=overwrite)
@@ -189,14 +189,7 @@ def _manifest(directory: Path) -> dict:
         document = json.loads(path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as error:
         raise ModelFileError(f"{path}: not a JSON manifest ({error})") from None
-    if not isinstance(document, dict) or document.get("format") != MACHINE_FORMAT:
-        raise ModelFileError(f"{path}: not a greybox machine manifest (format is not {MACHINE_FORMAT!r})")
-    version = document.get("format_version")
-    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-        raise ModelFileError(f"{path}: invalid format version {version!r}")
-    if version > MACHINE_FORMAT_VERSION:
-        raise ModelFileError(f"{path}: machine format version {version} was written by a newer greybox; this "
-                             f"greybox reads versions up to {MACHINE_FORMAT_VERSION}: upgrade greybox")
+    check_format(document, path, name=MACHINE_FORMAT, newest=MACHINE_FORMAT_VERSION, what="machine manifest")
     unknown = sorted(set(document) - {"format", "format_version", "greybox_version", "name", "axes"})
     if unknown:
         raise ModelFileError(f"{path}: unknown manifest key {unknown[0]!r}")

@@ -15,9 +15,10 @@ import greybox.cli as cli
 from greybox.data.io import write_log
 from greybox.data.prepare import prepare
 from greybox.errors import GreyboxError
-from greybox.fleet import MANIFEST, expand_logs
+from greybox.fleet import expand_logs
+from greybox.models.files import save_model
 from greybox.models.friction import StribeckModel
-from greybox.persistence import save_model
+from greybox.models.plant import MANIFEST
 from greybox.twin import make_dataset
 
 #: The module's tests take long together (model fits, end-to-end runs): left out of the default run;

@@ -31,9 +31,9 @@ from __future__ import annotations
 
 from typing import Callable, Sequence
 
-from .errors import GreyboxError
-from .identify.inertia import SPRING_SHARE_LIMIT, spring_share
-from .identify.selection import (
+from ..errors import GreyboxError
+from ..identify.inertia import SPRING_SHARE_LIMIT, spring_share
+from ..identify.selection import (
     choose,
     held_out_folds,
     lead_fold,
@@ -41,8 +41,8 @@ from .identify.selection import (
     selection_record,
     speed_fold,
 )
-from .models.friction.backlash import BacklashModel
-from .models.registry import MODEL_CLASSES
+from ..models.friction.backlash import BacklashModel
+from ..models.registry import MODEL_CLASSES
 
 __all__ = ["DEFAULT_CANDIDATES", "GAP_CANDIDATES", "GAP_EVIDENCE", "build_candidate", "choose_model", "gap_shown"]
 
