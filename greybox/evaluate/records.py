@@ -143,7 +143,7 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
 
 #: Words for the quantities of ``outside_training`` in the notes of :func:`training_region`.
 _REGION_WORDS = {"position": "positions", "velocity": "speeds", "acceleration": "accelerations",
-                 "motion": "motion never trained on (speed against the span of the last moments)",
+                 "motion": "motion never trained on",
                  "inputs": "kernel inputs", "effort": "predicted efforts beyond the trained ones"}
 
 

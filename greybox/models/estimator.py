@@ -73,6 +73,9 @@ EXTRAPOLATION_WARNING_SHARE = 0.05
 def outside_any(flags: dict) -> np.ndarray | None:
     """The samples outside the training region in any quantity: what ``outside_training`` means.
 
+    ``"standstill"`` does not count: it is what a memoryless model cannot know, not a region the training
+    runs left out, and what counts as inside must not depend on the kind of model (it has a column of its own).
+
     Parameters
     ----------
     flags : dict of str to ndarray of bool
@@ -81,9 +84,13 @@ def outside_any(flags: dict) -> np.ndarray | None:
     Returns
     -------
     ndarray of bool or None
-        True where any flag is set; None when ``flags`` is empty (a model file that predates the record).
+        True where any flag but ``"standstill"`` is set; None when ``flags`` is empty (a model file that
+        predates the record).
     """
-    return np.logical_or.reduce(list(flags.values())) if flags else None
+    if not flags:
+        return None
+    region = [values for name, values in flags.items() if name != "standstill"]
+    return np.logical_or.reduce(region) if region else np.zeros(len(next(iter(flags.values()))), dtype=bool)
 
 
 def extrapolates(shares: dict, share: float) -> bool:
@@ -491,7 +498,7 @@ class CurrentModel(ModelProtocol):
             def checked(run, state, region):
                 current, end, _, _ = inner(run, state, own)
                 flags, region = operating.flags(run, region, sample_time=sample_time)
-                return current, end, {**flags, **self.effort_flags(current)}, region
+                return current, end, {**flags, **self._standstill_flags(run), **self.effort_flags(current)}, region
 
             return checked
 
@@ -689,6 +696,7 @@ class CurrentModel(ModelProtocol):
         operating = self.operating_region()
         if operating is not None:
             flags, _ = operating.flags(log, operating.start(), sample_time=log.sample_time)
+            flags.update(self._standstill_flags(log))
         else:
             flags = self._input_region(log)
         return {**flags, **self.effort_flags(self.predict(log))}
@@ -772,7 +780,8 @@ class CurrentModel(ModelProtocol):
         check_is_fitted(self)
         operating = self.operating_region()
         if operating is not None:
-            return operating.flags(log, state, sample_time=sample_time)
+            flags, state = operating.flags(log, state, sample_time=sample_time)
+            return {**flags, **self._standstill_flags(log)}, state
         return self._region_flags(log, state, sample_time)
 
     def _region_flags(self, log: AxisLog, state, sample_time: float):
@@ -783,12 +792,18 @@ class CurrentModel(ModelProtocol):
             if bounds is not None:
                 values = getattr(log, channel)
                 out[channel] = (values < bounds[0]) | (values > bounds[1])
+        return {**out, **self._standstill_flags(log)}, state
+
+    def _standstill_flags(self, log: AxisLog) -> dict[str, np.ndarray]:
+        """``{"standstill": ...}`` of a memoryless model (:meth:`initial_state` None), else empty.
+
+        A memoryless model gives the friction of the velocity alone: at rest the drive holds whatever
+        friction the last motion left (up to the breakaway level), which it cannot know.
+        """
         speeds = getattr(self, "velocity_range_mm_s_", None)
-        if self.initial_state() is None and speeds is not None:
-            # a memoryless model gives the friction of the velocity alone: at rest the drive holds whatever
-            # friction the last motion left (up to the breakaway level), which it cannot know
-            out["standstill"] = np.abs(log.velocity) < STANDSTILL_SHARE * max(abs(speeds[0]), abs(speeds[1]))
-        return out, state
+        if self.initial_state() is not None or speeds is None:
+            return {}
+        return {"standstill": np.abs(log.velocity) < STANDSTILL_SHARE * max(abs(speeds[0]), abs(speeds[1]))}
 
     def _check_predict_runs(self, logs) -> list[AxisLog]:
         check_is_fitted(self)
