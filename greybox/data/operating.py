@@ -3,7 +3,7 @@
 A sample of a run lies inside the region when its position, velocity and acceleration lie within the
 ranges of the training runs (the training record's ``ranges``) and its *motion* was seen in training: the
 pair (speed ``|v|``, local span) falls in a cell of a grid that training samples occupied, or in a
-neighbouring cell. The local span is ``max - min`` of the position over the trailing window
+neighbouring cell (:data:`NEIGHBOURS`). The local span is ``max - min`` of the position over the trailing window
 :data:`SPAN_WINDOW_S` ending at the sample: a sweep has the span of its travel, a dwell none, and a small
 oscillation a small span at a speed that in the training runs only came with a large one. The region
 depends on the training runs alone, never on the model: every kind of model trained on the same runs has
@@ -253,7 +253,7 @@ class OperatingRegion:
         flags : dict of str to ndarray of bool
             ``"position"``, ``"velocity"``, ``"acceleration"`` (each where the record holds its range):
             True outside the training range; ``"motion"``: True where the pair (speed, local span) lies in
-            no cell seen in training nor next to one.
+            no cell seen in training nor within ``neighbours`` cells of one.
         state : ndarray
             The positions of the trailing window: the ``state`` of the next chunk.
         """
