@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d, minimum_filter1d
+from numba import njit
 
 __all__ = ["SPAN_WINDOW_S", "SPEED_DECADES", "SPAN_DECADES", "CELLS_PER_DECADE", "MIN_CELL_SAMPLES", "MIN_CELL_SHARE",
            "NEIGHBOURS",
@@ -87,23 +87,56 @@ def local_span(position: np.ndarray, samples: int, history: np.ndarray | None = 
     history : ndarray
         The last ``samples - 1`` positions: the ``history`` of the next chunk.
     """
-    position = np.asarray(position, dtype=np.float64)
-    past = np.empty(0) if history is None else np.asarray(history, dtype=np.float64)
+    position = np.ascontiguousarray(position, dtype=np.float64)
+    past = np.empty(0) if history is None else np.ascontiguousarray(history, dtype=np.float64)
+    span = np.empty(position.size)
     if position.size == 0:
-        return np.empty(0), past
-    pad = samples - 1 - past.size
-    full = np.concatenate((np.full(max(pad, 0), past[0] if past.size else position[0]), past[max(-pad, 0):],
-                           position))
-    start = samples // 2  # centred filter output at c covers input [c - samples//2, c - samples//2 + samples)
-    span = (maximum_filter1d(full, samples) - minimum_filter1d(full, samples))[start:start + position.size]
-    return span, full[full.size - (samples - 1):] if samples > 1 else np.empty(0)
+        return span, past
+    _span_kernel(position, past, samples, span)
+    keep = samples - 1
+    return span, np.concatenate((past, position))[-keep:] if keep else np.empty(0)
 
 
-def _cells(speed: np.ndarray, span: np.ndarray, speed_edges, span_edges) -> tuple[np.ndarray, np.ndarray]:
+@njit(cache=True, error_model="numpy")
+def _span_kernel(position, history, window, out):  # pragma: no cover - compiled; reference in the tests
+    """``out[k]`` = ``max - min`` of the trailing ``window`` samples of ``history`` then ``position`` ending at
+    ``position[k]``; the run's first position stands for the samples before the run (:func:`local_span`)."""
+    h = history.size
+    pad = history[0] if h > 0 else position[0]
+    for k in range(position.size):
+        start = h + k - window + 1
+        high = -np.inf
+        low = np.inf
+        if start < 0:
+            high = pad
+            low = pad
+            start = 0
+        for t in range(start, h + k + 1):
+            value = history[t] if t < h else position[t - h]
+            if value > high:
+                high = value
+            if value < low:
+                low = value
+        out[k] = high - low
+
+
+@njit(cache=True, error_model="numpy")
+def _unseen_kernel(speed, span, speed_inner, span_inner, seen, out):  # pragma: no cover - compiled
+    """``out[k]`` = the grid cell of (``speed[k]``, ``span[k]``) is not ``seen`` (outer cells take what lies
+    beyond the outer edges)."""
+    for k in range(speed.size):
+        out[k] = not seen[np.searchsorted(speed_inner, speed[k], side="right"),
+                          np.searchsorted(span_inner, span[k], side="right")]
+
+
+def _inner(edges) -> np.ndarray:
+    """The inner edges of one axis of the grid, as :func:`_cells` takes them."""
+    return np.asarray(edges[1:-1], dtype=np.float64)
+
+
+def _cells(speed: np.ndarray, span: np.ndarray, speed_inner: np.ndarray, span_inner: np.ndarray):
     """Grid indices (speed, span) of the samples; values beyond the outer edges go to the outer cells."""
-    i = np.searchsorted(np.asarray(speed_edges[1:-1], dtype=float), speed, side="right")
-    j = np.searchsorted(np.asarray(span_edges[1:-1], dtype=float), span, side="right")
-    return i, j
+    return np.searchsorted(speed_inner, speed, side="right"), np.searchsorted(span_inner, span, side="right")
 
 
 def operating_record(runs, *, cells_per_decade: int = CELLS_PER_DECADE, min_share: float = MIN_CELL_SHARE) -> dict:
@@ -138,7 +171,7 @@ def operating_record(runs, *, cells_per_decade: int = CELLS_PER_DECADE, min_shar
     counts = np.zeros((len(speed_edges) - 1, len(span_edges) - 1), dtype=np.int64)
     for run, speed in zip(runs, speeds):
         span, _ = local_span(run.position, _window_samples(SPAN_WINDOW_S, run.sample_time))
-        i, j = _cells(speed, span, speed_edges, span_edges)
+        i, j = _cells(speed, span, _inner(speed_edges), _inner(span_edges))
         np.add.at(counts, (i, j), 1)
     least = max(MIN_CELL_SAMPLES, int(math.ceil(min_share * counts.sum())))
     cells = [[int(i), int(j)] for i, j in zip(*np.nonzero(counts >= least))]
@@ -218,6 +251,9 @@ class OperatingRegion:
         for i, j in operating["cells"]:
             seen[max(i - neighbours, 0):i + neighbours + 1, max(j - neighbours, 0):j + neighbours + 1] = True
         self._seen = seen
+        self._speed_inner, self._span_inner = _inner(speed), _inner(span)
+        self._bounds = [(channel, *ranges[channel]) for channel in ("position", "velocity", "acceleration")
+                        if ranges.get(channel) is not None]
 
     @classmethod
     def of(cls, training: dict | None) -> "OperatingRegion | None":
@@ -258,12 +294,12 @@ class OperatingRegion:
             The positions of the trailing window: the ``state`` of the next chunk.
         """
         out = {}
-        for channel in ("position", "velocity", "acceleration"):
-            bounds = self.ranges.get(channel)
+        for channel, low, high in self._bounds:
             values = getattr(log, channel, None)
-            if bounds is not None and values is not None:
-                out[channel] = (values < bounds[0]) | (values > bounds[1])
+            if values is not None:
+                out[channel] = (values < low) | (values > high)
         span, state = local_span(log.position, _window_samples(self.operating["window_s"], sample_time), state)
-        i, j = _cells(np.abs(log.velocity), span, self.operating["speed_edges"], self.operating["span_edges"])
-        out["motion"] = ~self._seen[i, j]
+        out["motion"] = np.empty(span.size, dtype=np.bool_)
+        _unseen_kernel(np.abs(np.asarray(log.velocity, dtype=np.float64)), span, self._speed_inner,
+                       self._span_inner, self._seen, out["motion"])
         return out, state

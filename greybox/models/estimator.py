@@ -668,7 +668,12 @@ class CurrentModel(ModelProtocol):
             without the record (fitted in Python without :func:`greybox.train.record_training`, or read
             from a file that predates it): then the model's own ranges define its region.
         """
-        return OperatingRegion.of(getattr(self, TRAINING_ATTRIBUTE, None))
+        record = getattr(self, TRAINING_ATTRIBUTE, None)
+        cached = vars(self).get("_operating_cache")
+        if cached is None or cached[0] is not record:  # built once per record: chunks of a stream ask each time
+            cached = (record, OperatingRegion.of(record))
+            self._operating_cache = cached
+        return cached[1]
 
     def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
         """Samples of one prepared run outside the region the training runs covered.

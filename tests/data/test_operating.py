@@ -76,3 +76,17 @@ def test_a_malformed_record_is_refused_naming_the_key(change, word):
     change(record)
     with pytest.raises(ValueError, match=word):
         check_operating_record(record)
+
+
+def test_the_compiled_motion_flags_equal_the_plain_grid_lookup():
+    region = _region([_run(20.0, 0.25), _run(5.0, 1.0)])
+    run = _run(3.0, 2.0, seconds=6.0)
+    flags, _ = region.flags(run, region.start(), sample_time=0.002)
+    span = _reference_span(run.position, 250)  # 0.5 s at 2 ms
+    speed_edges, span_edges = region.operating["speed_edges"], region.operating["span_edges"]
+    seen = {tuple(cell) for cell in region.operating["cells"]}
+    plain = [(int(np.searchsorted(speed_edges[1:-1], abs(v), side="right")),
+              int(np.searchsorted(span_edges[1:-1], s, side="right"))) not in seen
+             for v, s in zip(run.velocity, span)]
+    np.testing.assert_array_equal(flags["motion"], plain)
+    assert flags["motion"].any() and not flags["motion"].all()
