@@ -18,6 +18,7 @@ import sys
 from importlib import metadata
 
 from .data.effort import EFFORT_UNITS
+from .data.operating import check_operating_record
 
 __all__ = ["LIBRARIES", "provenance", "provenance_line", "TRAINING_RECORD", "TRAINING_ATTRIBUTE", "PREPARATION_KEYS",
            "file_identity", "file_sha256",
@@ -125,7 +126,8 @@ def file_identity(path) -> dict:
     return {"name": os.path.basename(os.fspath(path)), "bytes": os.path.getsize(path), "sha256": file_sha256(path)}
 
 
-def training_record(files, preparation: dict, runs, total: dict, ranges: dict, axis: str | None = None) -> dict:
+def training_record(files, preparation: dict, runs, total: dict, ranges: dict, axis: str | None = None,
+                    operating: dict | None = None) -> dict:
     """The record of how a model was made, checked (:func:`check_training_record`), JSON-ready.
 
     Parameters
@@ -145,12 +147,14 @@ def training_record(files, preparation: dict, runs, total: dict, ranges: dict, a
         ``{channel: [low, high]}`` of the training runs (position, velocity, acceleration in the log's units).
     axis : str, optional
         The axis the training logs name (``"axis"``, left out when they name none).
+    operating : dict, optional
+        The operating region of the training runs (:func:`greybox.data.operating.operating_record`).
 
     Returns
     -------
     dict
         ``{"version", "greybox", "files", "preparation", "runs", "training_error", "ranges"}`` and
-        ``"axis"`` where known: the same
+        ``"axis"`` and ``"operating"`` where known: the same
         logs and options give the same record (no time stamps, no output name), so a model file stays
         reproducible byte for byte.
     """
@@ -159,6 +163,8 @@ def training_record(files, preparation: dict, runs, total: dict, ranges: dict, a
               "training_error": dict(total), "ranges": {name: list(pair) for name, pair in ranges.items()}}
     if axis is not None:
         record["axis"] = str(axis)
+    if operating is not None:
+        record["operating"] = operating
     return check_training_record(record)
 
 
@@ -199,8 +205,10 @@ def check_training_record(record) -> dict:
     if not isinstance(record, dict):
         raise ValueError("the record must be an object")
     expected = {"version", "greybox", "files", "preparation", "runs", "training_error", "ranges"}
-    if set(record) - {"axis"} != expected:  # "axis": files since the axis was recorded
-        raise ValueError(f"the record must hold exactly {', '.join(sorted(expected))} (and axis)")
+    if set(record) - {"axis", "operating"} != expected:  # "axis", "operating": files since they were recorded
+        raise ValueError(f"the record must hold exactly {', '.join(sorted(expected))} (and axis, operating)")
+    if "operating" in record:
+        check_operating_record(record["operating"])
     if "axis" in record:
         _text(record["axis"], "axis", 256)
     if record["version"] != TRAINING_RECORD_VERSION:

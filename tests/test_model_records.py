@@ -47,6 +47,7 @@ def test_the_model_file_records_files_preparation_errors_and_ranges(trained):
     assert record["training_error"]["samples"] == residual.size == sum(run["samples"] for run in record["runs"])
     assert record["ranges"]["position"] == pytest.approx([min(r.position.min() for r in runs),
                                                            max(r.position.max() for r in runs)])
+    assert record["operating"]["cells"]  # the region of the motion the runs showed (greybox.data.operating)
 
 
 def test_info_shows_the_record(trained, capsys):
@@ -126,6 +127,8 @@ def _rewrite(path, target, change) -> None:
     (lambda d: d["records"]["training"]["ranges"].update(position=[5.0, 1.0]), "low 5.0 above high 1.0"),
     (lambda d: d["records"]["training"]["preparation"].update(cutoff_hz="50"), "cutoff_hz must be a finite"),
     (lambda d: d.update(records=[1, 2]), "records must be an object"),
+    (lambda d: d["records"]["training"]["operating"]["cells"].append([0, 10 ** 9]), "within the grid"),
+    (lambda d: d["records"]["training"]["operating"].update(window_s=float("inf")), "window_s"),
 ])
 def test_a_hostile_record_is_refused_in_one_line(trained, tmp_path, capsys, change, message):
     _, path = trained

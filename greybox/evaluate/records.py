@@ -142,8 +142,9 @@ def evaluate_models(models: dict, runs, run_names) -> tuple[list[dict], dict]:
 
 
 #: Words for the quantities of ``outside_training`` in the notes of :func:`training_region`.
-_REGION_WORDS = {"position": "positions", "velocity": "speeds", "inputs": "kernel inputs",
-                 "effort": "predicted efforts beyond the trained ones"}
+_REGION_WORDS = {"position": "positions", "velocity": "speeds", "acceleration": "accelerations",
+                 "motion": "motion never trained on",
+                 "inputs": "kernel inputs", "effort": "predicted efforts beyond the trained ones"}
 
 
 def _log_label(run, name: str) -> str:

@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
 from ..atomic import write_text_atomic
+from ..data.operating import SPAN_WINDOW_S
 from ..json_values import jsonable
 from ..provenance import provenance, provenance_line
 from .html import write_html
@@ -521,9 +522,12 @@ def training_region_table(records: Sequence[Mapping], unit: str = "A",
         rows.append([_label(record["model"]), _number(share, 1), str(inside["n"]), _number(inside["rmse"], 4),
                      _number(inside["re"], 2), str(outside["n"]), _number(outside["rmse"], 4),
                      _number(outside["re"], 2)])
-    notes = ["Outside: samples whose position, speed (kernel models: inputs) lies beyond what the model's training "
-             "runs covered, or, for a memoryless model, at standstill (the column outside_training of greybox "
-             "predict); inside: the others. A dash: the model file has no record of its training region.", RE_NOTE]
+    notes = ["Outside: samples whose position, speed or acceleration lies beyond what the training runs covered, "
+             f"whose motion (speed against the span of the last {SPAN_WINDOW_S:g} s) they never showed, or whose "
+             "predicted effort leaves the range of the trained efforts: the same region for every kind of model "
+             "trained on the same runs (older files: the model's own ranges) (the column outside_training of "
+             "greybox predict); inside: the others. A dash: the model file has no record of its training region.",
+             RE_NOTE]
     return Table(title, header, rows, notes)
 
 

@@ -22,12 +22,14 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..base import EFFORT, LENGTH, ModelProtocol, Parameter
 from ..data.log import AxisLog, as_log_list
+from ..data.operating import OperatingRegion
 from ..data.quantities import MOTIONS, Motion
 from ..errors import GreyboxError, LogError, ParameterError, Setting
 from ..identify.inertia import axis_inertia_note, inertia_note
 from ..identify.intervals import with_intervals
 from ..identify.progress import make_progress
 from ..metrics import rmse
+from ..provenance import TRAINING_ATTRIBUTE
 
 __all__ = ["CurrentModel", "StreamView", "check_inertia", "check_runs", "extrapolates", "outside_any",
            "EXTRAPOLATION_WARNING_SHARE", "MAX_PARAMETER_MAGNITUDE", "PLAUSIBLE_EFFORT_FACTOR", "STANDSTILL_SHARE",
@@ -71,6 +73,9 @@ EXTRAPOLATION_WARNING_SHARE = 0.05
 def outside_any(flags: dict) -> np.ndarray | None:
     """The samples outside the training region in any quantity: what ``outside_training`` means.
 
+    ``"standstill"`` does not count: it is what a memoryless model cannot know, not a region the training
+    runs left out, and what counts as inside must not depend on the kind of model (it has a column of its own).
+
     Parameters
     ----------
     flags : dict of str to ndarray of bool
@@ -79,9 +84,13 @@ def outside_any(flags: dict) -> np.ndarray | None:
     Returns
     -------
     ndarray of bool or None
-        True where any flag is set; None when ``flags`` is empty (a model file that predates the record).
+        True where any flag but ``"standstill"`` is set; None when ``flags`` is empty (a model file that
+        predates the record).
     """
-    return np.logical_or.reduce(list(flags.values())) if flags else None
+    if not flags:
+        return None
+    region = [values for name, values in flags.items() if name != "standstill"]
+    return np.logical_or.reduce(region) if region else np.zeros(len(next(iter(flags.values()))), dtype=bool)
 
 
 def extrapolates(shares: dict, share: float) -> bool:
@@ -479,8 +488,19 @@ class CurrentModel(ModelProtocol):
         return StreamView(self, self._flagged_step(float(sample_time)))
 
     def _flagged_step(self, sample_time: float):
-        """:meth:`_stream_step` with the ``"effort"`` flag of its prediction added (:meth:`effort_flags`)."""
+        """:meth:`_stream_step` with the ``"effort"`` flag of its prediction added (:meth:`effort_flags`), its
+        region flags those of the operating region where the training record holds one."""
         inner = self._stream_step(sample_time)
+        operating = self.operating_region()
+        if operating is not None:
+            own = self._own_region_state()
+
+            def checked(run, state, region):
+                current, end, _, _ = inner(run, state, own)
+                flags, region = operating.flags(run, region, sample_time=sample_time)
+                return current, end, {**flags, **self._standstill_flags(run), **self.effort_flags(current)}, region
+
+            return checked
 
         def step(run, state, region):
             current, end, flags, region = inner(run, state, region)
@@ -638,6 +658,23 @@ class CurrentModel(ModelProtocol):
                 ours = getattr(self, name)
                 setattr(self, name, [min(ours[0], theirs[0]), max(ours[1], theirs[1])])
 
+    def operating_region(self) -> OperatingRegion | None:
+        """The operating region of the model's training record, the same for every kind of model.
+
+        Returns
+        -------
+        OperatingRegion or None
+            :class:`~greybox.data.operating.OperatingRegion` of ``training_record_``; None for a model
+            without the record (fitted in Python without :func:`greybox.train.record_training`, or read
+            from a file that predates it): then the model's own ranges define its region.
+        """
+        record = getattr(self, TRAINING_ATTRIBUTE, None)
+        cached = vars(self).get("_operating_cache")
+        if cached is None or cached[0] is not record:  # built once per record: chunks of a stream ask each time
+            cached = (record, OperatingRegion.of(record))
+            self._operating_cache = cached
+        return cached[1]
+
     def outside_training(self, log: AxisLog) -> dict[str, np.ndarray]:
         """Samples of one prepared run outside the region the training runs covered.
 
@@ -649,6 +686,10 @@ class CurrentModel(ModelProtocol):
         Returns
         -------
         dict of str to ndarray of bool
+            With the operating region of the training record (:meth:`operating_region`), its flags
+            (:meth:`~greybox.data.operating.OperatingRegion.flags`: position, velocity, acceleration,
+            motion) and ``"effort"``, whatever the kind of model. Without it (a model fitted in Python, or
+            an older file), the model's own:
             ``{"position": ..., "velocity": ...}``: True where the position [mm] or the velocity [mm/s]
             lies outside the range of the training runs (kernel models add ``"inputs"``, their input
             space). A memoryless model (:meth:`initial_state` None: Coulomb, Stribeck, SVR) adds
@@ -657,7 +698,13 @@ class CurrentModel(ModelProtocol):
             (:meth:`effort_flags`): where the prediction leaves the range of the efforts measured in the
             training runs. Empty for a model loaded from a file that predates the record of the ranges.
         """
-        return {**self._input_region(log), **self.effort_flags(self.predict(log))}
+        operating = self.operating_region()
+        if operating is not None:
+            flags, _ = operating.flags(log, operating.start(), sample_time=log.sample_time)
+            flags.update(self._standstill_flags(log))
+        else:
+            flags = self._input_region(log)
+        return {**flags, **self.effort_flags(self.predict(log))}
 
     def _input_region(self, log: AxisLog) -> dict[str, np.ndarray]:
         """The flags of :meth:`outside_training` that the run's inputs give (all but ``"effort"``)."""
@@ -701,7 +748,16 @@ class CurrentModel(ModelProtocol):
     def region_state(self):
         """State carried by :meth:`outside_training_chunk` from chunk to chunk of a run, at its start.
 
-        None here: whether a sample lies in the training region depends on that sample alone.
+        With the operating region of the training record, its start (the trailing window of positions);
+        else the model's own (:meth:`_own_region_state`).
+        """
+        operating = self.operating_region()
+        return self._own_region_state() if operating is None else operating.start()
+
+    def _own_region_state(self):
+        """The state of the model's own region check at the start of a run.
+
+        None here: whether a sample lies in the model's own region depends on that sample alone.
         Kernel models on the states of a dynamic model carry that model's state.
         """
         return None
@@ -727,6 +783,10 @@ class CurrentModel(ModelProtocol):
             The state after the chunk: the ``state`` of the next chunk.
         """
         check_is_fitted(self)
+        operating = self.operating_region()
+        if operating is not None:
+            flags, state = operating.flags(log, state, sample_time=sample_time)
+            return {**flags, **self._standstill_flags(log)}, state
         return self._region_flags(log, state, sample_time)
 
     def _region_flags(self, log: AxisLog, state, sample_time: float):
@@ -737,12 +797,18 @@ class CurrentModel(ModelProtocol):
             if bounds is not None:
                 values = getattr(log, channel)
                 out[channel] = (values < bounds[0]) | (values > bounds[1])
+        return {**out, **self._standstill_flags(log)}, state
+
+    def _standstill_flags(self, log: AxisLog) -> dict[str, np.ndarray]:
+        """``{"standstill": ...}`` of a memoryless model (:meth:`initial_state` None), else empty.
+
+        A memoryless model gives the friction of the velocity alone: at rest the drive holds whatever
+        friction the last motion left (up to the breakaway level), which it cannot know.
+        """
         speeds = getattr(self, "velocity_range_mm_s_", None)
-        if self.initial_state() is None and speeds is not None:
-            # a memoryless model gives the friction of the velocity alone: at rest the drive holds whatever
-            # friction the last motion left (up to the breakaway level), which it cannot know
-            out["standstill"] = np.abs(log.velocity) < STANDSTILL_SHARE * max(abs(speeds[0]), abs(speeds[1]))
-        return out, state
+        if self.initial_state() is not None or speeds is None:
+            return {}
+        return {"standstill": np.abs(log.velocity) < STANDSTILL_SHARE * max(abs(speeds[0]), abs(speeds[1]))}
 
     def _check_predict_runs(self, logs) -> list[AxisLog]:
         check_is_fitted(self)

@@ -318,7 +318,7 @@ class GMSSVRModel(KernelRegressionModel):
     def _inputs_chunk(self, run: AxisLog, state, sample_time: float):
         return self._inputs(run, state, sample_time)
 
-    def region_state(self):
+    def _own_region_state(self):
         """The GMS stage's state at the start of a run: the SVR inputs hold its element deflections."""
         return self.gms_.initial_state()
 

@@ -189,7 +189,7 @@ class KernelRegressionModel(CurrentModel):
         log : AxisLog
             One prepared run.
         """
-        state, parts = self.region_state(), []
+        state, parts = self._own_region_state(), []
         for samples in chunk_slices(len(log), samples_per_chunk(log.sample_time, DEFAULT_CHUNK_S)):
             flags, state = self.outside_training_chunk(log.select(samples), state, sample_time=log.sample_time)
             parts.append(flags)

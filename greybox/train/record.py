@@ -12,6 +12,7 @@ import os
 import numpy as np
 
 from ..data.effort import EFFORT_UNITS, check_one_axis, check_one_effort
+from ..data.operating import operating_record
 from ..json_values import jsonable
 from ..metrics import metrics_table
 from ..provenance import TRAINING_ATTRIBUTE, file_identity, preparation_of, training_record
@@ -59,7 +60,8 @@ def record_training(model, runs, predictions, *, names, files=(), read=None) -> 
     Returns
     -------
     dict
-        The record (:func:`greybox.provenance.training_record`).
+        The record (:func:`greybox.provenance.training_record`), with the ``operating`` region of the runs
+        (:func:`greybox.data.operating.operating_record`).
     """
     quantity = check_one_effort(runs)
     axis = check_one_axis(runs)
@@ -74,6 +76,6 @@ def record_training(model, runs, predictions, *, names, files=(), read=None) -> 
                              preparation_of(runs, read or {}),
                              [{"name": str(name), **_figures(table)} for name, table in zip(names, tables)],
                              {**_figures(total), "unit": EFFORT_UNITS[quantity], "quantity": quantity}, ranges,
-                             axis=axis)
+                             axis=axis, operating=operating_record(runs))
     setattr(model, TRAINING_ATTRIBUTE, record)
     return record

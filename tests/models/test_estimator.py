@@ -52,3 +52,34 @@ def test_a_fit_far_beyond_the_measured_efforts_is_refused_and_a_sound_one_passes
     with pytest.raises(GreyboxError, match=f"beyond {PLAUSIBLE_EFFORT_FACTOR:g} times the largest effort") as caught:
         check_plausible(model, [run])
     assert "\n" not in str(caught.value) and "viscous" in str(caught.value)
+
+
+def test_with_its_training_record_every_kind_of_model_has_the_same_region_and_a_file_keeps_it(tmp_path):
+    from greybox.models.friction import LuGreModel
+    from greybox.persistence import load_model, save_model
+    from greybox.train.record import record_training
+
+    train, test = _run(1, 20.0), _run(2, 40.0)
+    models = {}
+    for kind in (CoulombModel, LuGreModel):  # memoryless (once flagged standstill) and dynamic (never did)
+        model = kind().fit(train)
+        record_training(model, [train], [model.predict(train)], names=["run1"])
+        models[kind.__name__] = model
+    flags = {name: model.outside_training(test) for name, model in models.items()}
+    assert "standstill" in flags["CoulombModel"] and "standstill" not in flags["LuGreModel"]  # not the region
+    inputs = [{q: f for q, f in each.items() if q not in ("effort", "standstill")} for each in flags.values()]
+    assert set(inputs[0]) == {"position", "velocity", "acceleration", "motion"}
+    for quantity in inputs[0]:
+        np.testing.assert_array_equal(inputs[0][quantity], inputs[1][quantity])
+    assert inputs[0]["velocity"].any()  # the test run is twice as fast
+    lugre = models["LuGreModel"]
+    state, region, parts = lugre.initial_state(), lugre.region_state(), []
+    for samples in (slice(0, 7), slice(7, 900), slice(900, None)):
+        _, state, chunk, region = lugre.predict_flag_chunk(test.select(samples), state, region,
+                                                           sample_time=test.sample_time)
+        parts.append(chunk)
+    for quantity, values in flags["LuGreModel"].items():
+        np.testing.assert_array_equal(np.concatenate([part[quantity] for part in parts]), values)
+    loaded = load_model(save_model(lugre, tmp_path / "lugre.gbm"))
+    for quantity, values in loaded.outside_training(test).items():
+        np.testing.assert_array_equal(values, flags["LuGreModel"][quantity])

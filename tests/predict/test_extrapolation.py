@@ -98,8 +98,10 @@ def test_inside_the_window_there_is_no_note_and_every_format_carries_the_column(
     assert status == 0 and "extrapolates" not in captured.err
     assert "(position 0.0 %, velocity 0.0 %, standstill" in captured.out
     flags = read_log(out, columns={"current_A": "current_measured_A"}).extras["outside_training"]
+    columns = read_log(out, columns={"current_A": "current_measured_A"}).extras
     standstill = model.outside_training(prepare([read_log(tmp_path / "cut.mcap")])[0])["standstill"]
-    assert flags.size > 1000 and np.array_equal(flags == 1.0, standstill)  # only the memoryless model's rests
+    assert standstill.any() and np.array_equal(columns["standstill"] == 1.0, standstill)  # a column of its own
+    assert flags.size > 1000 and not flags.any()  # and not outside the training region (issue 40)
 
 
 def test_a_model_file_without_a_region_still_predicts_and_says_so(logs, tmp_path, capsys):

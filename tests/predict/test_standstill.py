@@ -44,7 +44,8 @@ def test_a_static_model_flags_the_stops_and_not_the_motion():
     at_rest = np.abs(run.velocity) < STANDSTILL_SHARE * np.abs(run.velocity).max()
     assert at_rest.mean() > 0.2
     np.testing.assert_array_equal(model.outside_training(run)["standstill"], at_rest)
-    assert np.all(result.outside[at_rest]) and not result.outside[np.abs(run.velocity) > 5.0].any()
+    # the model's own limitation, a column of its own: not outside the training region (issue 40)
+    assert not result.outside[at_rest].any() and np.array_equal(result.standstill, at_rest)
     # the phantom process current the flag marks: the held friction the model cannot know
     assert np.abs(result.process[at_rest]).mean() > 0.5 * HELD_A
 
@@ -70,5 +71,5 @@ def test_predict_writes_the_flag_and_notes_it_once(tmp_path, capsys, suffix):
     assert len(notes) == 1 and "left out of the process force" in notes[0]
     table = pd.read_csv(out)
     resting = np.abs(table["velocity_mm_s"].to_numpy()) < STANDSTILL_SHARE * np.abs(table["velocity_mm_s"]).max()
-    np.testing.assert_array_equal(table["outside_training"].to_numpy() == 1, resting)
+    assert not (table["outside_training"].to_numpy() == 1)[resting].any()  # not the training region (issue 40)
     np.testing.assert_array_equal(table["standstill"].to_numpy() == 1, resting)
