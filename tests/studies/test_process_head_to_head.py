@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from greybox.twin.cutting import cut_segments
 from greybox.twin.part_series import PartSeriesSpec, make_part_series
@@ -16,3 +17,34 @@ def test_the_breakage_falls_inside_the_fourth_cut_of_a_part_with_any_wait():
         a, b = cut_segments(logs[0].extras["truth_process_A"])[3]
         assert logs[0].time[a] + 0.5 < at < logs[0].time[b - 1] - 0.5
         assert np.abs(logs[0].extras["truth_process_A"][np.searchsorted(logs[0].time, at)]) > 0.05
+
+
+def test_the_false_alarm_summary_extrapolates_the_rate_of_part_maxima_drawn_from_the_model():
+    import math
+
+    from scipy.stats import t as student
+
+    from studies.process_head_to_head import TEACH, false_alarm_summary
+
+    rng = np.random.default_rng(0)
+    scale, dof, count, factor = math.sqrt(1 + 1 / TEACH), 5 * (TEACH - 1), 300, 4.0
+    maxima = scale * np.abs(rng.standard_t(dof, size=(2000, count))).max(axis=1)
+    rows = [{"false_alarms": int(np.sum(half > factor)), "good_parts": half.size, "band_factor": factor,
+             "maxima": half.tolist(), "mean_ratios": (0.25 * rng.standard_normal(half.size)).tolist()}
+            for half in (maxima[:1000], maxima[1000:])]
+    summary = false_alarm_summary(rows)
+    truth = 1 - (1 - 2 * student.sf(factor / scale, dof)) ** count
+    assert summary["good_parts"] == 2000 and summary["false_alarms"] == sum(r["false_alarms"] for r in rows)
+    assert summary["band_count"] == pytest.approx(count, rel=0.1)
+    assert summary["band_rate_ci"][0] < truth < summary["band_rate_ci"][1]
+    assert summary["counted_ci"][0] < summary["false_alarms"] / 2000 < summary["counted_ci"][1]
+    assert summary["mean_rate"] == pytest.approx(2 * student.sf(4.0, 1e9), rel=0.5)  # |D| / limit sd 0.25
+
+
+def test_no_false_alarm_in_n_parts_bounds_the_rate_by_about_three_over_n():
+    from studies.process_head_to_head import false_alarm_summary
+
+    row = {"false_alarms": 0, "good_parts": 600, "band_factor": 6.0, "maxima": [4.0] * 600,
+           "mean_ratios": [0.1] * 600}
+    low, high = false_alarm_summary([row])["counted_ci"]
+    assert low == 0.0 and high == pytest.approx(3.69 / 600, rel=0.05)
