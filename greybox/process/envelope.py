@@ -1,7 +1,8 @@
 """The teach-in envelope: the signal of good parts along the part, its spread, and the limits of a check.
 
 :meth:`Envelope.fit` lays every good part on the sample grid of a reference part (the one of median
-length) by the bounded velocity shift of :mod:`~greybox.process.alignment`, smooths each with a moving mean
+length), block by block where the logs carry NC block numbers, else by the bounded velocity shift
+(:mod:`~greybox.process.alignment`), smooths each with a moving mean
 of ``smoothing_s`` and learns per position
 
 - the centre ``c_i`` (mean of the parts) and the spread ``s_i`` (their standard deviation, pooled over a
@@ -58,7 +59,7 @@ from ..atomic import write_text_atomic
 from ..errors import GreyboxError
 from ..predict.relevel import level_direction, relevelled
 from ..windows import centred_nanmean
-from .alignment import STANDSTILL_MM_S, best_shift, shifted
+from .alignment import BLOCK_COLUMN, STANDSTILL_MM_S, best_shift, block_positions, shifted, warped
 
 __all__ = ["ENVELOPE_FORMAT", "Envelope", "band_count", "cut_samples", "level_direction", "relevelled"]
 
@@ -199,19 +200,23 @@ class Envelope:
         self.width_ = max(1, int(round(self.smoothing_s / dt)))
         self.max_shift_ = int(round(self.max_shift_s / dt))
         self.reference_velocity_ = np.asarray(reference.velocity, dtype=float)
+        blocks = reference.extras.get(BLOCK_COLUMN)
+        self.blocks_ = blocks is not None
+        self.reference_block_ = (np.nan_to_num(np.asarray(blocks, dtype=float), nan=-1.0) if self.blocks_
+                                 else np.zeros(self.reference_velocity_.size))
         self.direction_ = np.where(np.abs(self.reference_velocity_) > STANDSTILL_MM_S,
                                    np.sign(self.reference_velocity_), 0.0)
         self.held_direction_ = level_direction(self.reference_velocity_)
         self.scaled_ = all(part.level is not None for part in parts)
         raw = [self._aligned(part) for part in parts]
-        first = np.vstack([centred_nanmean(row, self.width_) for row, _, _ in raw])
+        first = np.vstack([centred_nanmean(row, self.width_) for row, _, _, _ in raw])
         centre = np.nanmean(first, axis=0)
         self.cut_ = cut_samples(centre, self.direction_, self.cut_share)
         self.air_ = (self.direction_ != 0) & ~_dilated(self.cut_, self.width_)
         aligned = first
         if self.relevel:
-            aligned = np.vstack([centred_nanmean(self._relevelled(part, row, template, shift, centre)[0], self.width_)
-                                 for part, (row, template, shift) in zip(parts, raw)])
+            aligned = np.vstack([centred_nanmean(self._relevelled(part, row, template, place, centre)[0], self.width_)
+                                 for part, (row, template, _, place) in zip(parts, raw)])
             centre = np.nanmean(aligned, axis=0)
         self.centre_ = centre
         self.spread_ = self._spread(aligned)
@@ -245,14 +250,28 @@ class Envelope:
         pooled = np.sqrt(centred_nanmean(spread ** 2, SPREAD_POOL * self.width_))
         return np.maximum(pooled, 0.5 * float(np.nanmedian(pooled)))
 
-    def _aligned(self, part) -> tuple[np.ndarray, np.ndarray | None, int]:
-        """The part's signal and template on the reference grid (unsmoothed), and its shift [samples]."""
-        shift = best_shift(self.reference_velocity_, part.velocity, self.max_shift_)
+    def _aligned(self, part) -> tuple:
+        """The part's signal and template on the reference grid (unsmoothed), its shift [samples] and the function
+        that lays any of its arrays on the grid: block by block where both carry NC block numbers, else by the
+        velocity's shift."""
         length = self.reference_velocity_.size
-        template = None if part.level is None or not self.scaled_ else shifted(part.level, shift, length)
-        return shifted(part.signal, shift, length), template, shift
+        blocks = part.extras.get(BLOCK_COLUMN) if self.blocks_ else None
+        if blocks is not None:
+            positions = block_positions(self.reference_block_, blocks)
+            offset = positions - np.arange(length)
+            shift = int(round(float(np.nanmedian(offset)))) if np.isfinite(offset).any() else 0
 
-    def _relevelled(self, part, signal, template, shift, centre) -> tuple[np.ndarray, dict]:
+            def place(values):
+                return warped(values, positions)
+        else:
+            shift = best_shift(self.reference_velocity_, part.velocity, self.max_shift_)
+
+            def place(values):
+                return shifted(values, shift, length)
+        template = None if part.level is None or not self.scaled_ else place(part.level)
+        return place(part.signal), template, shift, place
+
+    def _relevelled(self, part, signal, template, place, centre) -> tuple[np.ndarray, dict]:
         """Re-level a part's aligned signal; a force is re-levelled as its process current, then converted."""
         if not self.scaled_:
             return relevelled(signal, self.held_direction_, self.air_, target=centre)
@@ -260,10 +279,8 @@ class Envelope:
             raise GreyboxError("the envelope re-levels a model's signal; the part has no model current")
         if part.current is None or part.convert is None:
             return relevelled(signal, self.held_direction_, self.air_, template=template)
-        length = self.reference_velocity_.size
-        current, corrections = relevelled(shifted(part.current, shift, length), self.held_direction_, self.air_,
-                                          template=template)
-        return part.convert(current, shifted(part.velocity, shift, length)), corrections
+        current, corrections = relevelled(place(part.current), self.held_direction_, self.air_, template=template)
+        return part.convert(current, place(part.velocity)), corrections
 
     def deviation(self, aligned) -> float:
         """Mean load deviation ``D`` [signal unit] of an aligned signal over the cut samples.
@@ -294,10 +311,10 @@ class Envelope:
         offsets : dict
             The re-levelling offsets (empty without re-levelling).
         """
-        aligned, template, shift = self._aligned(part)
+        aligned, template, shift, place = self._aligned(part)
         offsets: dict = {}
         if self.relevel:
-            aligned, offsets = self._relevelled(part, aligned, template, shift, self.centre_)
+            aligned, offsets = self._relevelled(part, aligned, template, place, self.centre_)
         return centred_nanmean(aligned, self.width_, complete=True), shift, offsets
 
     @property
@@ -311,8 +328,8 @@ class Envelope:
         return self.mean_factor_ * self.deviation_sd_
 
     # ------------------------------------------------------------------ files
-    _ARRAYS = ("reference_velocity_", "direction_", "held_direction_", "centre_", "spread_", "cut_", "air_",
-               "air_level_")
+    _ARRAYS = ("reference_velocity_", "reference_block_", "direction_", "held_direction_", "centre_", "spread_",
+               "cut_", "air_", "air_level_")
     _NUMBERS = ("sample_time_", "band_factor_", "band_count_", "deviation_sd_", "mean_factor_", "cut_load_")
     _INTEGERS = ("width_", "max_shift_", "n_parts_")
 
@@ -323,7 +340,7 @@ class Envelope:
         arrays = {name: [bool(v) for v in getattr(self, name)] if name in ("cut_", "air_")
                   else [float(v) for v in getattr(self, name)] for name in self._ARRAYS}
         return {"format": ENVELOPE_FORMAT, "params": params, "unit": self.unit_, "signal": self.signal_,
-                "scaled": bool(self.scaled_),
+                "scaled": bool(self.scaled_), "blocks": bool(self.blocks_),
                 "parts": self.parts_, **{name: float(getattr(self, name)) for name in self._NUMBERS},
                 **{name: int(getattr(self, name)) for name in self._INTEGERS}, "arrays": arrays}
 
@@ -409,9 +426,9 @@ class Envelope:
         if not (np.all(np.isin(envelope.direction_, (-1.0, 0.0, 1.0)))
                 and np.all(np.isin(envelope.held_direction_, (-1.0, 0.0, 1.0)))) or np.any(envelope.spread_ <= 0):
             raise bad("direction not -1/0/1 or spread not positive")
-        if not isinstance(content.get("scaled"), bool):
-            raise bad("scaled")
-        envelope.scaled_ = content["scaled"]
+        if not isinstance(content.get("scaled"), bool) or not isinstance(content.get("blocks"), bool):
+            raise bad("scaled or blocks")
+        envelope.scaled_, envelope.blocks_ = content["scaled"], content["blocks"]
         if not isinstance(content.get("unit"), str) or not isinstance(content.get("signal"), dict) \
                 or not isinstance(content.get("parts"), list):
             raise bad("unit, signal or parts")
