@@ -49,7 +49,8 @@ from greybox.twin.part_series import PartSeriesSpec, ToolEvents, WarmUp, make_pa
 from greybox.windows import centred_nanmean
 
 __all__ = ["PARTS", "TEACH", "RATE", "VARIANTS", "GOOD_PARTS", "breakage_time", "false_alarm_series",
-           "false_alarm_summary", "false_alarm_table", "head_to_head", "head_to_head_table", "seed_series", "targets"]
+           "false_alarm_summary", "false_alarm_table", "head_to_head", "head_to_head_table", "seed_series", "targets",
+           "truth_cut_force"]
 
 PARTS, TEACH, WEAR_START, MISSING, OVERSIZED, BREAKAGE = 80, 10, 50, 30, 40, 75
 #: Warm-up time constant [s] and drop.
@@ -185,7 +186,18 @@ def false_alarm_summary(rows) -> dict:
             "rate_ci": [band[1], band[2] + mean[1]]}
 
 
-def _truth_cut_force(envelope, part, shift: int) -> float:
+def truth_cut_force(envelope, part, shift: int) -> float:
+    """Mean truth process force [N] over the envelope's cut samples of a part laid on the grid by ``shift``.
+
+    Parameters
+    ----------
+    envelope : Envelope
+        The envelope.
+    part : Part
+        A twin part (with ``truth_process_force_N``).
+    shift : int
+        Its shift [samples].
+    """
     truth = centred_nanmean(shifted(part.extras["truth_process_force_N"], shift, envelope.centre_.size),
                         envelope.width_)
     return float(np.nanmean((envelope.direction_ * truth)[envelope.cut_]))
@@ -213,7 +225,7 @@ def _variant(parts, unit: str, relevel: bool, truth: dict, kind: str) -> dict:
         errors = []
         for k in good:
             part, done = checks[k]
-            reference = _truth_cut_force(envelope, part, int(round(done.shift_s / envelope.sample_time_)))
+            reference = truth_cut_force(envelope, part, int(round(done.shift_s / envelope.sample_time_)))
             errors.append(100.0 * (done.cut_load / reference - 1.0))
         row["cut_force_error_pct"] = {"mean_abs": float(np.mean(np.abs(errors))), "max_abs": float(np.max(
             np.abs(errors))), "mean": float(np.mean(errors))}
