@@ -31,6 +31,7 @@ from greybox.evaluate.report import (
     svr_generalisation_table,
 )
 
+from .process_head_to_head import false_alarm_table, head_to_head_table, targets
 from .records import ROOT, read_record
 
 __all__ = ["BLOCK", "View", "VIEWS", "PAGES", "render_text", "render_pages", "cited_records"]
@@ -251,6 +252,22 @@ def _predict_hour(record: dict) -> str:
             f"({_where(record)}).\n")
 
 
+def _process_head_to_head(label: str) -> Callable[[dict], str]:
+    def view(record: dict) -> str:
+        results = record["figures"][label]
+        seeds = ", ".join(results["series"])
+        good = ", ".join(results["good"])
+        parts = record["figures"]["good_parts_per_series"]
+        met = "; ".join(f"{name}: " + ", ".join(f"{what} {_met(ok)}" for what, ok in targets(results, name).items()
+                                                if ok is not None)
+                        for name in ("force, re-levelled", "raw, re-levelled"))
+        return (f"Seeds {seeds} (the protocol's series):\n\n{head_to_head_table(results['series'])}\n"
+                f"False alarms of all good parts: the series above and {len(results['good'])} series of {parts} "
+                f"good parts (seeds {good}; the first 10 taught):\n\n{false_alarm_table(results['false_alarms'])}\n"
+                f"Targets: {met}. `{record['command']}`, {record['seconds'] / 60:.1f} min ({_where(record)}).\n")
+    return view
+
+
 def _live_speed(record: dict) -> str:
     f = record["figures"]
     c, share, ends = f["compute"], f["cpu_share"], f["end_to_end"]
@@ -310,6 +327,8 @@ VIEWS = {
     "readme-measured": View(("reproduce", "default-tests", "monitor-independent"), _readme_table),
     "live-cut-force": View(("live-low-latency",), _live_cut_force),
     "live-low-latency": View(("live-low-latency",), _live_low_latency),
+    "process-head-to-head": View(("process-head-to-head",), _process_head_to_head("held_out")),
+    "process-head-to-head-development": View(("process-head-to-head",), _process_head_to_head("development")),
 }
 
 

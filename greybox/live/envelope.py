@@ -170,6 +170,7 @@ class EnvelopeWatch:
         self._recent: dict | None = None  # the last samples, for the rest before a part's first motion
         self._lead = int(np.argmax(np.abs(envelope.reference_velocity_) > STANDSTILL_MM_S))  # the reference's rest
         self._part: dict | None = None  # the part being cut: its number, start, samples, watch
+        self._ended: dict | None = None  # a part checked whole at the end of a run, its alarms still raised
         self._parts = 0
         self._corrections: dict | None = None
         self._raised = False
@@ -267,6 +268,24 @@ class EnvelopeWatch:
         self._resting, self._recent = 0, None
         return alarms
 
+    def end_run(self, time_s: float = math.nan) -> list[EnvelopeAlarm]:
+        """The stream ended or went quiet: the part being cut is checked whole; its alarms stay raised until the
+        next part starts or the next run re-arms the watch.
+
+        Parameters
+        ----------
+        time_s : float, optional
+            Time of the last sample of the run [s].
+
+        Returns
+        -------
+        list of EnvelopeAlarm
+            The whole part's alarms.
+        """
+        alarms = self._end_part(time_s, clear=False)
+        self._resting, self._recent = 0, None
+        return alarms
+
     def _start_part(self) -> list[EnvelopeAlarm]:
         """Start the next part with the rest before its first motion; the alarms of that rest (none expected)."""
         self._parts += 1
@@ -298,10 +317,15 @@ class EnvelopeWatch:
         self._raised |= bool(out)
         return out
 
-    def _end_part(self, time_s: float) -> list[EnvelopeAlarm]:
+    def _end_part(self, time_s: float, clear: bool = True) -> list[EnvelopeAlarm]:
         part, self._part = self._part, None
         if part is None:
-            return []
+            ended, self._ended = self._ended, None
+            if ended is None or not clear:
+                self._ended = ended
+                return []
+            self._raised = False
+            return [EnvelopeAlarm(ended["number"], "", ended["start"], time_s, state="cleared")]
         alarms = []
         samples = {key: np.concatenate([piece[key] for piece in part["samples"]]) for key in part["samples"][0]}
         if samples["time"].size > 1:
@@ -318,6 +342,10 @@ class EnvelopeWatch:
             if whole.mean_kind:
                 alarms.append(EnvelopeAlarm(part["number"], whole.mean_kind, part["start"], end, whole_part=True))
             self._corrections = whole.offsets or None
+        if not clear:
+            if self._raised or alarms:
+                self._raised, self._ended = True, part
+            return alarms
         if self._raised or alarms:
             alarms.append(EnvelopeAlarm(part["number"], "", part["start"], time_s, state="cleared"))
         self._raised = False
@@ -390,3 +418,13 @@ class Watches:
             Time of the last sample of the run that ended [s].
         """
         return [alarm for watch in self.watches for alarm in watch.rearm(time_s)]
+
+    def end_run(self, time_s: float = math.nan) -> list:
+        """Each watch's ``end_run``.
+
+        Parameters
+        ----------
+        time_s : float, optional
+            Time of the last sample of the run [s].
+        """
+        return [alarm for watch in self.watches for alarm in watch.end_run(time_s)]

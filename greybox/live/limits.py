@@ -174,6 +174,22 @@ class LimitWatch:
             self._since[column], self._peak[column], self._raised[column] = None, 0.0, False
         return cleared
 
+    def end_run(self, time_s: float = math.nan) -> list[Alarm]:
+        """The stream ended or went quiet: nothing to check; the alarms raised stay raised (:meth:`rearm` clears
+        them when the next run starts).
+
+        Parameters
+        ----------
+        time_s : float, optional
+            Time of the last sample of the run [s].
+
+        Returns
+        -------
+        list of Alarm
+            None.
+        """
+        return []
+
     def _cleared(self, limit: Limit, time_s: float) -> Alarm:
         name = limit.column
         return Alarm(name, limit.bound, self._peak[name], self._since[name], time_s, self.hold_s, "cleared")

@@ -187,8 +187,12 @@ class LiveSession:
             self.limits.check_columns(self.estimator.output_columns)
 
     def finish(self) -> None:
-        """The end of the stream: the samples still waiting are estimated as the end of a log."""
+        """The end of the stream (or of a run, :meth:`idle`): the samples still waiting are estimated as the end
+        of a log, and the limits see the run end (an envelope checks the part being cut whole, as at a gap; the
+        alarms raised stay raised until the next run)."""
         self._publish(self.estimator.finish(), None)
+        if self.limits is not None:
+            self._alarms(self.limits.end_run(self._last_s), None)
 
     def idle(self, idle_s: float) -> None:
         """The stream went quiet: the samples waiting are estimated as the end of a run (the next sample

@@ -9,6 +9,12 @@ Two parts of the same program differ by small timing differences (the loading ti
 starts). :func:`best_shift` finds the shift of one part against the reference part that maximises the
 cross-correlation of their velocities, bounded to ``max_shift`` samples; :func:`shifted` lays the part on
 the reference's sample grid (NaN where it has no sample).
+
+A log that carries the NC block number per sample (column :data:`BLOCK_COLUMN`, as a control logs it) is
+aligned block by block instead (:func:`block_positions`, :func:`warped`): each run of one block number in the
+reference is matched with the same run in the part (the k-th run of a number with its k-th run) and the part's
+samples of that run are stretched linearly onto the reference's, so timing differences inside the part (a
+feed override, a longer dwell) are taken out too.
 """
 
 from __future__ import annotations
@@ -19,10 +25,13 @@ from scipy.signal import correlate
 from ..errors import GreyboxError
 from ..predict.relevel import STANDSTILL_MM_S
 
-__all__ = ["PART_COLUMN", "STANDSTILL_MM_S", "part_slices", "best_shift", "shifted"]
+__all__ = ["BLOCK_COLUMN", "PART_COLUMN", "STANDSTILL_MM_S", "block_positions", "part_slices", "best_shift",
+           "shifted", "warped"]
 
 #: Name of the part counter column of a long log.
 PART_COLUMN = "part"
+#: Name of the NC block number column of a log.
+BLOCK_COLUMN = "block"
 
 
 def part_slices(velocity, *, counter=None, sample_time: float, min_rest_s: float = 2.0) -> list[slice]:
@@ -105,4 +114,64 @@ def shifted(values, shift: int, length: int) -> np.ndarray:
     index = np.arange(length) + shift
     inside = (index >= 0) & (index < v.size)
     out[inside] = v[index[inside]]
+    return out
+
+
+def _runs(blocks: np.ndarray) -> dict:
+    """``{(number, k): (start, end)}``: the k-th run of each block number (NaN counted as -1)."""
+    b = np.nan_to_num(np.asarray(blocks, dtype=float), nan=-1.0)
+    edges = np.concatenate(([0], np.flatnonzero(np.diff(b) != 0) + 1, [b.size]))
+    runs, seen = {}, {}
+    for a, e in zip(edges[:-1].tolist(), edges[1:].tolist()):
+        key = float(b[a])
+        runs[(key, seen.get(key, 0))] = (a, e)
+        seen[key] = seen.get(key, 0) + 1
+    return runs
+
+
+def block_positions(reference_blocks, blocks) -> np.ndarray:
+    """Where in a part each sample of the reference lies, block by block (module docstring).
+
+    Parameters
+    ----------
+    reference_blocks : array_like, shape (m,)
+        The reference part's NC block number per sample.
+    blocks : array_like, shape (n,)
+        The part's.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        Fractional sample index into the part per reference sample; NaN in the runs the part lacks.
+
+    Raises
+    ------
+    GreyboxError
+        If either is empty.
+    """
+    reference, part = _runs(reference_blocks), _runs(blocks)
+    if not reference or not part:
+        raise GreyboxError("alignment: a part without samples")
+    positions = np.full(sum(e - a for a, e in reference.values()), np.nan)
+    for key, (a, e) in reference.items():
+        if key in part:
+            pa, pe = part[key]
+            positions[a:e] = pa - 0.5 + (np.arange(e - a) + 0.5) * (pe - pa) / (e - a)
+    return positions
+
+
+def warped(values, positions) -> np.ndarray:
+    """``values`` at fractional sample indices, by linear interpolation; NaN where the index is NaN or outside.
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        A part's samples.
+    positions : ndarray, shape (m,)
+        From :func:`block_positions`.
+    """
+    v = np.asarray(values, dtype=float)
+    out = np.full(positions.size, np.nan)
+    inside = np.isfinite(positions) & (positions >= -0.5) & (positions <= v.size - 0.5)
+    out[inside] = np.interp(positions[inside], np.arange(v.size), v)
     return out

@@ -1,7 +1,8 @@
 """The teach-in envelope: the signal of good parts along the part, its spread, and the limits of a check.
 
 :meth:`Envelope.fit` lays every good part on the sample grid of a reference part (the one of median
-length) by the bounded velocity shift of :mod:`~greybox.process.alignment`, smooths each with a moving mean
+length), block by block where the logs carry NC block numbers, else by the bounded velocity shift
+(:mod:`~greybox.process.alignment`), smooths each with a moving mean
 of ``smoothing_s`` and learns per position
 
 - the centre ``c_i`` (mean of the parts) and the spread ``s_i`` (their standard deviation, pooled over a
@@ -23,17 +24,23 @@ friction the axis holds):
 
 **Limits, from the false-alarm rate** ``alpha`` per good part, split evenly between two checks:
 
-- the band: a position is outside when ``|y_i - c_i| > k_b s_i``; with ``m = L / w`` nearly independent
-  smoothed values per part of ``L`` samples (``w`` samples per smoothing length) and Gaussian deviations,
-  ``k_b = t_nu(alpha / (4 m)) sqrt(1 + 1/n)`` for ``n`` teach-in parts (``t_nu(p)`` the upper ``p`` quantile
-  of Student's t, two-sided, with ``nu = 5 (n - 1)`` degrees of freedom: the spread is pooled over five
-  smoothing lengths of ``n`` parts);
+- the band: a position is outside when ``|y_i - c_i| > k_b s_i`` while the reference moves. A part is a
+  false alarm of the band when its largest standardised deviation ``u = max_i |y_i - c_i| / s_i`` passes
+  ``k_b``, so ``k_b`` is set on the distribution of ``u`` (:func:`band_count`): the smoothed deviations are
+  taken as Gaussian and ``u`` as the largest of ``M`` independent ones (``M``, the *effective count*, stands
+  for the smoothed signal's correlation, which no formula in ``L / w`` gets right). Each teach-in part's ``u``
+  is measured against the centre and spread of the *other* parts (leave one out), ``M`` is fitted to those
+  ``n`` maxima by maximum likelihood and its one-sided 95 % upper confidence bound ``M_95`` kept (a larger
+  ``M`` widens the band), and ``k_b = t_nu(p / 2) sqrt(1 + 1/n)`` with ``1 - (1 - p)^M_95 = alpha / 2``
+  (``t_nu(q)`` the upper ``q`` quantile of Student's t with ``nu = 5 (n - 1)`` degrees of freedom: the
+  spread is pooled over five smoothing lengths of ``n`` parts);
 - the part's mean load deviation over the cut samples, ``D = mean_cut(d_i (y_i - c_i))``: outside when
   ``|D| > k_m sd(D)``, ``sd(D)`` over the teach-in parts and ``k_m = t_{n-1}(alpha / 4) sqrt(1 + 1/n)``
   (Student's t, two-sided). A worn tool raises ``D`` long before single positions leave the band.
 
-The rule assumes Gaussian, independent deviations; how many false alarms it gives on good parts is
-measured (``scripts/process_head_to_head.py``), not promised. An envelope is saved as JSON (no pickle) and
+The rule assumes Gaussian deviations whose part maxima behave as those of ``M`` independent ones; how many
+false alarms it gives on good parts is measured on held-out twin parts (``scripts/process_head_to_head.py``),
+not promised. An envelope is saved as JSON (no pickle) and
 validated fully when loaded (:meth:`Envelope.load`).
 """
 
@@ -45,22 +52,60 @@ from os import PathLike
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import chi2
 from scipy.stats import t as student
 
 from ..atomic import write_text_atomic
 from ..errors import GreyboxError
 from ..predict.relevel import level_direction, relevelled
 from ..windows import centred_nanmean
-from .alignment import STANDSTILL_MM_S, best_shift, shifted
+from .alignment import BLOCK_COLUMN, STANDSTILL_MM_S, best_shift, block_positions, shifted, warped
 
-__all__ = ["ENVELOPE_FORMAT", "Envelope", "cut_samples", "level_direction", "relevelled"]
+__all__ = ["ENVELOPE_FORMAT", "Envelope", "band_count", "cut_samples", "level_direction", "relevelled"]
 
 #: Format tag of an envelope file.
-ENVELOPE_FORMAT = "greybox-envelope/1"
+ENVELOPE_FORMAT = "greybox-envelope/2"
 #: Percentile of the load over a direction's samples taken as its air level (:func:`cut_samples`).
 AIR_PERCENTILE = 20.0
 #: Pooling window of the spread, in smoothing lengths.
 SPREAD_POOL = 5
+#: Confidence of the upper bound of the effective count the band is set with (:func:`band_count`).
+COUNT_CONFIDENCE = 0.95
+
+
+def band_count(maxima, dof: float, scale: float, confidence: float = COUNT_CONFIDENCE) -> tuple[float, float]:
+    """Effective count ``M`` of independent deviations whose largest matches the part maxima ``u_j``.
+
+    Model: ``u / scale`` is the largest of ``M`` independent ``|t_dof|`` values, ``P(u <= x) = G(x)^M`` with
+    ``G(x) = P(|t_dof| <= x / scale)``. Then ``-log G(u_j)`` is exponential with rate ``M``: the maximum
+    likelihood ``M = n / S`` with ``S = sum_j -log G(u_j)``, and ``2 M S`` is chi-square with ``2 n`` degrees
+    of freedom, which gives the one-sided upper bound ``M_c = chi2_{2n}(confidence) / (2 S)``.
+
+    Parameters
+    ----------
+    maxima : array_like, shape (n,)
+        Largest standardised deviation of each part (dimensionless, > 0).
+    dof : float
+        Degrees of freedom of the standardised deviations.
+    scale : float
+        Their scale beyond Student's t (``sqrt(1 + 1/n')`` for a centre of ``n'`` parts).
+    confidence : float, default 0.95
+        Confidence of the upper bound, in (0, 1).
+
+    Returns
+    -------
+    estimate : float
+        Maximum-likelihood ``M`` (at least 1).
+    upper : float
+        Its upper confidence bound (at least 1).
+    """
+    maxima = np.asarray(maxima, dtype=float)
+    inside = 1.0 - 2.0 * student.sf(maxima / scale, dof)
+    total = float(np.sum(-np.log(np.clip(inside, 1e-300, None))))
+    if not total > 0:
+        return 1.0, 1.0
+    n = maxima.size
+    return max(1.0, n / total), max(1.0, float(chi2.ppf(confidence, 2 * n)) / (2.0 * total))
 
 
 def cut_samples(centre, direction, share: float) -> np.ndarray:
@@ -155,29 +200,36 @@ class Envelope:
         self.width_ = max(1, int(round(self.smoothing_s / dt)))
         self.max_shift_ = int(round(self.max_shift_s / dt))
         self.reference_velocity_ = np.asarray(reference.velocity, dtype=float)
-        length = self.reference_velocity_.size
+        blocks = reference.extras.get(BLOCK_COLUMN)
+        self.blocks_ = blocks is not None
+        self.reference_block_ = (np.nan_to_num(np.asarray(blocks, dtype=float), nan=-1.0) if self.blocks_
+                                 else np.zeros(self.reference_velocity_.size))
         self.direction_ = np.where(np.abs(self.reference_velocity_) > STANDSTILL_MM_S,
                                    np.sign(self.reference_velocity_), 0.0)
         self.held_direction_ = level_direction(self.reference_velocity_)
         self.scaled_ = all(part.level is not None for part in parts)
         raw = [self._aligned(part) for part in parts]
-        first = np.vstack([centred_nanmean(row, self.width_) for row, _, _ in raw])
+        first = np.vstack([centred_nanmean(row, self.width_) for row, _, _, _ in raw])
         centre = np.nanmean(first, axis=0)
         self.cut_ = cut_samples(centre, self.direction_, self.cut_share)
         self.air_ = (self.direction_ != 0) & ~_dilated(self.cut_, self.width_)
         aligned = first
         if self.relevel:
-            aligned = np.vstack([centred_nanmean(self._relevelled(part, row, template, shift, centre)[0], self.width_)
-                                 for part, (row, template, shift) in zip(parts, raw)])
+            aligned = np.vstack([centred_nanmean(self._relevelled(part, row, template, place, centre)[0], self.width_)
+                                 for part, (row, template, _, place) in zip(parts, raw)])
             centre = np.nanmean(aligned, axis=0)
         self.centre_ = centre
-        spread = np.nanstd(aligned, axis=0, ddof=1)
-        pooled = np.sqrt(centred_nanmean(spread ** 2, SPREAD_POOL * self.width_))
-        self.spread_ = np.maximum(pooled, 0.5 * float(np.nanmedian(pooled)))
+        self.spread_ = self._spread(aligned)
         n = len(parts)
-        independent = max(1.0, length / self.width_)
-        self.band_factor_ = float(student.isf(self.false_alarm_rate / (4.0 * independent), (n - 1) * SPREAD_POOL)
-                                  * math.sqrt(1.0 + 1.0 / n))
+        moving = self.direction_ != 0
+        maxima = []
+        for j in range(n):
+            others = np.delete(aligned, j, axis=0)
+            standardised = np.abs(aligned[j] - np.nanmean(others, axis=0)) / self._spread(others)
+            maxima.append(float(np.nanmax(standardised[moving])))
+        _, self.band_count_ = band_count(maxima, (n - 2) * SPREAD_POOL, math.sqrt(1.0 + 1.0 / (n - 1)))
+        per_value = -math.expm1(math.log1p(-self.false_alarm_rate / 2.0) / self.band_count_)
+        self.band_factor_ = float(student.isf(per_value / 2.0, (n - 1) * SPREAD_POOL) * math.sqrt(1.0 + 1.0 / n))
         deviations = np.array([self.deviation(row) for row in aligned])
         self.deviation_sd_ = float(np.std(deviations, ddof=1))
         self.mean_factor_ = float(student.isf(self.false_alarm_rate / 4.0, n - 1) * math.sqrt(1.0 + 1.0 / n))
@@ -192,14 +244,34 @@ class Envelope:
         self.parts_ = [{"source": Path(part.source).name, "number": part.number} for part in parts]
         return self
 
-    def _aligned(self, part) -> tuple[np.ndarray, np.ndarray | None, int]:
-        """The part's signal and template on the reference grid (unsmoothed), and its shift [samples]."""
-        shift = best_shift(self.reference_velocity_, part.velocity, self.max_shift_)
-        length = self.reference_velocity_.size
-        template = None if part.level is None or not self.scaled_ else shifted(part.level, shift, length)
-        return shifted(part.signal, shift, length), template, shift
+    def _spread(self, rows) -> np.ndarray:
+        """Spread per position of aligned parts: standard deviation pooled over five smoothing lengths, floored."""
+        spread = np.nanstd(rows, axis=0, ddof=1)
+        pooled = np.sqrt(centred_nanmean(spread ** 2, SPREAD_POOL * self.width_))
+        return np.maximum(pooled, 0.5 * float(np.nanmedian(pooled)))
 
-    def _relevelled(self, part, signal, template, shift, centre) -> tuple[np.ndarray, dict]:
+    def _aligned(self, part) -> tuple:
+        """The part's signal and template on the reference grid (unsmoothed), its shift [samples] and the function
+        that lays any of its arrays on the grid: block by block where both carry NC block numbers, else by the
+        velocity's shift."""
+        length = self.reference_velocity_.size
+        blocks = part.extras.get(BLOCK_COLUMN) if self.blocks_ else None
+        if blocks is not None:
+            positions = block_positions(self.reference_block_, blocks)
+            offset = positions - np.arange(length)
+            shift = int(round(float(np.nanmedian(offset)))) if np.isfinite(offset).any() else 0
+
+            def place(values):
+                return warped(values, positions)
+        else:
+            shift = best_shift(self.reference_velocity_, part.velocity, self.max_shift_)
+
+            def place(values):
+                return shifted(values, shift, length)
+        template = None if part.level is None or not self.scaled_ else place(part.level)
+        return place(part.signal), template, shift, place
+
+    def _relevelled(self, part, signal, template, place, centre) -> tuple[np.ndarray, dict]:
         """Re-level a part's aligned signal; a force is re-levelled as its process current, then converted."""
         if not self.scaled_:
             return relevelled(signal, self.held_direction_, self.air_, target=centre)
@@ -207,10 +279,8 @@ class Envelope:
             raise GreyboxError("the envelope re-levels a model's signal; the part has no model current")
         if part.current is None or part.convert is None:
             return relevelled(signal, self.held_direction_, self.air_, template=template)
-        length = self.reference_velocity_.size
-        current, corrections = relevelled(shifted(part.current, shift, length), self.held_direction_, self.air_,
-                                          template=template)
-        return part.convert(current, shifted(part.velocity, shift, length)), corrections
+        current, corrections = relevelled(place(part.current), self.held_direction_, self.air_, template=template)
+        return part.convert(current, place(part.velocity)), corrections
 
     def deviation(self, aligned) -> float:
         """Mean load deviation ``D`` [signal unit] of an aligned signal over the cut samples.
@@ -241,10 +311,10 @@ class Envelope:
         offsets : dict
             The re-levelling offsets (empty without re-levelling).
         """
-        aligned, template, shift = self._aligned(part)
+        aligned, template, shift, place = self._aligned(part)
         offsets: dict = {}
         if self.relevel:
-            aligned, offsets = self._relevelled(part, aligned, template, shift, self.centre_)
+            aligned, offsets = self._relevelled(part, aligned, template, place, self.centre_)
         return centred_nanmean(aligned, self.width_, complete=True), shift, offsets
 
     @property
@@ -258,9 +328,9 @@ class Envelope:
         return self.mean_factor_ * self.deviation_sd_
 
     # ------------------------------------------------------------------ files
-    _ARRAYS = ("reference_velocity_", "direction_", "held_direction_", "centre_", "spread_", "cut_", "air_",
-               "air_level_")
-    _NUMBERS = ("sample_time_", "band_factor_", "deviation_sd_", "mean_factor_", "cut_load_")
+    _ARRAYS = ("reference_velocity_", "reference_block_", "direction_", "held_direction_", "centre_", "spread_",
+               "cut_", "air_", "air_level_")
+    _NUMBERS = ("sample_time_", "band_factor_", "band_count_", "deviation_sd_", "mean_factor_", "cut_load_")
     _INTEGERS = ("width_", "max_shift_", "n_parts_")
 
     def to_dict(self) -> dict:
@@ -270,7 +340,7 @@ class Envelope:
         arrays = {name: [bool(v) for v in getattr(self, name)] if name in ("cut_", "air_")
                   else [float(v) for v in getattr(self, name)] for name in self._ARRAYS}
         return {"format": ENVELOPE_FORMAT, "params": params, "unit": self.unit_, "signal": self.signal_,
-                "scaled": bool(self.scaled_),
+                "scaled": bool(self.scaled_), "blocks": bool(self.blocks_),
                 "parts": self.parts_, **{name: float(getattr(self, name)) for name in self._NUMBERS},
                 **{name: int(getattr(self, name)) for name in self._INTEGERS}, "arrays": arrays}
 
@@ -303,6 +373,8 @@ class Envelope:
         def bad(what: str) -> GreyboxError:
             return GreyboxError(f"{source}: not a valid envelope file ({what})")
 
+        if isinstance(content, dict) and content.get("format") == "greybox-envelope/1":
+            raise bad("format greybox-envelope/1 has the earlier band rule: teach it again")
         if not isinstance(content, dict) or content.get("format") != ENVELOPE_FORMAT:
             raise bad(f"format is not {ENVELOPE_FORMAT}")
         params = content.get("params")
@@ -328,7 +400,8 @@ class Envelope:
             if isinstance(value, bool) or not isinstance(value, int) or value < 0:
                 raise bad(name)
             setattr(envelope, name, value)
-        if envelope.sample_time_ <= 0 or envelope.width_ < 1 or envelope.n_parts_ < 3 or envelope.deviation_sd_ < 0:
+        if (envelope.sample_time_ <= 0 or envelope.band_count_ < 1 or envelope.width_ < 1 or envelope.n_parts_ < 3
+                or envelope.deviation_sd_ < 0):
             raise bad("sample time, smoothing, parts or spread out of range")
         arrays = content.get("arrays")
         if not isinstance(arrays, dict) or set(arrays) != set(cls._ARRAYS):
@@ -353,9 +426,9 @@ class Envelope:
         if not (np.all(np.isin(envelope.direction_, (-1.0, 0.0, 1.0)))
                 and np.all(np.isin(envelope.held_direction_, (-1.0, 0.0, 1.0)))) or np.any(envelope.spread_ <= 0):
             raise bad("direction not -1/0/1 or spread not positive")
-        if not isinstance(content.get("scaled"), bool):
-            raise bad("scaled")
-        envelope.scaled_ = content["scaled"]
+        if not isinstance(content.get("scaled"), bool) or not isinstance(content.get("blocks"), bool):
+            raise bad("scaled or blocks")
+        envelope.scaled_, envelope.blocks_ = content["scaled"], content["blocks"]
         if not isinstance(content.get("unit"), str) or not isinstance(content.get("signal"), dict) \
                 or not isinstance(content.get("parts"), list):
             raise bad("unit, signal or parts")

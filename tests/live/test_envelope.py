@@ -131,6 +131,42 @@ def test_a_gap_ends_the_part_and_a_limit_watches_beside_the_envelope(raw_envelop
     assert both.rearm() == []
 
 
+def test_the_last_part_is_checked_whole_when_the_stream_ends_and_its_alarm_stays_raised(raw_envelope):
+    rng = np.random.default_rng(6)
+    parts = [*good_parts(1, seed=25), make_part(2, rng, wait_s=1.05, break_at_s=4.0)]
+    columns = _stream(parts)["columns"]
+    both = Watches([LimitWatch([Limit("current_measured_A", 1e6)]), EnvelopeWatch(raw_envelope, kind="raw",
+                                                                                  min_rest_s=0.8)])
+    both.check_columns(list(columns))
+    _watched(both, columns)
+    last = float(columns["time_s"][-1])
+    ended = both.end_run(last)  # the end of the input: the broken part's mean deviation, raised and kept
+    assert [(alarm.part, alarm.state, alarm.whole_part, alarm.kind) for alarm in ended] == [(2, "raised", True,
+                                                                                           "drop")]
+    assert both.end_run(last) == []  # once
+    cleared = both.rearm(last + 5.0)  # the next run: the part's alarm cleared
+    assert [(alarm.part, alarm.state) for alarm in cleared] == [(2, "cleared")]
+    assert both.rearm() == []
+
+
+@pytest.mark.slow
+def test_live_checks_the_streams_last_part_whole_at_the_end_of_its_input(twin_parts):
+    import io
+
+    from live_helpers import EXAMPLE_AXIS, json_batches
+
+    from greybox.live.run import run_live
+
+    out, said = io.StringIO(), []
+    run_live(twin_parts["model"], source="-", axis_config_path=EXAMPLE_AXIS, envelope_path=twin_parts["envelope"],
+             stdin=io.StringIO("\n".join(json_batches(twin_parts["log"], (250,)))), stdout=out, say=said.append)
+    alarms = [json.loads(line) for line in out.getvalue().splitlines() if '"alarm"' in line]
+    whole = [alarm for alarm in alarms if alarm.get("whole_part")]
+    assert [(alarm["part"], alarm["state"], alarm["kind"]) for alarm in whole] == [(3, "raised", "drop")]
+    assert whole[0]["time_s"] == pytest.approx(float(twin_parts["log"].time[-1]))
+    assert not [alarm for alarm in alarms if alarm["part"] == 3 and alarm["state"] == "cleared"]
+
+
 def test_an_envelope_of_a_signal_the_output_lacks_is_refused_in_one_line(tmp_path):
     force = Envelope().fit(good_parts(5, seed=1), unit="N", signal={"kind": "force"})
     watch = EnvelopeWatch(force, kind="force", name="env.json")

@@ -43,3 +43,17 @@ def test_shifted_lays_a_part_on_the_reference_grid_with_nan_outside():
     out = shifted(values, -2, 4)
     assert np.isnan(out[:2]).all() and list(out[2:]) == [0.0, 1.0]
     assert np.isnan(shifted(values, 8, 4)[2:]).all()
+
+
+def test_block_positions_stretch_each_block_of_the_part_onto_the_reference():
+    from greybox.process.alignment import block_positions, warped
+
+    reference = np.array([1, 1, 2, 2, 2, 2, 1, 1.0])  # block 1 runs twice: matched run by run
+    part = np.array([1, 2, 2, 2, 2, 2, 2, 2, 2, 1, 1, 1.0])
+    positions = block_positions(reference, part)
+    np.testing.assert_allclose(positions[:2], [-0.25, 0.25])  # one sample for two
+    np.testing.assert_allclose(positions[2:6], [1.5, 3.5, 5.5, 7.5])  # eight samples for four
+    np.testing.assert_allclose(positions[6:], [9.25, 10.75])
+    np.testing.assert_allclose(warped(np.arange(12.0), positions), np.clip(positions, 0, 11))
+    lacking = block_positions(reference, np.array([1, 1, 1.0]))
+    assert np.isnan(lacking[2:]).all() and np.isfinite(lacking[:2]).all()

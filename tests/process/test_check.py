@@ -38,3 +38,17 @@ def test_a_load_in_air_is_an_extra_cut_and_a_heavier_cut_a_rise(envelope):
     assert light.mean_kind == "drop" and "missing cut" in light.kinds
     slight = check_part(envelope, make_part(7, np.random.default_rng(5), cut=1.02))  # the part mean sees 2 %
     assert slight.mean_kind == "rise" and slight.deviation == pytest.approx(0.02, abs=0.005)
+
+
+def test_nc_block_numbers_align_a_part_whose_dwell_is_longer_which_the_shift_cannot():
+    rng = np.random.default_rng(12)
+    teach = [make_part(k, rng, wait_s=float(rng.uniform(1.0, 1.1)), blocks=True) for k in range(1, 11)]
+    slow = make_part(11, rng, wait_s=1.05, dwell_s=0.9, blocks=True)  # the return stroke 0.4 s later
+    by_blocks = Envelope().fit(teach)
+    assert by_blocks.blocks_ and not check_part(by_blocks, slow).flagged
+    plain = [make_part(p.number, rng, wait_s=1.05) for p in teach]  # no block column: aligned by the shift
+    by_shift = Envelope().fit(plain)
+    assert not by_shift.blocks_ and check_part(by_shift, make_part(11, rng, wait_s=1.05, dwell_s=0.9)).flagged
+    broken = make_part(12, rng, wait_s=1.05, dwell_s=0.9, break_at_s=4.0, blocks=True)
+    found = check_part(by_blocks, broken)
+    assert "missing cut" in found.kinds and found.stretches[0].start_s == pytest.approx(4.0, abs=0.06)

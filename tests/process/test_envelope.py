@@ -11,7 +11,32 @@ from process_parts import good_parts, make_part
 from scipy.stats import t as student
 
 from greybox.errors import GreyboxError
-from greybox.process.envelope import Envelope, level_direction, relevelled
+from greybox.process.envelope import Envelope, band_count, level_direction, relevelled
+
+
+def test_band_count_recovers_the_number_of_independent_values_behind_part_maxima():
+    rng = np.random.default_rng(3)
+    maxima = np.abs(rng.standard_t(40, size=(400, 250))).max(axis=1)
+    estimate, upper = band_count(maxima, 40, 1.0)
+    assert estimate == pytest.approx(250, rel=0.15) and upper > estimate
+    few, few_upper = band_count(maxima[:10], 40, 1.0)
+    assert few_upper / few == pytest.approx(student_chi2_ratio(10))
+
+
+def student_chi2_ratio(n):
+    from scipy.stats import chi2
+
+    return chi2.ppf(0.95, 2 * n) / (2 * n)
+
+
+def test_band_count_of_correlated_values_is_smaller_than_their_number():
+    rng = np.random.default_rng(4)
+    noise = rng.standard_normal((300, 5000))
+    kernel = np.ones(50) / np.sqrt(50)  # a moving sum of 50: unit variance, correlated over 50 values
+    smoothed = np.array([np.convolve(row, kernel, mode="valid") for row in noise])
+    estimate, _ = band_count(np.abs(smoothed).max(axis=1), 1e6, 1.0)
+    # fewer than the values, and more than the windows (L / w, the earlier rule's count, undercounts maxima)
+    assert 2 * 4950 / 50 < estimate < 4950 / 2
 
 
 def test_level_direction_holds_the_last_motion_at_rest():
@@ -29,9 +54,10 @@ def test_envelope_learns_the_cut_where_the_parts_cut_and_sets_its_limits_by_the_
     outside = (time < start + 0.8) | (time > start + 5.2)
     assert envelope.cut_[inside].all() and not envelope.cut_[outside].any()
     assert envelope.cut_load_ == pytest.approx(2.0, abs=0.05)  # friction 1 + cut 1 on the raw signal
-    length = envelope.centre_.size
-    expected = student.isf(1e-3 / (4 * length / envelope.width_), 5 * 11) * math.sqrt(1 + 1 / 12)
-    assert envelope.band_factor_ == pytest.approx(expected)
+    # the band from the effective count: a part's largest deviation passes it with probability 1e-3 / 2
+    per_value = 2 * student.sf(envelope.band_factor_ / math.sqrt(1 + 1 / 12), 5 * 11)
+    assert 1 - (1 - per_value) ** envelope.band_count_ == pytest.approx(0.5e-3)
+    assert 1 <= envelope.band_count_ < envelope.centre_.size
     assert envelope.air_.any() and not (envelope.air_ & envelope.cut_).any()
 
 
@@ -86,6 +112,8 @@ def test_an_envelope_file_round_trips_and_bad_files_are_refused_by_name(tmp_path
             Envelope.load(target)
 
     refused(lambda c: c.update(format="pickle"), "format")
+    refused(lambda c: c.update(format="greybox-envelope/1"), "earlier band rule: teach it again")
+    refused(lambda c: c.update(band_count_=0.5), "out of range")
     refused(lambda c: c["arrays"]["centre_"].pop(), "centre_")
     refused(lambda c: c["arrays"]["cut_"].__setitem__(0, 1), "cut_")
     refused(lambda c: c.update(band_factor_="5"), "band_factor_")

@@ -102,3 +102,15 @@ def test_both_layouts_hold_the_same_samples_and_nothing_is_overwritten(tmp_path)
     with pytest.raises(GreyboxError, match="file exists"):
         synthesize_part_series(spec, 3, tmp_path)
     assert (tmp_path / "X_series.mcap").read_bytes() == before
+
+
+def test_a_parquet_series_holds_the_samples_of_the_mcap_one(tmp_path):
+    spec = PartSeriesSpec(parts=2, program=SHORT, loading_s=0.5)
+    synthesize_part_series(spec, 2, tmp_path / "m", layout="series")
+    written = synthesize_part_series(spec, 2, tmp_path / "p", layout="series", suffix="parquet")
+    assert sorted(path.name for path in written) == ["X_part.mpf", "X_parts.json", "X_series.parquet"]
+    mcap, parquet = read_log(tmp_path / "m" / "X_series.mcap"), read_log(tmp_path / "p" / "X_series.parquet")
+    np.testing.assert_array_equal(parquet.effort, mcap.effort)
+    np.testing.assert_array_equal(parquet.extras[PART_COLUMN], mcap.extras[PART_COLUMN])
+    with pytest.raises(GreyboxError, match="mcap or parquet"):
+        synthesize_part_series(spec, 2, tmp_path / "c", suffix="csv")
