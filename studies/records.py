@@ -96,7 +96,7 @@ SPECS = {spec.name: spec for spec in (
                "independent split's cutting logs; publish-to-estimate and publish-to-alarm times through Mosquitto"),
     RecordSpec("process-head-to-head", ("scripts/process_head_to_head.py", "--json", "-"),
                ("greybox/process", "greybox/predict", "greybox/models", "greybox/identify", "greybox/twin",
-                "greybox/data", "greybox/windows.py", "greybox/persistence.py", "studies/process_head_to_head.py",
+                "greybox/data", "greybox/windows.py", "greybox/train", "greybox/cli", "studies/process_head_to_head.py",
                 "scripts/process_head_to_head.py", "data", "examples/axis_x.toml"),
                "teach-in envelopes of the raw current and the force through a warm-up on the twin's part series: "
                "events found, false alarms of good parts, mean cut force"),
