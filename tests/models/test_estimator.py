@@ -55,8 +55,8 @@ def test_a_fit_far_beyond_the_measured_efforts_is_refused_and_a_sound_one_passes
 
 
 def test_with_its_training_record_every_kind_of_model_has_the_same_region_and_a_file_keeps_it(tmp_path):
-    from greybox.models.friction import LuGreModel
     from greybox.models.files import load_model, save_model
+    from greybox.models.friction import LuGreModel
     from greybox.train.record import record_training
 
     train, test = _run(1, 20.0), _run(2, 40.0)
