@@ -44,6 +44,15 @@ _REPRODUCTION = ("data", "greybox/data", "greybox/identify", "greybox/models", "
                  "greybox/reproduce", "greybox/base.py", "greybox/metrics.py", "greybox/persistence.py",
                  "greybox/threads.py", "greybox/provenance.py", "benchmarks/bench_reproduce.py")
 
+#: What a fit of a friction model on a real data set depends on: the models, their laws and identification,
+#: the log type and its preparation, the metrics.
+_FRICTION_FITS = ("greybox/models", "greybox/identify", "greybox/data", "greybox/base.py", "greybox/threads.py",
+                  "greybox/metrics.py")
+#: The ARTS record's models: every one of the study but ``auto``, whose choice takes more than an hour here
+#: (each candidate, the GMS ones behind a backlash among them, fitted once per held-out training file).
+_ARTS_MODELS = ("coulomb", "coulomb_asym", "stribeck", "stribeck_asym", "lugre", "lugre_asym", "gms", "gms_asym",
+                "gms_backlash", "gms_asym_backlash")
+
 
 @dataclass(frozen=True)
 class RecordSpec:
@@ -94,6 +103,18 @@ SPECS = {spec.name: spec for spec in (
                 "benchmarks/bench_live.py", "data", "examples/axis_x.toml"),
                "greybox live --latency low: mean cut force against the exact mode on the twin's and the "
                "independent split's cutting logs; publish-to-estimate and publish-to-alarm times through Mosquitto"),
+    # -- the real-data benchmarks (EMPS, ARTS): issue 43 --
+    RecordSpec("emps-benchmark", ("scripts/emps_benchmark.py", "--record", "--quiet"),
+               ("scripts/emps_benchmark.py", "studies/emps.py", "studies/auto.py", *_FRICTION_FITS,
+                "greybox/model_choice.py"),
+               "the EMPS benchmark (real ball-screw drive): relerr of every friction model and of --model auto on "
+               "the training and cross-test files, beside the published IDIM-LS"),
+    RecordSpec("arts-benchmark", ("scripts/arts_benchmark.py", "--record", "--quiet", "--models", *_ARTS_MODELS),
+               ("scripts/arts_benchmark.py", "studies/arts.py", "studies/arts_data.py", "studies/emps.py",
+                *_FRICTION_FITS),
+               "the ARTS friction device (real, with backlash): RE and relerr of every friction model on the "
+               "training, test and 1-2 Hz files, per file, and in the band of the motion"),
+    # -- end of the real-data benchmarks --
 )}
 
 
