@@ -48,6 +48,10 @@ _REPRODUCTION = ("data", "greybox/data", "greybox/identify", "greybox/models", "
 #: the log type and its preparation, the metrics.
 _FRICTION_FITS = ("greybox/models", "greybox/identify", "greybox/data", "greybox/base.py", "greybox/threads.py",
                   "greybox/metrics.py")
+#: The EMPS record's models: every one of the study but ``auto``, whose choice (candidates fitted on three
+#: held-out stretches) takes about five minutes of the machine alone, more than the rest together.
+_EMPS_MODELS = ("coulomb_idim_ls", "coulomb_asym_idim_ls", "coulomb", "coulomb_asym", "stribeck", "stribeck_asym",
+                "lugre", "lugre_asym", "gms", "gms_asym", "gms_2ms", "gms_asym_backlash")
 #: The ARTS record's models: every one of the study but ``auto``, whose choice takes more than an hour here
 #: (each candidate, the GMS ones behind a backlash among them, fitted once per held-out training file).
 _ARTS_MODELS = ("coulomb", "coulomb_asym", "stribeck", "stribeck_asym", "lugre", "lugre_asym", "gms", "gms_asym",
@@ -103,18 +107,27 @@ SPECS = {spec.name: spec for spec in (
                 "benchmarks/bench_live.py", "data", "examples/axis_x.toml"),
                "greybox live --latency low: mean cut force against the exact mode on the twin's and the "
                "independent split's cutting logs; publish-to-estimate and publish-to-alarm times through Mosquitto"),
-    # -- the real-data benchmarks (EMPS, ARTS): issue 43 --
-    RecordSpec("emps-benchmark", ("scripts/emps_benchmark.py", "--record", "--quiet"),
-               ("scripts/emps_benchmark.py", "studies/emps.py", "studies/auto.py", *_FRICTION_FITS,
-                "greybox/model_choice.py"),
-               "the EMPS benchmark (real ball-screw drive): relerr of every friction model and of --model auto on "
-               "the training and cross-test files, beside the published IDIM-LS"),
+    # -- the real-data benchmarks and speed (issue 43) --
+    RecordSpec("emps-benchmark", ("scripts/emps_benchmark.py", "--record", "--quiet", "--models", *_EMPS_MODELS),
+               ("scripts/emps_benchmark.py", "studies/emps.py", *_FRICTION_FITS),
+               "the EMPS benchmark (real ball-screw drive): relerr of every friction model on the training and "
+               "cross-test files, beside the published IDIM-LS"),
     RecordSpec("arts-benchmark", ("scripts/arts_benchmark.py", "--record", "--quiet", "--models", *_ARTS_MODELS),
                ("scripts/arts_benchmark.py", "studies/arts.py", "studies/arts_data.py", "studies/emps.py",
                 *_FRICTION_FITS),
                "the ARTS friction device (real, with backlash): RE and relerr of every friction model on the "
                "training, test and 1-2 Hz files, per file, and in the band of the motion"),
-    # -- end of the real-data benchmarks --
+    RecordSpec("gms-speed", ("benchmarks/bench_gms.py", "--json"),
+               ("benchmarks/bench_gms.py", "benchmarks/gms_loop.c", "tests/friction_reference.py",
+                "tests/friction_signals.py", *_FRICTION_FITS),
+               "the GMS kernel against plain Python and plain C, and a default GMS identification on 180 s at 500 Hz"),
+    RecordSpec("svr-predict", ("benchmarks/bench_svr_predict.py",),
+               ("benchmarks/bench_svr_predict.py", "greybox/models/kernel", "greybox/threads.py"),
+               "the compiled RBF expansion against scikit-learn's SVR.predict on 200 000 random samples"),
+    RecordSpec("read-hour", ("benchmarks/bench_read.py", "--json"),
+               ("benchmarks/bench_read.py", "greybox/data"),
+               "read_log on a one-hour 500 Hz log in MCAP, Parquet and CSV, each in a fresh process: time and peak"),
+    # -- end of the real-data benchmarks and speed (issue 43) --
 )}
 
 
