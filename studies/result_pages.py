@@ -33,7 +33,9 @@ from greybox.evaluate.report import (
     svr_generalisation_table,
 )
 
+from .arts import MODEL_NAMES as ARTS_MODELS
 from .arts import markdown_table as arts_table
+from .emps import MODEL_NAMES as EMPS_MODELS
 from .emps import markdown_table as emps_table
 from .records import ROOT, read_record
 
@@ -280,9 +282,22 @@ def _live_speed(record: dict) -> str:
 
 
 # -- the real-data benchmarks and speed (issue 43) --
+def _in_study_order(figures: dict, names: tuple) -> dict:
+    """The figures with the models in the study's order, and the files in the protocol's (a record keeps its keys
+    sorted)."""
+    models = {name: figures["models"][name] for name in names if name in figures["models"]}
+    ordered = {**figures, "models": models}
+    if "files" in figures:
+        files = [*figures["protocol"]["train"], *figures["protocol"]["test"]]
+        ordered["files"] = {name: figures["files"][name] for name in files}
+    return ordered
+
+
 def _fit_seconds(record: dict) -> str:
     models = record["figures"]["models"]
-    return ", ".join(f"`{name}` {entry['seconds']:.0f} s" for name, entry in models.items() if entry["seconds"] >= 1)
+    order = EMPS_MODELS if record["name"].startswith("emps") else ARTS_MODELS
+    return ", ".join(f"`{name}` {models[name]['seconds']:.0f} s" for name in order
+                     if name in models and models[name]["seconds"] >= 1)
 
 
 def _benchmark_run(record: dict) -> str:
@@ -294,7 +309,8 @@ def _benchmark_run(record: dict) -> str:
 def _emps_benchmark(record: dict) -> str:
     models = record["figures"]["models"]
     condition = models["coulomb_idim_ls"]["condition_number"]
-    return (emps_table(record["figures"]) + f"\nThe condition number of the decimated observation matrix is "
+    table = emps_table(_in_study_order(record["figures"], EMPS_MODELS))
+    return (table + f"\nThe condition number of the decimated observation matrix is "
             f"{condition:.2f}.\n\n" + _benchmark_run(record))
 
 
@@ -312,7 +328,7 @@ def _emps_targets(record: dict) -> str:
 
 
 def _arts_benchmark(record: dict) -> str:
-    return arts_table(record["figures"]) + "\n" + _benchmark_run(record)
+    return arts_table(_in_study_order(record["figures"], ARTS_MODELS)) + "\n" + _benchmark_run(record)
 
 
 def _arts_targets(record: dict) -> str:
@@ -352,8 +368,7 @@ def _emps_summary(record: dict) -> str:
     rows = (("Coulomb + viscous (IDIM-LS, ours)", ("coulomb_idim_ls", "coulomb_asym_idim_ls")),
             ("Coulomb + viscous (greybox fit)", ("coulomb", "coulomb_asym")),
             ("Stribeck", ("stribeck", "stribeck_asym")), ("LuGre", ("lugre", "lugre_asym")),
-            ("GMS, 1 ms", ("gms", "gms_asym")), ("GMS, 2 ms step", ("gms_2ms", None)),
-            ("asymmetric GMS behind an identified backlash", (None, "gms_asym_backlash")))
+            ("GMS, 1 ms", ("gms", "gms_asym")), ("GMS, 2 ms step", ("gms_2ms", None)))
     lines = ["| model | train (DATA_EMPS) symmetric / asymmetric | cross-test (DATA_EMPS_PULSES) symmetric / "
              "asymmetric |",
              "|---|---|---|",
