@@ -411,7 +411,7 @@ def _gms_kernel(record: dict) -> str:
          f"{f['c_ns_per_step']:.1f} ns/step (numba / C {f['ratio_to_c']:.2f}; largest difference "
          f"{f['c_max_abs_diff']:.1e} A)")
     return ("| quantity | value |\n|---|---|\n"
-            f"| numba kernel, N = {f['n_elements']}, {f['n_steps']:.0e} steps, best of the repeats | "
+            f"| numba kernel, N = {f['n_elements']}, {f['n_steps'] / 1e6:g} M steps, best of the repeats | "
             f"{f['ns_per_step']:.1f} ns/step |\n"
             f"| plain C loop (`cc -O2`), same recursion | {c} |\n"
             f"| plain-Python reference ({f['python_steps']} steps) | {f['python_ns_per_step'] / 1000:.2f} us/step "
