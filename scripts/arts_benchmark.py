@@ -7,11 +7,13 @@ force) and prints the Markdown tables.
 Usage::
 
     python scripts/arts_benchmark.py --json arts.json --markdown arts.md --plot arts.png
+    python scripts/arts_benchmark.py --record --quiet   # the results as JSON on standard output
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
@@ -19,7 +21,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
 
 from greybox.errors import GreyboxError
-from studies.arts import MODEL_NAMES, arts_benchmark
+from studies.arts import MODEL_NAMES, arts_benchmark, run_benchmark
 
 #: Default data folder: ``$GREYBOX_REAL_DATA/ARTS_friction_damper``, else ``../shared/data/real/ARTS_friction_damper``
 #: beside the repository (as the tests look for it).
@@ -29,7 +31,11 @@ DEFAULT_DATA = Path(os.environ.get("GREYBOX_REAL_DATA")
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--json", required=True, type=Path, metavar="OUT", help="JSON results file")
+    outputs = parser.add_mutually_exclusive_group(required=True)
+    outputs.add_argument("--json", type=Path, metavar="OUT", help="JSON results file")
+    outputs.add_argument("--record", action="store_true",
+                         help="write no file: print the JSON results on standard output, last "
+                              "(the command of a record, scripts/record.py)")
     parser.add_argument("--markdown", type=Path, metavar="MD", help="Markdown tables")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="figure of force against displacement")
     parser.add_argument("--data", type=Path, default=DEFAULT_DATA, metavar="DIR",
@@ -40,7 +46,13 @@ def main(argv=None) -> int:
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     parser.add_argument("--force", action="store_true", help="overwrite existing output files")
     args = parser.parse_args(argv)
+    if args.record and (args.markdown or args.plot):
+        parser.error("--record writes no file: give --markdown and --plot with --json")
     try:
+        if args.record:
+            results, _ = run_benchmark(args.data, args.models, args.model_seed, progress=None if args.quiet else True)
+            print(json.dumps(results, indent=1))
+            return 0
         table = arts_benchmark(args.data, args.json, markdown_path=args.markdown, plot_path=args.plot,
                                names=args.models, seed=args.model_seed, progress=None if args.quiet else True,
                                force=args.force)

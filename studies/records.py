@@ -44,6 +44,20 @@ _REPRODUCTION = ("data", "greybox/data", "greybox/identify", "greybox/models", "
                  "greybox/reproduce", "greybox/base.py", "greybox/metrics.py", "greybox/threads.py",
                  "greybox/provenance.py", "benchmarks/bench_reproduce.py")
 
+#: What a fit of a friction model on a real data set depends on: the models, their laws and identification,
+#: the log type and its preparation, the metrics.
+_FRICTION_FITS = ("greybox/models", "greybox/identify", "greybox/data", "greybox/base.py", "greybox/threads.py",
+                  "greybox/metrics.py")
+#: The EMPS record's models: every one of the study but the asymmetric GMS behind a backlash and ``auto``. The
+#: backlash search fits an asymmetric GMS per trial width and ``auto`` fits its candidates on three held-out
+#: stretches: each takes several times the rest together; the page gives their figures as single runs.
+_EMPS_MODELS = ("coulomb_idim_ls", "coulomb_asym_idim_ls", "coulomb", "coulomb_asym", "stribeck", "stribeck_asym",
+                "lugre", "lugre_asym", "gms", "gms_asym", "gms_2ms")
+#: The ARTS record's models: every one of the study but the two behind a backlash and ``auto``. Each backlash
+#: model fits a GMS per trial width (about nine minutes each on the machine alone, three times that beside the
+#: other jobs of a session), and ``auto`` more than an hour; the pages give their figures as single runs.
+_ARTS_MODELS = ("coulomb", "coulomb_asym", "stribeck", "stribeck_asym", "lugre", "lugre_asym", "gms", "gms_asym")
+
 
 @dataclass(frozen=True)
 class RecordSpec:
@@ -100,6 +114,27 @@ SPECS = {spec.name: spec for spec in (
                 "scripts/process_head_to_head.py", "data", "examples/axis_x.toml"),
                "teach-in envelopes of the raw current and the force through a warm-up on the twin's part series: "
                "events found, false alarms of good parts, mean cut force"),
+    # -- the real-data benchmarks and speed (issue 43) --
+    RecordSpec("emps-benchmark", ("scripts/emps_benchmark.py", "--record", "--quiet", "--models", *_EMPS_MODELS),
+               ("scripts/emps_benchmark.py", "studies/emps.py", *_FRICTION_FITS),
+               "the EMPS benchmark (real ball-screw drive): relerr of the friction models (none behind a backlash) on "
+               "the training and cross-test files, beside the published IDIM-LS"),
+    RecordSpec("arts-benchmark", ("scripts/arts_benchmark.py", "--record", "--quiet", "--models", *_ARTS_MODELS),
+               ("scripts/arts_benchmark.py", "studies/arts.py", "studies/arts_data.py", "studies/emps.py",
+                *_FRICTION_FITS),
+               "the ARTS friction device (real, with backlash): RE and relerr of the friction models (none behind a "
+               "backlash) on the training, test and 1-2 Hz files, per file, and in the band of the motion"),
+    RecordSpec("gms-speed", ("benchmarks/bench_gms.py", "--json"),
+               ("benchmarks/bench_gms.py", "benchmarks/gms_loop.c", "tests/friction_reference.py",
+                "tests/friction_signals.py", *_FRICTION_FITS),
+               "the GMS kernel against plain Python and plain C, and a default GMS identification on 180 s at 500 Hz"),
+    RecordSpec("svr-predict", ("benchmarks/bench_svr_predict.py",),
+               ("benchmarks/bench_svr_predict.py", "greybox/models/kernel", "greybox/threads.py"),
+               "the compiled RBF expansion against scikit-learn's SVR.predict on 200 000 random samples"),
+    RecordSpec("read-hour", ("benchmarks/bench_read.py", "--json"),
+               ("benchmarks/bench_read.py", "greybox/data"),
+               "read_log on a one-hour 500 Hz log in MCAP, Parquet and CSV, each in a fresh process: time and peak"),
+    # -- end of the real-data benchmarks and speed (issue 43) --
 )}
 
 

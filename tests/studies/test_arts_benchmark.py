@@ -252,3 +252,20 @@ def test_the_script_finds_the_data_through_greybox_real_data(tmp_path):
     env = {**os.environ, "GREYBOX_REAL_DATA": str(tmp_path / "elsewhere")}
     result = _script("--json", tmp_path / "x.json", "--models", "coulomb", env=env)
     assert result.returncode == 2 and str(tmp_path / "elsewhere" / "ARTS_friction_damper") in result.stderr
+
+
+def test_record_prints_the_results_as_json_last_and_writes_nothing(tmp_path, arts):
+    result = subprocess.run([sys.executable, str(SCRIPT), "--record", "--quiet", "--data", str(arts), "--models",
+                             "coulomb"], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    printed = json.loads(result.stdout)  # the whole output is one JSON object: the record's figures
+    assert list(printed["models"]) == ["coulomb"] and printed["protocol"]["train"] == list(bench.TRAIN_FILES)
+    written, _ = bench.run_benchmark(arts, ["coulomb"])
+    assert printed["models"]["coulomb"]["test"]["re"] == pytest.approx(written["models"]["coulomb"]["test"]["re"])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_record_refuses_the_file_options(tmp_path):
+    result = _script("--record", "--plot", tmp_path / "arts.png", "--data", tmp_path)
+    assert result.returncode == 2 and "--record writes no file" in result.stderr
+    assert result.stdout == "" and not (tmp_path / "arts.png").exists()

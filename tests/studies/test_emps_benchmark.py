@@ -134,6 +134,23 @@ def test_script_writes_json_markdown_and_plot(tmp_path, emps):
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
 
 
+def test_record_prints_the_results_as_json_last_and_writes_nothing(tmp_path, emps):
+    result = subprocess.run([sys.executable, str(SCRIPT), "--record", "--quiet", "--data", str(emps), "--models",
+                             "coulomb_idim_ls", "coulomb"], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert result.returncode == 0, result.stderr
+    printed = json.loads(result.stdout)  # the whole output is one JSON object: the record's figures
+    assert list(printed["models"]) == ["coulomb_idim_ls", "coulomb"]
+    assert printed["models"]["coulomb_idim_ls"]["train_relerr"] == pytest.approx(TRAIN_RELERR, abs=0.2)
+    assert printed["published"]["coulomb_idim_ls"]["test_relerr"] == TEST_RELERR
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_record_refuses_the_file_options(tmp_path):
+    result = subprocess.run([sys.executable, str(SCRIPT), "--record", "--markdown", str(tmp_path / "emps.md")],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 2 and "--record writes no file" in result.stderr
+    assert result.stdout == "" and not (tmp_path / "emps.md").exists()
+
 def test_missing_data_folder_is_reported(tmp_path):
     with pytest.raises(GreyboxError, match="nowhere"):
         bench.emps_benchmark(tmp_path / "nowhere", tmp_path / "x.json")
