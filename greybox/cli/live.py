@@ -131,11 +131,11 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--latency", choices=LATENCIES, default="exact",
                         help="'exact' (default): the derivatives of 'greybox predict', each estimate after its "
                         "look-ahead (0.368 s at 2 ms); 'low': causal derivatives, each message's estimates at once, "
-                        "the derived acceleration delayed by the causal filter (1.4 ms at 2 ms for a logged velocity, 2.4 ms for a "
-                        "position, whose derived velocity is led to no delay at low frequencies)")
+                        "the derived acceleration delayed by the causal filter (1.4 ms at 2 ms for a logged velocity, "
+                        "2.4 ms for a position, whose derived velocity is led to no delay at low frequencies)")
     parser.add_argument("--cutoff-hz", type=POSITIVE, metavar="HZ",
-                        help="cut-off [Hz] of the derivative filter (default as 'greybox predict'; with --latency low 0.9 "
-                        "of the Nyquist frequency)")
+                        help="cut-off [Hz] of the derivative filter (default as 'greybox predict'; with --latency "
+                        "low 0.9 of the Nyquist frequency)")
     parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
     parser.add_argument("--max-message-bytes", type=POSITIVE_INT, default=MAX_MESSAGE_BYTES, metavar="N",

@@ -13,7 +13,8 @@ Without a time variable (no column ``time_s``, ``time_ms``, ...) a sample's ``ti
 variables' source time stamps [s since 1970]: time stamps that jitter by a fraction of the step, bridged by
 ``greybox live --max-gap`` as any jittered stream.
 
-A value whose stamp is not later than the latest of the last sample given is that sample again (a subscription made anew after a reconnection starts with the variables' current values) and is left out.
+A value whose stamp is not later than the latest of the last sample given is that sample again (a subscription
+made anew after a reconnection starts with the variables' current values) and is left out.
 
 A sample some of whose variables never deliver its stamp (every such variable has delivered a later one) is
 given as it is, without them: the decoder refuses it for the columns it lacks, in one line.

@@ -94,7 +94,8 @@ def test_each_variable_with_its_own_jittered_stamp_and_no_time_variable(opcua_se
               for column in columns}
     mean = np.array([math.fsum(values) / len(values) for values in zip(*(stamps[column] for column in columns))])
     assert np.diff(mean).max() > 1.25 * log.sample_time  # a jitter beyond the tolerance, bridged by --max-gap
-    expected = offline(path, log.replace(time=mean), name="cut-stamped", extra=["--resample", "0.002", "--max-gap", "5"])
+    expected = offline(path, log.replace(time=mean), name="cut-stamped",
+                       extra=["--resample", "0.002", "--max-gap", "5"])
     axis = opcua_server.axis()
     axis.publish_stamped(log, stamps, 0, 1)
     output, said = live_until(path, opcua_server.url, OpcUaOptions(nodes=axis.node_ids(columns)),
