@@ -86,6 +86,10 @@ def add_parser(subparsers) -> None:
                         help="OPC UA publishing interval of the subscription (default 20)")
     parser.add_argument("--opcua-queue-size", type=POSITIVE_INT, default=1000, metavar="N",
                         help="values the server holds per variable between two publishes (default 1000)")
+    parser.add_argument("--opcua-stamp-tolerance-ms", type=non_negative("milliseconds"), default=0.5, metavar="MS",
+                        help="largest difference between the source time stamps of one sample's variables (default "
+                        "0.5; 0: one stamp per sample); without a time_s variable a sample's time is the mean of its "
+                        "variables' stamps")
     parser.add_argument("--axis-config", metavar="TOML",
                         help="axis metadata: adds force_process_N (torque_process_Nm), channel names")
     parser.add_argument("--machine", metavar="TOML",
@@ -127,9 +131,11 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--latency", choices=LATENCIES, default="exact",
                         help="'exact' (default): the derivatives of 'greybox predict', each estimate after its "
                         "look-ahead (0.368 s at 2 ms); 'low': causal derivatives, each message's estimates at once, "
-                        "the derived velocity/acceleration delayed by the filter (about 9 ms at 2 ms, 50 Hz)")
+                        "the derived acceleration delayed by the causal filter (1.4 ms at 2 ms for a logged velocity, "
+                        "2.4 ms for a position, whose derived velocity is led to no delay at low frequencies)")
     parser.add_argument("--cutoff-hz", type=POSITIVE, metavar="HZ",
-                        help="cut-off [Hz] of the derivative filter (default as 'greybox predict')")
+                        help="cut-off [Hz] of the derivative filter (default as 'greybox predict'; with --latency "
+                        "low 0.9 of the Nyquist frequency)")
     parser.add_argument("--chunk-s", type=positive("seconds"), default=DEFAULT_CHUNK_S, metavar="S",
                         help=f"chunk length in seconds (default {DEFAULT_CHUNK_S:g})")
     parser.add_argument("--max-message-bytes", type=POSITIVE_INT, default=MAX_MESSAGE_BYTES, metavar="N",
@@ -198,7 +204,8 @@ def run(args: argparse.Namespace) -> int:
                                                                  option="--opcua-password-file"),
             security=args.opcua_security, cert_file=args.opcua_cert, key_file=args.opcua_key,
             server_cert_file=args.opcua_server_cert, sampling_ms=args.sampling_ms, publishing_ms=args.publishing_ms,
-            queue_size=args.opcua_queue_size, connect_timeout=args.connect_timeout)
+            queue_size=args.opcua_queue_size, connect_timeout=args.connect_timeout,
+            stamp_tolerance_ms=args.opcua_stamp_tolerance_ms)
     broker = BrokerOptions(username=args.username, password=read_password(args.password_file), ca_file=args.tls_ca,
                            cert_file=args.tls_cert, key_file=args.tls_key, client_id=args.client_id, qos=args.qos,
                            session_expiry_s=args.session_expiry, queue_size=args.queue_size,

@@ -2,16 +2,26 @@
 
 The exact mode derives a sample as the whole log would (:mod:`greybox.live.zerophase`): a zero-phase
 low-pass that needs the samples after it, so an estimate leaves 0.368 s after its sample (at 2 ms, 50 Hz).
-The low-latency mode runs the same low-pass (:func:`greybox.data.prepare.derivative_filter`) forward only,
-from the steady state of the run's first value, and takes backward differences of its output: a sample's
-derivatives need nothing after it, and its estimate goes out with the message that brought it.
+The low-latency mode runs a 4th-order Butterworth low-pass (:func:`greybox.data.prepare.derivative_filter`)
+forward only, from the steady state of the run's first value, and takes backward differences of its output:
+a sample's derivatives need nothing after it, and its estimate goes out with the message that brought it.
 
-The price is a delay of the derived channels: at low frequencies (the feed motion) the low-pass's group
-delay at zero frequency, plus half a step for each backward difference (:func:`group_delay_samples`). At
-2 ms and the default 50 Hz cut-off: 4.5 samples (9.0 ms) for the acceleration of a logged velocity; for a
-position, 4.5 samples for its velocity and 5.0 samples (10.0 ms) for its acceleration. The estimate of a
-sample uses a derived velocity and acceleration that lag behind it by that much; the logged channels
-(position, current, a logged velocity) are not delayed.
+Its cut-off is :data:`CAUSAL_CUTOFF_FRACTION` of the Nyquist frequency (:func:`causal_cutoff`: 225 Hz at 2 ms),
+unless one is given: a causal filter's delay grows as its cut-off falls, and the estimate follows the delayed
+derivatives. The fraction was chosen on development data (the twin's cutting logs of seeds 7 and 11, datasets C
+and D, position only and with the velocity logged, and the independent split's ``cut_D``): among the cut-offs
+0.2, 0.4, 0.6, 0.8 and 0.9 of the Nyquist frequency, with and without the lead below, the one whose mean cut
+force lay nearest the exact mode's on the worst of those cuts.
+
+A derived velocity (a stream of position only) is moreover led by its own low-frequency delay: it is given as
+``first + lead * second`` with ``lead`` the delay of the first difference (a first-order prediction from the
+second difference), so that its delay at low frequencies is zero to first order; the acceleration is not led.
+
+The price is a delay of the derived acceleration: at low frequencies (the feed motion) the low-pass's group
+delay at zero frequency, plus half a step for each backward difference (:func:`group_delay_samples`). At 2 ms
+and 225 Hz: 0.71 samples (1.41 ms) for the acceleration of a logged velocity, 1.21 samples (2.41 ms) for that of
+a position, whose velocity is not delayed at low frequencies (to first order). The logged channels (position,
+current, a logged velocity) are not delayed.
 
 The kernel is compiled with numba; its plain-Python reference is in the tests.
 """
@@ -21,11 +31,25 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["causal_differences", "group_delay_samples", "CausalStream"]
+__all__ = ["CAUSAL_CUTOFF_FRACTION", "causal_cutoff", "causal_differences", "group_delay_samples", "CausalStream"]
+
+#: Cut-off of the causal low-pass as a fraction of the Nyquist frequency (chosen on development data, above).
+CAUSAL_CUTOFF_FRACTION = 0.9
+
+
+def causal_cutoff(sample_time: float) -> float:
+    """The default cut-off of the causal low-pass [Hz]: :data:`CAUSAL_CUTOFF_FRACTION` of the Nyquist frequency.
+
+    Parameters
+    ----------
+    sample_time : float
+        Nominal step [s].
+    """
+    return CAUSAL_CUTOFF_FRACTION * 0.5 / float(sample_time)
 
 
 @njit(cache=True)
-def causal_differences(sos, state, previous, x, step, differences):
+def causal_differences(sos, state, previous, x, step, differences, lead):
     """Low-pass ``x`` causally and take one or two backward differences, carrying the state in place.
 
     Parameters
@@ -42,11 +66,14 @@ def causal_differences(sos, state, previous, x, step, differences):
         Sample time [s].
     differences : int
         1 or 2.
+    lead : float
+        With 2 differences, the first is given as ``first + lead * second``: its low-frequency delay
+        shortened by ``lead`` [s] (a first-order prediction); 0 leaves it as it is.
 
     Returns
     -------
     ndarray, shape (differences, n)
-        The first difference [unit/s], then (with 2) the second [unit/s^2].
+        The first difference [unit/s] (led by ``lead``), then (with 2) the second [unit/s^2].
     """
     n = x.shape[0]
     out = np.empty((differences, n))
@@ -60,7 +87,9 @@ def causal_differences(sos, state, previous, x, step, differences):
         first = (x_cur - previous[0]) / step
         out[0, k] = first
         if differences == 2:
-            out[1, k] = (first - previous[1]) / step
+            second = (first - previous[1]) / step
+            out[0, k] = first + lead * second
+            out[1, k] = second
         previous[0] = x_cur
         previous[1] = first
     return out
@@ -110,6 +139,9 @@ class CausalStream:
         Samples needed before the filter can start (1).
     received : int
         Samples pushed.
+    lead : float
+        With 2 differences, the lead of the velocity: the low-frequency delay of the first difference [s]
+        (its delay is then zero to first order); 0 with 1 difference.
     delay : float
         Group delay of the last derivative (the acceleration) at low frequencies [samples]
         (:func:`group_delay_samples`).
@@ -124,6 +156,7 @@ class CausalStream:
         self.zi = np.ascontiguousarray(sosfilt_zi(self.sos))
         self.sample_time = float(sample_time)
         self.differences = int(differences)
+        self.lead = group_delay_samples(self.sos, 1) * self.sample_time if self.differences == 2 else 0.0
         self.delay = group_delay_samples(self.sos, self.differences)
         self.received = 0
         self._state: np.ndarray | None = None
@@ -150,7 +183,8 @@ class CausalStream:
         if self._state is None:  # the steady state of the first value: no motion before the run
             self._state = self.zi * values[0]
             self._previous[0] = values[0]
-        out = causal_differences(self.sos, self._state, self._previous, values, self.sample_time, self.differences)
+        out = causal_differences(self.sos, self._state, self._previous, values, self.sample_time, self.differences,
+                                 self.lead)
         self._out = np.concatenate((self._out, out), axis=1)
         self.received += values.size
 

@@ -26,7 +26,7 @@ import numpy as np
 from ..data.log import AxisLog
 from ..data.prepare import derivative_filter, derivative_margin
 from ..errors import LogError
-from .causal import CausalStream
+from .causal import CausalStream, causal_cutoff
 from .zerophase import ZeroPhaseStream
 
 __all__ = ["LATENCIES", "Lookahead"]
@@ -45,7 +45,8 @@ class Lookahead:
     sample_time : float
         Nominal step of the run [s].
     cutoff_hz : float, optional
-        Derivative-filter cut-off [Hz]; default :func:`~greybox.data.prepare.default_cutoff`.
+        Derivative-filter cut-off [Hz]; default :func:`~greybox.data.prepare.default_cutoff` (that of
+        ``greybox predict``), and with ``latency="low"`` :func:`~greybox.live.causal.causal_cutoff`.
     latency : {"exact", "low"}, default "exact"
         "exact": the zero-phase derivatives of ``greybox predict``, each sample given out once its look-ahead
         is in; "low": causal derivatives, every sample given out at once.
@@ -129,7 +130,9 @@ class Lookahead:
         self._attrs = dict(log.attrs)
         if not self._needs:
             return
-        sos, cutoff = derivative_filter(self.sample_time, cutoff_hz=self.cutoff_hz, source=log.source or None)
+        cutoff_hz = causal_cutoff(self.sample_time) if self.latency == "low" and self.cutoff_hz is None \
+            else self.cutoff_hz
+        sos, cutoff = derivative_filter(self.sample_time, cutoff_hz=cutoff_hz, source=log.source or None)
         differences = 1 + (log.velocity is None)
         if self.latency == "low":
             self._filter = CausalStream(sos, sample_time=self.sample_time, differences=differences)

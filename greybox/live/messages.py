@@ -103,20 +103,24 @@ class MessageError(GreyboxError):
 
 
 def _column(name: str, values) -> np.ndarray:
-    """One column of a message as a float array; refuses text, nested lists and booleans."""
-    if type(values) in (int, float):
-        return np.array([values], dtype=np.float64)
-    if type(values) is list and all(type(value) in (int, float) for value in values):
-        return np.array(values, dtype=np.float64)
+    """One column of a message as a float array; refuses text, nested lists and booleans.
+
+    A JSON ``null`` is a missing value: NaN, which ``--max-gap`` bridges as a gap and which is refused
+    without it, as a NaN is.
+    """
+    if values is None or type(values) in (int, float):
+        return np.array([np.nan if values is None else values], dtype=np.float64)
+    if type(values) is list and all(value is None or type(value) in (int, float) for value in values):
+        return np.array(values, dtype=np.float64)  # numpy reads None as NaN
     array = np.asarray(values, dtype=object)
     if array.ndim > 1:
         raise MessageError(f"column '{name}' holds nested lists, not numbers")
     array = array.reshape(-1)
     out = np.empty(array.size)
     for k, value in enumerate(array):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if isinstance(value, bool) or not isinstance(value, (int, float, type(None))):
             raise MessageError(f"column '{name}' holds {value!r}, not a number")
-        out[k] = value
+        out[k] = np.nan if value is None else value
     return out
 
 

@@ -111,6 +111,9 @@ class OpcUaOptions:
         Values the server holds per variable between two publishes.
     connect_timeout : float
         Seconds to wait for the server at the start.
+    stamp_tolerance_ms : float
+        Largest difference between the source time stamps of one sample's variables [ms]
+        (:class:`~greybox.live.opcua_samples.SampleAssembler`); 0: one stamp per sample.
     """
 
     nodes: Mapping[str, str] = field(default_factory=dict)
@@ -123,8 +126,11 @@ class OpcUaOptions:
     publishing_ms: float = 20.0
     queue_size: int = 1000
     connect_timeout: float = 10.0
+    stamp_tolerance_ms: float = 0.5
 
     def __post_init__(self):
+        if not self.stamp_tolerance_ms >= 0.0:
+            raise GreyboxError(f"--opcua-stamp-tolerance-ms {self.stamp_tolerance_ms}: give 0 or more milliseconds")
         if not self.nodes:
             raise GreyboxError("an opc.tcp:// source needs --node COLUMN=NODEID for each variable (time_s, "
                                "position_mm, velocity_mm_s, current_A, ...)")
@@ -280,7 +286,7 @@ class OpcUaSource(Source):
         self.options = options
         self.poll_s = float(poll_s)
         self._queue: queue.Queue = queue.Queue()
-        self._assembler = SampleAssembler(list(options.nodes))
+        self._assembler = SampleAssembler(list(options.nodes), tolerance_s=1e-3 * options.stamp_tolerance_ms)
         self._count = 0
         self._client = None
         self._watch = None

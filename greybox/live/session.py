@@ -309,6 +309,6 @@ class LiveSession:
                          f"({event.lookahead * event.sample_time:.3g} s), the look-ahead of the derivatives"
                          if event.lookahead else "")
                 if event.delay:
-                    delay += (f"; causal derivatives (--latency low): the derived channels lag by {event.delay:.3g} "
-                              f"samples ({1e3 * event.delay * event.sample_time:.3g} ms)")
+                    delay += ("; causal derivatives (--latency low): the derived acceleration lags by "
+                              f"{event.delay:.3g} samples ({1e3 * event.delay * event.sample_time:.3g} ms)")
                 self.say(f"stream starts at t = {event.time_s:.9g} s, step {1e3 * event.sample_time:.6g} ms{delay}")

@@ -43,22 +43,41 @@ class Axis:
         """``--node COLUMN=NODEID`` options of the axis's variables."""
         return [item for column in columns for item in ("--node", f"{column}=ns=2;s={self.name}.{VARIABLES[column]}")]
 
-    def node_ids(self) -> dict[str, str]:
-        return {column: f"ns=2;s={self.name}.{name}" for column, name in VARIABLES.items()}
+    def node_ids(self, columns=VARIABLES) -> dict[str, str]:
+        return {column: f"ns=2;s={self.name}.{VARIABLES[column]}" for column in columns}
 
-    async def _write(self, values: dict):
+    def publish_stamped(self, log, stamps: dict, start: int = 0, stop: int | None = None, *, every: int = 5) -> None:
+        """Write the samples ``start:stop`` of an axis log as :meth:`publish` does, only the columns of ``stamps``,
+        each value with its column's source time stamp ``stamps[column][k]`` [s since 1970] (a server that stamps
+        each variable as it writes it)."""
+        columns = {"time_s": log.time, "position_mm": log.position, "velocity_mm_s": log.velocity,
+                   "current_A": log.effort}
+
+        async def run():
+            for k in range(start, len(log) if stop is None else stop):
+                await self._write({column: float(columns[column][k]) for column in stamps},
+                                  {column: float(values[k]) for column, values in stamps.items()})
+                if (k + 1) % every == 0:
+                    await asyncio.sleep(0.001)
+
+        self.server.run(run(), timeout=120.0)
+
+    async def _write(self, values: dict, stamps: dict | None = None):
+        """Write ``{column: value}``, with one source time stamp or each column's of ``stamps`` ([s since 1970])."""
         from asyncua import ua
 
         self.server.stamp += datetime.timedelta(microseconds=1)
         for column, value in values.items():
+            stamp = self.server.stamp if stamps is None else \
+                datetime.datetime.fromtimestamp(stamps[column], tz=datetime.timezone.utc)
             variant = ua.Variant(value, ua.VariantType.String if isinstance(value, str) else ua.VariantType.Double)
             if isinstance(value, str) or column in self.text:  # the server takes another type after a null value
                 self.text.symmetric_difference_update({column} if isinstance(value, str) != (column in self.text)
                                                       else set())
                 await self.server.server.write_attribute_value(self.nodes[column].nodeid, ua.DataValue(
-                    StatusCode=ua.StatusCode(ua.StatusCodes.BadNoData), SourceTimestamp=self.server.stamp))
+                    StatusCode=ua.StatusCode(ua.StatusCodes.BadNoData), SourceTimestamp=stamp))
             await self.server.server.write_attribute_value(self.nodes[column].nodeid,
-                                                           ua.DataValue(variant, SourceTimestamp=self.server.stamp))
+                                                           ua.DataValue(variant, SourceTimestamp=stamp))
 
     def write(self, values: dict) -> None:
         """Write one sample: ``{column: value}`` with one source time stamp."""

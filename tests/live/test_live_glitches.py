@@ -1,5 +1,5 @@
 """Short glitches bridged as ``greybox predict --resample --max-gap`` bridges them (``greybox live --max-gap``):
-a NaN in a batch and time stamps jittered by +-0.3 ms keep the run going, with the estimates of ``greybox
+a NaN or a JSON null in a batch and time stamps jittered by +-0.3 ms keep the run going, with the estimates of ``greybox
 predict`` on the same log; a gap longer than ``--max-gap`` starts a new run once."""
 
 from __future__ import annotations
@@ -86,3 +86,45 @@ def test_a_gap_longer_than_max_gap_starts_a_new_run_once(model_file, offline, cu
     assert sum(line.startswith("gap of") for line in said) == 1
     expected = offline(path, log, name="cut-gap", extra=PREDICT)  # split into two runs there too
     assert_as_predict(table, expected)
+
+
+def test_a_json_null_is_a_missing_value_bridged_as_a_nan(model_file, offline, cut_raw):
+    path = model_file("gms")
+    messages = json_batches(cut_raw, (10,))
+    message = json.loads(messages[40])
+    message["position_mm"][3] = None  # sample 403, written as null
+    messages[40] = json.dumps(message)
+    assert "null" in messages[40]
+    without = cut_raw.select(np.flatnonzero(np.arange(len(cut_raw)) != 403))
+    expected = offline(path, without, name="cut-without-403", extra=PREDICT)
+    table, outcome, said = live(path, messages)
+    assert_as_predict(table, expected)
+    assert outcome.stats.gaps == 0 and outcome.stats.rejected == 0
+    assert outcome.stats.dropped == {"not finite": 1}
+
+
+def test_nulls_longer_than_max_gap_make_one_gap(model_file, offline, cut_raw):
+    path = model_file("gms")
+    missing = np.arange(300, 320)  # 20 samples, 42 ms between the finite ones: beyond --max-gap
+    messages = [json.loads(text) for text in json_batches(cut_raw, (10,))]
+    for k in missing:
+        messages[k // 10]["current_A"][k % 10] = None
+    table, outcome, said = live(path, [json.dumps(message) for message in messages])
+    assert outcome.stats.gaps == 1 and outcome.stats.rejected == 0
+    assert sum(line.startswith("gap of") for line in said) == 1
+    keep = np.flatnonzero(~np.isin(np.arange(len(cut_raw)), missing))
+    expected = offline(path, cut_raw.select(keep), name="cut-nulls", extra=PREDICT)
+    assert_as_predict(table, expected)
+
+
+def test_without_max_gap_a_null_is_refused_in_one_line(model_file, cut_raw):
+    messages = json_batches(cut_raw, (10,))
+    message = json.loads(messages[5])
+    message["current_A"][2] = None
+    messages[5] = json.dumps(message)
+    out, said = io.StringIO(), []
+    outcome = run_live(model_file("gms"), source="-", axis_config_path=EXAMPLE_AXIS, sample_time=STEP,
+                       stdin=io.StringIO("\n".join(messages)), stdout=out, say=said.append)
+    assert outcome.stats.rejected == 1
+    skipped = [line for line in said if "skipped" in line]
+    assert len(skipped) == 1 and "line 6: skipped: channel 'current_A' holds nan at sample 2" in skipped[0], said

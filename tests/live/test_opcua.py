@@ -5,7 +5,9 @@ line, exit 2); a malformed value is one line and the stream goes on; a server re
 from __future__ import annotations
 
 import _thread
+import datetime
 import io
+import math
 import threading
 
 import numpy as np
@@ -14,6 +16,7 @@ from live_helpers import EXAMPLE_AXIS, free_port, joined, run_cli, wait_until
 
 from greybox.errors import GreyboxError
 from greybox.live.opcua import OpcUaOptions, parse_nodes, parse_opcua_address
+from greybox.live.opcua_samples import stamp_seconds
 from greybox.live.run import run_live
 
 
@@ -74,6 +77,35 @@ def test_estimates_equal_predict(kind, seconds, opcua_server, model_file, offlin
     assert f"reading {opcua_server.url}" in said[0]
     assert f"0 rejected), {len(log)} samples received, {len(log)} estimated, 0 dropped" in said[-1], said
     assert "0 gap(s), 0 disconnection(s)" in said[-1], said
+
+
+def test_each_variable_with_its_own_jittered_stamp_and_no_time_variable(opcua_server, model_file, offline, cut_raw):
+    """A server that stamps each variable as it writes it, no time variable: the values of a sample (stamps within
+    0.4 ms of each other) are matched, its time is their stamps' mean, and the jitter of the samples' times (beyond
+    the 25 % tolerance) is bridged by --max-gap as ``greybox predict --resample --max-gap`` bridges it."""
+    path = model_file("coulomb")
+    log = cut_raw.select(slice(0, 500))
+    rng = np.random.default_rng(3)
+    times = 1e3 + log.time + rng.uniform(-0.3e-3, 0.3e-3, len(log))  # each sample's moment [s since 1970]
+    columns = ("position_mm", "velocity_mm_s", "current_A")
+    # whole microseconds (a datetime's resolution), as the client reads them back
+    stamps = {column: np.array([stamp_seconds(datetime.datetime.fromtimestamp(value, tz=datetime.timezone.utc))
+                                for value in np.round(1e6 * (times + rng.uniform(-0.2e-3, 0.2e-3, len(log)))) / 1e6])
+              for column in columns}
+    mean = np.array([math.fsum(values) / len(values) for values in zip(*(stamps[column] for column in columns))])
+    assert np.diff(mean).max() > 1.25 * log.sample_time  # a jitter beyond the tolerance, bridged by --max-gap
+    expected = offline(path, log.replace(time=mean), name="cut-stamped",
+                       extra=["--resample", "0.002", "--max-gap", "5"])
+    axis = opcua_server.axis()
+    axis.publish_stamped(log, stamps, 0, 1)
+    output, said = live_until(path, opcua_server.url, OpcUaOptions(nodes=axis.node_ids(columns)),
+                              act=lambda: axis.publish_stamped(log, stamps, 1, every=25),
+                              until=lambda out, _: estimated(out) >= len(expected), sample_time=0.002, max_gap=5.0)
+    live = joined(output.splitlines())
+    assert len(live["time_s"]) == len(expected)
+    for name in ("time_s", "current_model_A", "current_process_A"):
+        np.testing.assert_allclose(live[name], expected[name].to_numpy(), rtol=0, atol=1e-9, err_msg=name)
+    assert "0 gap(s)" in said[-1] and "0 rejected" in said[-1], said
 
 
 def test_a_user_logs_in_with_a_password(opcua_server, model_file, cut_raw, tmp_path, capsys, monkeypatch):

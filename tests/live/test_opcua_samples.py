@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import datetime
 import math
+
+import pytest
 
 from greybox.live.opcua_samples import SampleAssembler
 
@@ -68,3 +71,37 @@ def test_a_sample_given_again_is_left_out():
     assert assembler.take() == [] and assembler.pending == 0
     add_sample(assembler, 3, (0.006, 1.2, 0.7))
     assert assembler.take() == [(3, {"time_s": [0.006], "position_mm": [1.2], "current_A": [0.7]})]
+
+
+def test_stamps_of_one_sample_within_the_tolerance_are_matched():
+    """A server stamping each variable as it writes it: stamps a little apart are one sample, the nearest one
+    lacking the variable; a value of the next cycle (beyond the tolerance) starts the next sample."""
+    assembler = SampleAssembler(COLUMNS, tolerance_s=0.5e-3)
+    assembler.add("time_s", 1.0000, 0.002)
+    assembler.add("position_mm", 1.0003, 1.0)
+    assembler.add("time_s", 1.0021, 0.004)  # the next sample's time, before the first sample's current
+    assembler.add("current_A", 0.9998, 0.5)
+    assembler.add("position_mm", 1.0019, 1.1)
+    assembler.add("current_A", 1.0024, 0.6)
+    assert assembler.take() == [(1.0, {"time_s": [0.002, 0.004], "position_mm": [1.0, 1.1], "current_A": [0.5, 0.6]})]
+    exact = SampleAssembler(COLUMNS)
+    add_sample(exact, 1.0, (0.002, 1.0))
+    exact.add("current_A", 1.0003, 0.5)
+    assert exact.pending == 2  # without a tolerance, two samples
+
+
+def test_without_a_time_variable_the_time_is_the_mean_of_the_stamps():
+    start = datetime.datetime(2026, 1, 1, tzinfo=datetime.timezone.utc)
+    naive = datetime.datetime(2026, 1, 1)  # asyncua's stamps are naive UTC
+    assembler = SampleAssembler(("position_mm", "current_A"), tolerance_s=0.5e-3)
+    assembler.add("position_mm", start, 1.0)
+    assembler.add("current_A", naive + datetime.timedelta(microseconds=300), 0.5)
+    [(stamp, values)] = assembler.take()
+    assert stamp == start
+    assert values["time_s"] == [pytest.approx(start.timestamp() + 150e-6, abs=1e-6)]
+    assert values["position_mm"] == [1.0] and values["current_A"] == [0.5]
+
+
+def test_a_negative_tolerance_is_refused():
+    with pytest.raises(ValueError, match="tolerance_s"):
+        SampleAssembler(COLUMNS, tolerance_s=-1.0)
