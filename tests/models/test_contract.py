@@ -38,7 +38,6 @@ from greybox.persistence import load_model, save_model
 from greybox.twin import make_dataset
 
 
-
 def _quick_gms(**options) -> GMSModel:
     """A quick GMS: one start, one search pass."""
     return GMSModel(n_starts=1, max_iter=60, staged=False, **options)
@@ -125,8 +124,10 @@ def cogging_floor_A(log) -> float:
 #: Largest test RMSE of each case on an unseen air cut, as a multiple of :func:`noise_floor_A`, and why the
 #: kind cannot come closer. (RMSE over the noise floor equals RE over the floor's RE: one denominator.) Every
 #: kind leaves the twin's cogging unexplained, so no bound can lie below sqrt(1 + (cogging / noise)^2) = 1.27.
-#: The bounds leave 10-20 % over the ratios measured when they were set (static 2.10-2.12, LuGre/GMS
-#: 1.42-1.45, GMS+SVR 1.34-1.38, SVR 3.90); a kind that loses the physics its class has lands above its bound.
+#: The bounds leave about 15 % over the ratios measured when they were set (static 2.10-2.12, LuGre/GMS
+#: 1.42-1.44, GMS+SVR 1.35-1.37, SVR 3.90); a kind that loses the physics its class has lands above its bound
+#: (a GMS without pre-sliding is a Coulomb model: 2.1). The SVR stage of GMS+SVR gains only ~5 % on this twin,
+#: less than any margin: it is held to beating its own GMS stage instead (the test after this one).
 ACCURACY = {
     "coulomb": (2.45, "no pre-sliding and no memory: the current held at dwells and the pre-sliding ramps after "
                       "each reversal are its error"),
@@ -224,6 +225,14 @@ def test_unseen_air_cut_is_predicted_within_the_kinds_bound_over_the_noise_floor
     bound, reason = ACCURACY[case]
     ratio = rmse(unseen_aircut.effort, prediction) / noise_floor_A(unseen_aircut)
     assert ratio <= bound, f"{case}: test RMSE {ratio:.2f} times the noise floor, bound {bound} ({reason})"
+
+
+@pytest.mark.parametrize("case", sorted(case for case in CASES if _kind_of(case) == "gmssvr"))
+def test_the_svr_stage_explains_part_of_its_gms_stages_error(case, fitted, unseen_aircut):
+    """The SVR corrects the GMS in position and velocity: on an unseen air cut it lowers the GMS stage's RMSE."""
+    model = fitted[case]
+    assert rmse(unseen_aircut.effort, model.predict(unseen_aircut)) < 0.99 * rmse(
+        unseen_aircut.effort, model.gms_.predict(unseen_aircut))
 
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_parameter_table_lists_every_identified_parameter_with_a_unit(case, fitted):
