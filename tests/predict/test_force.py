@@ -33,13 +33,14 @@ def _write(tmp_path, text: str, name: str = "axis.toml") -> Path:
 
 
 def test_force_constant_against_a_hand_calculation(tmp_path):
-    # 2 Nm/A * 3 motor rev per screw rev * 2 pi * 0.8 / 0.005 m = 6031.857894892403 N/A driving,
-    # 2 * 3 * 2 pi / (0.8 * 0.005 m) = 9424.777960769379 N/A back-driven
+    # F per A = k_t i 2 pi eta / h driving, k_t i 2 pi / (eta h) back-driven, with the file's k_t = 2 Nm/A,
+    # i = 3 motor revolutions per screw revolution, eta = 0.8 and h = 0.005 m
+    driving, backdriven = 2.0 * 3.0 * 2 * np.pi * 0.8 / 0.005, 2.0 * 3.0 * 2 * np.pi / (0.8 * 0.005)
     config = read_axis_config(_write(tmp_path, VALID))
-    assert config.load_constants == pytest.approx((6031.857894892403, 9424.777960769379), rel=1e-12)
-    np.testing.assert_allclose(config.process_load([0.5, -1.0, 0.0], 1.0),
-                               [3015.9289474462, -9424.777960769379, 0.0])
-    np.testing.assert_allclose(config.process_load([0.5, -1.0], -1.0), [4712.38898038469, -6031.857894892403])
+    assert config.load_constants == pytest.approx((driving, backdriven), rel=1e-12)
+    # driving where current and velocity share their sign, back-driven where they differ; zero current, zero force
+    np.testing.assert_allclose(config.process_load([0.5, -1.0, 0.0], 1.0), [0.5 * driving, -backdriven, 0.0])
+    np.testing.assert_allclose(config.process_load([0.5, -1.0], -1.0), [0.5 * backdriven, -driving])
 
 
 @pytest.mark.parametrize("current_A, omega", [(3.0, 150.0), (-3.0, -150.0), (3.0, -150.0), (-3.0, 150.0)])
