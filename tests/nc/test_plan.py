@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -134,7 +136,8 @@ def test_plan_to_log_to_model_to_process_force(tmp_path, capsys):
     out = tmp_path / "process.csv"
     assert cli.main(["predict", str(tmp_path / "x.gbm"), str(tmp_path / "cut" / "X_D.mcap"), "--axis-config",
                      str(cli_example("axis_x.toml")), "--out", str(out), "--quiet"]) == 0
-    assert "(position 0.0 %, velocity 0.0 %, standstill" in capsys.readouterr().out  # stribeck: its stops flagged
+    printed = capsys.readouterr().out  # stribeck: inside the air cuts' region, its stops flagged apart
+    assert re.search(r"\(position 0\.0 %, velocity 0\.0 %, .*standstill (?!0\.0 %)[0-9.]+ %", printed)
     cut = read_log(tmp_path / "cut" / "X_D.mcap")
     in_cut = np.abs(cut.extras["truth_process_A"]) > 0
     estimated = pd.read_csv(out)["force_process_N"].to_numpy()[in_cut].mean()
