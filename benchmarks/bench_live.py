@@ -222,6 +222,33 @@ def _free_port() -> int:
         return probe.getsockname()[1]
 
 
+def _publisher(port: int):
+    """A client of the broker that writes each message to its socket in the calling thread.
+
+    Without a network thread of its own (no ``loop_start``), paho writes a QoS 0 message at once in
+    ``publish``: the time stamped just before it is the time the message goes out, not that time plus the
+    wake-up of a network thread of the benchmark's own (which the end-to-end figure would count).
+    """
+    import paho.mqtt.client as mqtt
+
+    publisher = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2)
+    publisher.on_socket_open = lambda c, u, sock: sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    publisher.connect("127.0.0.1", port, keepalive=600)
+    deadline = time.monotonic() + 10
+    while not publisher.is_connected():
+        publisher.loop(0.05)
+        if time.monotonic() > deadline:
+            raise RuntimeError("the benchmark's publisher did not connect")
+    return publisher
+
+
+def _process_cpu_s(pid: int) -> float:
+    """User and system CPU time of process ``pid``, all its threads [s] (Linux ``/proc``)."""
+    with open(f"/proc/{pid}/stat") as stream:
+        fields = stream.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float, latency: str = "exact",
                alarm_limit: float | None = None) -> dict:
     import paho.mqtt.client as mqtt
@@ -273,15 +300,20 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float, la
                                 + (["--limit", f"current_process_A={alarm_limit}"] if alarm_limit else []),
                                 stderr=subprocess.PIPE, text=True)
         live.stderr.readline()  # connected
+        publisher = _publisher(port)
         published = {}
+        cpu_start = _process_cpu_s(live.pid)
         start = time.perf_counter()
         for seq, message in enumerate(messages):
             due = start + (seq + 1) * batch * step_s
             while time.perf_counter() < due:
                 time.sleep(min(0.001, max(0.0, due - time.perf_counter())))
             published[seq] = time.perf_counter()
-            client.publish("axis/X", message)
+            publisher.publish("axis/X", message)  # written to the socket here, by this thread
+        streamed_s = time.perf_counter() - start
         time.sleep(1.0)
+        live_cpu_s = _process_cpu_s(live.pid) - cpu_start
+        publisher.disconnect()
         client.disconnect()
         client.loop_stop()
     finally:
@@ -293,7 +325,8 @@ def end_to_end(model_path, messages, folder: Path, batch: int, step_s: float, la
     delays = np.array([arrived[seq] - published[seq] for seq in published if seq in arrived]) * 1e3
     figures = {"latency": latency, "messages": len(published), "answered": len(delays), "rate_hz": 1 / step_s,
                "batch": batch, "p50_ms": float(np.percentile(delays, 50)), "p99_ms": float(np.percentile(delays, 99)),
-               "max_ms": float(delays.max())}
+               "max_ms": float(delays.max()), "over_5_ms": int((delays > 5.0).sum()),
+               "live_cpu_s": live_cpu_s, "live_cpu_share_of_one_core": live_cpu_s / streamed_s}
     if alarm_limit:
         to_alarm = np.array([now - published[seq] for seq, now in alarms if seq in published]) * 1e3
         figures.update({"alarm_limit_A": alarm_limit, "alarms": len(to_alarm)})
