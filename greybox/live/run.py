@@ -30,7 +30,7 @@ from .recording import DEFAULT_RECORD_S, Recorder
 from .report import LINES_PER_INTERVAL, LineLimiter
 from .session import LiveSession
 from .sources import DEFAULT_IDLE_S, Idle
-from .stats import LiveStats
+from .stats import LiveStats, StatsFile
 
 __all__ = ["ALARM_STATUS", "SWITCH_INTERVAL_S", "LiveOutcome", "responsive_threads", "run_live", "settled_memory"]
 
@@ -361,6 +361,7 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         ends.close()
         raise
     status, stopped = 0, True
+    stats_file = StatsFile(stats_path) if stats_path is not None else None
     deferred = _Deferred()
     try:
         with deferred, settled_memory(), responsive_threads():
@@ -385,8 +386,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                     if session.alarmed and exit_on_alarm:
                         status = ALARM_STATUS
                         break
-                if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
-                    session.write_stats(stats_path)
+                if stats_file is not None and time.monotonic() - last_stats > STATS_EVERY_S:
+                    stats_file.write(session.counters())  # the file written by a thread of its own
                     last_stats = time.monotonic()
             else:
                 with deferred.held():
@@ -400,8 +401,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
             session.close(stopped=stopped)
             stream.close()
         finally:
-            if stats_path is not None:
-                session.write_stats(stats_path)
+            if stats_file is not None:
+                stats_file.close(session.counters())
             for line in session.stats_line().splitlines():
                 say(line)
     return LiveOutcome(session.stats, status, [path for recorder in recorders for path in recorder.written])
