@@ -9,10 +9,8 @@ machine file's channel names map others) and feeds every axis it names. Each axi
 
 from __future__ import annotations
 
-import json
 from typing import Callable, Mapping
 
-from ..atomic import write_text_atomic
 from .messages import DEFAULT_BOUNDS, Decoder, MessageBounds, MessageError
 from .session import LiveSession
 from .sources import ConnectionChange, Received
@@ -130,13 +128,3 @@ class MachineSession:
         """The counters of the machine and of each axis as they are now, JSON-able."""
         return {**self.stats.to_dict(),
                 "axes": {axis: session.current_stats().to_dict() for axis, session in self.sessions.items()}}
-
-    def write_stats(self, path) -> None:
-        """Write the counters of the machine and of each axis to a JSON file, atomically.
-
-        Parameters
-        ----------
-        path : path-like
-            The stats file.
-        """
-        write_text_atomic(path, json.dumps(self.counters(), indent=1) + "\n")

@@ -30,9 +30,9 @@ from .recording import DEFAULT_RECORD_S, Recorder
 from .report import LINES_PER_INTERVAL, LineLimiter
 from .session import LiveSession
 from .sources import DEFAULT_IDLE_S, Idle
-from .stats import LiveStats
+from .stats import LiveStats, StatsFile
 
-__all__ = ["ALARM_STATUS", "LiveOutcome", "run_live", "settled_memory"]
+__all__ = ["ALARM_STATUS", "SWITCH_INTERVAL_S", "LiveOutcome", "responsive_threads", "run_live", "settled_memory"]
 
 #: Exit status of ``greybox live --exit-on-alarm`` after an alarm.
 ALARM_STATUS = 3
@@ -126,6 +126,33 @@ def settled_memory():
         yield
     finally:
         gc.unfreeze()
+
+
+#: Python's GIL switch interval while a stream runs [s] (CPython's default is 5 ms).
+SWITCH_INTERVAL_S = 0.0005
+
+
+@contextlib.contextmanager
+def responsive_threads(interval_s: float = SWITCH_INTERVAL_S):
+    """Let paho's network threads in within ``interval_s`` while the main thread estimates.
+
+    A message arrives in the source's network thread and its estimate leaves through the sink's; both need
+    the GIL, which the main thread holds while it handles a message. A thread waiting for the GIL asks for
+    it after the switch interval (CPython's default 5 ms): on a busy machine, where the main thread's
+    handling of a message is stretched by other processes, the next message's arrival or the last
+    estimate's sending waited up to that long. The interval is set back after the block.
+
+    Parameters
+    ----------
+    interval_s : float, default SWITCH_INTERVAL_S
+        The switch interval [s] while the block runs.
+    """
+    previous = sys.getswitchinterval()
+    sys.setswitchinterval(interval_s)
+    try:
+        yield
+    finally:
+        sys.setswitchinterval(previous)
 
 
 def _axis_session(model_path, axis_config_path, options: dict, *, record_dir, record_s, limits, hold_s, columns,
@@ -334,9 +361,10 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
         ends.close()
         raise
     status, stopped = 0, True
+    stats_file = StatsFile(stats_path) if stats_path is not None else None
     deferred = _Deferred()
     try:
-        with deferred, settled_memory():
+        with deferred, settled_memory(), responsive_threads():
             say(f"greybox live: {kind} model {model_path}, reading {'stdin' if source == '-' else stream.address}, "
                 f"writing {'stdout' if sink == '-' else out.address}"
                 + (f", status on {ends.status.topic}" if ends.status is not None else ""))
@@ -358,8 +386,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
                     if session.alarmed and exit_on_alarm:
                         status = ALARM_STATUS
                         break
-                if stats_path is not None and time.monotonic() - last_stats > STATS_EVERY_S:
-                    session.write_stats(stats_path)
+                if stats_file is not None and time.monotonic() - last_stats > STATS_EVERY_S:
+                    stats_file.write(session.counters())  # the file written by a thread of its own
                     last_stats = time.monotonic()
             else:
                 with deferred.held():
@@ -373,8 +401,8 @@ def run_live(model_path, *, source: str, sink: str = "-", axis_config_path=None,
             session.close(stopped=stopped)
             stream.close()
         finally:
-            if stats_path is not None:
-                session.write_stats(stats_path)
+            if stats_file is not None:
+                stats_file.close(session.counters())
             for line in session.stats_line().splitlines():
                 say(line)
     return LiveOutcome(session.stats, status, [path for recorder in recorders for path in recorder.written])

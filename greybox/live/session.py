@@ -164,16 +164,6 @@ class LiveSession:
         """The counters as they are now, JSON-able."""
         return self.current_stats().to_dict()
 
-    def write_stats(self, path) -> None:
-        """Write the counters (as they are now) to a JSON file, atomically.
-
-        Parameters
-        ----------
-        path : path-like
-            The stats file.
-        """
-        self.current_stats().write(path)
-
     def warm_up(self) -> None:
         """Load the compiled kernels before the stream starts, so that the first message is not kept waiting
         (:meth:`LiveEstimator.warm_up`); check the limits against the columns of the output then.

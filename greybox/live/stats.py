@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass, field
 
 from ..atomic import write_text_atomic
 
-__all__ = ["LiveStats"]
+__all__ = ["LiveStats", "StatsFile"]
 
 
 @dataclass
@@ -115,12 +115,73 @@ class LiveStats:
         """JSON-able counters, with ``skipped`` (dropped + lost)."""
         return {**asdict(self), "skipped": self.skipped}
 
-    def write(self, path) -> None:
-        """Write the counters as JSON, atomically.
+
+class StatsFile:
+    """The counters file of a stream, written by a thread of its own while the stream runs.
+
+    Writing a file atomically syncs it to the disk, which on a busy disk takes from milliseconds to
+    seconds; done by the main thread it held up the messages behind it. :meth:`write` takes the
+    counters as they are (in the caller's thread) and leaves the file to a writer thread; a write that falls
+    due while the previous one is still going is left out (the next one brings the counters up to date).
+    :meth:`close` writes the last counters and waits for it: the file then holds them.
+
+    Parameters
+    ----------
+    path : path-like
+        The stats file (replaced each time).
+
+    Attributes
+    ----------
+    written : int
+        Writes done.
+    skipped : int
+        Writes left out because the previous one was still going.
+    """
+
+    def __init__(self, path):
+        from concurrent.futures import ThreadPoolExecutor
+
+        self.path = path
+        self.written = self.skipped = 0
+        self._writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="greybox-stats")
+        self._pending = None
+
+    def write(self, counters: dict) -> None:
+        """Write ``counters`` (JSON-able) in the writer thread, unless the previous write is still going.
 
         Parameters
         ----------
-        path : path-like
-            The stats file (replaced each time).
+        counters : dict
+            The counters as they are now.
+
+        Raises
+        ------
+        OSError
+            The previous write's error (e.g. the folder is gone).
         """
-        write_text_atomic(path, json.dumps(self.to_dict(), indent=1) + "\n")
+        if self._pending is not None:
+            if not self._pending.done():
+                self.skipped += 1
+                return
+            self._pending.result()
+        self._pending = self._writer.submit(self._write, json.dumps(counters, indent=1) + "\n")
+
+    def close(self, counters: dict) -> None:
+        """Wait for the write in progress, then write ``counters`` and wait for it.
+
+        Parameters
+        ----------
+        counters : dict
+            The last counters.
+        """
+        try:
+            if self._pending is not None:
+                self._pending.result()
+            self._pending = None
+            self._writer.submit(self._write, json.dumps(counters, indent=1) + "\n").result()
+        finally:
+            self._writer.shutdown(wait=True)
+
+    def _write(self, text: str) -> None:
+        write_text_atomic(self.path, text)
+        self.written += 1
