@@ -482,7 +482,8 @@ def _auto_twin_time(record: dict) -> str:
     f = record["figures"]
     out = [label for label, entry in f["candidates"].items() if entry["error"]]
     return (f"`greybox train --model auto --train data/X_A.mcap data/X_B.mcap` took **{f['auto_seconds']:.0f} s** "
-            f"wall and {f['auto_cpu_seconds']:.0f} s of CPU time (the run and its workers) "
+            f"wall and {f['auto_cpu_seconds']:.0f} s of CPU time (the run and its workers: "
+            f"{f['auto_cpu_seconds'] / f['cores']:.0f} s on {f['cores']} idle cores at best) "
             f"on {f['workers']} workers (target 3 minutes on 2 cores: "
             f"{_met(f['auto_seconds'] <= 180.0 and f['cores'] <= 2)}) and chose `{f['chosen']}`"
             + (f"; out after the lead fold or disqualified: {', '.join(f'`{label}`' for label in out)}" if out else "")
