@@ -135,6 +135,12 @@ SPECS = {spec.name: spec for spec in (
                ("benchmarks/bench_read.py", "greybox/data"),
                "read_log on a one-hour 500 Hz log in MCAP, Parquet and CSV, each in a fresh process: time and peak"),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    RecordSpec("auto-twin", ("benchmarks/bench_auto.py", "--json"),
+               ("benchmarks/bench_auto.py", "greybox/train", "greybox/models", "greybox/identify", "greybox/data",
+                "greybox/evaluate", "greybox/cli", "greybox/base.py", "greybox/threads.py", "greybox/metrics.py",
+                "greybox/provenance.py", "data"),
+               "greybox train --model auto on the twin's X_A and X_B: wall time, the choice and its folds; the "
+               "chosen model and coulomb:offset on the fastest held-out log X_C"),
 )}
 
 

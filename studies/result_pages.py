@@ -486,6 +486,29 @@ class View:
 
 
 #: The views the pages render, by name.
+def _auto_twin_time(record: dict) -> str:
+    f = record["figures"]
+    out = [label for label, entry in f["candidates"].items() if entry["error"]]
+    return (f"`greybox train --model auto --train data/X_A.mcap data/X_B.mcap` took **{f['auto_seconds']:.0f} s** "
+            f"wall and {f['auto_cpu_seconds']:.0f} s of CPU time (the run and its workers: "
+            f"{f['auto_cpu_seconds'] / f['cores']:.0f} s on {f['cores']} idle cores at best) "
+            f"on {f['workers']} workers (target 3 minutes on 2 cores: "
+            f"{_met(f['auto_seconds'] <= 180.0 and f['cores'] <= 2)}) and chose `{f['chosen']}`"
+            + (f"; out after the lead fold or disqualified: {', '.join(f'`{label}`' for label in out)}" if out else "")
+            + f" (`{record['command']}`, {_where(record)}).\n")
+
+
+def _auto_twin_speed(record: dict) -> str:
+    f = record["figures"]
+    re = f["fastest_re"]
+    return ("| development set | chosen | its RE on the fastest held-out run | `coulomb:offset` there | noise floor | "
+            "no worse than `coulomb:offset` |\n|---|---|---|---|---|---|\n"
+            f"| twin, X_A + X_B -> {f['fastest']} | `{f['chosen']}` | {re['auto']:.2f} % "
+            f"| {re['coulomb_offset']:.2f} % "
+            f"| {re['noise_floor']:.2f} % | {_met(re['auto'] <= re['coulomb_offset'])} |\n\n"
+            f"`{record['command']}` ({_where(record)}).\n")
+
+
 VIEWS = {
     "reproduce-run": View(("reproduce",), _reproduce_run),
     "reproduce-exp1": View(("reproduce",), _reproduce_exp(1)),
@@ -518,6 +541,8 @@ VIEWS = {
     "gms-kernel": View(("gms-speed",), _gms_kernel),
     "speed-table": View(("gms-speed", "svr-predict", "read-hour"), _speed_table),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    "auto-twin-time": View(("auto-twin",), _auto_twin_time),
+    "auto-twin-speed": View(("auto-twin",), _auto_twin_speed),
 }
 
 

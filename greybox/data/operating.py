@@ -92,32 +92,41 @@ def local_span(position: np.ndarray, samples: int, history: np.ndarray | None = 
     span = np.empty(position.size)
     if position.size == 0:
         return span, past
-    _span_kernel(position, past, samples, span)
+    values = np.concatenate((past, position))
+    _span_kernel(values, past.size, samples, span)
     keep = samples - 1
-    return span, np.concatenate((past, position))[-keep:] if keep else np.empty(0)
+    return span, values[-keep:].copy() if keep else np.empty(0)
 
 
 @njit(cache=True, error_model="numpy")
-def _span_kernel(position, history, window, out):  # pragma: no cover - compiled; reference in the tests
-    """``out[k]`` = ``max - min`` of the trailing ``window`` samples of ``history`` then ``position`` ending at
-    ``position[k]``; the run's first position stands for the samples before the run (:func:`local_span`)."""
-    h = history.size
-    pad = history[0] if h > 0 else position[0]
-    for k in range(position.size):
-        start = h + k - window + 1
-        high = -np.inf
-        low = np.inf
-        if start < 0:
-            high = pad
-            low = pad
-            start = 0
-        for t in range(start, h + k + 1):
-            value = history[t] if t < h else position[t - h]
-            if value > high:
-                high = value
-            if value < low:
-                low = value
-        out[k] = high - low
+def _span_kernel(values, first, window, out):  # pragma: no cover - compiled; reference in the tests
+    """``out[k]`` = ``max - min`` of the trailing ``window`` of ``values`` ending at ``values[first + k]``
+    (fewer at the start: what the sequence has shown so far, :func:`local_span`).
+
+    A running maximum and minimum: two monotone queues of indices (the maximum's values decreasing, the
+    minimum's increasing), each index pushed and popped once: O(1) amortised a sample whatever the window,
+    and the same values as taking ``max - min`` of each window.
+    """
+    high = np.empty(values.size, dtype=np.int64)
+    low = np.empty(values.size, dtype=np.int64)
+    high_head, high_tail, low_head, low_tail = 0, 0, 0, 0
+    for t in range(values.size):
+        value = values[t]
+        while high_tail > high_head and values[high[high_tail - 1]] <= value:
+            high_tail -= 1
+        high[high_tail] = t
+        high_tail += 1
+        while low_tail > low_head and values[low[low_tail - 1]] >= value:
+            low_tail -= 1
+        low[low_tail] = t
+        low_tail += 1
+        oldest = t - window + 1
+        while high[high_head] < oldest:
+            high_head += 1
+        while low[low_head] < oldest:
+            low_head += 1
+        if t >= first:
+            out[t - first] = values[high[high_head]] - values[low[low_head]]
 
 
 @njit(cache=True, error_model="numpy")

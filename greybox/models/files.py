@@ -1,13 +1,13 @@
 """Saving and loading fitted models, without pickle.
 
-File format (format name ``greybox-model``, version 3)
+File format (format name ``greybox-model``, version 4)
 ------------------------------------------------------
 A model file is a ZIP archive (any file name; ``.gbm`` by convention) with
 
 ``model.json``
     A JSON object::
 
-        {"format": "greybox-model", "format_version": 3,
+        {"format": "greybox-model", "format_version": 4,
          "greybox_version": "0.1.0",
          "model": {"kind": "gms",
                    "params": {...},       # get_params(deep=False)
@@ -92,8 +92,11 @@ RECORD_CHECKS = {TRAINING_RECORD: check_training_record}
 FORMAT_NAME = "greybox-model"
 #: Newest format version this greybox writes and reads. Version 2 renamed learned attributes
 #: (:data:`RENAMED_ATTRIBUTES`); version-1 files are read with the old names mapped. Version 3 added the
-#: member :data:`DIGEST_MEMBER` (an older greybox would refuse it as an unexpected member).
-FORMAT_VERSION = 3
+#: member :data:`DIGEST_MEMBER` (an older greybox would refuse it as an unexpected member). Version 4 added
+#: the ``operating`` record inside the ``training`` record (:mod:`greybox.data.operating`), which an older
+#: greybox's check of that record refuses as an unknown key: with the bump it says "written by a newer
+#: greybox" instead. Files of versions 1 to 3 load as before (a version-3 file may already hold ``operating``).
+FORMAT_VERSION = 4
 
 #: Member holding the SHA-256 of every other member (and the signature with the plant's key).
 DIGEST_MEMBER = "digest.json"

@@ -4,9 +4,17 @@ import copy
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from greybox.data.log import AxisLog
-from greybox.data.operating import OperatingRegion, check_operating_record, local_span, operating_record
+from greybox.data.operating import (
+    OperatingRegion,
+    _span_kernel,
+    check_operating_record,
+    local_span,
+    operating_record,
+)
 
 
 def _run(amplitude: float, frequency: float, seconds: float = 20.0, step: float = 0.002) -> AxisLog:
@@ -20,6 +28,35 @@ def _run(amplitude: float, frequency: float, seconds: float = 20.0, step: float 
 
 def _reference_span(position, samples):
     return np.array([np.ptp(position[max(k - samples + 1, 0):k + 1]) for k in range(len(position))])
+
+
+def _reference_kernel(position, history, window):
+    """The plain-Python reference of the compiled running span: ``max - min`` over each trailing window of
+    ``history`` then ``position``, scanned sample by sample (O(window) a sample)."""
+    values = list(history) + list(position)
+    out = []
+    for t in range(len(history), len(values)):
+        seen = values[max(t - window + 1, 0):t + 1]
+        out.append(max(seen) - min(seen))
+    return np.array(out)
+
+
+@settings(max_examples=60, deadline=None)
+@given(values=st.lists(st.floats(-1e6, 1e6, allow_nan=False), min_size=1, max_size=80),
+       repeats=st.integers(1, 3), window=st.integers(1, 40), cut=st.integers(0, 120))
+def test_the_running_span_equals_the_plain_windows_on_random_data(values, repeats, window, cut):
+    """Exactly equal (the same subtraction of the same two samples), also with the compiler off (``py_func``,
+    what NUMBA_DISABLE_JIT=1 runs), with ties (repeated values) and with a history shorter or longer than the
+    window."""
+    sequence = np.repeat(np.asarray(values), repeats)
+    history, position = sequence[:min(cut, sequence.size - 1)], sequence[min(cut, sequence.size - 1):]
+    expected = _reference_kernel(position, history, window)
+    for kernel in (_span_kernel, getattr(_span_kernel, "py_func", _span_kernel)):
+        out = np.empty(position.size)
+        kernel(np.concatenate((history, position)), history.size, window, out)
+        np.testing.assert_array_equal(out, expected)
+    span, _ = local_span(position, window, history if history.size else None)
+    np.testing.assert_array_equal(span, expected)
 
 
 def test_local_span_matches_the_plain_trailing_window_and_carries_across_chunks():

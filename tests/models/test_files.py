@@ -515,3 +515,34 @@ def test_a_signed_file_is_checked_with_the_plants_key(tmp_path, data, monkeypatc
     key_file.write_bytes(b"")
     with pytest.raises(ModelFileError, match="the model key file is empty"):
         load_model(signed)
+
+
+def test_a_file_with_an_operating_record_tells_an_older_greybox_it_is_newer(tmp_path):
+    """Format 4 added the ``operating`` record: a greybox that reads up to 3 says "newer greybox" (not a record
+    error), and version-3 files (with or without that record) still load and predict the same."""
+    from export_logs import write_export_logs
+
+    from greybox.cli import main
+    from greybox.data.io import read_log
+    from greybox.data.prepare import prepare
+
+    logs = write_export_logs(tmp_path)
+    path = tmp_path / "c.gbm"
+    assert main(["train", "--model", "coulomb", "--train", str(logs["aircut_1"]), "--out", str(path),
+                 "--quiet"]) == 0
+    with zipfile.ZipFile(path) as archive:
+        document = json.loads(archive.read("model.json"))
+    assert document["format_version"] == FORMAT_VERSION == 4 and "operating" in document["records"]["training"]
+    with pytest.raises(ModelFileError, match=r"c\.gbm: model file format version 4 was written by a newer greybox"):
+        files.check_format(document, path, name=files.FORMAT_NAME, newest=3, what="model file")
+    run = prepare([read_log(logs["aircut_1"])])[0]
+    reference = load_model(path).predict(run)
+    for name, change in (("v3.gbm", lambda d: d.update(format_version=3)),
+                         ("v3_plain.gbm", lambda d: (d.update(format_version=3),
+                                                     d["records"]["training"].pop("operating")))):
+        older = tmp_path / name
+        older.write_bytes(path.read_bytes())
+        _rewrite_json(older, change)
+        loaded, records = load_model(older, records=True)
+        assert ("operating" in records["training"]) == (name == "v3.gbm")
+        np.testing.assert_array_equal(loaded.predict(run), reference)
