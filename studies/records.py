@@ -135,6 +135,17 @@ SPECS = {spec.name: spec for spec in (
                ("benchmarks/bench_read.py", "greybox/data"),
                "read_log on a one-hour 500 Hz log in MCAP, Parquet and CSV, each in a fresh process: time and peak"),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    # -- the pages of h43pages1 (issue 43): compensate, validation, discover --
+    RecordSpec("compensate-twin", ("scripts/compensate_twin.py",),
+               ("scripts/compensate_twin.py", "greybox/control", "greybox/cli/compensate.py", "greybox/cli/_build.py",
+                "greybox/train", "greybox/twin",
+                *_FRICTION_FITS),
+               "greybox compensate on the twin's X axis: RMS and peak tracking error of the PID loop with each "
+               "model's friction feed-forward, on the low- and high-stroke references"),
+    RecordSpec("intervals-cost", ("benchmarks/bench_intervals.py", "time", "--json"),
+               ("benchmarks/bench_intervals.py", "data/X_A.mcap", *_FRICTION_FITS),
+               "the cost of the sandwich parameter intervals beside the default GMS fit on data/X_A.mcap"),
+    # -- end of the pages of h43pages1 --
 )}
 
 

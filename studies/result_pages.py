@@ -461,6 +461,52 @@ def _speed_table(gms: dict, svr: dict, read: dict) -> str:
 # -- end of the real-data benchmarks and speed (issue 43) --
 
 
+
+# -- the pages of h43pages1 (issue 43): compensate, validation, discover --
+#: The feed-forwards of ``greybox compensate`` as the pages name them.
+_FEEDFORWARDS = {"none": "inertia only", "coulomb": "Coulomb", "stribeck": "Stribeck", "lugre": "LuGre",
+                 "gms": "GMS", "gmssvr": "GMS+SVR"}
+
+
+def _compensate_rows(record: dict, reference: str) -> list[dict]:
+    rows = [row for row in record["figures"]["rows"] if row["reference"] == reference]
+    if not rows:
+        raise GreyboxError(f"record {record['name']}: no rows of the {reference} reference")
+    return rows
+
+
+def _compensate_tables(record: dict) -> str:
+    f = record["figures"]
+    lines = []
+    for reference, label in (("low-stroke", "Low-stroke reference (0.2 mm)"),
+                             ("high-stroke", "High-stroke reference (20 mm)")):
+        lines += [f"{label}:", "", "| friction feed-forward | RMS error [um] | max error [um] | RMS vs none [%] |",
+                  "|---|---:|---:|---:|"]
+        lines += [f"| {row['feedforward']} | {1e3 * row['rms_error_mm']:.4g} | {1e3 * row['peak_error_mm']:.4g} | "
+                  f"{100 * row['rms_vs_none']:.1f} |" for row in _compensate_rows(record, reference)]
+        lines.append("")
+    return (f"`{f['command']}` (`{record['command']}`) took {f['seconds']:.0f} s ({_where(record)}).\n\n"
+            + "\n".join(lines))
+
+
+def _compensate_summary(record: dict) -> str:
+    low, high = (_compensate_rows(record, reference) for reference in ("low-stroke", "high-stroke"))
+    lines = ["| feed-forward | low stroke | high stroke |", "|---|---|---|"]
+    lines += [f"| {_FEEDFORWARDS.get(a['feedforward'], a['feedforward'])} | {1e3 * a['rms_error_mm']:.3g} "
+              f"({100 * a['rms_vs_none']:.0f}) | {1e3 * b['rms_error_mm']:.3g} ({100 * b['rms_vs_none']:.0f}) |"
+              for a, b in zip(low, high)]
+    return ("\n".join(lines) + f"\n\n`{record['command']}`, {record['figures']['seconds']:.0f} s "
+            f"({_where(record)}).\n")
+
+
+def _intervals_cost(record: dict) -> str:
+    f = record["figures"]
+    return (f"Cost on the shipped data (`{record['command']}`, {f['model'].upper()} on {f['log']}, {f['n_samples']} "
+            f"samples; {_where(record)}): the fit took {f['fit_s']:.1f} s, the sandwich intervals over "
+            f"{f['n_clusters']} {f['clusters']} {f['intervals_s']:.2f} s (ratio {f['ratio']:.3f}).\n")
+# -- end of the pages of h43pages1 --
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -510,6 +556,11 @@ VIEWS = {
     "gms-kernel": View(("gms-speed",), _gms_kernel),
     "speed-table": View(("gms-speed", "svr-predict", "read-hour"), _speed_table),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    # -- the pages of h43pages1 (issue 43): compensate, validation, discover --
+    "compensate-twin": View(("compensate-twin",), _compensate_tables),
+    "compensate-summary": View(("compensate-twin",), _compensate_summary),
+    "intervals-cost": View(("intervals-cost",), _intervals_cost),
+    # -- end of the pages of h43pages1 --
 }
 
 
