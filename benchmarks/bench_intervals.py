@@ -8,7 +8,8 @@ Usage::
 
 ``time`` fits ``--model`` on the log as ``greybox train`` does (default settings) and then computes
 the sandwich intervals; it prints both wall times, their ratio and the parameter table with the
-intervals (``--json``: then the figures as one JSON object, last; the command of record ``intervals-cost``). ``coverage`` simulates a 3-element GMS axis of known parameters (forward Euler, AR(1)
+intervals (``--json``: then the figures as one JSON object, last; the command of record
+``intervals-cost``). ``coverage`` simulates a 3-element GMS axis of known parameters (forward Euler, AR(1)
 noise of time constant 0.1 s on the current), fits a GMS model to each seed's run and counts how often
 each scalar parameter's 95 % sandwich interval contains the truth, and how often a parameter is
 flagged. A fit that ends in another local minimum than the truth's counts as a miss: the figure is the

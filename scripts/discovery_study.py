@@ -22,7 +22,7 @@ Example (the figures of docs/discover.md)::
     python scripts/discovery_study.py --section family --first-seed 100 --seeds 5 --workers 2 \
         --json family.json --markdown family.md
     python scripts/discovery_study.py --section emps --data ../shared/data/real/EMPS --json emps.json --markdown emps.md
-    python scripts/discovery_study.py --section emps --record   # the JSON last on standard output (record discover-emps)
+    python scripts/discovery_study.py --section emps --record   # the JSON last on standard output
 
 The JSON is rewritten after every case, so a long run can be followed (and
 an interrupted one still holds its cases).
