@@ -145,6 +145,11 @@ SPECS = {spec.name: spec for spec in (
     RecordSpec("intervals-cost", ("benchmarks/bench_intervals.py", "time", "--json"),
                ("benchmarks/bench_intervals.py", "data/X_A.mcap", *_FRICTION_FITS),
                "the cost of the sandwich parameter intervals beside the default GMS fit on data/X_A.mcap"),
+    RecordSpec("discover-emps", ("scripts/discovery_study.py", "--section", "emps", "--record"),
+               ("scripts/discovery_study.py", "studies/discovery.py", "studies/emps.py", "greybox/discover",
+                *_FRICTION_FITS),
+               "greybox discover on the real EMPS drive with a Coulomb and a GMS base (each with an offset): the "
+               "effects named, the base refinements, the errors before and after on the cross-test"),
     # -- end of the pages of h43pages1 --
 )}
 
