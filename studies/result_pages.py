@@ -492,8 +492,8 @@ def _compensate_tables(record: dict) -> str:
 def _compensate_summary(record: dict) -> str:
     low, high = (_compensate_rows(record, reference) for reference in ("low-stroke", "high-stroke"))
     lines = ["| feed-forward | low stroke | high stroke |", "|---|---|---|"]
-    lines += [f"| {_FEEDFORWARDS.get(a['feedforward'], a['feedforward'])} | {1e3 * a['rms_error_mm']:.3g} "
-              f"({100 * a['rms_vs_none']:.0f}) | {1e3 * b['rms_error_mm']:.3g} ({100 * b['rms_vs_none']:.0f}) |"
+    lines += [f"| {_FEEDFORWARDS.get(a['feedforward'], a['feedforward'])} | {1e3 * a['rms_error_mm']:.3f} "
+              f"({100 * a['rms_vs_none']:.0f}) | {1e3 * b['rms_error_mm']:.3f} ({100 * b['rms_vs_none']:.0f}) |"
               for a, b in zip(low, high)]
     return ("\n".join(lines) + f"\n\n`{record['command']}`, {record['figures']['seconds']:.0f} s "
             f"({_where(record)}).\n")
