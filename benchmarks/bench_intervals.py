@@ -2,13 +2,14 @@
 
 Usage::
 
-    python benchmarks/bench_intervals.py time [--log data/X_A.mcap] [--model gms]
+    python benchmarks/bench_intervals.py time [--log data/X_A.mcap] [--model gms] [--json]
     python benchmarks/bench_intervals.py coverage [--seeds 20] [--duration 20]
     python benchmarks/bench_intervals.py compare [--replicates 30] [--duration 20] [--seed 0]
 
 ``time`` fits ``--model`` on the log as ``greybox train`` does (default settings) and then computes
 the sandwich intervals; it prints both wall times, their ratio and the parameter table with the
-intervals. ``coverage`` simulates a 3-element GMS axis of known parameters (forward Euler, AR(1)
+intervals (``--json``: then the figures as one JSON object, last; the command of record
+``intervals-cost``). ``coverage`` simulates a 3-element GMS axis of known parameters (forward Euler, AR(1)
 noise of time constant 0.1 s on the current), fits a GMS model to each seed's run and counts how often
 each scalar parameter's 95 % sandwich interval contains the truth, and how often a parameter is
 flagged. A fit that ends in another local minimum than the truth's counts as a miss: the figure is the
@@ -20,6 +21,7 @@ other machines.
 from __future__ import annotations
 
 import argparse
+import json
 import time
 
 import numpy as np
@@ -41,7 +43,7 @@ TRUTH = {"alpha": np.array([0.1, 0.3, 0.6]), "k": np.array([30.0, 50.0, 60.0]), 
          "viscous": 0.01, "s_0": 0.02, "s_inf": 0.015, "v_s": 5.0, "J": 2e-3}
 
 
-def bench_time(log: str, kind: str) -> None:
+def bench_time(log: str, kind: str, as_json: bool = False) -> None:
     runs = prepare([read_log(log)])
     model = model_class(kind)()
     started = time.perf_counter()
@@ -54,6 +56,11 @@ def bench_time(log: str, kind: str) -> None:
     print(f"{kind} on {log}: fit {fitted:.1f} s, sandwich intervals {intervals:.2f} s "
           f"(ratio {intervals / fitted:.3f}) over {record['n_clusters']} {record['clusters']}")
     print("\n".join(model_lines(model)))
+    if as_json:
+        print(json.dumps({"log": log, "model": kind, "n_samples": int(sum(run.time.size for run in runs)),
+                          "fit_s": round(fitted, 2), "intervals_s": round(intervals, 3),
+                          "ratio": round(intervals / fitted, 4), "n_clusters": int(record["n_clusters"]),
+                          "clusters": record["clusters"]}))
 
 
 def truth_run(seed: int, duration: float) -> AxisLog:
@@ -125,6 +132,7 @@ def main() -> None:
     timing = sub.add_parser("time")
     timing.add_argument("--log", default="data/X_A.mcap")
     timing.add_argument("--model", default="gms")
+    timing.add_argument("--json", action="store_true", help="print the figures as one JSON object, last")
     coverage = sub.add_parser("coverage")
     coverage.add_argument("--seeds", type=int, default=20)
     coverage.add_argument("--duration", type=float, default=20.0)
@@ -134,7 +142,7 @@ def main() -> None:
     compare.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     if args.what == "time":
-        bench_time(args.log, args.model)
+        bench_time(args.log, args.model, args.json)
     elif args.what == "coverage":
         bench_coverage(args.seeds, args.duration)
     else:

@@ -141,6 +141,22 @@ SPECS = {spec.name: spec for spec in (
                 "greybox/provenance.py", "data"),
                "greybox train --model auto on the twin's X_A and X_B: wall time, the choice and its folds; the "
                "chosen model and coulomb:offset on the fastest held-out log X_C"),
+    # -- the pages of h43pages1 (issue 43): compensate, validation, discover --
+    RecordSpec("compensate-twin", ("scripts/compensate_twin.py",),
+               ("scripts/compensate_twin.py", "greybox/control", "greybox/cli/compensate.py", "greybox/cli/_build.py",
+                "greybox/train", "greybox/twin",
+                *_FRICTION_FITS),
+               "greybox compensate on the twin's X axis: RMS and peak tracking error of the PID loop with each "
+               "model's friction feed-forward, on the low- and high-stroke references"),
+    RecordSpec("intervals-cost", ("benchmarks/bench_intervals.py", "time", "--json"),
+               ("benchmarks/bench_intervals.py", "data/X_A.mcap", *_FRICTION_FITS),
+               "the cost of the sandwich parameter intervals beside the default GMS fit on data/X_A.mcap"),
+    RecordSpec("discover-emps", ("scripts/discovery_study.py", "--section", "emps", "--record"),
+               ("scripts/discovery_study.py", "studies/discovery.py", "studies/emps.py", "greybox/discover",
+                *_FRICTION_FITS),
+               "greybox discover on the real EMPS drive with a Coulomb and a GMS base (each with an offset): the "
+               "effects named, the base refinements, the errors before and after on the cross-test"),
+    # -- end of the pages of h43pages1 --
 )}
 
 

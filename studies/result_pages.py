@@ -469,6 +469,108 @@ def _speed_table(gms: dict, svr: dict, read: dict) -> str:
 # -- end of the real-data benchmarks and speed (issue 43) --
 
 
+
+# -- the pages of h43pages1 (issue 43): compensate, validation, discover --
+#: The feed-forwards of ``greybox compensate`` as the pages name them.
+_FEEDFORWARDS = {"none": "inertia only", "coulomb": "Coulomb", "stribeck": "Stribeck", "lugre": "LuGre",
+                 "gms": "GMS", "gmssvr": "GMS+SVR"}
+
+
+def _compensate_rows(record: dict, reference: str) -> list[dict]:
+    rows = [row for row in record["figures"]["rows"] if row["reference"] == reference]
+    if not rows:
+        raise GreyboxError(f"record {record['name']}: no rows of the {reference} reference")
+    return rows
+
+
+def _compensate_tables(record: dict) -> str:
+    f = record["figures"]
+    lines = []
+    for reference, label in (("low-stroke", "Low-stroke reference (0.2 mm)"),
+                             ("high-stroke", "High-stroke reference (20 mm)")):
+        lines += [f"{label}:", "", "| friction feed-forward | RMS error [um] | max error [um] | RMS vs none [%] |",
+                  "|---|---:|---:|---:|"]
+        lines += [f"| {row['feedforward']} | {1e3 * row['rms_error_mm']:.4g} | {1e3 * row['peak_error_mm']:.4g} | "
+                  f"{100 * row['rms_vs_none']:.1f} |" for row in _compensate_rows(record, reference)]
+        lines.append("")
+    return (f"`{f['command']}` (`{record['command']}`) took {f['seconds']:.0f} s ({_where(record)}).\n\n"
+            + "\n".join(lines))
+
+
+def _compensate_summary(record: dict) -> str:
+    low, high = (_compensate_rows(record, reference) for reference in ("low-stroke", "high-stroke"))
+    lines = ["| feed-forward | low stroke | high stroke |", "|---|---|---|"]
+    lines += [f"| {_FEEDFORWARDS.get(a['feedforward'], a['feedforward'])} | {1e3 * a['rms_error_mm']:.3f} "
+              f"({100 * a['rms_vs_none']:.0f}) | {1e3 * b['rms_error_mm']:.3f} ({100 * b['rms_vs_none']:.0f}) |"
+              for a, b in zip(low, high)]
+    return ("\n".join(lines) + f"\n\n`{record['command']}`, {record['figures']['seconds']:.0f} s "
+            f"({_where(record)}).\n")
+
+
+def _intervals_cost(record: dict) -> str:
+    f = record["figures"]
+    return (f"Cost on the shipped data (`{record['command']}`, {f['model'].upper()} on {f['log']}, {f['n_samples']} "
+            f"samples; {_where(record)}): the fit took {f['fit_s']:.1f} s, the sandwich intervals over "
+            f"{f['n_clusters']} {f['clusters']} {f['intervals_s']:.2f} s (ratio {f['ratio']:.3f}).\n")
+
+
+#: The bases of ``scripts/discovery_study.py --section emps`` as the pages name them.
+_DISCOVER_BASES = {"coulomb --offset": "Coulomb + offset", "gms --offset": "GMS + offset"}
+
+
+def _named(document: dict) -> str:
+    return ", ".join(f"`{effect['name']}`" for effect in document["effects"]) or "none"
+
+
+def _held_out(held_out: dict) -> str:
+    return f"held-out gain {100 * held_out['gain']:.2f} +- {100 * held_out['uncertainty']:.2f} %"
+
+
+def _refinements(document: dict) -> str:
+    refinements = (document.get("base_misfit") or {}).get("refinements", {})
+    return "; ".join(f"`{name}` {'kept' if entry['kept'] else 'not kept'} ({_held_out(entry['held_out'])})"
+                     for name, entry in refinements.items()) or "none tried"
+
+
+def _discover_emps(record: dict) -> str:
+    bases = record["figures"]
+    lines = ["| base | named (in order) | train relerr % | cross-test relerr % | test RMSE [N], 1 kHz | "
+             "at constant feed [N] | at reversals [N] | s |", "|---|---|---|---|---|---|---|---|"]
+    notes = []
+    for key, label in _DISCOVER_BASES.items():
+        document, bench = bases[key]["document"], bases[key]["benchmark"]
+        regimes = document["test"]["regimes"]
+        lines.append(
+            f"| {label} | {_named(document)} | "
+            f"{bench['train_relerr_before']:.2f} -> {bench['train_relerr_after']:.2f} | "
+            f"{bench['test_relerr_before']:.2f} -> {bench['test_relerr_after']:.2f} | "
+            f"{document['test_rmse_before']:.2f} -> {document['test_rmse_after']:.2f} | "
+            f"{regimes['constant_feed']['rmse_before']:.2f} -> {regimes['constant_feed']['rmse_after']:.2f} | "
+            f"{regimes['reversal']['rmse_before']:.2f} -> {regimes['reversal']['rmse_after']:.2f} | "
+            f"{document['seconds']:.0f} |")
+        effects = "; ".join(
+            f"`{effect['name']}` (" + ", ".join(f"{name} {value:.4g}" for name, value in effect["parameters"].items())
+            + f"; {_held_out(effect['evidence']['held_out'])})" for effect in document["effects"]) or "none"
+        rejected = "; ".join(f"`{entry['name']}` ({', '.join(entry['held_out']['reasons']) or entry['reason']})"
+                             if "held_out" in entry else f"`{entry['name']}` ({entry['reason']})"
+                             for entry in document["rejected"]) or "none"
+        notes.append(f"- **{label}**, verdict `{document['verdict']}`. Named: {effects}. Base refinements: "
+                     f"{_refinements(document)}. Passed the null test but not named: {rejected}.")
+    return ("\n".join(lines) + "\n\n" + "\n".join(notes) + f"\n\n`{record['command']}` took "
+            f"{record['seconds']:.0f} s ({_where(record)}).\n")
+
+
+def _discover_emps_summary(record: dict) -> str:
+    lines = ["| base | named (in order) | train RMSE [N] | cross-test relerr % |", "|---|---|---|---|"]
+    for key, label in _DISCOVER_BASES.items():
+        document, bench = record["figures"][key]["document"], record["figures"][key]["benchmark"]
+        lines.append(f"| {label} | {_named(document)} | {document['train_rmse_before']:.2f} -> "
+                     f"{document['train_rmse_after']:.2f} | {bench['test_relerr_before']:.2f} -> "
+                     f"{bench['test_relerr_after']:.2f} |")
+    return "\n".join(lines) + f"\n\n`{record['command']}`, {record['seconds']:.0f} s ({_where(record)}).\n"
+# -- end of the pages of h43pages1 --
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -543,6 +645,13 @@ VIEWS = {
     # -- end of the real-data benchmarks and speed (issue 43) --
     "auto-twin-time": View(("auto-twin",), _auto_twin_time),
     "auto-twin-speed": View(("auto-twin",), _auto_twin_speed),
+    # -- the pages of h43pages1 (issue 43): compensate, validation, discover --
+    "compensate-twin": View(("compensate-twin",), _compensate_tables),
+    "compensate-summary": View(("compensate-twin",), _compensate_summary),
+    "intervals-cost": View(("intervals-cost",), _intervals_cost),
+    "discover-emps": View(("discover-emps",), _discover_emps),
+    "discover-emps-summary": View(("discover-emps",), _discover_emps_summary),
+    # -- end of the pages of h43pages1 --
 }
 
 
