@@ -135,6 +135,11 @@ SPECS = {spec.name: spec for spec in (
                ("benchmarks/bench_read.py", "greybox/data"),
                "read_log on a one-hour 500 Hz log in MCAP, Parquet and CSV, each in a fresh process: time and peak"),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    RecordSpec("process-speed", ("benchmarks/bench_process_check.py", "--json"),
+               ("greybox/process", "greybox/predict", "greybox/models", "greybox/identify", "greybox/twin",
+                "greybox/data", "greybox/windows.py", "greybox/train", "greybox/cli", "greybox/nc",
+                "benchmarks/bench_process_check.py", "data", "examples/axis_x.toml"),
+               "greybox process check of a 100-part series of one-minute twin parts on one core, against real time"),
 )}
 
 

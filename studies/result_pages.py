@@ -461,6 +461,16 @@ def _speed_table(gms: dict, svr: dict, read: dict) -> str:
 # -- end of the real-data benchmarks and speed (issue 43) --
 
 
+def _process_speed(record: dict) -> str:
+    f = record["figures"]
+    ratio = f["real_time_ratio"]
+    return (f"`{record['command']}`: {f['parts']} good parts of the twin ({f['log_s']:.0f} s of log) checked in "
+            f"{f['wall_s']:.1f} s {'on one core' if f['one_core'] else 'unpinned (no taskset)'}: "
+            f"**{ratio:.1f} x real time** (target at least {f['target_ratio']:g} x: {_met(ratio >= f['target_ratio'])});"
+            f" {f['flagged']} of them flagged; load {f['load_before'][0]:.1f} before the check, "
+            f"{f['load_after'][0]:.1f} after ({_where(record)}).\n")
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -510,6 +520,7 @@ VIEWS = {
     "gms-kernel": View(("gms-speed",), _gms_kernel),
     "speed-table": View(("gms-speed", "svr-predict", "read-hour"), _speed_table),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    "process-speed": View(("process-speed",), _process_speed),
 }
 
 
