@@ -5,7 +5,8 @@ Usage::
     python benchmarks/bench_process_check.py [--model gms_x.gbm] [--parts 100] [--json]
 
 Steps: without ``--model`` the model is trained first (``greybox train --model gms --train data/X_A.mcap
-data/X_C.mcap``; not timed); the twin writes a series of ``--parts`` parts of the default part program (about 61 s each, one long
+data/X_C.mcap``; not timed); the twin writes a series of ``--parts`` parts of the default part program (about
+61 s each, one long
 MCAP log with a part counter; not timed); an envelope of the process force is taught on its first 10 parts
 (``--relevel``); then ``greybox process check`` runs in a fresh process pinned to one core (``taskset -c 0``
 where present, and one thread for BLAS and numba): reading, the model's force of every part, the check and the

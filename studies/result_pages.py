@@ -466,7 +466,8 @@ def _process_speed(record: dict) -> str:
     ratio = f["real_time_ratio"]
     return (f"`{record['command']}`: {f['parts']} good parts of the twin ({f['log_s']:.0f} s of log) checked in "
             f"{f['wall_s']:.1f} s {'on one core' if f['one_core'] else 'unpinned (no taskset)'}: "
-            f"**{ratio:.1f} x real time** (target at least {f['target_ratio']:g} x: {_met(ratio >= f['target_ratio'])});"
+            f"**{ratio:.1f} x real time** (target at least {f['target_ratio']:g} x: "
+            f"{_met(ratio >= f['target_ratio'])});"
             f" {f['flagged']} of them flagged; load {f['load_before'][0]:.1f} before the check, "
             f"{f['load_after'][0]:.1f} after ({_where(record)}).\n")
 

@@ -50,7 +50,8 @@ from .nc_run import program_trajectory
 from .noise import CurrentNoise
 from .plant import default_plant_parameters
 
-__all__ = ["PART_FEEDS_MM_MIN", "PART_COLUMN", "BLOCK_COLUMN", "PartSeriesSpec", "block_numbers", "ToolEvents", "WarmUp", "WarmPlant",
+__all__ = ["PART_FEEDS_MM_MIN", "PART_COLUMN", "BLOCK_COLUMN", "PartSeriesSpec", "block_numbers", "ToolEvents",
+           "WarmUp", "WarmPlant",
            "part_program", "make_part_series", "synthesize_part_series"]
 
 #: Feeds [mm/min] of the passes of the default part program, in order.
@@ -553,8 +554,9 @@ def synthesize_part_series(spec: PartSeriesSpec, seed: int, out_dir: str | PathL
         raise GreyboxError(f"{existing[0]}: file exists; pass --force to overwrite it")
     logs, truth = make_part_series(spec, seed)
     out.mkdir(parents=True, exist_ok=True)
+    counters = (PART_COLUMN, BLOCK_COLUMN)
     kept = [stored(log, truth_channels).replace(extras={**stored(log, truth_channels).extras,
-                                                        **{name: log.extras[name] for name in (PART_COLUMN, BLOCK_COLUMN)}})
+                                                        **{name: log.extras[name] for name in counters}})
             for log in logs]
     written = []
     if layout in ("parts", "both"):

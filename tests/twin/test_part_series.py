@@ -9,9 +9,9 @@ import pytest
 
 from greybox.data.io import read_log
 from greybox.errors import GreyboxError
+from greybox.nc.blocks import Dwell, Move, Program
 from greybox.twin.axes import axis_geometry
 from greybox.twin.nc_run import program_trajectory
-from greybox.nc.blocks import Dwell, Move, Program
 from greybox.twin.part_series import (
     BLOCK_COLUMN,
     PART_COLUMN,
