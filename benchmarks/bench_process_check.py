@@ -2,9 +2,11 @@
 
 Usage::
 
-    python benchmarks/bench_process_check.py --model gms_x.gbm [--parts 100] [--json]
+    python benchmarks/bench_process_check.py [--model gms_x.gbm] [--parts 100] [--json]
 
-Steps: the twin writes a series of ``--parts`` parts of the default part program (about 61 s each, one long
+Steps: without ``--model`` the model is trained first (``greybox train --model gms --train data/X_A.mcap
+data/X_C.mcap``; not timed); the twin writes a series of ``--parts`` parts of the default part program (about
+61 s each, one long
 MCAP log with a part counter; not timed); an envelope of the process force is taught on its first 10 parts
 (``--relevel``); then ``greybox process check`` runs in a fresh process pinned to one core (``taskset -c 0``
 where present, and one thread for BLAS and numba): reading, the model's force of every part, the check and the
@@ -29,12 +31,13 @@ from greybox.twin.datasets import ESSENTIAL_TRUTH_CHANNELS
 from greybox.twin.part_series import PartSeriesSpec, synthesize_part_series
 
 ROOT = Path(__file__).resolve().parents[1]
+#: How the model is trained when none is given.
+TRAIN = ("train", "--model", "gms", "--train", "data/X_A.mcap", "data/X_C.mcap")
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--model", required=True, help="model file (greybox train --model gms --train "
-                        "data/X_A.mcap data/X_C.mcap)")
+    parser.add_argument("--model", help="model file (default: train it with greybox " + " ".join(TRAIN) + ")")
     parser.add_argument("--parts", type=int, default=100)
     parser.add_argument("--seed", type=int, default=31)
     parser.add_argument("--json", action="store_true", help="print the figures as JSON")
@@ -42,10 +45,15 @@ def main(argv=None) -> int:
     axis = str(ROOT / "examples" / "axis_x.toml")
     with tempfile.TemporaryDirectory() as scratch:
         root = Path(scratch)
+        model = args.model
+        if model is None:
+            model = str(root / "gms_x.gbm")
+            subprocess.run([sys.executable, "-m", "greybox", *TRAIN, "--out", model], cwd=ROOT, check=True,
+                           stdout=subprocess.DEVNULL)
         synthesize_part_series(PartSeriesSpec(parts=args.parts), args.seed, root / "parts", layout="both",
                                truth_channels=ESSENTIAL_TRUTH_CHANNELS)
         teach = sorted(str(p) for p in (root / "parts").glob("X_part*.mcap"))[:10]
-        teach_logs(teach, root / "env.json", model=args.model, axis_config=axis, relevel=True)
+        teach_logs(teach, root / "env.json", model=model, axis_config=axis, relevel=True)
         env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
                "NUMBA_NUM_THREADS": "1"}
         pin = ["taskset", "-c", "0"] if shutil.which("taskset") else []
@@ -63,7 +71,8 @@ def main(argv=None) -> int:
         log_s = float(summary.split("(")[1].split(" s of log")[0])
     figures = {"parts": args.parts, "log_s": log_s, "wall_s": elapsed, "real_time_ratio": log_s / elapsed,
                "one_core": bool(pin), "load_before": load, "load_after": os.getloadavg(),
-               "flagged": rows["parts_flagged"]}
+               "flagged": rows["parts_flagged"], "model": args.model or "greybox " + " ".join(TRAIN),
+               "seed": args.seed, "target_ratio": 10.0}
     if args.json:
         print(json.dumps(figures, indent=1))
     else:

@@ -157,6 +157,11 @@ SPECS = {spec.name: spec for spec in (
                "greybox discover on the real EMPS drive with a Coulomb and a GMS base (each with an offset): the "
                "effects named, the base refinements, the errors before and after on the cross-test"),
     # -- end of the pages of h43pages1 --
+    RecordSpec("process-speed", ("benchmarks/bench_process_check.py", "--json"),
+               ("greybox/process", "greybox/predict", "greybox/models", "greybox/identify", "greybox/twin",
+                "greybox/data", "greybox/windows.py", "greybox/train", "greybox/cli", "greybox/nc",
+                "benchmarks/bench_process_check.py", "data", "examples/axis_x.toml"),
+               "greybox process check of a 100-part series of one-minute twin parts on one core, against real time"),
 )}
 
 

@@ -569,6 +569,15 @@ def _discover_emps_summary(record: dict) -> str:
                      f"{bench['test_relerr_after']:.2f} |")
     return "\n".join(lines) + f"\n\n`{record['command']}`, {record['seconds']:.0f} s ({_where(record)}).\n"
 # -- end of the pages of h43pages1 --
+def _process_speed(record: dict) -> str:
+    f = record["figures"]
+    ratio = f["real_time_ratio"]
+    return (f"`{record['command']}`: {f['parts']} good parts of the twin ({f['log_s']:.0f} s of log) checked in "
+            f"{f['wall_s']:.1f} s {'on one core' if f['one_core'] else 'unpinned (no taskset)'}: "
+            f"**{ratio:.1f} x real time** (target at least {f['target_ratio']:g} x: "
+            f"{_met(ratio >= f['target_ratio'])});"
+            f" {f['flagged']} of them flagged; load {f['load_before'][0]:.1f} before the check, "
+            f"{f['load_after'][0]:.1f} after ({_where(record)}).\n")
 
 
 @dataclass(frozen=True)
@@ -652,6 +661,7 @@ VIEWS = {
     "discover-emps": View(("discover-emps",), _discover_emps),
     "discover-emps-summary": View(("discover-emps",), _discover_emps_summary),
     # -- end of the pages of h43pages1 --
+    "process-speed": View(("process-speed",), _process_speed),
 }
 
 

@@ -23,7 +23,8 @@ from part ``k_0`` on), a breakage (0 from a time inside its part on, and in ever
 to the air level), a missing blank (0 for the part), an oversized blank (a factor, deeper cut).
 
 :func:`synthesize_part_series` writes one log per part and/or one long log with a ``part`` column (the part
-counter a control logs), and the truth beside them as JSON.
+counter a control logs) and a ``block`` column (the program line of the NC block being run, :func:`block_numbers`),
+and the truth beside them as JSON.
 """
 
 from __future__ import annotations
@@ -49,13 +50,16 @@ from .nc_run import program_trajectory
 from .noise import CurrentNoise
 from .plant import default_plant_parameters
 
-__all__ = ["PART_FEEDS_MM_MIN", "PART_COLUMN", "PartSeriesSpec", "ToolEvents", "WarmUp", "WarmPlant",
+__all__ = ["PART_FEEDS_MM_MIN", "PART_COLUMN", "BLOCK_COLUMN", "PartSeriesSpec", "block_numbers", "ToolEvents",
+           "WarmUp", "WarmPlant",
            "part_program", "make_part_series", "synthesize_part_series"]
 
 #: Feeds [mm/min] of the passes of the default part program, in order.
 PART_FEEDS_MM_MIN = (300.0, 400.0, 500.0, 600.0, 350.0, 450.0, 550.0)
 #: Name of the part-counter column of the logs.
 PART_COLUMN = "part"
+#: Name of the NC block column of the logs: the program line of the block being run, per sample.
+BLOCK_COLUMN = "block"
 #: The default part on X: the air approach starts at PART_START_MM, the cut crosses the workpiece
 #: PART_WORKPIECE_MM, the pass ends at PART_END_MM, the return runs at PART_RETURN_FEED_MM_MIN.
 PART_START_MM, PART_END_MM, PART_WORKPIECE_MM, PART_RETURN_FEED_MM_MIN = -226.0, -272.0, (-264.0, -236.0), 2000.0
@@ -353,6 +357,53 @@ def _lead_in_end(velocity_mm_s) -> int:
     return first + int(after[0]) if moving.any() and after.size else 0
 
 
+def block_numbers(program: Program, position_mm, velocity_mm_s) -> np.ndarray:
+    """The program line of the block being run at each sample, as a control logs it.
+
+    A sample in motion belongs to the move whose stretch of the path it lies on (by the path length travelled
+    since the program's first position); a sample at rest to the dwell it waits in, else to the move that
+    starts next (after the last move: the last block).
+
+    Parameters
+    ----------
+    program : Program
+        The program run; its first move is the start position.
+    position_mm : array_like, shape (n,)
+        Axis position [mm or deg] of the run from its first position, without noise.
+    velocity_mm_s : array_like, shape (n,)
+        Axis velocity [mm/s or deg/s] of the run (exactly 0 at rest).
+
+    Returns
+    -------
+    ndarray of float, shape (n,)
+        The block's line per sample.
+    """
+    position = program.blocks[0].target
+    ends, lines, rest_lines, dwell = [], [], [], None
+    for block in program.blocks[1:]:
+        if isinstance(block, Dwell):
+            dwell = block.line
+            continue
+        distance = abs(block.target - position)
+        position = block.target
+        if distance == 0.0:
+            continue
+        ends.append((ends[-1] if ends else 0.0) + distance)
+        lines.append(block.line)
+        rest_lines.append(block.line if dwell is None else dwell)
+        dwell = None
+    if not lines:
+        return np.full(np.shape(position_mm), float(dwell or program.blocks[0].line))
+    lines.append(lines[-1] if dwell is None else dwell)
+    rest_lines.append(lines[-1])
+    travelled = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(np.asarray(position_mm, dtype=float))))])
+    ends, tolerance = np.asarray(ends), 1e-9 * max(float(ends[-1]), 1.0)  # the sum's rounding
+    moving = np.asarray(velocity_mm_s, dtype=float) != 0.0
+    on = np.minimum(np.searchsorted(ends, travelled - tolerance, side="left"), ends.size - 1)  # its end not passed
+    after = np.searchsorted(ends, travelled + tolerance, side="right")  # the first move whose end lies ahead
+    return np.where(moving, np.asarray(lines, dtype=float)[on], np.asarray(rest_lines, dtype=float)[after])
+
+
 def _part_seed(seed: int, part: int) -> int:
     return int(np.random.SeedSequence([int(seed), int(part)]).generate_state(1)[0])
 
@@ -390,10 +441,13 @@ def make_part_series(spec: PartSeriesSpec, seed: int) -> tuple[list[AxisLog], di
             warmth = spec.warm_up.paused(warmth, pauses[part])
             clock += pauses[part]
             events.append({"kind": "pause", "part": part, "series_time_s": clock, "seconds": pauses[part]})
-        trajectory = program_trajectory(_waiting(program, spec.loading_s + float(waits[index])), geometry)
+        waiting = _waiting(program, spec.loading_s + float(waits[index]))
+        trajectory = program_trajectory(waiting, geometry)
         n = int(np.floor(trajectory.duration_s / SAMPLE_TIME_S + 1e-9)) + 1
         time = np.round(np.arange(n) * SAMPLE_TIME_S, 9)
-        start = _lead_in_end(trajectory.motion.evaluate(time)[1])
+        motion = trajectory.motion.evaluate(time)
+        start = _lead_in_end(motion[1])
+        blocks = block_numbers(waiting, motion[0], motion[1])[start:]
         time = np.round(time - time[start], 9)
         scale = spec.events.scale(part, time)
         log = make_dataset(geometry.name, "S", _part_seed(seed, part), trajectory=trajectory, cutting=cutting,
@@ -404,7 +458,7 @@ def make_part_series(spec: PartSeriesSpec, seed: int) -> tuple[list[AxisLog], di
         log = log.select(slice(start, None))
         log = log.replace(time=np.round(log.time - log.time[0], 9))
         n = len(log)
-        log = log.replace(extras={**log.extras, PART_COLUMN: np.full(n, float(part))},
+        log = log.replace(extras={**log.extras, PART_COLUMN: np.full(n, float(part)), BLOCK_COLUMN: blocks},
                           attrs={**log.attrs, "part": {"number": part, "series_start_s": clock}})
         logs.append(log)
         end_warmth = float(spec.warm_up.running(warmth, log.duration))
@@ -500,8 +554,10 @@ def synthesize_part_series(spec: PartSeriesSpec, seed: int, out_dir: str | PathL
         raise GreyboxError(f"{existing[0]}: file exists; pass --force to overwrite it")
     logs, truth = make_part_series(spec, seed)
     out.mkdir(parents=True, exist_ok=True)
+    counters = (PART_COLUMN, BLOCK_COLUMN)
     kept = [stored(log, truth_channels).replace(extras={**stored(log, truth_channels).extras,
-                                                        PART_COLUMN: log.extras[PART_COLUMN]}) for log in logs]
+                                                        **{name: log.extras[name] for name in counters}})
+            for log in logs]
     written = []
     if layout in ("parts", "both"):
         for log in kept:

@@ -11,6 +11,7 @@ from greybox.cli import main
 from greybox.data.prepare import prepare
 from greybox.models.files import save_model
 from greybox.models.friction import GMSModel
+from greybox.process.envelope import Envelope
 from greybox.twin import make_dataset
 from greybox.twin.part_series import PartSeriesSpec, ToolEvents, part_program, synthesize_part_series
 
@@ -37,6 +38,7 @@ def test_teach_on_good_parts_and_check_finds_the_breakage_and_the_missing_blank(
     out = capsys.readouterr().out
     assert "envelope of the force signal [N] from 6 parts" in out
     assert json.loads(envelope.read_text())["signal"]["kind"] == "force"
+    assert Envelope.load(envelope).blocks_  # the twin's parts carry their NC block numbers: aligned block by block
     report = series / "report"
     assert main(["process", "check", str(envelope), str(series / "parts" / "X_series.mcap"), "--out",
                  str(report)]) == 0

@@ -9,14 +9,17 @@ import pytest
 
 from greybox.data.io import read_log
 from greybox.errors import GreyboxError
+from greybox.nc.blocks import Dwell, Move, Program
 from greybox.twin.axes import axis_geometry
 from greybox.twin.nc_run import program_trajectory
 from greybox.twin.part_series import (
+    BLOCK_COLUMN,
     PART_COLUMN,
     PartSeriesSpec,
     ToolEvents,
     WarmPlant,
     WarmUp,
+    block_numbers,
     make_part_series,
     part_program,
     synthesize_part_series,
@@ -96,6 +99,7 @@ def test_both_layouts_hold_the_same_samples_and_nothing_is_overwritten(tmp_path)
     assert np.all(np.diff(series.time) > 0)
     np.testing.assert_array_equal(series.effort, np.concatenate([p.effort for p in parts]))
     np.testing.assert_array_equal(series.extras[PART_COLUMN], np.repeat([1.0, 2.0, 3.0], [len(p) for p in parts]))
+    np.testing.assert_array_equal(series.extras[BLOCK_COLUMN], np.concatenate([p.extras[BLOCK_COLUMN] for p in parts]))
     truth = json.loads((tmp_path / "X_parts.json").read_text())
     assert [p["file"] for p in truth["parts"]] == ["X_part001.mcap", "X_part002.mcap", "X_part003.mcap"]
     before = (tmp_path / "X_series.mcap").read_bytes()
@@ -114,3 +118,25 @@ def test_a_parquet_series_holds_the_samples_of_the_mcap_one(tmp_path):
     np.testing.assert_array_equal(parquet.extras[PART_COLUMN], mcap.extras[PART_COLUMN])
     with pytest.raises(GreyboxError, match="mcap or parquet"):
         synthesize_part_series(spec, 2, tmp_path / "c", suffix="csv")
+
+
+def test_block_numbers_follow_the_program_lines_where_each_block_runs():
+    program = Program("X", (Move(-226.0, None, 1), Move(-250.0, 600.0, 2), Move(-260.0, 300.0, 3), Dwell(0.7, 4),
+                            Move(-226.0, 2000.0, 5)), source="test")
+    trajectory = program_trajectory(program, axis_geometry("X"))
+    time = np.arange(int(trajectory.duration_s / 0.002) + 1) * 0.002
+    position, velocity, _ = trajectory.motion.evaluate(time)
+    blocks = block_numbers(program, position, velocity)
+    runs = [int(b) for k, b in enumerate(blocks) if k == 0 or b != blocks[k - 1]]
+    assert runs == [2, 3, 4, 5]  # the rest before the first move already waits for it; the last block stays
+    # lines 2 and 3 form one stroke: the block changes where the position passes -250 mm, at the cut's feed
+    change = int(np.argmax(blocks == 3))
+    assert position[change - 1] > -250.0 >= position[change] - 1e-3 and abs(velocity[change]) > 4.0
+    # the dwell holds at rest at -260 mm from the end of line 3's move until line 5 moves
+    dwell = blocks == 4
+    assert np.all(velocity[dwell] == 0.0) and np.allclose(position[dwell], -260.0)
+    assert 0.7 <= dwell.sum() * 0.002 <= 0.7 + 0.01
+    # a log of the series carries the column: the program's lines in order after the loading wait (line 0)
+    logs, _ = make_part_series(PartSeriesSpec(parts=1, program=SHORT, loading_s=0.5), 3)
+    column = logs[0].extras[BLOCK_COLUMN]
+    assert [int(b) for k, b in enumerate(column) if k == 0 or b != column[k - 1]] == [0, 2, 3]
