@@ -135,6 +135,14 @@ SPECS = {spec.name: spec for spec in (
                ("benchmarks/bench_read.py", "greybox/data"),
                "read_log on a one-hour 500 Hz log in MCAP, Parquet and CSV, each in a fresh process: time and peak"),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    # -- the predict and monitor pages (issue 43) --
+    RecordSpec("cutting-validation", ("scripts/cutting_validation.py", "--record"),
+               ("scripts/cutting_validation.py", "studies/cutting.py", "studies/cut_recovery.py", "greybox/models",
+                "greybox/identify", "greybox/data", "greybox/predict", "greybox/twin", "greybox/base.py",
+                "greybox/metrics.py", "greybox/threads.py", "data", "examples/axis_x.toml"),
+               "greybox predict on the twin's cutting logs: every model kind fitted on the shipped air cuts X_A + X_B, "
+               "the process current and force recovered against the truth at four cut strengths"),
+    # -- end of the predict and monitor pages (issue 43) --
 )}
 
 

@@ -35,6 +35,8 @@ from greybox.evaluate.report import (
 
 from .arts import MODEL_NAMES as ARTS_MODELS
 from .arts import markdown_table as arts_table
+from .cutting import detail_table as cutting_detail_table
+from .cutting import sweep_table as cutting_sweep_table
 from .emps import MODEL_NAMES as EMPS_MODELS
 from .emps import markdown_table as emps_table
 from .process_head_to_head import false_alarm_table, head_to_head_table, targets
@@ -461,6 +463,25 @@ def _speed_table(gms: dict, svr: dict, read: dict) -> str:
 # -- end of the real-data benchmarks and speed (issue 43) --
 
 
+# -- the predict and monitor pages (issue 43) --
+def _cutting_detail(record: dict) -> str:
+    f = record["figures"]
+    noise = ", ".join(f"{case['name']} {case['noise_rms_A']:.4f} A" for case in f["cases"])
+    return (f"At the cut strength {f['detail_strength_A']:g} A:\n\n{cutting_detail_table(f['rows'])}\n"
+            f"Current noise rms (`truth_noise_A`): {noise}.\n")
+
+
+def _cutting_sweep(record: dict) -> str:
+    f = record["figures"]
+    fits = {}
+    for row in f["rows"]:
+        fits.setdefault(row["model"], row["fit_s"])
+    slow = ", ".join(f"{MODEL_LABELS.get(kind, kind)} {seconds:.0f} s" for kind, seconds in fits.items())
+    return (cutting_sweep_table(f["rows"], f["cases"], f["target"])
+            + f"\n`{record['command']}` took {record['seconds']:.0f} s wall ({_where(record)}); the fits: {slow}.\n")
+# -- end of the predict and monitor pages (issue 43) --
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -510,6 +531,10 @@ VIEWS = {
     "gms-kernel": View(("gms-speed",), _gms_kernel),
     "speed-table": View(("gms-speed", "svr-predict", "read-hour"), _speed_table),
     # -- end of the real-data benchmarks and speed (issue 43) --
+    # -- the predict and monitor pages (issue 43) --
+    "cutting-validation-detail": View(("cutting-validation",), _cutting_detail),
+    "cutting-validation-sweep": View(("cutting-validation",), _cutting_sweep),
+    # -- end of the predict and monitor pages (issue 43) --
 }
 
 
