@@ -479,6 +479,68 @@ def _cutting_sweep(record: dict) -> str:
     slow = ", ".join(f"{MODEL_LABELS.get(kind, kind)} {seconds:.0f} s" for kind, seconds in fits.items())
     return (cutting_sweep_table(f["rows"], f["cases"], f["target"])
             + f"\n`{record['command']}` took {record['seconds']:.0f} s wall ({_where(record)}); the fits: {slow}.\n")
+def _drift_rate(kind: str, rate: float) -> str:
+    return f"{rate * 1000:g} um of play per day" if kind == "backlash" else f"{rate * 100:g} % of the level per day"
+
+
+def _monitor_detection(record: dict) -> str:
+    results = record["figures"]
+    drifts = {kind: r for kind, r in results.items() if kind != "none"}
+    seeds = len(next(iter(drifts.values()))["delays_days"])
+    lines = [f"| drift (rate) | days from onset to the first alarm ({seeds} seeds) | median | within 7 days | "
+             "first alarm named | right feature first |", "|---|---|---|---|---|---|"]
+    for kind, r in drifts.items():
+        delays = ", ".join("never" if d is None else str(d) for d in r["delays_days"])
+        named = ", ".join(f"{name} ({r['first_named'].count(name)})"
+                          for name in sorted(set(r["first_named"]), key=lambda n: -r["first_named"].count(n)))
+        median = "–" if r.get("median_delay_days") is None else f"{r['median_delay_days']:g}"
+        right = f"{r['right_first']} of {seeds}"
+        lines.append(f"| {kind} ({_drift_rate(kind, r['rate_per_day'])}) | {delays} | {median} | "
+                     f"{r['within_7_days']} of {seeds} | {named} | "
+                     f"{right if r['right_first'] == seeds else f'**{right}**'} |")
+    early = sum(r["false_alarms"] for r in drifts.values())
+    watched = sum(r["axis_days_watched_stable"] for r in drifts.values())
+    text = "\n".join(lines) + f"\n\nAlarms before an onset: {early} in {watched} axis-days"
+    if "none" in results:
+        stable = results["none"]
+        text += (f"; on the {seeds} stable axes: {stable['false_alarms']} in {stable['axis_days_watched_stable']} "
+                 f"axis-days after the baseline")
+    total = seeds * len(drifts)
+    within = sum(r["within_7_days"] for r in drifts.values())
+    right = sum(r["right_first"] for r in drifts.values())
+    quiet = early == 0 and results.get("none", {}).get("false_alarms", 0) == 0
+    return (text + f". Targets: within 7 days of the onset {within} of {total} ({_met(within == total)}), the right "
+            f"feature first {right} of {total} ({_met(right == total)}), nothing before an onset or on a stable axis "
+            f"({_met(quiet)}). `{record['command']}`, {record['seconds']:.0f} s ({_where(record)}).\n")
+
+
+def _monitor_fleet(record: dict) -> str:
+    f = record["figures"]
+    return ("| logs | samples | predict | monitor | monitor / predict | without detection and dashboard | "
+            "target (>= 80 % on one-hour logs) |\n|---|---|---|---|---|---|---|\n"
+            f"| {f['logs']} production days of {f['samples'] // f['logs']:,} samples ({f['repeat']} runs of the day's "
+            f"programme) | "
+            f"{f['samples']:,} | {f['predict_s']:.1f} s ({f['predict_samples_per_s'] / 1e3:.0f} k samples/s) | "
+            f"{f['monitor_s']:.1f} s ({f['monitor_samples_per_s'] / 1e3:.0f} k samples/s) | "
+            f"**{100 * f['ratio']:.0f} %** | {100 * f['ratio_logs_only']:.0f} % ({f['analysis_s']:.1f} s timed "
+            f"alone) | "
+            f"{_met(f['ratio'] >= 0.8)} |\n\n"
+            f"{f['workers']} worker, {f['model']} reference model, {f['fingerprinted']} logs fingerprinted, "
+            f"{f['predict_failed']} failed in predict. `{record['command']}`, {record['seconds']:.0f} s "
+            f"({_where(record)}).\n")
+
+
+def _monitor_query(record: dict) -> str:
+    f = record["figures"]
+    size, compacted = f["size"], f["compacted"]
+    rows = size["machines"] * size["axes"] * size["days"]
+    compaction = ("" if "compaction_s" not in f else
+                  f"; the last day's {f['files_before_compaction']} row files compacted in {f['compaction_s']:.1f} s")
+    return (f"A history of {size['machines']} machines x {size['axes']} axes x {size['days']} days of daily "
+            f"fingerprints ({rows:,} rows){compaction}, then `changed_most(history, days=30)` over its "
+            f"{compacted['files']} files: median {compacted['median_s']:.2f} s, largest {compacted['max_s']:.2f} s "
+            f"of the repeated queries, one DuckDB thread; the shifted axes first: "
+            f"{'yes' if compacted['shifted_axes_first'] else '**no**'}. `{record['command']}` ({_where(record)}).\n")
 # -- end of the predict and monitor pages (issue 43) --
 
 
@@ -534,6 +596,9 @@ VIEWS = {
     # -- the predict and monitor pages (issue 43) --
     "cutting-validation-detail": View(("cutting-validation",), _cutting_detail),
     "cutting-validation-sweep": View(("cutting-validation",), _cutting_sweep),
+    "monitor-detection": View(("monitor-detection",), _monitor_detection),
+    "monitor-fleet": View(("monitor-fleet",), _monitor_fleet),
+    "monitor-query": View(("monitor-query",), _monitor_query),
     # -- end of the predict and monitor pages (issue 43) --
 }
 
