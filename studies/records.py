@@ -160,6 +160,12 @@ SPECS = {spec.name: spec for spec in (
                ("benchmarks/bench_monitor_query.py", "greybox/monitor"),
                "'which axes changed most this month' (changed_most) on a history of 100 machines x 3 axes x a year, "
                "after filing and compacting the last day"),
+    RecordSpec("predict-relevel", ("scripts/predict_relevel.py", "--record"),
+               ("scripts/predict_relevel.py", "studies/process_head_to_head.py", "greybox/predict", "greybox/models",
+                "greybox/identify", "greybox/data", "greybox/twin", "greybox/train", "greybox/cli",
+                "greybox/threads.py", "data", "examples/axis_x.toml"),
+               "greybox predict --relevel on the twin's part series, through a warm-up and on a cold machine: error "
+               "of each part's mean cut force with and without re-levelling"),
     # -- end of the predict and monitor pages (issue 43) --
 )}
 

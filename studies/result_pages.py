@@ -541,6 +541,21 @@ def _monitor_query(record: dict) -> str:
             f"{compacted['files']} files: median {compacted['median_s']:.2f} s, largest {compacted['max_s']:.2f} s "
             f"of the repeated queries, one DuckDB thread; the shifted axes first: "
             f"{'yes' if compacted['shifted_axes_first'] else '**no**'}. `{record['command']}` ({_where(record)}).\n")
+def _predict_relevel(record: dict) -> str:
+    f = record["figures"]
+
+    def cell(errors: dict) -> str:
+        return f"{errors['mean_pct']:.1f} / {errors['mean_abs_pct']:.1f} / {errors['max_abs_pct']:.1f} %"
+
+    lines = ["| series | chunk | off: mean / mean abs / max abs | on: mean / mean abs / max abs |", "|---|---|---|---|"]
+    for case in f["series"].values():
+        for i, (chunk, on) in enumerate(case["on"].items()):
+            label = f"{case['what']}, parts {case['parts']} ({on['parts']} parts)" if i == 0 else "same"
+            lines.append(f"| {label} | {chunk} s | {cell(case['off']) if i == 0 else 'same'} | {cell(on)} |")
+    return ("\n".join(lines) + f"\n\nModel: `{f['model']}`. `{record['command']}`, {record['seconds']:.0f} s "
+            f"({_where(record)}).\n")
+
+
 # -- end of the predict and monitor pages (issue 43) --
 
 
@@ -599,6 +614,7 @@ VIEWS = {
     "monitor-detection": View(("monitor-detection",), _monitor_detection),
     "monitor-fleet": View(("monitor-fleet",), _monitor_fleet),
     "monitor-query": View(("monitor-query",), _monitor_query),
+    "predict-relevel": View(("predict-relevel",), _predict_relevel),
     # -- end of the predict and monitor pages (issue 43) --
 }
 
