@@ -548,8 +548,10 @@ def _predict_relevel(record: dict) -> str:
         return f"{errors['mean_pct']:.1f} / {errors['mean_abs_pct']:.1f} / {errors['max_abs_pct']:.1f} %"
 
     lines = ["| series | chunk | off: mean / mean abs / max abs | on: mean / mean abs / max abs |", "|---|---|---|---|"]
-    for case in f["series"].values():
-        for i, (chunk, on) in enumerate(case["on"].items()):
+    names = sorted(f["series"], key=lambda name: (name != "warm-up", name))  # a record keeps its keys sorted
+    for case in (f["series"][name] for name in names):
+        for i, chunk in enumerate(f"{chunk:g}" for chunk in f["chunks_s"]):
+            on = case["on"][chunk]
             label = f"{case['what']}, parts {case['parts']} ({on['parts']} parts)" if i == 0 else "same"
             lines.append(f"| {label} | {chunk} s | {cell(case['off']) if i == 0 else 'same'} | {cell(on)} |")
     return ("\n".join(lines) + f"\n\nModel: `{f['model']}`. `{record['command']}`, {record['seconds']:.0f} s "
