@@ -485,7 +485,9 @@ def _drift_rate(kind: str, rate: float) -> str:
 
 def _monitor_detection(record: dict) -> str:
     results = record["figures"]
-    drifts = {kind: r for kind, r in results.items() if kind != "none"}
+    order = ("lubrication", "preload", "backlash", "defect")  # a record keeps its keys sorted
+    drifts = {kind: results[kind] for kind in sorted(set(results) - {"none"},
+                                                    key=lambda k: (order.index(k) if k in order else len(order), k))}
     seeds = len(next(iter(drifts.values()))["delays_days"])
     lines = [f"| drift (rate) | days from onset to the first alarm ({seeds} seeds) | median | within 7 days | "
              "first alarm named | right feature first |", "|---|---|---|---|---|---|"]
@@ -499,8 +501,9 @@ def _monitor_detection(record: dict) -> str:
                      f"{r['within_7_days']} of {seeds} | {named} | "
                      f"{right if r['right_first'] == seeds else f'**{right}**'} |")
     early = sum(r["false_alarms"] for r in drifts.values())
-    watched = sum(r["axis_days_watched_stable"] for r in drifts.values())
-    text = "\n".join(lines) + f"\n\nAlarms before an onset: {early} in {watched} axis-days"
+    watched = next(iter(drifts.values()))["axis_days_watched_stable"]  # the same days before every kind's onset
+    text = "\n".join(lines) + (f"\n\nAlarms before an onset: {early} (the {watched} axis-days from the end of the "
+                               f"baseline to the onset, in each drift's run)")
     if "none" in results:
         stable = results["none"]
         text += (f"; on the {seeds} stable axes: {stable['false_alarms']} in {stable['axis_days_watched_stable']} "
