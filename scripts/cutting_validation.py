@@ -7,11 +7,13 @@ process current recovered and compared with the truth) and prints its tables.
 Usage::
 
     python scripts/cutting_validation.py --markdown validation.md --json validation.json --plot-dir figures
+    python scripts/cutting_validation.py --record    # the figures as one JSON object last (scripts/record.py)
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -48,6 +50,8 @@ def main(argv=None) -> int:
     parser.add_argument("--plot-dir", type=Path, help="write the correlation figure and one picture per model and "
                         "test log (at the detailed strength) here")
     parser.add_argument("--force", action="store_true", help="overwrite existing outputs")
+    parser.add_argument("--record", action="store_true",
+                        help="print every figure as one JSON object at the end (the record of scripts/record.py)")
     args = parser.parse_args(argv)
 
     kinds = list(dict.fromkeys(args.model))
@@ -65,6 +69,10 @@ def main(argv=None) -> int:
     print(f"noise floor rms(truth_noise_A): {noise}")
     if result.figure is not None:
         print(f"wrote {result.figure}")
+    if args.record:
+        print(json.dumps({"seed": args.seed, "strengths_A": list(args.strengths), "detail_strength_A": args.strength,
+                          "target": args.target, "force_constant_N_per_A": result.force_constant_N_per_A,
+                          "rows": result.rows, "cases": result.summaries}, indent=1))
     return 0
 
 

@@ -67,7 +67,8 @@ from greybox.twin.cutting import CuttingSpec
 from studies.cut_recovery import correlation_at_strength, recovery_metrics, strength_for_correlation
 
 __all__ = ["TRAIN_FILES", "TEST_DATASETS", "KINDS", "DEFAULT_STRENGTHS", "CuttingCase", "evaluate_model",
-           "detail_table", "sweep_table", "plot_correlation_vs_force", "CuttingValidation", "cutting_validation"]
+           "detail_table", "case_summary", "sweep_table", "plot_correlation_vs_force", "CuttingValidation",
+           "cutting_validation"]
 
 #: The shipped air cuts the models are fitted on.
 TRAIN_FILES = ("X_A.mcap", "X_B.mcap")
@@ -173,7 +174,7 @@ def evaluate_model(kind: str, model, case: CuttingCase, config, detail_strength:
         **detail[0],
         "by_strength": by_strength,
         "target": target,
-        "strength_for_target_A": needed,
+        "strength_for_target_A": float(needed) if np.isfinite(needed) else None,
         "mean_cut_force_for_target_N": case.mean_cut_force_N(needed, factor) if np.isfinite(needed) else None,
     }
     return row, detail[1]
@@ -202,31 +203,57 @@ def detail_table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def sweep_table(rows: list[dict], cases: dict, factor: float, target: float) -> str:
+def case_summary(case: CuttingCase, factor: float, target: float) -> dict:
+    """What a perfect model reaches on one cutting case, and the case's cut forces, as plain numbers.
+
+    Parameters
+    ----------
+    case : CuttingCase
+        Cutting logs of one trajectory.
+    factor : float
+        Driving load constant of the axis [N/A], turning process current into cut force.
+    target : float
+        Correlation target of recovered and true process current.
+
+    Returns
+    -------
+    dict
+        ``name``, ``strengths_A``, ``mean_cut_force_N`` and ``ceiling`` (the correlation of a perfect model)
+        per strength, ``strength_for_target_A`` and ``mean_cut_force_for_target_N`` of a perfect model (None
+        when not reached), ``noise_rms_A`` (RMS of the log's current noise [A]).
+    """
+    needed = strength_for_correlation(case.unit_truth, case.noise, target)
+    reached = bool(np.isfinite(needed))
+    return {"name": case.name, "strengths_A": list(case.strengths),
+            "mean_cut_force_N": [case.mean_cut_force_N(s, factor) for s in case.strengths],
+            "ceiling": [float(correlation_at_strength(case.unit_truth, case.noise, s)) for s in case.strengths],
+            "strength_for_target_A": float(needed) if reached else None,
+            "mean_cut_force_for_target_N": case.mean_cut_force_N(needed, factor) if reached else None,
+            "noise_rms_A": float(np.sqrt(np.mean(case.noise ** 2)))}
+
+
+def sweep_table(rows: list[dict], cases: list[dict], target: float) -> str:
     """Correlation per cut strength and the mean cut force needed for the target, as a Markdown table.
 
     Parameters
     ----------
     rows : list of dict
         One per model and cutting log: the row :func:`evaluate_model` returns first.
-    cases : dict
-        ``{name: CuttingCase}``; the swept strengths are those of the first case.
-    factor : float
-        Driving load constant of the axis [N/A], turning process current into cut force.
+    cases : list of dict
+        One per cutting log, as :func:`case_summary` gives them; the swept strengths are those of the first.
     target : float
         Correlation target of recovered and true process current.
     """
-    strengths = next(iter(cases.values())).strengths
+    strengths = cases[0]["strengths_A"]
     header = " | ".join(f"r at {s:g} A" for s in strengths)
     lines = [f"| model | cutting log | {header} | r >= {target:g} from a cut of [A] / mean force [N] |",
              "|---|---|" + "---:|" * len(strengths) + "---:|"]
-    for name, case in cases.items():
-        forces = ", ".join(f"{s:g} A: {case.mean_cut_force_N(s, factor):.0f} N" for s in strengths)
-        ceiling = [correlation_at_strength(case.unit_truth, case.noise, s) for s in strengths]
-        needed = strength_for_correlation(case.unit_truth, case.noise, target)
+    for case in cases:
+        name = case["name"]
+        forces = ", ".join(f"{s:g} A: {force:.0f} N" for s, force in zip(strengths, case["mean_cut_force_N"]))
         lines.append(f"| perfect model (noise only) | {name} ({forces}) | "
-                     + " | ".join(f"{r:.3f}" for r in ceiling)
-                     + f" | {_needed(needed, case.mean_cut_force_N(needed, factor))} |")
+                     + " | ".join(f"{r:.3f}" for r in case["ceiling"])
+                     + f" | {_needed(case['strength_for_target_A'], case['mean_cut_force_for_target_N'])} |")
         for row in rows:
             if row["test"] != name:
                 continue
@@ -236,8 +263,8 @@ def sweep_table(rows: list[dict], cases: dict, factor: float, target: float) -> 
     return "\n".join(lines) + "\n"
 
 
-def _needed(strength: float, force: float | None) -> str:
-    if not np.isfinite(strength):
+def _needed(strength: float | None, force: float | None) -> str:
+    if strength is None or not np.isfinite(strength):
         return "not reached"
     return f"{strength:.2f} / {force:.0f}"
 
@@ -300,6 +327,8 @@ class CuttingValidation:
         The detailed and the sweep table (Markdown).
     noise_rms_A : dict
         ``{case name: RMS of the log's current noise [A]}``, the noise floor.
+    summaries : list of dict
+        One per cutting log, as :func:`case_summary` gives them.
     figure : pathlib.Path or None
         The correlation figure, when drawn.
     """
@@ -309,6 +338,7 @@ class CuttingValidation:
     force_constant_N_per_A: float
     tables: str
     noise_rms_A: dict
+    summaries: list
     figure: Path | None = None
 
 
@@ -399,9 +429,10 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
 
                 plot_process(result, plot_dir / f"predict_{kind}_X_{case.dataset}.png")
 
+    summaries = [case_summary(case, factor, target) for case in cases.values()]
     tables = (f"Cut strength {strength:g} A at 1000 mm/min:\n\n" + detail_table(rows)
-              + "\nCorrelation by cut strength:\n\n" + sweep_table(rows, cases, factor, target))
-    noise = {name: float(np.sqrt(np.mean(case.noise ** 2))) for name, case in cases.items()}
+              + "\nCorrelation by cut strength:\n\n" + sweep_table(rows, summaries, target))
+    noise = {summary["name"]: summary["noise_rms_A"] for summary in summaries}
     machine = provenance()
     if markdown_path:
         write_text_atomic(markdown_path, f"{tables}\nMeasured with {provenance_line(machine)}.\n")
@@ -409,8 +440,8 @@ def cutting_validation(data: str | os.PathLike, axis_config: str | os.PathLike, 
         write_text_atomic(json_path, json.dumps({
             "seed": seed, "train": list(TRAIN_FILES), "axis_config": str(axis_config),
             "force_constant_N_per_A": factor, "strengths_A": list(strengths), "detail_strength_A": strength,
-            "provenance": machine, "rows": rows}, indent=2) + "\n")
+            "target": target, "provenance": machine, "rows": rows, "cases": summaries}, indent=2) + "\n")
     figure = None
     if plot_dir:
         figure = plot_correlation_vs_force(rows, cases, factor, target, plot_dir / "correlation_vs_cut_force.png")
-    return CuttingValidation(rows, cases, factor, tables, noise, figure)
+    return CuttingValidation(rows, cases, factor, tables, noise, summaries, figure)

@@ -162,6 +162,38 @@ SPECS = {spec.name: spec for spec in (
                 "greybox/data", "greybox/windows.py", "greybox/train", "greybox/cli", "greybox/nc",
                 "benchmarks/bench_process_check.py", "data", "examples/axis_x.toml"),
                "greybox process check of a 100-part series of one-minute twin parts on one core, against real time"),
+    # -- the predict and monitor pages (issue 43) --
+    RecordSpec("cutting-validation", ("scripts/cutting_validation.py", "--record"),
+               ("scripts/cutting_validation.py", "studies/cutting.py", "studies/cut_recovery.py", "greybox/models",
+                "greybox/identify", "greybox/data", "greybox/predict", "greybox/twin", "greybox/base.py",
+                "greybox/metrics.py", "greybox/threads.py", "data", "examples/axis_x.toml"),
+               "greybox predict on the twin's cutting logs: every model kind fitted on the shipped air cuts X_A + X_B, "
+               "the process current and force recovered against the truth at four cut strengths"),
+    RecordSpec("monitor-detection",
+               ("benchmarks/bench_monitor_detection.py", "--seeds", "30", "--first-seed", "6000", "--days", "45",
+                "--json"),
+               ("benchmarks/bench_monitor_detection.py", "greybox/monitor", "greybox/twin", "greybox/data",
+                "greybox/models", "greybox/identify"),
+               "greybox monitor's fingerprint and detector on the ageing twin: days from the onset of each drift kind "
+               "to the first alarm and the feature it names, on the held-out seeds 6000-6029"),
+    RecordSpec("monitor-fleet", ("benchmarks/bench_monitor_fleet.py", "--logs", "2", "--repeat", "310", "--json"),
+               ("benchmarks/bench_monitor_fleet.py", "greybox/fleet", "greybox/monitor", "greybox/predict",
+                "greybox/models", "greybox/data", "greybox/twin", "greybox/threads.py"),
+               "greybox monitor against greybox predict on two one-hour production days, each on a fresh local Dask "
+               "cluster of one worker: samples per second and their ratio"),
+    RecordSpec("monitor-query",
+               ("benchmarks/bench_monitor_query.py", "--machines", "100", "--axes", "3", "--days", "365",
+                "--write-compacted", "--append-days", "1", "--json"),
+               ("benchmarks/bench_monitor_query.py", "greybox/monitor"),
+               "'which axes changed most this month' (changed_most) on a history of 100 machines x 3 axes x a year, "
+               "after filing and compacting the last day"),
+    RecordSpec("predict-relevel", ("scripts/predict_relevel.py", "--record"),
+               ("scripts/predict_relevel.py", "studies/process_head_to_head.py", "greybox/predict", "greybox/models",
+                "greybox/identify", "greybox/data", "greybox/twin", "greybox/train", "greybox/cli",
+                "greybox/threads.py", "data", "examples/axis_x.toml"),
+               "greybox predict --relevel on the twin's part series, through a warm-up and on a cold machine: error "
+               "of each part's mean cut force with and without re-levelling"),
+    # -- end of the predict and monitor pages (issue 43) --
 )}
 
 

@@ -35,6 +35,8 @@ from greybox.evaluate.report import (
 
 from .arts import MODEL_NAMES as ARTS_MODELS
 from .arts import markdown_table as arts_table
+from .cutting import detail_table as cutting_detail_table
+from .cutting import sweep_table as cutting_sweep_table
 from .emps import MODEL_NAMES as EMPS_MODELS
 from .emps import markdown_table as emps_table
 from .process_head_to_head import false_alarm_table, head_to_head_table, targets
@@ -578,6 +580,105 @@ def _process_speed(record: dict) -> str:
             f"{_met(ratio >= f['target_ratio'])});"
             f" {f['flagged']} of them flagged; load {f['load_before'][0]:.1f} before the check, "
             f"{f['load_after'][0]:.1f} after ({_where(record)}).\n")
+# -- the predict and monitor pages (issue 43) --
+def _cutting_detail(record: dict) -> str:
+    f = record["figures"]
+    noise = ", ".join(f"{case['name']} {case['noise_rms_A']:.4f} A" for case in f["cases"])
+    return (f"At the cut strength {f['detail_strength_A']:g} A:\n\n{cutting_detail_table(f['rows'])}\n"
+            f"Current noise rms (`truth_noise_A`): {noise}.\n")
+
+
+def _cutting_sweep(record: dict) -> str:
+    f = record["figures"]
+    fits = {}
+    for row in f["rows"]:
+        fits.setdefault(row["model"], row["fit_s"])
+    slow = ", ".join(f"{MODEL_LABELS.get(kind, kind)} {seconds:.0f} s" for kind, seconds in fits.items())
+    return (cutting_sweep_table(f["rows"], f["cases"], f["target"])
+            + f"\n`{record['command']}` took {record['seconds']:.0f} s wall ({_where(record)}); the fits: {slow}.\n")
+def _drift_rate(kind: str, rate: float) -> str:
+    return f"{rate * 1000:g} um of play per day" if kind == "backlash" else f"{rate * 100:g} % of the level per day"
+
+
+def _monitor_detection(record: dict) -> str:
+    results = record["figures"]
+    order = ("lubrication", "preload", "backlash", "defect")  # a record keeps its keys sorted
+    drifts = {kind: results[kind] for kind in sorted(set(results) - {"none"},
+                                                    key=lambda k: (order.index(k) if k in order else len(order), k))}
+    seeds = len(next(iter(drifts.values()))["delays_days"])
+    lines = [f"| drift (rate) | days from onset to the first alarm ({seeds} seeds) | median | within 7 days | "
+             "first alarm named | right feature first |", "|---|---|---|---|---|---|"]
+    for kind, r in drifts.items():
+        delays = ", ".join("never" if d is None else str(d) for d in r["delays_days"])
+        named = ", ".join(f"{name} ({r['first_named'].count(name)})"
+                          for name in sorted(set(r["first_named"]), key=lambda n: -r["first_named"].count(n)))
+        median = "–" if r.get("median_delay_days") is None else f"{r['median_delay_days']:g}"
+        right = f"{r['right_first']} of {seeds}"
+        lines.append(f"| {kind} ({_drift_rate(kind, r['rate_per_day'])}) | {delays} | {median} | "
+                     f"{r['within_7_days']} of {seeds} | {named} | "
+                     f"{right if r['right_first'] == seeds else f'**{right}**'} |")
+    early = sum(r["false_alarms"] for r in drifts.values())
+    watched = next(iter(drifts.values()))["axis_days_watched_stable"]  # the same days before every kind's onset
+    text = "\n".join(lines) + (f"\n\nAlarms before an onset: {early} (the {watched} axis-days from the end of the "
+                               f"baseline to the onset, in each drift's run)")
+    if "none" in results:
+        stable = results["none"]
+        text += (f"; on the {seeds} stable axes: {stable['false_alarms']} in {stable['axis_days_watched_stable']} "
+                 f"axis-days after the baseline")
+    total = seeds * len(drifts)
+    within = sum(r["within_7_days"] for r in drifts.values())
+    right = sum(r["right_first"] for r in drifts.values())
+    quiet = early == 0 and results.get("none", {}).get("false_alarms", 0) == 0
+    return (text + f". Targets: within 7 days of the onset {within} of {total} ({_met(within == total)}), the right "
+            f"feature first {right} of {total} ({_met(right == total)}), nothing before an onset or on a stable axis "
+            f"({_met(quiet)}). `{record['command']}`, {record['seconds']:.0f} s ({_where(record)}).\n")
+
+
+def _monitor_fleet(record: dict) -> str:
+    f = record["figures"]
+    return ("| logs | samples | predict | monitor | monitor / predict | without detection and dashboard | "
+            "target (>= 80 % on one-hour logs) |\n|---|---|---|---|---|---|---|\n"
+            f"| {f['logs']} production days of {f['samples'] // f['logs']:,} samples ({f['repeat']} runs of the day's "
+            f"programme) | "
+            f"{f['samples']:,} | {f['predict_s']:.1f} s ({f['predict_samples_per_s'] / 1e3:.0f} k samples/s) | "
+            f"{f['monitor_s']:.1f} s ({f['monitor_samples_per_s'] / 1e3:.0f} k samples/s) | "
+            f"**{100 * f['ratio']:.0f} %** | {100 * f['ratio_logs_only']:.0f} % ({f['analysis_s']:.1f} s timed "
+            f"alone) | "
+            f"{_met(f['ratio'] >= 0.8)} |\n\n"
+            f"{f['workers']} worker, {f['model']} reference model, {f['fingerprinted']} logs fingerprinted, "
+            f"{f['predict_failed']} failed in predict. `{record['command']}`, {record['seconds']:.0f} s "
+            f"({_where(record)}).\n")
+
+
+def _monitor_query(record: dict) -> str:
+    f = record["figures"]
+    size, compacted = f["size"], f["compacted"]
+    rows = size["machines"] * size["axes"] * size["days"]
+    compaction = ("" if "compaction_s" not in f else
+                  f"; the last day's {f['files_before_compaction']} row files compacted in {f['compaction_s']:.1f} s")
+    return (f"A history of {size['machines']} machines x {size['axes']} axes x {size['days']} days of daily "
+            f"fingerprints ({rows:,} rows){compaction}, then `changed_most(history, days=30)` over its "
+            f"{compacted['files']} files: median {compacted['median_s']:.2f} s, largest {compacted['max_s']:.2f} s "
+            f"of the repeated queries, one DuckDB thread; the shifted axes first: "
+            f"{'yes' if compacted['shifted_axes_first'] else '**no**'}. `{record['command']}` ({_where(record)}).\n")
+def _predict_relevel(record: dict) -> str:
+    f = record["figures"]
+
+    def cell(errors: dict) -> str:
+        return f"{errors['mean_pct']:.1f} / {errors['mean_abs_pct']:.1f} / {errors['max_abs_pct']:.1f} %"
+
+    lines = ["| series | chunk | off: mean / mean abs / max abs | on: mean / mean abs / max abs |", "|---|---|---|---|"]
+    names = sorted(f["series"], key=lambda name: (name != "warm-up", name))  # a record keeps its keys sorted
+    for case in (f["series"][name] for name in names):
+        for i, chunk in enumerate(f"{chunk:g}" for chunk in f["chunks_s"]):
+            on = case["on"][chunk]
+            label = f"{case['what']}, parts {case['parts']} ({on['parts']} parts)" if i == 0 else "same"
+            lines.append(f"| {label} | {chunk} s | {cell(case['off']) if i == 0 else 'same'} | {cell(on)} |")
+    return ("\n".join(lines) + f"\n\nModel: `{f['model']}`. `{record['command']}`, {record['seconds']:.0f} s "
+            f"({_where(record)}).\n")
+
+
+# -- end of the predict and monitor pages (issue 43) --
 
 
 @dataclass(frozen=True)
@@ -662,6 +763,14 @@ VIEWS = {
     "discover-emps-summary": View(("discover-emps",), _discover_emps_summary),
     # -- end of the pages of h43pages1 --
     "process-speed": View(("process-speed",), _process_speed),
+    # -- the predict and monitor pages (issue 43) --
+    "cutting-validation-detail": View(("cutting-validation",), _cutting_detail),
+    "cutting-validation-sweep": View(("cutting-validation",), _cutting_sweep),
+    "monitor-detection": View(("monitor-detection",), _monitor_detection),
+    "monitor-fleet": View(("monitor-fleet",), _monitor_fleet),
+    "monitor-query": View(("monitor-query",), _monitor_query),
+    "predict-relevel": View(("predict-relevel",), _predict_relevel),
+    # -- end of the predict and monitor pages (issue 43) --
 }
 
 

@@ -7,11 +7,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from greybox.errors import GreyboxError
-from studies.cutting import cutting_validation
+from studies.cutting import cutting_validation, detail_table, sweep_table
 
 #: A validation study's tests (runs of the study, its script, the real data sets): left out of the default
 #: run (`pytest -m slow` runs them, as .ci/run does).
@@ -61,8 +60,8 @@ def test_correlation_rises_with_strength_and_the_threshold_sits_between(run):
         needed = row["strength_for_target_A"]
         # The threshold is consistent with the swept logs: below it r < target, above it r >= target.
         for item in (weak, strong):
-            assert (item["correlation"] >= row["target"]) == (item["strength_A"] >= needed)
-        if np.isfinite(needed):
+            assert (item["correlation"] >= row["target"]) == (needed is not None and item["strength_A"] >= needed)
+        if needed is not None:
             assert row["mean_cut_force_for_target_N"] == pytest.approx(
                 abs(weak["mean_cut_force_true_N"]) * needed / 0.5, rel=1e-9)
 
@@ -76,11 +75,16 @@ def test_strength_of_the_table_must_be_swept_and_kinds_registered():
 
 def test_the_script_runs_as_a_user_runs_it(tmp_path):
     result = subprocess.run([sys.executable, str(SCRIPT), "--model", "coulomb", "--strengths", "0.5", "2",
-                             "--strength", "0.5", "--json", str(tmp_path / "v.json")],
+                             "--strength", "0.5", "--json", str(tmp_path / "v.json"), "--record"],
                             capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert result.returncode == 0, result.stderr
     assert "Correlation by cut strength" in result.stdout and "noise floor rms(truth_noise_A)" in result.stdout
     assert [row["model"] for row in json.loads((tmp_path / "v.json").read_text())["rows"]] == ["coulomb"] * 2
+    # --record: the figures last, from which the printed tables render again (the page's view of the record)
+    record = json.loads(result.stdout[result.stdout.rindex("\n{") + 1:])
+    assert detail_table(record["rows"]) in result.stdout
+    assert sweep_table(record["rows"], record["cases"], record["target"]) in result.stdout
+    assert [case["name"] for case in record["cases"]] == ["X_C seed 7", "X_D seed 7"]
     refused = subprocess.run([sys.executable, str(SCRIPT), "--model", "coulomb", "--strengths", "0.5", "2",
                               "--strength", "1"], capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert refused.returncode == 2 and "not one of the swept strengths" in refused.stderr
