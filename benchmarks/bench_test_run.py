@@ -1,7 +1,7 @@
-"""Time the default test run (the README's ``pytest -q``) and count its tests.
+"""Time the default test run (the README's ``pytest -q -n 2``) and count its tests.
 
-Runs ``python -m pytest -q`` from the repository's root in a subprocess (the test session the README's
-command runs), then prints one JSON object:
+Runs ``python -m pytest -q -n 2`` (the fast tests on two pytest-xdist processes) from the repository's root
+in a subprocess (the test session the README's command runs), then prints one JSON object:
 
 - ``passed``, ``skipped``, ``failed``, ``errors``: the counts of pytest's summary line;
 - ``seconds``: wall time of the whole session, as pytest reports it;
@@ -22,6 +22,9 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+
+#: The README's test command after ``pytest`` (the fast tests on two processes).
+TEST_COMMAND = ("-q", "-n", "2")
 
 #: One count of pytest's summary line, e.g. ``2141 passed``.
 COUNT = re.compile(r"(\d+) (passed|skipped|failed|errors?|xfailed|xpassed|deselected)")
@@ -57,7 +60,7 @@ def summary(text: str) -> dict:
 
 
 def main() -> int:
-    result = subprocess.run([sys.executable, "-m", "pytest", "-q"], cwd=ROOT,
+    result = subprocess.run([sys.executable, "-m", "pytest", *TEST_COMMAND], cwd=ROOT,
                             stdout=subprocess.PIPE, text=True)
     figures = {**summary(result.stdout), "cores": len(os.sched_getaffinity(0))}
     print(json.dumps(figures, indent=1))

@@ -1,4 +1,4 @@
-"""Model choice by held-out runs (greybox.identify.selection, greybox.train.candidates)."""
+"""Model choice by held-out runs (greybox.identify.selection)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from axis_dev_data import axis_dev
-from friction_signals import motion_log, velocity_profile
+from selection_runs import coulomb_run, score
 from sklearn.base import BaseEstimator, clone
 
 from greybox.errors import GreyboxError, ParameterError
@@ -25,19 +25,7 @@ from greybox.identify.selection import (
     speed_fold,
 )
 from greybox.models.files import load_model, save_model
-from greybox.models.friction import CoulombModel, GMSModel, StribeckModel
-from greybox.models.friction.backlash import BacklashModel
-from greybox.models.gmssvr import GMSSVRModel
-from greybox.train.candidates import build_candidate, choose_model
-
-
-def _coulomb_run(seed: int, duration: float = 6.0, noise: float = 0.02):
-    """A run whose effort is Coulomb + viscous friction plus a little white noise."""
-    velocity = velocity_profile(duration, seed=seed, v_max=60.0)
-    log = motion_log(velocity, source=f"run{seed}.csv")
-    rng = np.random.default_rng(seed)
-    effort = 0.8 * np.sign(velocity) + 0.01 * velocity + noise * rng.standard_normal(len(velocity))
-    return log.replace(effort=effort)
+from greybox.models.friction import CoulombModel
 
 
 class _Memoriser(BaseEstimator):
@@ -57,7 +45,7 @@ class _Memoriser(BaseEstimator):
 
 
 def test_leave_one_group_out_holds_each_file_out_once():
-    runs = [_coulomb_run(s, 2.0) for s in range(4)]
+    runs = [coulomb_run(s, 2.0) for s in range(4)]
     groups = ["a.csv", "a.csv", "b.csv", "c.csv"]
     folds = held_out_folds(runs, groups)
     assert [fold.name for fold in folds] == ["a.csv", "b.csv", "c.csv"]
@@ -67,7 +55,7 @@ def test_leave_one_group_out_holds_each_file_out_once():
 
 
 def test_one_file_is_cut_into_contiguous_stretches_that_cover_it():
-    run = _coulomb_run(0, 6.0)
+    run = coulomb_run(0, 6.0)
     folds = held_out_folds([run], ["only.csv"], n_blocks=3)
     assert len(folds) == 3
     held = np.concatenate([fold.test[0].time for fold in folds])
@@ -79,13 +67,13 @@ def test_one_file_is_cut_into_contiguous_stretches_that_cover_it():
 
 def test_too_short_a_single_file_is_one_clear_error():
     with pytest.raises(GreyboxError, match="too short to hold out"):
-        held_out_folds([_coulomb_run(0, 1.0)], ["short.csv"])
+        held_out_folds([coulomb_run(0, 1.0)], ["short.csv"])
     with pytest.raises(GreyboxError, match="one group per run"):
-        held_out_folds([_coulomb_run(0, 1.0)], ["a", "b"])
+        held_out_folds([coulomb_run(0, 1.0)], ["a", "b"])
 
 
 def test_the_choice_follows_held_out_error_not_training_error():
-    runs = [_coulomb_run(s) for s in range(3)]
+    runs = [coulomb_run(s) for s in range(3)]
     np.testing.assert_array_equal(_Memoriser().fit(runs).predict(runs), np.concatenate([r.effort for r in runs]))
     folds = held_out_folds(runs, ["r0", "r1", "r2"])
     scores = score_candidates([("memoriser", _Memoriser()), ("coulomb", CoulombModel())], folds, race=False)
@@ -94,53 +82,23 @@ def test_the_choice_follows_held_out_error_not_training_error():
     assert choose(scores) == 1
 
 
-def _score(label, folds, n_params, error=None):
-    return CandidateScore(label, fold_re=list(folds), fold_rmse=[0.1] * len(folds), n_params=n_params, error=error)
-
-
 def test_one_standard_error_rule_prefers_the_simpler_model():
-    best = _score("complex", [10.0, 12.0, 14.0], 20)  # mean 12, SE 1.15
-    close = _score("simple", [12.0, 13.0, 13.9], 4)  # mean 12.97 within one SE
-    far = _score("simplest", [15.0, 16.0, 17.0], 2)
+    best = score("complex", [10.0, 12.0, 14.0], 20)  # mean 12, SE 1.15
+    close = score("simple", [12.0, 13.0, 13.9], 4)  # mean 12.97 within one SE
+    far = score("simplest", [15.0, 16.0, 17.0], 2)
     assert choose([best, close, far]) == 1
     assert choose([best, far]) == 0  # nothing simpler lies within one SE
-    failed = _score("failed", [1.0, 1.0, 1.0], 1, error="fold x: diverged")
+    failed = score("failed", [1.0, 1.0, 1.0], 1, error="fold x: diverged")
     assert math.isnan(failed.re)
     assert choose([failed, best]) == 1
     with pytest.raises(GreyboxError, match="no candidate model could be scored"):
         choose([failed])
 
 
-def test_candidate_specifications_build_the_models_they_name():
-    model = build_candidate("gms:asymmetric,elements=3")
-    assert isinstance(model, GMSModel) and model.asymmetric and model.n_elements == 3
-    model = build_candidate("gmssvr:asymmetric", inertia=0.0)
-    assert isinstance(model, GMSSVRModel) and model.gms.asymmetric and model.gms.inertia == 0.0
-    model = build_candidate("stribeck:offset,backlash,inertia=0.5")
-    assert isinstance(model, BacklashModel) and model.base.fit_offset and model.base.inertia == 0.5
-    for bad, message in (("nosuch", "unknown model kind"), ("gms:wobble", "unknown option"),
-                         ("gms:elements=x", "needs a number"), ("coulomb:elements=3", "takes no n_elements")):
-        with pytest.raises(GreyboxError, match=message):
-            build_candidate(bad)
-
-
-def test_choose_model_refits_the_choice_and_records_the_table(tmp_path):
-    runs = [_coulomb_run(s) for s in range(3)]
-    model = choose_model(runs, ["a.csv", "b.csv", "c.csv"], candidates=["coulomb", "stribeck"])
-    record = model.selection_
-    assert record["folds"] == ["a.csv", "b.csv", "c.csv"]
-    assert [c["label"] for c in record["candidates"]] == ["coulomb", "stribeck"]
-    assert all(len(c["fold_re"]) == 3 and c["error"] is None for c in record["candidates"])
-    assert isinstance(model, CoulombModel if record["chosen"] == "coulomb" else StribeckModel)
-    assert model.n_samples_fit_ == sum(len(r) for r in runs)  # refitted on every run
-    path = save_model(model, tmp_path / "auto.gbm")
-    assert load_model(path).selection_ == record
-
-
 def test_a_hostile_selection_record_is_refused_on_load(tmp_path):
-    runs = [_coulomb_run(s, 3.0) for s in range(2)]
+    runs = [coulomb_run(s, 3.0) for s in range(2)]
     model = CoulombModel().fit(runs)
-    scores = [_score("coulomb", [1.0, 2.0], 4)]
+    scores = [score("coulomb", [1.0, 2.0], 4)]
     good = selection_record(scores, held_out_folds(runs, ["a", "b"]), 0)
     check_selection_record(good)
     for broken in ({**good, "chosen": "other"}, {**good, "candidates": []}, {**good, "extra": 1},
@@ -152,33 +110,6 @@ def test_a_hostile_selection_record_is_refused_on_load(tmp_path):
         path = save_model(model, tmp_path / "hostile.gbm", overwrite=True)
         with pytest.raises(GreyboxError, match="hostile.gbm: invalid CoulombModel.*selection_"):
             load_model(path)
-
-
-def _gap_run(seed: int, width: float, duration: float = 6.0):
-    """Coulomb friction behind a gap on a sine: after each reversal no force until the motion crossed ``width`` [mm]."""
-    t = np.arange(int(duration / 0.002)) * 0.002
-    w = 2 * np.pi * (0.5 + 0.25 * seed)
-    velocity = (10.0 + 5.0 * seed) * w * np.cos(w * t)
-    log = motion_log(velocity, source=f"gap{seed}.csv")
-    effort = np.zeros(len(log))
-    direction, start = 0.0, log.position[0]
-    for i, (x, v) in enumerate(zip(log.position, velocity)):
-        if v != 0.0 and np.sign(v) != direction:
-            direction, start = np.sign(v), x
-        effort[i] = direction * 1.0 if abs(x - start) >= width else 0.0
-    noise = 0.01 * np.random.default_rng(seed).standard_normal(len(log))
-    return log.replace(effort=effort + noise)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("width, tried", [(3.0, True), (0.0, False)])
-def test_dynamic_models_behind_a_gap_are_tried_when_the_runs_show_one(width, tried):
-    runs = [_gap_run(s, width, duration=6.0) for s in range(3)]
-    model = choose_model(runs, ["a", "b", "c"], candidates=["stribeck:asymmetric", "stribeck:asymmetric,backlash"],
-                         gap_candidates=["coulomb:backlash"])
-    labels = [c["label"] for c in model.selection_["candidates"]]
-    assert ("coulomb:backlash" in labels) is tried
-    assert any("a gap:" in note for note in model.selection_["notes"]) is tried
 
 
 class _Runaway(BaseEstimator):
@@ -213,7 +144,7 @@ def test_an_exploding_fold_disqualifies_a_candidate_with_a_note():
 
 
 def test_speed_fold_is_the_one_holding_out_faster_runs():
-    slow, fast, other = _coulomb_run(2), _coulomb_run(1), _coulomb_run(3)  # 99th percentiles 22, 54, 21 mm/s
+    slow, fast, other = coulomb_run(2), coulomb_run(1), coulomb_run(3)  # 99th percentiles 22, 54, 21 mm/s
     folds = held_out_folds([slow, fast, other], ["slow.csv", "fast.csv", "other.csv"])
     assert speed_fold(folds) == 1
     same = held_out_folds([slow, other], ["a.csv", "b.csv"])
@@ -222,25 +153,12 @@ def test_speed_fold_is_the_one_holding_out_faster_runs():
 
 def test_a_choice_that_does_not_carry_to_speed_loses_to_the_simplest():
     # fold 0 holds out the fastest run: the complex candidate wins the mean but predicts that fold worse
-    simplest = _score("coulomb:offset", [20.0, 14.0, 14.0, 14.0], 4)  # mean 15.5, SE 1.5
-    complex_ = _score("lugre:asymmetric", [22.0, 8.0, 8.0, 8.0], 9)  # mean 11.5, SE 3.5
-    middle = _score("stribeck:offset", [21.0, 9.0, 9.0, 9.0], 6)  # mean 12, SE 3
+    simplest = score("coulomb:offset", [20.0, 14.0, 14.0, 14.0], 4)  # mean 15.5, SE 1.5
+    complex_ = score("lugre:asymmetric", [22.0, 8.0, 8.0, 8.0], 9)  # mean 11.5, SE 3.5
+    middle = score("stribeck:offset", [21.0, 9.0, 9.0, 9.0], 6)  # mean 12, SE 3
     assert choose([simplest, complex_]) == 1  # without the speed rule: the lowest mean, the simplest beyond one SE
     assert choose([simplest, complex_], speed=0) == 0  # 22 > 20 + 1.5
     assert choose([simplest, complex_, middle], speed=0) == 2  # 21 <= 21.5
-
-
-def test_the_folds_fit_each_candidate_with_a_smaller_search_of_the_same_model():
-    for spec in ("gms:offset", "gmssvr:asymmetric", "lugre:offset", "stribeck:asymmetric,backlash"):
-        full = build_candidate(spec)
-        fold = full.held_out_search()
-        assert type(fold) is type(full) and fold is not full
-        settings, reduced = full.get_params(deep=True), fold.get_params(deep=True)
-        changed = {name for name in settings if not isinstance(settings[name], BaseEstimator)
-                   and settings[name] != reduced[name]}
-        # only the size of the search differs: no option of the candidate
-        assert changed and all(name.split("__")[-1] in ("n_starts", "n_calls", "refine") for name in changed)
-        assert all(reduced[name] < settings[name] for name in changed)
 
 
 #: Fits of ``_Scaled`` models: (factors, runs) per fit (the folds run in this process).
@@ -278,7 +196,7 @@ class _Scaled(BaseEstimator):
 
 def _three_runs():
     """Three runs of about one speed (no fold tests speed: the lead fold is the first)."""
-    runs = [_coulomb_run(s, noise=0.2) for s in (2, 3, 7)]
+    runs = [coulomb_run(s, noise=0.2) for s in (2, 3, 7)]
     return runs, held_out_folds(runs, [run.source for run in runs])
 
 
@@ -299,7 +217,7 @@ def test_a_candidate_far_behind_on_the_lead_fold_is_not_fitted_on_the_others():
 def test_racing_keeps_a_candidate_behind_on_the_lead_fold_that_wins_the_mean():
     # behind by less than RACE_FACTOR on the lead fold, better on the two others: the best on the mean. A rule
     # that dropped every candidate behind on the lead fold would lose it.
-    runs = [_coulomb_run(s) for s in (2, 3, 7)]
+    runs = [coulomb_run(s) for s in (2, 3, 7)]
     folds = held_out_folds(runs, [run.source for run in runs])
     high = _Scaled(factors={run.source: 1.2 for run in runs})  # a fifth too high on every run
     mixed = _Scaled(factors={runs[0].source: 1.25})  # worse than that on the lead fold, right on the others
@@ -311,7 +229,7 @@ def test_racing_keeps_a_candidate_behind_on_the_lead_fold_that_wins_the_mean():
 
 
 def test_the_lead_fold_is_the_one_that_tests_speed():
-    slow, fast, other = _coulomb_run(2), _coulomb_run(1), _coulomb_run(3)
+    slow, fast, other = coulomb_run(2), coulomb_run(1), coulomb_run(3)
     folds = held_out_folds([slow, fast, other], ["slow.csv", "fast.csv", "other.csv"])
     assert lead_fold(folds) == speed_fold(folds) == 1
 
@@ -328,33 +246,13 @@ def test_a_two_stage_candidate_freezes_the_fit_of_the_candidate_that_is_its_firs
     assert shared[1].fold_re == alone[0].fold_re == shared[0].fold_re
 
 
-def test_the_real_two_stage_candidates_share_the_gms_candidate_of_their_own_options():
-    labels = ["gms:offset", "gms:asymmetric", "gmssvr:offset", "gmssvr:asymmetric", "lugre:offset"]
-    models = [build_candidate(label).held_out_search() for label in labels]
-    assert shared_stages(models) == [None, None, 0, 1, None]
-    other = [build_candidate("gms:offset,elements=3").held_out_search(), models[2]]
-    assert shared_stages(other) == [None, None]  # another GMS: the stage is fitted with its own settings
-
-
 def test_a_raced_out_simplest_candidate_sets_no_speed_ceiling_on_the_others():
     # the speed fold is the lead fold: coulomb was raced out there, beyond 1.5 times the best, so every candidate
     # left beats it on the fastest runs; the next simplest one (lugre) must not take its place as the ceiling
     raced = CandidateScore("coulomb:offset", fold_re=[30.0], fold_rmse=[0.3], n_params=4, error="raced out",
                            raced=True)
-    lugre = _score("lugre:offset", [10.0, 10.0, 10.0], 8)
-    gms = _score("gms:asymmetric", [10.5, 8.0, 8.0], 14)  # mean 8.83 +- 0.83: the best, beyond lugre's reach
+    lugre = score("lugre:offset", [10.0, 10.0, 10.0], 8)
+    gms = score("gms:asymmetric", [10.5, 8.0, 8.0], 14)  # mean 8.83 +- 0.83: the best, beyond lugre's reach
     assert choose([raced, lugre, gms], speed=0) == 2
     failed = CandidateScore("coulomb:offset", error="fold x: diverged", n_params=4)  # not raced: no figure at all
     assert choose([failed, lugre, gms], speed=0) == 1  # the simplest scored one sets the ceiling, as before
-
-
-def test_a_gap_shows_on_the_lead_fold_when_the_model_without_it_was_raced_out():
-    from greybox.train.candidates import gap_shown
-
-    without = CandidateScore("stribeck:asymmetric", fold_re=[80.0], fold_rmse=[1.0], n_params=9, error="raced out",
-                             raced=True)
-    behind = _score("stribeck:asymmetric,backlash", [20.0, 50.0, 30.0], 10)  # lead fold 1 here: 50 < 80
-    assert gap_shown(without, behind, lead=1) == (80.0, 50.0, " on the lead fold")
-    assert gap_shown(without, _score("b", [20.0, 90.0, 30.0], 10), lead=1) is None  # worse on the lead fold
-    assert gap_shown(_score("a", [9.0, 9.0, 9.0], 9), _score("b", [8.0, 8.0, 8.0], 10), lead=0)[:2] == (9.0, 8.0)
-    assert gap_shown(_score("a", [9.0] * 3, 9, error="fold x: diverged"), behind, lead=1) is None
