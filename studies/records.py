@@ -96,7 +96,7 @@ SPECS = {spec.name: spec for spec in (
                "both experiments of the paper on the shipped twin (greybox reproduce), with its wall time"),
     RecordSpec("default-tests", ("benchmarks/bench_test_run.py",),
                ("greybox", "tests", "studies", "data", "pyproject.toml", "benchmarks/bench_test_run.py"),
-               "the default test run (pytest -q): tests passed, skipped, wall time"),
+               "the default test run (pytest -q -n 2, the README's test command): tests passed, skipped, wall time"),
     RecordSpec("monitor-independent",
                ("scripts/monitor_independent.py", "--variants", "spindle,plain,air", "--json", "-"),
                ("greybox/monitor", "greybox/data", "greybox/models", "greybox/identify",

@@ -129,7 +129,7 @@ def _reproduce_table(table_of: Callable, key: str = "metrics") -> Callable[[dict
 def _tests_run(record: dict) -> str:
     figures = record["figures"]
     skipped = f", {figures['skipped']} skipped" if figures["skipped"] else ""
-    return f"`pytest -q`: {figures['passed']} passed{skipped} in {figures['seconds']:.0f} s ({_where(record)}).\n"
+    return f"`pytest -q -n 2`: {figures['passed']} passed{skipped} in {figures['seconds']:.0f} s ({_where(record)}).\n"
 
 
 def _readme_table(reproduction: dict, tests: dict, monitor: dict) -> str:
@@ -142,8 +142,8 @@ def _readme_table(reproduction: dict, tests: dict, monitor: dict) -> str:
             f"| the paper's experiments on the shipped twin (`greybox reproduce --out DIR`) | GMS+SVR test RE X / Y "
             f"{second} % (experiment 2); the paper's pattern: {met} of {len(checks)} checks met; "
             f"{reproduction['figures']['seconds']:.0f} s ({_where(reproduction)}) | [reproduce](docs/reproduce.md) |\n"
-            f"| the default test run (`pytest -q`) | {figures['passed']} passed{skipped} in {figures['seconds']:.0f} s "
-            f"({_where(tests)}) | [installation and tests](docs/install.md) |\n"
+            f"| the default test run (`pytest -q -n 2`) | {figures['passed']} passed{skipped} in "
+            f"{figures['seconds']:.0f} s ({_where(tests)}) | [installation and tests](docs/install.md) |\n"
             f"{_readme_monitor_row(monitor)}")
 
 

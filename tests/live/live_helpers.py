@@ -135,14 +135,47 @@ class Broker:
         self.config.write_text("\n".join(lines) + "\n")
         self.log = folder / "mosquitto.log"
         self.process = None
+        self._this_start_log = ""
 
     def start(self) -> None:
+        """Start the broker and wait until it runs on its port.
+
+        A port taken meanwhile by another process (a broker of a test in another pytest-xdist worker took the
+        same free port) makes Mosquitto exit: then a new free port is taken, up to three times; a restart keeps
+        its port, as the clients reconnect to it.
+        """
+        for _ in range(3):
+            if self._started():
+                return
+            if "Address already in use" not in self._this_start_log:
+                break
+            self.port = self._move_to(free_port())
+        raise RuntimeError(f"mosquitto did not run on port {self.port} within {BROKER_START_S} s: "
+                           f"{self._this_start_log[-500:]}")
+
+    def _started(self) -> bool:
+        """Start Mosquitto once; True when it listens and has said it runs (its own log, not another broker)."""
+        offset = self.log.stat().st_size if self.log.exists() else 0
         with open(self.log, "ab") as log:
             self.process = subprocess.Popen([self.binary, "-c", str(self.config)], stdout=log, stderr=log)
-        if not _wait_for_port(self.port, time.monotonic() + BROKER_START_S):
-            self.stop()
-            raise RuntimeError(f"mosquitto did not listen on port {self.port} within {BROKER_START_S} s: "
-                               f"{self.log.read_text()[-500:]}")
+        deadline = time.monotonic() + BROKER_START_S
+        while time.monotonic() < deadline:
+            self._this_start_log = self.log.read_bytes()[offset:].decode(errors="replace")
+            if self.process.poll() is not None:
+                break
+            if "running" in self._this_start_log and _wait_for_port(self.port, deadline):
+                return True
+            time.sleep(0.05)
+        self.stop()
+        self._this_start_log = self.log.read_bytes()[offset:].decode(errors="replace")
+        return False
+
+    def _move_to(self, port: int) -> int:
+        """Rewrite the configuration's listener for ``port``; returns it."""
+        lines = self.config.read_text().splitlines()
+        self.config.write_text("\n".join(f"listener {port} 127.0.0.1" if line.startswith("listener ") else line
+                                         for line in lines) + "\n")
+        return port
 
     def stop(self) -> None:
         if self.process is not None and self.process.poll() is None:
