@@ -596,6 +596,8 @@ def _cutting_sweep(record: dict) -> str:
     slow = ", ".join(f"{MODEL_LABELS.get(kind, kind)} {seconds:.0f} s" for kind, seconds in fits.items())
     return (cutting_sweep_table(f["rows"], f["cases"], f["target"])
             + f"\n`{record['command']}` took {record['seconds']:.0f} s wall ({_where(record)}); the fits: {slow}.\n")
+
+
 def _drift_rate(kind: str, rate: float) -> str:
     return f"{rate * 1000:g} um of play per day" if kind == "backlash" else f"{rate * 100:g} % of the level per day"
 
@@ -611,7 +613,7 @@ def _monitor_detection(record: dict) -> str:
     for kind, r in drifts.items():
         delays = ", ".join("never" if d is None else str(d) for d in r["delays_days"])
         named = ", ".join(f"{name} ({r['first_named'].count(name)})"
-                          for name in sorted(set(r["first_named"]), key=lambda n: -r["first_named"].count(n)))
+                          for name in sorted(set(r["first_named"]), key=lambda n: (-r["first_named"].count(n), n)))
         median = "–" if r.get("median_delay_days") is None else f"{r['median_delay_days']:g}"
         right = f"{r['right_first']} of {seeds}"
         lines.append(f"| {kind} ({_drift_rate(kind, r['rate_per_day'])}) | {delays} | {median} | "

@@ -86,3 +86,13 @@ def test_an_unknown_view_names_the_page_and_the_views():
     text = "<!-- record nothing -->\n| x |\n<!-- end record -->\n"
     with pytest.raises(GreyboxError, match="page.md: no view 'nothing'; views: reproduce-run, "):
         render_text(text, where="page.md", read=lambda name: {})
+
+
+def test_features_named_equally_often_are_listed_by_name_whatever_the_hash_seed():
+    record = read_record("monitor-detection")
+    names = [f"feature_{letter} falls" for letter in "hgfedcba"]  # 8 ties: a hash order is alphabetical 1 in 40320
+    figures = {kind: dict(results) for kind, results in record["figures"].items()}
+    figures["preload"]["first_named"] = ["breakaway_pos falls"] * 9 + names
+    text = VIEWS["monitor-detection"].render({**record, "figures": figures})
+    row = next(line for line in text.splitlines() if line.startswith("| preload"))
+    assert "breakaway_pos falls (9), " + ", ".join(f"{name} (1)" for name in sorted(names)) in row
