@@ -7,14 +7,16 @@ All figures come from one run and are printed with the core count and the load o
    one BLAS and numba thread); the time of each message divided by its samples, percentiles over the
    messages after the look-ahead has filled: wall-clock time (what a sample waits, including the time
    the core spends on other processes) and the thread's CPU time (the work itself). The figures are those
-   of the first pass; with ``--repeats R`` (default 3) the run is made R times and the percentiles of
+   of the first pass; with ``--repeats R`` (default 5) the run is made R times and the percentiles of
    each message's least CPU time over the passes are printed too: on a core shared with other jobs the
    CPU time of a message also holds what their interference costs (caches refilled, interrupts), which
    differs from pass to pass, while the code's own cost of a message is the same in every pass;
 2. CPU share of ``--axes`` axes at 500 Hz: as many sessions in one process, each fed the log; the
    process CPU time divided by the stream's duration (the share of one core they need to keep up); only
-   the sessions run meanwhile (no publisher, no MQTT thread). With ``--repeats R`` also each message's
-   least CPU time over R passes, summed (the code's own cost, as in 1.);
+   the sessions run meanwhile (no publisher, no MQTT thread). The first pass's share, every pass's, and
+   their median over the ``--repeats R`` passes (the target's figure: one pass on a shared machine holds a
+   varying share of other jobs' interference, the median is not moved by one pass); also each message's
+   least CPU time over the R passes, summed (the code's own cost, as in 1.);
 3. end to end: a Mosquitto broker on a free loopback port, ``greybox live`` reading and writing it, the
    log published at real time in batches of ``--batch`` (500 Hz, 50 messages/s); per message, the time
    from its publication to the arrival of the output message it completes (percentiles, and the count of
@@ -173,16 +175,21 @@ def _share_pass(model_path, messages, axes: int, step_s: float) -> np.ndarray:
 
 
 def cpu_share(model_path, messages, axes: int, duration_s: float, step_s: float, repeats: int = 1) -> dict:
-    """CPU of ``axes`` sessions fed the stream, as a share of one core: the first pass's process CPU time over
-    the stream's duration (the target's figure), and with ``repeats`` > 1 the sum of each message's least CPU
-    time over the passes (the code's own cost, other jobs' interference left out, as for the compute run).
+    """CPU of ``axes`` sessions fed the stream, as a share of one core: each pass's process CPU time over the
+    stream's duration, the first pass's and the median over the passes (the target's figure: on a shared
+    machine one pass's CPU time also holds what other jobs cost it, more in one pass than in the next, and the
+    median of the passes is not moved by one unlucky or lucky pass); with ``repeats`` > 1 also the sum of each
+    message's least CPU time over the passes (the code's own cost, other jobs' interference left out, as for the
+    compute run).
 
     Only the sessions run in the process meanwhile (the end-to-end run's publisher comes later): the figure
     holds every session's decoding of its message, the estimates and the output messages' text, not the
     MQTT network threads (the end-to-end run prints the ``greybox live`` process's whole CPU time)."""
     passes = [_share_pass(model_path, messages, axes, step_s) for _ in range(repeats)]
     used = float(passes[0].sum())
-    figures = {"axes": axes, "stream_s": duration_s, "cpu_s": used, "share_of_one_core": used / duration_s}
+    shares = [float(pass_cpu.sum()) / duration_s for pass_cpu in passes]
+    figures = {"axes": axes, "stream_s": duration_s, "cpu_s": used, "share_of_one_core": used / duration_s,
+               "pass_shares_of_one_core": shares, "median_share_of_one_core": float(np.median(shares))}
     if repeats > 1:
         least = float(np.min(passes, axis=0).sum())
         figures.update({"repeats": repeats, "least_cpu_s": least, "least_share_of_one_core": least / duration_s})
@@ -420,8 +427,9 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=10, help="samples per message (default 10)")
     parser.add_argument("--axes", type=int, default=16, help="axes of the CPU-share run (default 16)")
     parser.add_argument("--core", type=int, default=0, help="core of the compute runs (default 0)")
-    parser.add_argument("--repeats", type=int, default=3,
-                        help="passes of the compute run; their least CPU time per message is printed too (default 3)")
+    parser.add_argument("--repeats", type=int, default=5,
+                        help="passes of the compute and CPU-share runs; their least CPU time per message, and the "
+                        "CPU share's median over the passes, are printed too (default 5)")
     parser.add_argument("--record-minutes", type=float, default=0.0,
                         help="also stream and record a synthetic log of this many minutes (default 0: not)")
     parser.add_argument("--low-latency", action="store_true",

@@ -358,11 +358,17 @@ def message_log(columns: Mapping[str, np.ndarray], *, name: str, mapping: Mappin
     return log.replace(extras={}) if log.extras else log
 
 
+def _all_finite(arrays: list[np.ndarray]) -> bool:
+    """True when every value of ``arrays`` is finite: their sum is, in one reduction (the usual message); False
+    also for finite values whose sum overflows, which the caller's value-by-value check then finds finite."""
+    return math.isfinite(float(np.add.reduce(np.concatenate(arrays))))
+
+
 def _check_finite(log: AxisLog) -> None:
     """Refuse a message whose channels hold NaN or infinity, naming the first such value."""
     channels = log.named_channels(time=True)
-    if math.isfinite(sum(float(np.add.reduce(values)) for _, values in channels)):
-        return  # a sum of finite values overflowing to infinity gets the check below, which finds nothing
+    if _all_finite([values for _, values in channels]):
+        return
     for channel, values in channels:
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
@@ -385,7 +391,7 @@ def finite_rows(columns: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray
         Samples left out.
     """
     numbers = [values for values in columns.values() if values.dtype.kind == "f"]
-    if not numbers or math.isfinite(sum(float(np.add.reduce(values)) for values in numbers)):
+    if not numbers or _all_finite(numbers):
         return dict(columns), 0
     good = np.logical_and.reduce([np.isfinite(values) for values in numbers])
     if good.all():  # a sum of finite values overflowing

@@ -93,6 +93,14 @@ def outside_any(flags: dict) -> np.ndarray | None:
     return np.logical_or.reduce(region) if region else np.zeros(len(next(iter(flags.values()))), dtype=bool)
 
 
+def _effort_outside(bounds: tuple[float, float] | None, predicted: np.ndarray) -> dict[str, np.ndarray]:
+    """``{"effort": ...}``: where ``predicted`` [A, N or Nm] leaves the checked ``bounds`` (empty without them)."""
+    if bounds is None:
+        return {}
+    predicted = np.asarray(predicted, dtype=float)
+    return {"effort": ~((predicted >= bounds[0]) & (predicted <= bounds[1]))}
+
+
 def extrapolates(shares: dict, share: float) -> bool:
     """Whether a log lies outside the training region enough to warn about.
 
@@ -491,6 +499,7 @@ class CurrentModel(ModelProtocol):
         """:meth:`_stream_step` with the ``"effort"`` flag of its prediction added (:meth:`effort_flags`), its
         region flags those of the operating region where the training record holds one."""
         inner = self._stream_step(sample_time)
+        bounds = self._effort_bounds()  # checked once here, not per chunk
         operating = self.operating_region()
         if operating is not None:
             own = self._own_region_state()
@@ -498,13 +507,14 @@ class CurrentModel(ModelProtocol):
             def checked(run, state, region):
                 current, end, _, _ = inner(run, state, own)
                 flags, region = operating.flags(run, region, sample_time=sample_time)
-                return current, end, {**flags, **self._standstill_flags(run), **self.effort_flags(current)}, region
+                return current, end, {**flags, **self._standstill_flags(run), **_effort_outside(bounds, current)}, \
+                    region
 
             return checked
 
         def step(run, state, region):
             current, end, flags, region = inner(run, state, region)
-            return current, end, {**flags, **self.effort_flags(current)}, region
+            return current, end, {**flags, **_effort_outside(bounds, current)}, region
 
         return step
 
@@ -732,9 +742,13 @@ class CurrentModel(ModelProtocol):
         ParameterError
             If the record is not two finite numbers, the first not above the second (a corrupt model file).
         """
+        return _effort_outside(self._effort_bounds(), predicted)
+
+    def _effort_bounds(self) -> tuple[float, float] | None:
+        """The range of the training efforts ``(low, high)`` [A, N or Nm], checked; None for a file without it."""
         bounds = getattr(self, _EFFORT_RANGE, None)
         if bounds is None:
-            return {}
+            return None
         try:
             low, high = (float(value) for value in bounds)
         except (TypeError, ValueError):
@@ -742,8 +756,7 @@ class CurrentModel(ModelProtocol):
         if not (np.isfinite(low) and np.isfinite(high) and low <= high):
             raise ParameterError(f"{_EFFORT_RANGE} (the range of the training efforts) must be two finite numbers, "
                                  f"low then high, got {bounds!r}")
-        predicted = np.asarray(predicted, dtype=float)
-        return {"effort": ~((predicted >= low) & (predicted <= high))}
+        return low, high
 
     def region_state(self):
         """State carried by :meth:`outside_training_chunk` from chunk to chunk of a run, at its start.

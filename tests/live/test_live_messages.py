@@ -13,6 +13,7 @@ from greybox.live.messages import (
     MessageError,
     MessageLogs,
     estimate_message,
+    finite_rows,
     json_depth,
     message_log,
     parse_json,
@@ -75,6 +76,20 @@ def test_non_finite_values_are_refused_naming_the_channel():
     columns, _ = parse_json('{"time_s": [0, 0.002], "position_mm": [1, NaN], "current_A": [0, 0]}')
     with pytest.raises(MessageError, match="channel 'position_mm' holds nan at sample 1"):
         message_log(columns, name="m")
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
+def test_finite_values_whose_sum_overflows_are_taken_and_one_infinity_among_them_is_named():
+    big = {"time_s": np.array([0.0, 0.002]), "position_mm": np.array([1e308, 1e308]),
+           "current_A": np.array([-1e308, -1e308])}  # every value finite, their sum not
+    reader = MessageLogs()
+    for k in range(2):  # the first message read afresh, the second through the stream's plan
+        np.testing.assert_array_equal(reader.log(big, name=f"message {k}").position, big["position_mm"])
+    assert finite_rows(big)[1] == 0
+    bad = {**big, "current_A": np.array([-1e308, -np.inf])}
+    with pytest.raises(MessageError, match="channel 'current_A' holds -inf at sample 1"):
+        reader.log(bad, name="message 2")
+    assert finite_rows(bad)[1] == 1
 
 
 def test_estimate_messages_are_json_with_the_sequence_tag():

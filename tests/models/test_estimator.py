@@ -44,6 +44,23 @@ def test_a_model_file_without_the_effort_record_has_no_effort_flag_and_a_corrupt
         model.effort_flags(np.zeros(3))
 
 
+def test_a_stream_checks_the_effort_record_once_at_its_start_and_flags_each_chunk_as_the_model_does():
+    slow, fast = _run(1, 20.0), _run(2, 200.0)
+    model = CoulombModel().fit(slow)
+    view = model.stream_view(fast.select(slice(0, 10)), sample_time=fast.sample_time)
+    region, state, flags = view.region_state(), view.initial_state(), []
+    for start in range(0, len(fast), 10):
+        _, state, flagged, region = view.predict_flag_chunk(fast.select(slice(start, start + 10)), state, region,
+                                                            sample_time=fast.sample_time)
+        flags.append(flagged["effort"])
+    expected = model.effort_flags(model.predict(fast))["effort"]
+    assert expected.any() and not expected.all()
+    np.testing.assert_array_equal(np.concatenate(flags), expected)
+    model.effort_range_ = [2.0, 1.0]  # a corrupt record: refused when the stream starts, before any chunk
+    with pytest.raises(ParameterError, match="effort_range_"):
+        model.stream_view(fast.select(slice(0, 10)), sample_time=fast.sample_time)
+
+
 def test_a_fit_far_beyond_the_measured_efforts_is_refused_and_a_sound_one_passes():
     run = _run(3, 40.0)
     model = CoulombModel().fit(run)  # fit calls the check: a sound fit passes

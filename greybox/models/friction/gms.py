@@ -347,15 +347,18 @@ def gms_trajectory_runner(sample_time, *, alpha, C, s_0, s_inf, v_s, k=None, sig
     step, sigma, C = float(sample_time), float(sigma), float(C)
     curves, mu = _curves(s_0, s_inf, v_s), direction_pair(mu, "GMS mu")
 
+    handed = [None]  # the state the last call returned: made by the kernel (which copies it), it needs no check
+
     def runner(velocity, state=None):
-        start = _as_state(state, alpha.size)
+        start = state if state is not None and state is handed[0] else _as_state(state, alpha.size)
         velocity = np.ascontiguousarray(velocity, dtype=float)
         z = np.empty((velocity.size, alpha.size))
         mode = np.empty((velocity.size, alpha.size), dtype=np.int8)
         w, friction = np.empty(velocity.size), np.empty(velocity.size)
         z_end, mode_end = gms_trajectory_kernel(velocity, step, alpha, k, sigma, curves, C, mu, start.z, start.mode,
                                                 z, mode, w, friction)
-        return z, mode == 0, w, friction, GMSState(z_end, mode_end)
+        handed[0] = GMSState(z_end, mode_end)
+        return z, mode == 0, w, friction, handed[0]
 
     return runner
 

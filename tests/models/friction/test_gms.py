@@ -174,6 +174,24 @@ def test_predict_chunk_carries_the_state():
     np.testing.assert_allclose(np.concatenate(parts), model.predict(log), rtol=0, atol=1e-12)
 
 
+def test_a_stream_runner_fed_its_own_states_gives_the_whole_run_and_still_checks_a_foreign_state():
+    log = synthetic_log(2.0, seed=9)
+    model = fitted()
+    runner = model.trajectory_runner(STEP)
+    whole, z_whole, stick_whole, _ = runner(log)
+    parts, state = [], None
+    for index in np.array_split(np.arange(len(log)), 7):
+        current, z, stick, state = runner(log.select(index), state)
+        parts.append((current, z, stick))
+    for k, expected in enumerate((whole, z_whole, stick_whole)):
+        np.testing.assert_array_equal(np.concatenate([part[k] for part in parts]), expected)
+    foreign = (state.z.copy(), np.full(state.mode.shape, 5, dtype=np.int8))
+    with pytest.raises(ParameterError, match="modes in"):
+        runner(log.select(slice(0, 10)), foreign)
+    with pytest.raises(ParameterError, match="deflections"):
+        runner(log.select(slice(0, 10)), (np.zeros(3), np.zeros(3, dtype=np.int8)))
+
+
 @pytest.mark.slow  # an identification, > 5 s
 def test_identification_recovers_the_parameters_from_noise_free_data():
     log = synthetic_log(20.0, seed=1)
