@@ -194,6 +194,14 @@ SPECS = {spec.name: spec for spec in (
                "greybox predict --relevel on the twin's part series, through a warm-up and on a cold machine: error "
                "of each part's mean cut force with and without re-levelling"),
     # -- end of the predict and monitor pages (issue 43) --
+    # -- the walk-through of usage.md and predict.md (issue 43, h43pages3) --
+    RecordSpec("walkthrough", ("scripts/walkthrough.py", "--figures", "docs/figures"),
+               ("scripts/walkthrough.py", "greybox/cli", "greybox/train", "greybox/predict", "greybox/evaluate",
+                "greybox/twin", *_FRICTION_FITS, "greybox/provenance.py", "data", "examples/axis_x.toml"),
+               "the walk-through of docs/usage.md and docs/predict.md run as printed: train GMS+SVR on X_A + X_B, "
+               "predict the cutting log X_D (seed 7) with and without calibration, a Coulomb model's "
+               "training-region note on X_D; the console lines, the table's rows and the pictures"),
+    # -- end of the walk-through (issue 43, h43pages3) --
 )}
 
 

@@ -683,6 +683,59 @@ def _predict_relevel(record: dict) -> str:
 # -- end of the predict and monitor pages (issue 43) --
 
 
+# -- the walk-through of usage.md and predict.md, the log formats' reading speed (issue 43, h43pages3) --
+
+
+def _console(lines: list) -> str:
+    return "```\n" + "\n".join(lines) + "\n```\n"
+
+
+def _walkthrough_predict(record: dict) -> str:
+    return _console(record["figures"]["predict_lines"]) + f"\n(`{record['command']}`, {_where(record)}.)\n"
+
+
+def _walkthrough_table(record: dict) -> str:
+    return _console(record["figures"]["table_text"].splitlines())
+
+
+def _walkthrough_row(record: dict) -> str:
+    row = record["figures"]["row_at_10_s"]
+    return (f"At 10 s the axis feeds at {row['velocity_mm_s']:.0f} mm/s through the workpiece: the model expects "
+            f"{row['current_model_A']:.2f} A of friction, the drive draws {row['current_measured_A']:.2f} A, and the "
+            f"{abs(row['current_process_A']):.2f} A more are {row['force_process_N']:.0f} N of feed force (the "
+            f"tooth-passing ripple and the current noise of a single sample included).\n")
+
+
+def _walkthrough_cut(record: dict) -> str:
+    f = record["figures"]
+    start, end = f["cut_stretch_s"]
+    return (f"In the cut the process current stands at {f['cut_mean_current_A']:.2f} A, {f['cut_mean_force_N']:.0f} N "
+            f"(its mean from {start:g} to {end:g} s; the true cut there, `truth_process_force_N`, is "
+            f"{f['cut_true_force_N']:.0f} N). On the air-cut return stroke (after {f['air_after_s']:g} s) it "
+            f"scatters around zero with a standard deviation of {f['air_process_std_A']:.3f} A, the model's "
+            f"air-cut error with the log's current noise ({f['noise_rms_A']:.3f} A rms) in it: the resolution of "
+            f"the force estimate.\n")
+
+
+def _walkthrough_interval(record: dict) -> str:
+    return _console(record["figures"]["interval_lines"])
+
+
+def _walkthrough_outside(record: dict) -> str:
+    return _console(record["figures"]["evaluate_lines"])
+
+
+def _log_formats_read_speed(record: dict) -> str:
+    read = record["figures"]["read"]
+    fast, general = read["mcap"], read["mcap, general JSON reader"]
+    return (f"{fast['samples_per_s'] / 1e6:.2f} M samples/s with the compiled reader against "
+            f"{general['samples_per_s'] / 1e6:.2f} M samples/s with the general one (median of 5 reads; "
+            f"`{record['command']}`, {_where(record)}).\n")
+
+
+# -- end of the walk-through (issue 43, h43pages3) --
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -773,6 +826,15 @@ VIEWS = {
     "monitor-query": View(("monitor-query",), _monitor_query),
     "predict-relevel": View(("predict-relevel",), _predict_relevel),
     # -- end of the predict and monitor pages (issue 43) --
+    # -- the walk-through of usage.md and predict.md, the log formats' reading speed (issue 43, h43pages3) --
+    "walkthrough-predict": View(("walkthrough",), _walkthrough_predict),
+    "walkthrough-table": View(("walkthrough",), _walkthrough_table),
+    "walkthrough-row": View(("walkthrough",), _walkthrough_row),
+    "walkthrough-cut": View(("walkthrough",), _walkthrough_cut),
+    "walkthrough-interval": View(("walkthrough",), _walkthrough_interval),
+    "walkthrough-outside": View(("walkthrough",), _walkthrough_outside),
+    "log-formats-read-speed": View(("predict-hour",), _log_formats_read_speed),
+    # -- end of the walk-through (issue 43, h43pages3) --
 }
 
 
