@@ -2,7 +2,8 @@
 
 Trains the walk-through's GMS+SVR model on the shipped air cuts X_A and X_B, makes the synthetic cutting log
 (trajectory D, seed 7), predicts it with the axis file, once more with an air run of D (seed 8) as calibration,
-and scores a Coulomb model trained on X_A alone on X_D (the training-region note). Every command runs with
+predicts it with a Stribeck model trained on X_A alone and scores a Coulomb model trained on X_A alone on X_D
+(the training-region notes). Every command runs with
 the greybox of this Python in a temporary folder holding links to ``data/`` and ``examples/``, so what it
 prints names the files as the pages do. Prints the console output of each command and the figures the pages
 quote, as one JSON object last (the record ``walkthrough`` of ``scripts/record.py``).
@@ -64,6 +65,8 @@ def walkthrough(folder: Path) -> dict:
     interval = _greybox(folder, "predict", "x_gmssvr.gbm", "cutting/X_D.mcap", "--out", "interval.csv",
                         "--axis-config", "examples/axis_x.toml", "--calibration", "aircut/X_D.mcap",
                         "--plot", "interval.png")
+    _greybox(folder, "train", "--model", "stribeck", "--train", "data/X_A.mcap", "--out", "s_a.gbm")
+    stribeck = _greybox(folder, "predict", "s_a.gbm", "cutting/X_D.mcap", "--out", "pe.csv")
     _greybox(folder, "train", "--model", "coulomb", "--train", "data/X_A.mcap", "--out", "c.gbm")
     evaluate = _greybox(folder, "evaluate", "c.gbm", "--test", "data/X_D.mcap")
 
@@ -86,6 +89,10 @@ def walkthrough(folder: Path) -> dict:
         "noise_rms_A": float(np.sqrt(np.mean(truth.extras["truth_noise_A"] ** 2))),
         "interval_lines": [line for line in _lines(interval) if line.lstrip().startswith("interval")],
         "evaluate_lines": _lines(evaluate),
+        "outside_lines": [line for line in _lines(stribeck)
+                          if line.startswith("note:") or line.lstrip().startswith("outside the training region")],
+        "outside_gmssvr": next(line.strip() for line in _lines(predict)
+                               if line.lstrip().startswith("outside the training region")),
     }
 
 
@@ -99,7 +106,7 @@ def main(argv=None) -> int:
         if args.figures:
             for made, name in (("process.png", "predict-gmssvr-X_D.png"), ("interval.png", "predict-interval-X_D.png")):
                 write_bytes_atomic(args.figures / name, (Path(folder) / made).read_bytes())
-    for key in ("predict_lines", "interval_lines", "evaluate_lines"):
+    for key in ("predict_lines", "interval_lines", "outside_lines", "evaluate_lines"):
         print("\n".join(figures[key]))
     print(figures["table_text"])
     print(json.dumps(figures, indent=1))

@@ -201,6 +201,17 @@ SPECS = {spec.name: spec for spec in (
                "the walk-through of docs/usage.md and docs/predict.md run as printed: train GMS+SVR on X_A + X_B, "
                "predict the cutting log X_D (seed 7) with and without calibration, a Coulomb model's "
                "training-region note on X_D; the console lines, the table's rows and the pictures"),
+    RecordSpec("discover-twin", ("scripts/discover_shipped.py",),
+               ("scripts/discover_shipped.py", "greybox/discover", "greybox/cli/discover.py", *_FRICTION_FITS,
+                "data/X_A.mcap", "data/X_C.mcap"),
+               "greybox discover with a GMS base on the shipped X axis (train X_A, test X_C): the effects named, "
+               "their held-out gains, the test error before and after against the noise floor"),
+    RecordSpec("process-example", ("scripts/process_example.py", "--figures", "docs/figures"),
+               ("scripts/process_example.py", "greybox/process", "greybox/cli", "greybox/train", "greybox/predict",
+                "greybox/twin", "greybox/windows.py", *_FRICTION_FITS, "data/X_A.mcap", "data/X_C.mcap",
+                "examples/axis_x.toml"),
+               "the example of docs/process.md as printed: a GMS on X_A + X_C, the twin's 12-part series with the "
+               "tool broken in part 12, a re-levelled force envelope taught on parts 1-10 and the series checked"),
     # -- end of the walk-through (issue 43, h43pages3) --
 )}
 
