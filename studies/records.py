@@ -212,6 +212,9 @@ SPECS = {spec.name: spec for spec in (
                 "examples/axis_x.toml"),
                "the example of docs/process.md as printed: a GMS on X_A + X_C, the twin's 12-part series with the "
                "tool broken in part 12, a re-levelled force envelope taught on parts 1-10 and the series checked"),
+    RecordSpec("intervals-example", ("scripts/intervals_example.py",),
+               ("scripts/intervals_example.py", "greybox/cli", "greybox/train", *_FRICTION_FITS, "data/X_A.mcap"),
+               "the example of docs/intervals.md as printed: a GMS on X_A, its parameters' 95 % intervals and flags"),
     # -- end of the walk-through (issue 43, h43pages3) --
 )}
 

@@ -803,6 +803,21 @@ def _process_example(record: dict) -> str:
             f"{', '.join(f'{limit:.1f}' for limit in limits)} N). (`{record['command']}`, {_where(record)}.)\n")
 
 
+def _intervals_example(record: dict) -> str:
+    f = record["figures"]
+    widths, flagged = [], []
+    for name, entry in f["parameters"].items():
+        value, lower, upper = entry["value"], entry.get("lower_95"), entry.get("upper_95")
+        if entry.get("flag"):
+            flagged.append(f"`{name}` ({entry['flag']})")
+        elif isinstance(value, (int, float)) and lower is not None and upper is not None and value > 0 and lower > 0:
+            widths.append(f"`{name}` {value / lower:.2f} / {upper / value:.2f}")
+    return (_console([f"{f['command']}", "...", *f["lines"]])
+            + "\nEach determined parameter's interval as the factors value / lower end and upper end / value: "
+            + (", ".join(widths) or "none") + ". Flagged: " + ("; ".join(flagged) or "none")
+            + f". (`{record['command']}`, {_where(record)}.)\n")
+
+
 # -- end of the walk-through (issue 43, h43pages3) --
 
 
@@ -907,6 +922,7 @@ VIEWS = {
     "log-formats-read-speed": View(("predict-hour",), _log_formats_read_speed),
     "discover-twin": View(("discover-twin",), _discover_twin),
     "process-example": View(("process-example",), _process_example),
+    "intervals-example": View(("intervals-example",), _intervals_example),
     "readme-more": View(("monitor-detection", "process-head-to-head", "process-speed"), _readme_more),
     # -- end of the walk-through (issue 43, h43pages3) --
 }
