@@ -702,7 +702,7 @@ def _walkthrough_row(record: dict) -> str:
     row = record["figures"]["row_at_10_s"]
     return (f"At 10 s the axis feeds at {row['velocity_mm_s']:.0f} mm/s through the workpiece: the model expects "
             f"{row['current_model_A']:.2f} A of friction, the drive draws {row['current_measured_A']:.2f} A, and the "
-            f"{abs(row['current_process_A']):.2f} A more are {row['force_process_N']:.0f} N of feed force (the "
+            f"{abs(row['current_process_A']):.2f} A more are {abs(row['force_process_N']):.0f} N of feed force (the "
             f"tooth-passing ripple and the current noise of a single sample included).\n")
 
 
@@ -818,6 +818,17 @@ def _intervals_example(record: dict) -> str:
             + f". (`{record['command']}`, {_where(record)}.)\n")
 
 
+def _friction_models_idim(record: dict) -> str:
+    f = record["figures"]
+    ours, published = f["models"]["coulomb_idim_ls"], f["published"]["coulomb_idim_ls"]
+    keys = (("M_kg", "M", "kg", 2), ("Fv_N_s_per_m", "Fv", "N s/m", 1), ("Fc_N", "Fc", "N", 2),
+            ("offset_N", "offset", "N", 2))
+    mine = ", ".join(f"{label} = {ours['params'][key]:.{digits}f} {unit}" for key, label, unit, digits in keys)
+    theirs = " / ".join(f"{published['params'][key]:.{digits}f}" for key, _, _, digits in keys)
+    return (f"On the EMPS benchmark, fitted on the benchmark's decimated observation matrix (its record "
+            f"`emps-benchmark`, `{record['command']}`), it gives {mine}, against the published {theirs}.\n")
+
+
 # -- end of the walk-through (issue 43, h43pages3) --
 
 
@@ -923,6 +934,7 @@ VIEWS = {
     "discover-twin": View(("discover-twin",), _discover_twin),
     "process-example": View(("process-example",), _process_example),
     "intervals-example": View(("intervals-example",), _intervals_example),
+    "friction-models-idim": View(("emps-benchmark",), _friction_models_idim),
     "readme-more": View(("monitor-detection", "process-head-to-head", "process-speed"), _readme_more),
     # -- end of the walk-through (issue 43, h43pages3) --
 }
