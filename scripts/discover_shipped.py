@@ -13,14 +13,15 @@ Usage::
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
 from greybox.data import read_log
+from studies.as_printed import reader_folder, run_greybox
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The command's arguments after ``greybox discover``, without ``--json``.
@@ -28,15 +29,10 @@ ARGUMENTS = ("--model", "gms", "--train", "data/X_A.mcap", "--test", "data/X_C.m
 
 
 def main() -> int:
-    with tempfile.TemporaryDirectory(prefix="greybox-discover-") as folder:
-        out = Path(folder) / "x.json"
-        done = subprocess.run([sys.executable, "-m", "greybox", "discover", *ARGUMENTS, "--json", str(out)],
-                              cwd=ROOT, stdout=subprocess.PIPE, text=True)
-        if done.returncode != 0:
-            print(f"error: greybox discover exited with status {done.returncode}", file=sys.stderr)
-            return 2
-        document = json.loads(out.read_text(encoding="utf-8"))
-    print(done.stdout, end="")
+    with reader_folder("greybox-discover-") as folder:
+        printed = run_greybox(folder, "discover", *ARGUMENTS, "--json", "x.json")
+        document = json.loads((folder / "x.json").read_text(encoding="utf-8"))
+    print("\n".join(printed))
     test = read_log(ROOT / "data" / "X_C.mcap")
     floor = float(np.sqrt(np.mean((test.effort - test.extras["truth_current_A"]) ** 2)))
     print(json.dumps({"command": "greybox discover " + " ".join(ARGUMENTS) + " --json x.json",

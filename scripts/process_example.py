@@ -17,16 +17,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import pandas as pd
 
-from greybox.atomic import write_bytes_atomic
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
 
-ROOT = Path(__file__).resolve().parents[1]
+from greybox.atomic import write_bytes_atomic
+from studies.as_printed import reader_folder, run_greybox
+
 #: The page's commands, after ``greybox``.
 COMMANDS = (
     ("train", "--model", "gms", "--train", "data/X_A.mcap", "data/X_C.mcap", "--out", "gms_x.gbm"),
@@ -37,19 +37,9 @@ COMMANDS = (
 )
 
 
-def _greybox(folder: Path, args: tuple) -> list[str]:
-    """Run one greybox command in ``folder``; the lines of its standard output."""
-    done = subprocess.run([sys.executable, "-m", "greybox", *args], cwd=folder, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"error: greybox {' '.join(args)} failed ({done.returncode}): {done.stderr.strip()}")
-    return [line for line in done.stdout.splitlines() if line.strip()]
-
-
 def process_example(folder: Path) -> dict:
-    """Run the example in ``folder``; the console lines and figures the page quotes."""
-    for name in ("data", "examples"):
-        (folder / name).symlink_to(ROOT / name, target_is_directory=True)
-    printed = [_greybox(folder, args) for args in COMMANDS]
+    """Run the example in ``folder`` (:func:`studies.as_printed.reader_folder`); the lines and figures quoted."""
+    printed = [run_greybox(folder, *args) for args in COMMANDS]
     truth = json.loads((folder / "series" / "X_parts.json").read_text(encoding="utf-8"))
     parts = pd.read_csv(folder / "report" / "parts.csv")
     stretches = pd.read_csv(folder / "report" / "stretches.csv")
@@ -69,10 +59,10 @@ def main(argv=None) -> int:
     parser.add_argument("--figures", type=Path, help="copy the check's picture of part 12 here as "
                         "process-part-breakage.png (the page's figure)")
     args = parser.parse_args(argv)
-    with tempfile.TemporaryDirectory(prefix="greybox-process-example-") as folder:
-        figures = process_example(Path(folder))
+    with reader_folder("greybox-process-example-") as folder:
+        figures = process_example(folder)
         if args.figures:
-            picture = Path(folder) / "report" / "part_X_series_012.png"
+            picture = folder / "report" / "part_X_series_012.png"
             write_bytes_atomic(args.figures / "process-part-breakage.png", picture.read_bytes())
     print("\n".join(figures["teach_lines"] + figures["check_lines"]))
     print(json.dumps(figures, indent=1))

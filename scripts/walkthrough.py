@@ -17,18 +17,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
 from greybox.atomic import write_bytes_atomic
 from greybox.data import read_log
+from studies.as_printed import reader_folder, run_greybox
 
-ROOT = Path(__file__).resolve().parents[1]
 #: The rows of the process table the pages show [s].
 TABLE_TIMES_S = (0.0, 10.0, 20.0)
 #: The stretch of the outbound stroke inside the cut whose mean the pages quote [s].
@@ -37,38 +37,21 @@ CUT_STRETCH_S = (6.0, 20.0)
 AIR_AFTER_S = 28.0
 
 
-def _greybox(folder: Path, *args: str) -> str:
-    """Run one greybox command in ``folder``: its ``note:`` lines (standard error), then its standard output.
-
-    The progress lines on standard error are dropped."""
-    done = subprocess.run([sys.executable, "-m", "greybox", *args], cwd=folder, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"error: greybox {' '.join(args)} failed ({done.returncode}): {done.stderr.strip()}")
-    notes = [line for line in done.stderr.splitlines() if line.startswith("note:")]
-    return "\n".join([*notes, done.stdout])
-
-
-def _lines(text: str, *, drop_wall: bool = False) -> list[str]:
-    return [line for line in text.splitlines() if line.strip() and not (drop_wall and line.startswith("done in"))]
-
-
 def walkthrough(folder: Path) -> dict:
-    """Run the walk-through in ``folder``; the console lines and figures the pages quote."""
-    for name in ("data", "examples"):
-        (folder / name).symlink_to(ROOT / name, target_is_directory=True)
-    _greybox(folder, "train", "--model", "gmssvr", "--train", "data/X_A.mcap", "data/X_B.mcap",
+    """Run the walk-through in ``folder`` (:func:`studies.as_printed.reader_folder`); the lines and figures quoted."""
+    run_greybox(folder, "train", "--model", "gmssvr", "--train", "data/X_A.mcap", "data/X_B.mcap",
              "--out", "x_gmssvr.gbm")
-    _greybox(folder, "synth", "--axis", "X", "--datasets", "D", "--cutting", "--seed", "7", "--out", "cutting")
-    predict = _greybox(folder, "predict", "x_gmssvr.gbm", "cutting/X_D.mcap", "--out", "process.csv",
+    run_greybox(folder, "synth", "--axis", "X", "--datasets", "D", "--cutting", "--seed", "7", "--out", "cutting")
+    predict = run_greybox(folder, "predict", "x_gmssvr.gbm", "cutting/X_D.mcap", "--out", "process.csv",
                        "--axis-config", "examples/axis_x.toml", "--plot", "process.png")
-    _greybox(folder, "synth", "--axis", "X", "--datasets", "D", "--seed", "8", "--out", "aircut")
-    interval = _greybox(folder, "predict", "x_gmssvr.gbm", "cutting/X_D.mcap", "--out", "interval.csv",
+    run_greybox(folder, "synth", "--axis", "X", "--datasets", "D", "--seed", "8", "--out", "aircut")
+    interval = run_greybox(folder, "predict", "x_gmssvr.gbm", "cutting/X_D.mcap", "--out", "interval.csv",
                         "--axis-config", "examples/axis_x.toml", "--calibration", "aircut/X_D.mcap",
                         "--plot", "interval.png")
-    _greybox(folder, "train", "--model", "stribeck", "--train", "data/X_A.mcap", "--out", "s_a.gbm")
-    stribeck = _greybox(folder, "predict", "s_a.gbm", "cutting/X_D.mcap", "--out", "pe.csv")
-    _greybox(folder, "train", "--model", "coulomb", "--train", "data/X_A.mcap", "--out", "c.gbm")
-    evaluate = _greybox(folder, "evaluate", "c.gbm", "--test", "data/X_D.mcap")
+    run_greybox(folder, "train", "--model", "stribeck", "--train", "data/X_A.mcap", "--out", "s_a.gbm")
+    stribeck = run_greybox(folder, "predict", "s_a.gbm", "cutting/X_D.mcap", "--out", "pe.csv")
+    run_greybox(folder, "train", "--model", "coulomb", "--train", "data/X_A.mcap", "--out", "c.gbm")
+    evaluate = run_greybox(folder, "evaluate", "c.gbm", "--test", "data/X_D.mcap")
 
     table = pd.read_csv(folder / "process.csv")
     shown = table[table["time_s"].isin(TABLE_TIMES_S)]
@@ -77,7 +60,7 @@ def walkthrough(folder: Path) -> dict:
     stretch = (t >= CUT_STRETCH_S[0]) & (t <= CUT_STRETCH_S[1])
     truth_stretch = (truth.time >= CUT_STRETCH_S[0]) & (truth.time <= CUT_STRETCH_S[1])
     return {
-        "predict_lines": _lines(predict),
+        "predict_lines": predict,
         "table_text": shown.to_string(index=False),
         "row_at_10_s": {key: float(value) for key, value in shown[shown["time_s"] == 10.0].iloc[0].items()},
         "cut_stretch_s": list(CUT_STRETCH_S),
@@ -87,11 +70,11 @@ def walkthrough(folder: Path) -> dict:
         "air_after_s": AIR_AFTER_S,
         "air_process_std_A": float(np.std(table["current_process_A"].to_numpy()[t > AIR_AFTER_S])),
         "noise_rms_A": float(np.sqrt(np.mean(truth.extras["truth_noise_A"] ** 2))),
-        "interval_lines": [line for line in _lines(interval) if line.lstrip().startswith("interval")],
-        "evaluate_lines": _lines(evaluate),
-        "outside_lines": [line for line in _lines(stribeck)
+        "interval_lines": [line for line in interval if line.lstrip().startswith("interval")],
+        "evaluate_lines": evaluate,
+        "outside_lines": [line for line in stribeck
                           if line.startswith("note:") or line.lstrip().startswith("outside the training region")],
-        "outside_gmssvr": next(line.strip() for line in _lines(predict)
+        "outside_gmssvr": next(line.strip() for line in predict
                                if line.lstrip().startswith("outside the training region")),
     }
 
@@ -101,11 +84,11 @@ def main(argv=None) -> int:
     parser.add_argument("--figures", type=Path, help="copy the two pictures here as predict-gmssvr-X_D.png and "
                         "predict-interval-X_D.png (the pages' figures)")
     args = parser.parse_args(argv)
-    with tempfile.TemporaryDirectory(prefix="greybox-walkthrough-") as folder:
-        figures = walkthrough(Path(folder))
+    with reader_folder("greybox-walkthrough-") as folder:
+        figures = walkthrough(folder)
         if args.figures:
             for made, name in (("process.png", "predict-gmssvr-X_D.png"), ("interval.png", "predict-interval-X_D.png")):
-                write_bytes_atomic(args.figures / name, (Path(folder) / made).read_bytes())
+                write_bytes_atomic(args.figures / name, (folder / made).read_bytes())
     for key in ("predict_lines", "interval_lines", "outside_lines", "evaluate_lines"):
         print("\n".join(figures[key]))
     print(figures["table_text"])
