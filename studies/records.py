@@ -194,6 +194,32 @@ SPECS = {spec.name: spec for spec in (
                "greybox predict --relevel on the twin's part series, through a warm-up and on a cold machine: error "
                "of each part's mean cut force with and without re-levelling"),
     # -- end of the predict and monitor pages (issue 43) --
+    # -- the walk-through of usage.md and predict.md (issue 43, h43pages3) --
+    RecordSpec("walkthrough", ("scripts/walkthrough.py", "--figures", "docs/figures"),
+               ("scripts/walkthrough.py", "studies/as_printed.py", "greybox/cli", "greybox/train", "greybox/predict",
+                "greybox/evaluate",
+                "greybox/twin", *_FRICTION_FITS, "greybox/provenance.py", "data", "examples/axis_x.toml"),
+               "the walk-through of docs/usage.md and docs/predict.md run as printed: train GMS+SVR on X_A + X_B, "
+               "predict the cutting log X_D (seed 7) with and without calibration, a Coulomb model's "
+               "training-region note on X_D; the console lines, the table's rows and the pictures"),
+    RecordSpec("discover-twin", ("scripts/discover_shipped.py",),
+               ("scripts/discover_shipped.py", "studies/as_printed.py", "greybox/discover", "greybox/cli/discover.py",
+                *_FRICTION_FITS,
+                "data/X_A.mcap", "data/X_C.mcap"),
+               "greybox discover with a GMS base on the shipped X axis (train X_A, test X_C): the effects named, "
+               "their held-out gains, the test error before and after against the noise floor"),
+    RecordSpec("process-example", ("scripts/process_example.py", "--figures", "docs/figures"),
+               ("scripts/process_example.py", "studies/as_printed.py", "greybox/process", "greybox/cli",
+                "greybox/train", "greybox/predict",
+                "greybox/twin", "greybox/windows.py", *_FRICTION_FITS, "data/X_A.mcap", "data/X_C.mcap",
+                "examples/axis_x.toml"),
+               "the example of docs/process.md as printed: a GMS on X_A + X_C, the twin's 12-part series with the "
+               "tool broken in part 12, a re-levelled force envelope taught on parts 1-10 and the series checked"),
+    RecordSpec("intervals-example", ("scripts/intervals_example.py",),
+               ("scripts/intervals_example.py", "studies/as_printed.py", "greybox/cli", "greybox/train",
+                *_FRICTION_FITS, "data/X_A.mcap"),
+               "the example of docs/intervals.md as printed: a GMS on X_A, its parameters' 95 % intervals and flags"),
+    # -- end of the walk-through (issue 43, h43pages3) --
 )}
 
 

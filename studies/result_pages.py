@@ -686,6 +686,155 @@ def _predict_relevel(record: dict) -> str:
 # -- end of the predict and monitor pages (issue 43) --
 
 
+# -- the walk-through of usage.md and predict.md, the log formats' reading speed (issue 43, h43pages3) --
+
+
+def _console(lines: list) -> str:
+    return "```\n" + "\n".join(lines) + "\n```\n"
+
+
+def _walkthrough_predict(record: dict) -> str:
+    return _console(record["figures"]["predict_lines"]) + f"\n(`{record['command']}`, {_where(record)}.)\n"
+
+
+def _walkthrough_table(record: dict) -> str:
+    return _console(record["figures"]["table_text"].splitlines())
+
+
+def _walkthrough_row(record: dict) -> str:
+    row = record["figures"]["row_at_10_s"]
+    return (f"At 10 s the axis feeds at {row['velocity_mm_s']:.0f} mm/s through the workpiece: the model expects "
+            f"{row['current_model_A']:.2f} A of friction, the drive draws {row['current_measured_A']:.2f} A, and the "
+            f"{abs(row['current_process_A']):.2f} A more are {abs(row['force_process_N']):.0f} N of feed force (the "
+            f"tooth-passing ripple and the current noise of a single sample included).\n")
+
+
+def _walkthrough_cut(record: dict) -> str:
+    f = record["figures"]
+    start, end = f["cut_stretch_s"]
+    return (f"In the cut the process current stands at {f['cut_mean_current_A']:.2f} A, {f['cut_mean_force_N']:.0f} N "
+            f"(its mean from {start:g} to {end:g} s; the true cut there, `truth_process_force_N`, is "
+            f"{f['cut_true_force_N']:.0f} N). On the air-cut return stroke (after {f['air_after_s']:g} s) it "
+            f"scatters around zero with a standard deviation of {f['air_process_std_A']:.3f} A, the model's "
+            f"air-cut error with the log's current noise ({f['noise_rms_A']:.3f} A rms) in it: the resolution of "
+            f"the force estimate.\n")
+
+
+def _walkthrough_interval(record: dict) -> str:
+    return _console(record["figures"]["interval_lines"])
+
+
+def _walkthrough_outside(record: dict) -> str:
+    return _console(record["figures"]["evaluate_lines"])
+
+
+def _walkthrough_stribeck(record: dict) -> str:
+    f = record["figures"]
+    return (_console(["..."] + f["outside_lines"]) + "\n(a Stribeck model trained on dataset A alone, the 50 mm "
+            "window, predicting the cut of trajectory D over the whole travel; D's 1200 mm/min lies inside A's "
+            f"speeds). The walk-through's GMS+SVR model, trained on A and B, prints on the same log: "
+            f"`{f['outside_gmssvr']}`.\n")
+
+
+def _log_formats_read_speed(record: dict) -> str:
+    read = record["figures"]["read"]
+    fast, general = read["mcap"], read["mcap, general JSON reader"]
+    return (f"{fast['samples_per_s'] / 1e6:.2f} M samples/s with the compiled reader against "
+            f"{general['samples_per_s'] / 1e6:.2f} M samples/s with the general one (median of 5 reads; "
+            f"`{record['command']}`, {_where(record)}).\n")
+
+
+def _discover_twin(record: dict) -> str:
+    f = record["figures"]
+    document = f["document"]
+    effects = "; ".join(
+        f"`{effect['name']}` (" + ", ".join(f"{name} {value:.4g}" for name, value in effect["parameters"].items())
+        + f"; {_held_out(effect['evidence']['held_out'])})" for effect in document["effects"]) or "none"
+    return (f"`{f['command']}` gives the verdict `{document['verdict']}` and names, in this order: {effects}. Test "
+            f"RMSE on X_C {document['test_rmse_before']:.4f} -> {document['test_rmse_after']:.4f} A (RE "
+            f"{document['test_re_before']:.2f} -> {document['test_re_after']:.2f} %), against a noise floor of "
+            f"{f['noise_floor_A']:.4f} A (`{record['command']}`, the record `discover-twin`: "
+            f"{record['seconds']:.0f} s, "
+            f"{_where(record)}).\n")
+
+
+def _readme_more(detection: dict, head_to_head: dict, speed: dict) -> str:
+    drifts = {kind: r for kind, r in detection["figures"].items() if kind != "none"}
+    seeds = len(next(iter(drifts.values()))["delays_days"])
+    total = seeds * len(drifts)
+    within = sum(r["within_7_days"] for r in drifts.values())
+    right = sum(r["right_first"] for r in drifts.values())
+    medians = ", ".join(f"{kind} {r['median_delay_days']:g}" for kind, r in drifts.items()
+                        if r.get("median_delay_days") is not None)
+    held_out = head_to_head["figures"]["held_out"]
+    met = "; ".join(f"{name}: " + ", ".join(f"{what} {_met(ok)}" for what, ok in targets(held_out, name).items()
+                                             if ok is not None)
+                    for name in ("force, re-levelled", "raw, re-levelled"))
+    ratio = speed["figures"]["real_time_ratio"]
+    return ("| what | figure | page |\n|---|---|---|\n"
+            f"| `greybox monitor` on ageing twin axes, held-out seeds (`{detection['command']}`) | drifts alarmed "
+            f"within "
+            f"7 days of onset: {within} of {total} ({_met(within == total)}; median days: {medians}); the right "
+            f"feature first: {right} of {total} ({_met(right == total)}) ({_where(detection)}) "
+            f"| [monitor](docs/monitor.md) |\n"
+            f"| teach-in envelopes on twin part series through a warm-up, held-out seeds "
+            f"{', '.join(held_out['series'])} and {', '.join(held_out['good'])} (`{head_to_head['command']}`) | "
+            f"targets: {met} ({_where(head_to_head)}); "
+            f"`greybox process check` at {ratio:.1f} times real time on one core (`{speed['command']}`, "
+            f"{_where(speed)}) | [process](docs/process.md) |\n")
+
+
+def _process_example(record: dict) -> str:
+    f = record["figures"]
+    part = f["truth_parts"][-1]
+    event = f["truth_events"][0]
+    warm_up = f["warm_up"]
+    passed = [row for row in f["parts"] if not row["flagged"]]
+    broken = [row for row in f["stretches"] if row["part"] == event["part"]]
+    first = min(row["start_s"] for row in broken) if broken else None
+    found = (f"the first stretch of part {event['part']} outside the band starts {first - event['time_s']:+.2f} s "
+             f"from the breakage" if first is not None else f"part {event['part']} has no stretch outside the band")
+    deviations = [row["deviation"] for row in passed]
+    limits = sorted({row["deviation_limit"] for row in passed})
+    return (_console(f["teach_lines"] + f["check_lines"])
+            + f"\nThe twin's {len(f['parts'])} parts warm up from cold ({100 * warm_up['drop']:.0f} % drop, "
+            f"{warm_up['time_constant_s'] / 60:.0f} min time constant): by the end of part {part['part']} the friction "
+            f"has fallen by {100 * (1 - part['friction_factor_end']):.1f} % (`friction_factor_end` "
+            f"{part['friction_factor_end']:.3f} in `series/X_parts.json`); the tool breaks in part {event['part']} at "
+            f"{event['time_s']:g} s. {found[0].upper() + found[1:]}; "
+            f"{len(passed)} parts passed with `D` between {min(deviations):.1f} and {max(deviations):.1f} N (limit "
+            f"{', '.join(f'{limit:.1f}' for limit in limits)} N). (`{record['command']}`, {_where(record)}.)\n")
+
+
+def _intervals_example(record: dict) -> str:
+    f = record["figures"]
+    widths, flagged = [], []
+    for name, entry in f["parameters"].items():
+        value, lower, upper = entry["value"], entry.get("lower_95"), entry.get("upper_95")
+        if entry.get("flag"):
+            flagged.append(f"`{name}` ({entry['flag']})")
+        elif isinstance(value, (int, float)) and lower is not None and upper is not None and value > 0 and lower > 0:
+            widths.append(f"`{name}` {value / lower:.2f} / {upper / value:.2f}")
+    return (_console([f"{f['command']}", "...", *f["lines"]])
+            + "\nEach determined parameter's interval as the factors value / lower end and upper end / value: "
+            + (", ".join(widths) or "none") + ". Flagged: " + ("; ".join(flagged) or "none")
+            + f". (`{record['command']}`, {_where(record)}.)\n")
+
+
+def _friction_models_idim(record: dict) -> str:
+    f = record["figures"]
+    ours, published = f["models"]["coulomb_idim_ls"], f["published"]["coulomb_idim_ls"]
+    keys = (("M_kg", "M", "kg", 2), ("Fv_N_s_per_m", "Fv", "N s/m", 1), ("Fc_N", "Fc", "N", 2),
+            ("offset_N", "offset", "N", 2))
+    mine = ", ".join(f"{label} = {ours['params'][key]:.{digits}f} {unit}" for key, label, unit, digits in keys)
+    theirs = " / ".join(f"{published['params'][key]:.{digits}f}" for key, _, _, digits in keys)
+    return (f"On the EMPS benchmark, fitted on the benchmark's decimated observation matrix (its record "
+            f"`emps-benchmark`, `{record['command']}`), it gives {mine}, against the published {theirs}.\n")
+
+
+# -- end of the walk-through (issue 43, h43pages3) --
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -776,6 +925,21 @@ VIEWS = {
     "monitor-query": View(("monitor-query",), _monitor_query),
     "predict-relevel": View(("predict-relevel",), _predict_relevel),
     # -- end of the predict and monitor pages (issue 43) --
+    # -- the walk-through of usage.md and predict.md, the log formats' reading speed (issue 43, h43pages3) --
+    "walkthrough-predict": View(("walkthrough",), _walkthrough_predict),
+    "walkthrough-table": View(("walkthrough",), _walkthrough_table),
+    "walkthrough-row": View(("walkthrough",), _walkthrough_row),
+    "walkthrough-cut": View(("walkthrough",), _walkthrough_cut),
+    "walkthrough-interval": View(("walkthrough",), _walkthrough_interval),
+    "walkthrough-outside": View(("walkthrough",), _walkthrough_outside),
+    "walkthrough-stribeck": View(("walkthrough",), _walkthrough_stribeck),
+    "log-formats-read-speed": View(("predict-hour",), _log_formats_read_speed),
+    "discover-twin": View(("discover-twin",), _discover_twin),
+    "process-example": View(("process-example",), _process_example),
+    "intervals-example": View(("intervals-example",), _intervals_example),
+    "friction-models-idim": View(("emps-benchmark",), _friction_models_idim),
+    "readme-more": View(("monitor-detection", "process-head-to-head", "process-speed"), _readme_more),
+    # -- end of the walk-through (issue 43, h43pages3) --
 }
 
 

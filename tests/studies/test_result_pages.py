@@ -96,3 +96,25 @@ def test_features_named_equally_often_are_listed_by_name_whatever_the_hash_seed(
     text = VIEWS["monitor-detection"].render({**record, "figures": figures})
     row = next(line for line in text.splitlines() if line.startswith("| preload"))
     assert "breakaway_pos falls (9), " + ", ".join(f"{name} (1)" for name in sorted(names)) in row
+
+
+def _example_record(stretch_start_s: float, deviations: list) -> dict:
+    parts = [{"part": n, "flagged": False, "deviation": d, "deviation_limit": 9.0} for n, d in enumerate(deviations, 1)]
+    parts.append({"part": len(parts) + 1, "flagged": True, "deviation": -30.0, "deviation_limit": 9.0})
+    return {"command": "python scripts/process_example.py", "cores": 2, "load_before": [1.0], "load_after": [1.0],
+            "commit": "0" * 40, "date": "2026-11-29T00:00:00+00:00",
+            "figures": {"teach_lines": ["taught"], "check_lines": ["checked"], "parts": parts,
+                        "stretches": [{"part": len(parts), "start_s": stretch_start_s + 1.0},
+                                      {"part": len(parts), "start_s": stretch_start_s}],
+                        "truth_parts": [{"part": len(parts), "friction_factor_end": 0.9}],
+                        "truth_events": [{"part": len(parts), "time_s": 33.4}],
+                        "warm_up": {"drop": 0.25, "time_constant_s": 2400.0}}}
+
+
+def test_the_process_example_reads_the_breakage_delay_and_the_passed_parts_from_the_record():
+    text = VIEWS["process-example"].render(_example_record(33.45, [-2.0, 1.5, 3.25]))
+    assert "starts +0.05 s from the breakage" in text  # the first stretch of the broken part, not the later one
+    assert "3 parts passed with `D` between -2.0 and 3.2 N (limit 9.0 N)" in text  # the flagged part left out
+    assert "fallen by 10.0 %" in text and "25 % drop, 40 min time constant" in text
+    later = VIEWS["process-example"].render(_example_record(34.0, [-2.0, 1.5, 3.25]))
+    assert "starts +0.60 s from the breakage" in later
