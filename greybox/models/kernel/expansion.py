@@ -377,8 +377,10 @@ class KernelFrame:
     def terms(self, X):
         """Expansion, hand-over weight and input-range flags of raw inputs ``X`` in one compiled pass.
 
-        A chunk of a log long enough to share (:func:`~greybox.models.kernel.rbf.threads_for`) has its
-        kernel sums dealt out over the threads of :func:`numba.get_num_threads`; the sums are the same.
+        A chunk of a log long enough to share (:func:`~greybox.models.kernel.rbf.threads_for` of two threads)
+        has its kernel sums added by :func:`~greybox.models.kernel.rbf.add_expansion`, dealt out over the threads
+        of :func:`numba.get_num_threads` (one or more): the same compiled code whatever their number, so the
+        same sums to the last bit.
 
         What :meth:`expansion`, :meth:`weight` and the model's ``"inputs"`` flag give, for the few samples of
         a live message: the per-call checks and copies of :func:`~greybox.models.kernel.rbf.rbf_expansion` are done
@@ -402,12 +404,11 @@ class KernelFrame:
         arguments = self._arguments()
         expansion, weight, outside = np.empty(len(X)), np.empty(len(X)), np.empty(len(X), dtype=np.bool_)
         support_t, alpha, _, gamma, cutoff = arguments[3:8]
-        threads = threads_for(len(X), numba.get_num_threads())
-        if threads == 1 or cutoff < 0.0:
+        if threads_for(len(X), 2) == 1 or cutoff < 0.0:  # the few samples of a live message: one call
             frame_terms(X, *arguments, expansion, weight, outside)
-        else:  # a chunk of a log: the kernel sums over threads, the rest in one pass without them
+        else:  # a chunk of a log: the kernel sums (over threads), the rest in one pass without them
             frame_terms(X, *arguments[:7], -1.0, *arguments[8:], expansion, weight, outside)
-            add_expansion(self.coordinates(X), support_t, alpha, gamma, cutoff, expansion, threads)
+            add_expansion(self.coordinates(X), support_t, alpha, gamma, cutoff, expansion, numba.get_num_threads())
         return expansion, (weight if arguments[-2] else None), (outside if arguments[-1] else None)
 
     def coordinates(self, X) -> np.ndarray:

@@ -33,11 +33,25 @@ def test_matches_reference_far_from_the_origin():
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-14 + 1e-13 * np.abs(alpha).sum())
 
 
+@pytest.mark.parametrize("n_samples", [1, 2, 3, 64, 65, 127, 131])
+def test_samples_taken_two_at_a_time_whatever_the_block_ends(n_samples):
+    """Blocks of odd length (the last sample of a pair alone) and of one sample match the reference."""
+    rng = np.random.default_rng(n_samples)
+    X = np.cumsum(rng.normal(scale=0.1, size=(n_samples, 3)), axis=0)
+    sv = rng.normal(size=(23, 3))
+    alpha = rng.normal(size=23)
+    expected = reference_expansion(X, sv, alpha, -0.2, 0.7)
+    got = rbf_expansion(X, sv, alpha, -0.2, 0.7, tolerance=1e-14, threads=1)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-14 + 1e-13 * np.abs(alpha).sum())
+
+
 def test_compiled_exponential_within_its_stated_relative_error():
-    t = np.concatenate([np.linspace(0.0, MAX_CUTOFF, 200_001), np.arange(65) + 0.5, np.arange(65) - 1e-12])
+    table = np.arange(int(MAX_CUTOFF) * rbf._EXP_STEPS + 1) / rbf._EXP_STEPS  # the table's points, and between them
+    t = np.concatenate([np.linspace(0.0, MAX_CUTOFF, 4001), table, table + 0.5 / rbf._EXP_STEPS,
+                        table + 0.5 / rbf._EXP_STEPS - 1e-12, np.arange(65) - 1e-12])
     t = t[(t >= 0) & (t <= MAX_CUTOFF)]
-    approx = np.array([rbf._exp_neg(value) for value in t[::50]])
-    exact = np.array([math.exp(-value) for value in t[::50]])
+    approx = np.array([rbf._exp_neg(value) for value in t])
+    exact = np.array([math.exp(-value) for value in t])
     assert np.max(np.abs(approx / exact - 1.0)) <= EXP_RELATIVE_ERROR
 
 
