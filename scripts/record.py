@@ -2,7 +2,8 @@
 
 Each name is a record of :data:`studies.records.SPECS`; its command runs from the repository's root, and
 the record (figures, command, commit, date, cores, load, versions) is written to ``docs/results/<name>.json``.
-Then every page's marked tables are rendered anew (``scripts/render_results.py``).
+The pictures drawn from a measured record are redrawn (``scripts/record_figures.py``), then every page's
+marked tables are rendered anew (``scripts/render_results.py``).
 
 Usage::
 
@@ -17,6 +18,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
+
+from record_figures import DRAWN_FROM  # noqa: E402 (beside this script)
 
 from greybox.errors import GreyboxError
 from studies.records import ROOT, SPECS, measure, record_path, write_record
@@ -46,6 +49,8 @@ def main(argv=None) -> int:
             path = write_record(record)
             print(f"wrote {path.relative_to(ROOT)} ({record['seconds']:.0f} s, load {record['load_before'][0]:.1f} "
                   f"before and {record['load_after'][0]:.1f} after, {record['cores']} cores)")
+            if name in DRAWN_FROM:
+                print(f"drew {DRAWN_FROM[name](ROOT / 'docs' / 'figures').relative_to(ROOT)}")
         missing = tuple(name for name in SPECS if not record_path(name).is_file())
         for page in render_pages(keep=missing):
             print(f"rendered {page.relative_to(ROOT)}")

@@ -36,6 +36,10 @@ def cut_correlation_figure(out: Path) -> Path:
                                      out / "cut-correlation-vs-force.png")
 
 
+#: The pictures drawn from a record, by the record's name: ``scripts/record.py`` redraws them after measuring it.
+DRAWN_FROM = {"cutting-validation": cut_correlation_figure}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "figures", help="folder of the pictures")

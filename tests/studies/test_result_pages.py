@@ -118,3 +118,18 @@ def test_the_process_example_reads_the_breakage_delay_and_the_passed_parts_from_
     assert "fallen by 10.0 %" in text and "25 % drop, 40 min time constant" in text
     later = VIEWS["process-example"].render(_example_record(34.0, [-2.0, 1.5, 3.25]))
     assert "starts +0.60 s from the breakage" in later
+
+
+
+def test_every_picture_drawn_from_a_record_names_a_record():
+    # scripts/record.py redraws these after measuring the record; a renamed record would leave the picture stale
+    import sys
+    from pathlib import Path
+
+    scripts = str(Path(__file__).resolve().parents[2] / "scripts")
+    sys.path.insert(0, scripts)
+    try:
+        from record_figures import DRAWN_FROM
+    finally:
+        sys.path.remove(scripts)
+    assert DRAWN_FROM and set(DRAWN_FROM) <= set(SPECS)
