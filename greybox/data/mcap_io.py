@@ -17,10 +17,12 @@ Layout written by :func:`write_mcap` (documented for logger authors in
 field names follow the same rules as CSV columns (unit suffixes, ``columns=``
 mapping). It walks the records itself, so that a file of millions of messages
 is decoded in bulk rather than message by message, and so that a damaged file
-gives a :class:`~greybox.errors.LogError`: chunks are decompressed ahead on a
-worker thread; each chunk's messages are parsed by the compiled reader of flat
-objects of numbers (:mod:`greybox.data.json_numbers`), or, when they are not all
-such objects, by pyarrow's JSON reader in batches of chunks.
+gives a :class:`~greybox.errors.LogError`: chunks are read ahead on a pool of
+worker threads (one per core), each taking whole chunks: decompressed, split
+into records and, once the channel to read is known, that channel's messages
+parsed by the compiled reader of flat objects of numbers
+(:mod:`greybox.data.json_numbers`); messages that are not all such objects go to
+pyarrow's JSON reader in batches of chunks.
 """
 
 from __future__ import annotations
@@ -29,8 +31,9 @@ import json
 import os
 import zlib
 from collections import deque
-from typing import Iterator, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
+import numba
 import numpy as np
 from numba import njit
 
@@ -77,7 +80,7 @@ _MESSAGE_HEADER = 22  # channel_id u16, sequence u32, log_time u64, publish_time
 _BATCH_BYTES = 16 << 20  # JSON text parsed per call of the bulk parser
 _BLOCK_BYTES = 4 << 20  # its block size (blocks are parsed in parallel)
 _WINDOW_BYTES = 8 << 20  # file bytes scanned at a time
-_CHUNKS_AHEAD = 2  # chunks decompressed ahead of the one being read
+_CHUNKS_AHEAD_PER_THREAD = 2  # chunks read ahead of the one being collected, per worker thread
 
 
 def topic_for(axis: str) -> str:
@@ -158,7 +161,7 @@ def write_mcap(logs: AxisLog | Sequence[AxisLog], path) -> None:
 
 
 # ----------------------------------------------------------------------- scan
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _read_u64(buf, pos):
     value = np.uint64(0)
     for k in range(8):
@@ -166,7 +169,7 @@ def _read_u64(buf, pos):
     return value
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def scan_records(buf, start, stop):
     """Split a byte range into MCAP records (opcode u8, length u64, content).
 
@@ -209,7 +212,7 @@ def scan_records(buf, start, stop):
     return opcodes, offsets, lengths, pos
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def join_slices(buf, offsets, lengths, separator):
     """Concatenate ``buf[offsets[k]:offsets[k] + lengths[k]]``, one ``separator`` byte between slices.
 
@@ -315,14 +318,14 @@ class _MessageCollector:
         self.pending_rows = 0
         self.batches: list[tuple[int, dict]] = []
 
-    def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, stamps_only: bool = False) -> None:
+    def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray,
+            parsed: tuple[np.ndarray, dict | None] | None = None) -> None:
+        """Collect the message records at ``offsets`` in ``buf``; ``parsed``: their :func:`_parse_messages`."""
         if not offsets.size:
             return
-        self.stamps.append(_log_times(buf, offsets))
+        stamps, columns = _parse_messages(buf, offsets, lengths) if parsed is None else parsed
+        self.stamps.append(stamps)
         self.rows += offsets.size
-        if stamps_only:
-            return
-        columns = parse_flat_objects(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER)
         if columns is not None:
             self.flush()
             self.batches.append((offsets.size, columns))
@@ -391,6 +394,17 @@ class _MessageCollector:
         return stamps, table
 
 
+def _parse_messages(buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray,
+                    threads: int | None = None) -> tuple[np.ndarray, dict | None]:
+    """The ``log_time`` [ns] of the message records at ``offsets`` and their fields by the compiled reader.
+
+    The fields are None when the messages are not all flat JSON objects of numbers with the same keys
+    (:func:`~greybox.data.json_numbers.parse_flat_objects`, on ``threads`` threads).
+    """
+    columns = parse_flat_objects(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER, threads=threads)
+    return _log_times(buf, offsets), columns
+
+
 def _as_array(column) -> np.ndarray:
     """A pyarrow column as float64 (nulls as NaN), or as objects when it is not numeric."""
     import pyarrow as pa
@@ -424,10 +438,73 @@ def _choose(channels: Mapping[int, _Channel], topic: str | None, path) -> _Chann
     raise LogError(path, f"no channel with topic '{topic}'; topics in the file: {topics}")
 
 
-def _walk(path) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """Yield (buffer, opcodes, offsets, lengths) for the data section, a window of the file or a chunk at a time."""
+def _walk(path, channel_id: Callable[[], int | None] = lambda: None) -> Iterator[tuple]:
+    """Yield (buffer, opcodes, offsets, lengths, parsed) of the data section, a stretch of records or a chunk at a time.
+
+    Chunks are read :data:`_CHUNKS_AHEAD_PER_THREAD` per worker thread ahead of the one given, on a pool of
+    one thread per core (:func:`_read_chunk`), while the caller works on the records already given; each
+    is read for the channel ``channel_id()`` names when it is handed to the pool (``parsed``, None for the
+    records outside chunks).
+    """
+    threads = max(1, numba.get_num_threads())
+    pool = shared_pool(threads, "mcap-chunks")
+    pending: deque = deque()  # records outside chunks (tuples) and chunks being read (futures), in file order
+    reading = 0  # futures in ``pending``
+    stretches = _stretches(path)
+    try:
+        while True:
+            while reading < _CHUNKS_AHEAD_PER_THREAD * threads:
+                item = next(stretches, None)
+                if item is None:
+                    break
+                if isinstance(item, bytes):
+                    pending.append(pool.submit(_read_chunk, item, channel_id(), path))
+                    reading += 1
+                else:
+                    pending.append(item)
+            if not pending:
+                return
+            item = pending.popleft()
+            if isinstance(item, tuple):
+                yield item
+            else:
+                reading -= 1
+                yield item.result()
+    finally:
+        for item in pending:
+            if not isinstance(item, tuple):
+                item.cancel()
+
+
+def _stretches(path) -> Iterator[tuple | bytes]:
+    """The data section in file order: records outside chunks as (buffer, opcodes, offsets, lengths, None),
+    each chunk record as its content (bytes)."""
     for buf, data, opcodes, offsets, lengths, _ in _windows(path):
-        yield from _expand(buf, data, opcodes, offsets, lengths, path)
+        begin = 0
+        for index in np.flatnonzero(opcodes == _OP_CHUNK).tolist() + [opcodes.size]:
+            if index > begin:
+                yield buf, opcodes[begin:index], offsets[begin:index], lengths[begin:index], None
+            if index < opcodes.size:
+                yield data[offsets[index]:offsets[index] + lengths[index]]
+            begin = index + 1
+
+
+def _read_chunk(content: bytes, channel_id: int | None, path) -> tuple:
+    """A chunk record's content decompressed and scanned: (buffer, opcodes, offsets, lengths, parsed).
+
+    ``parsed`` is None, or with a ``channel_id`` ``(channel_id, offsets, lengths, messages)``: the offsets
+    and lengths of that channel's message records and their :func:`_parse_messages` on this thread (None
+    when there are none, or when they fail a check, which the caller then meets if it reads that channel).
+    """
+    buf, opcodes, offsets, lengths = _chunk_records(_decompress(content, path), path)
+    parsed = None
+    if channel_id is not None and np.any(opcodes == _OP_MESSAGE):
+        try:
+            offs, lens = _channel_messages(buf, opcodes, offsets, lengths, channel_id, path)
+        except LogError:
+            return buf, opcodes, offsets, lengths, None
+        parsed = (channel_id, offs, lens, _parse_messages(buf, offs, lens, threads=1) if offs.size else None)
+    return buf, opcodes, offsets, lengths, parsed
 
 
 def _windows(path) -> Iterator[tuple[np.ndarray, bytes, np.ndarray, np.ndarray, np.ndarray, bool]]:
@@ -474,34 +551,6 @@ def _windows(path) -> Iterator[tuple[np.ndarray, bytes, np.ndarray, np.ndarray, 
             carry, start = data[end:], start + end
 
 
-def _expand(buf, data: bytes, opcodes, offsets, lengths, path):
-    """The records of a scanned stretch of the file, each chunk record replaced by the records it holds.
-
-    Chunks are decompressed :data:`_CHUNKS_AHEAD` ahead on a worker thread, while the caller works on
-    the records already given.
-    """
-    chunks = np.flatnonzero(opcodes == _OP_CHUNK).tolist()
-    pool = shared_pool(1, "decompress")
-    pending = deque(pool.submit(_decompress, data[offsets[k]:offsets[k] + lengths[k]], path)
-                    for k in chunks[:_CHUNKS_AHEAD])
-    begin = 0
-    try:
-        for number, index in enumerate(chunks + [opcodes.size]):
-            if index > begin:
-                yield buf, opcodes[begin:index], offsets[begin:index], lengths[begin:index]
-            if index < opcodes.size:
-                raw = pending.popleft().result()
-                if number + _CHUNKS_AHEAD < len(chunks):
-                    ahead = chunks[number + _CHUNKS_AHEAD]
-                    pending.append(pool.submit(_decompress, data[offsets[ahead]:offsets[ahead] + lengths[ahead]],
-                                               path))
-                yield _chunk_records(raw, path)
-            begin = index + 1
-    finally:
-        for future in pending:
-            future.cancel()
-
-
 def _chunk_records(raw: bytes, path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(buffer, opcodes, offsets, lengths) of the records of a decompressed chunk, which must hold whole records."""
     inner = np.frombuffer(raw, np.uint8)
@@ -520,17 +569,27 @@ def _collect(path, topic: str | None) -> tuple[dict[int, _Channel], _MessageColl
     return channels, collector
 
 
-def _messages(path, topic: str | None, channels: dict[int, _Channel], collector: _MessageCollector,
-              stamps_only: bool = False) -> Iterator[int]:
-    """Walk the file, adding channel records to ``channels`` and the chosen channel's messages to ``collector``
-    (their time stamps only with ``stamps_only``); yield the messages collected after each stretch."""
-    for buf, opcodes, offsets, lengths in _walk(path):
+def _messages(path, topic: str | None, channels: dict[int, _Channel], collector: _MessageCollector) -> Iterator[int]:
+    """Walk the file, adding channel records to ``channels`` and the chosen channel's messages to ``collector``;
+    yield the messages collected after each stretch.
+
+    A chunk read ahead for the channel chosen when it was handed to the pool keeps its parsed messages if
+    that is still the channel chosen once the records before it are known; otherwise they are parsed here.
+    """
+    def chosen_id() -> int | None:
+        chosen = _match(channels, topic)
+        return None if chosen is None else chosen.id
+
+    for buf, opcodes, offsets, lengths, parsed in _walk(path, chosen_id):
         _add_channels(channels, buf, opcodes, offsets, lengths, path)
         chosen = _match(channels, topic)
         if chosen is None or not np.any(opcodes == _OP_MESSAGE):
             continue
-        collector.add(buf, *_channel_messages(buf, opcodes, offsets, lengths, chosen.id, path),
-                      stamps_only=stamps_only)
+        if parsed is not None and parsed[0] == chosen.id:
+            _, offs, lens, messages = parsed
+        else:
+            (offs, lens), messages = _channel_messages(buf, opcodes, offsets, lengths, chosen.id, path), None
+        collector.add(buf, offs, lens, messages)
         yield collector.rows
 
 
@@ -695,7 +754,7 @@ def _add_channels(channels: dict[int, _Channel], buf: np.ndarray, opcodes, offse
 def _walked_channels(path) -> dict[int, _Channel]:
     """The channel records of the data section (a walk over the whole file)."""
     channels: dict[int, _Channel] = {}
-    for buf, opcodes, offsets, lengths in _walk(path):
+    for buf, opcodes, offsets, lengths, _ in _walk(path):
         _add_channels(channels, buf, opcodes, offsets, lengths, path)
     return channels
 

@@ -277,3 +277,78 @@ def test_documented_example_logger_writes_a_loadable_file(tmp_path, monkeypatch)
     assert (len(log), log.axis, log.dataset, log.effort_unit) == (5000, "X", "shop-floor", "A")
     assert log.sample_time == pytest.approx(0.002)
     np.testing.assert_allclose(log.position, 100 + 50 * np.sin(0.4 * np.pi * log.time), atol=1e-9)
+
+
+def _two_channel_file(path, n=700, late=300, chunk_size=2000):
+    """/axis/X from the start, /axis/Y registered after ``late`` samples; small chunks (read ahead on the pool).
+
+    Y's messages from sample 600 on carry a text field, so that those chunks go to the general JSON reader.
+    Returns the messages of each topic as (log_time_ns, dict) in the order written.
+    """
+    from mcap.writer import Writer
+
+    rng = np.random.default_rng(11)
+    written = {"/axis/X": [], "/axis/Y": []}
+    with open(path, "wb") as stream:
+        writer = Writer(stream, chunk_size=chunk_size)
+        writer.start()
+        schema_id = writer.register_schema("greybox.AxisSample", "jsonschema", b'{"type": "object"}')
+        ids = {"/axis/X": writer.register_channel("/axis/X", "json", schema_id, {"axis": "X"})}
+        for k in range(n):
+            if k == late:
+                ids["/axis/Y"] = writer.register_channel("/axis/Y", "json", schema_id, {"axis": "Y"})
+            for topic, channel_id in ids.items():
+                fields = {"position_mm": float(rng.normal()) * 10 ** int(rng.integers(-30, 30)),
+                          "current_A": float(rng.normal()), "extra_temperature_C": float(rng.normal())}
+                if topic == "/axis/Y" and k >= 600:
+                    fields["note"] = "text"
+                stamp = k * 2_000_000
+                written[topic].append((stamp, fields))
+                writer.add_message(channel_id, log_time=stamp, data=json.dumps(fields).encode(), publish_time=stamp)
+        writer.finish()
+    return written
+
+
+def test_chunks_read_ahead_on_the_pool_give_python_json_values_bit_for_bit(tmp_path):
+    path = tmp_path / "two.mcap"
+    written = _two_channel_file(path)
+    with open(path, "rb") as stream:
+        assert len(make_reader(stream).get_summary().chunk_indexes) > 20  # more chunks than are read ahead
+    for topic in ("/axis/X", "/axis/Y"):
+        log = read_log(path, topic=topic)
+        messages = written[topic]
+        assert np.array_equal(log.time, np.array([stamp for stamp, _ in messages]) * 1e-9)
+        for name, values in (("position", log.position), ("effort", log.effort),
+                             ("extra_temperature_C", log.extras["extra_temperature_C"])):
+            field = {"position": "position_mm", "effort": "current_A"}.get(name, name)
+            expected = np.array([fields[field] for _, fields in messages])
+            assert values.tobytes() == expected.tobytes(), (topic, name)
+
+
+def test_a_channel_registered_late_makes_the_file_ambiguous_without_a_topic(tmp_path):
+    path = tmp_path / "two.mcap"
+    _two_channel_file(path)
+    with pytest.raises(LogError, match="several channels") as error:
+        read_log(path)
+    assert str(path) in str(error.value)
+
+
+def test_reading_ahead_gives_the_same_log_on_any_number_of_threads(tmp_path, make_log):
+    import numba
+
+    rng = np.random.default_rng(2)
+    log = make_log(n=20000, velocity=rng.normal(size=20000), extras={"truth_friction_A": rng.normal(size=20000)})
+    path = tmp_path / "axis.mcap"
+    write_log(log, path)
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = read_log(path)
+    finally:
+        numba.set_num_threads(before)
+    every = read_log(path)
+    assert one.time.tobytes() == every.time.tobytes()
+    for name in ("position", "effort", "velocity"):
+        assert getattr(one, name).tobytes() == getattr(every, name).tobytes() == getattr(log, name).tobytes(), name
+    assert one.extras["truth_friction_A"].tobytes() == every.extras["truth_friction_A"].tobytes() \
+        == log.extras["truth_friction_A"].tobytes()
