@@ -51,7 +51,7 @@ NAMES = ("negative", "positive")
 #: The record's runs: the protocol's series of development seed 101, the good parts of development seed 111.
 RECORD_RUNS = ((101, False), (111, True))
 #: The training logs of the model (the shipped cold machine's air cuts, as the head to head).
-TRAIN_LOGS = (("X_A", "data/X_A.mcap"), ("X_C", "data/X_C.mcap"))
+TRAIN_LOGS = ("data/X_A.mcap", "data/X_C.mcap")
 
 
 def _laid(envelope, part):
@@ -190,12 +190,12 @@ def main(argv=None) -> int:
         model = args.model
         if model is None:
             model = str(Path(scratch) / "gms_x.gbm")
-            train_logs("gms", [(name, str(ROOT / path)) for name, path in TRAIN_LOGS], out=model)
+            train_logs("gms", [str(ROOT / path) for path in TRAIN_LOGS], out=model)
         runs = [pooled_errors(model, args.axis_config, seed, good) for seed, good in RECORD_RUNS]
     for figures in runs:
         print(f"seed {figures['seed']}{' (good parts)' if figures['good_series'] else ''}:")
         _print(figures)
-    trained = "greybox train --model gms --train " + " ".join(path for _, path in TRAIN_LOGS)
+    trained = "greybox train --model gms --train " + " ".join(TRAIN_LOGS)
     print(json.dumps({"model": trained if args.model is None else args.model, "runs": runs}))
     return 0
 
