@@ -21,8 +21,8 @@ Printed per variant: the mean, 95th percentile and largest of the absolute per-p
     python scripts/process_cut_force_pooling.py --model gms_x.gbm --seed 111 --good
     python scripts/process_cut_force_pooling.py --record    # both, the model trained first: one JSON object
 
-``--record`` (the record ``process-pooling``) trains the model into a temporary directory unless ``--model`` is
-given, and runs the protocol's series of seed 101 and the good parts of seed 111.
+``--record`` (the record ``process-pooling``) trains the model into a temporary directory (``greybox train``, in
+this process) unless ``--model`` is given, and runs the protocol's series of seed 101 and the good parts of seed 111.
 """
 
 from __future__ import annotations
@@ -37,11 +37,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
 
+from greybox.cli import main as greybox  # noqa: E402
 from greybox.predict.relevel import relevelled  # noqa: E402
 from greybox.process.check import check_part  # noqa: E402
 from greybox.process.envelope import Envelope  # noqa: E402
 from greybox.process.parts import PartSignal  # noqa: E402
-from greybox.train import train_logs  # noqa: E402
 from greybox.windows import centred_nanmean  # noqa: E402
 from studies.process_head_to_head import MISSING, OVERSIZED, RATE, TEACH, WEAR_START, seed_series  # noqa: E402
 
@@ -50,8 +50,8 @@ HALF_WIDTHS = (1, 2, 3, 5, 8, 12)
 NAMES = ("negative", "positive")
 #: The record's runs: the protocol's series of development seed 101, the good parts of development seed 111.
 RECORD_RUNS = ((101, False), (111, True))
-#: The training logs of the model (the shipped cold machine's air cuts, as the head to head).
-TRAIN_LOGS = ("data/X_A.mcap", "data/X_C.mcap")
+#: How the model is trained (on the shipped cold machine's air cuts, as the head to head).
+TRAIN = ("train", "--model", "gms", "--train", "data/X_A.mcap", "data/X_C.mcap")
 
 
 def _laid(envelope, part):
@@ -190,13 +190,13 @@ def main(argv=None) -> int:
         model = args.model
         if model is None:
             model = str(Path(scratch) / "gms_x.gbm")
-            train_logs("gms", [str(ROOT / path) for path in TRAIN_LOGS], out=model)
+            if greybox([*TRAIN, "--quiet", "--out", model]) != 0:
+                raise SystemExit(f"greybox {' '.join(TRAIN)} failed")
         runs = [pooled_errors(model, args.axis_config, seed, good) for seed, good in RECORD_RUNS]
     for figures in runs:
         print(f"seed {figures['seed']}{' (good parts)' if figures['good_series'] else ''}:")
         _print(figures)
-    trained = "greybox train --model gms --train " + " ".join(TRAIN_LOGS)
-    print(json.dumps({"model": trained if args.model is None else args.model, "runs": runs}))
+    print(json.dumps({"model": "greybox " + " ".join(TRAIN) if args.model is None else args.model, "runs": runs}))
     return 0
 
 

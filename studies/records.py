@@ -224,7 +224,7 @@ SPECS = {spec.name: spec for spec in (
     RecordSpec("process-pooling", ("scripts/process_cut_force_pooling.py", "--record"),
                ("scripts/process_cut_force_pooling.py", "studies/process_head_to_head.py", "greybox/process",
                 "greybox/predict", "greybox/models", "greybox/identify", "greybox/twin", "greybox/data",
-                "greybox/windows.py", "greybox/train", "greybox/base.py", "greybox/threads.py", "data",
+                "greybox/windows.py", "greybox/train", "greybox/cli", "greybox/base.py", "greybox/threads.py", "data",
                 "examples/axis_x.toml"),
                "each good part's mean cut force error through the twin's warm-up with the re-levelling factor per "
                "part, pooled over parts, from the warm-up law and with the true friction (development seeds 101 "
