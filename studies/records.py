@@ -229,6 +229,10 @@ SPECS = {spec.name: spec for spec in (
                "each good part's mean cut force error through the twin's warm-up with the re-levelling factor per "
                "part, pooled over parts, from the warm-up law and with the true friction (development seeds 101 "
                "and 111)"),
+    RecordSpec("twin-axes", ("scripts/twin_axes.py",),
+               ("scripts/twin_axes.py", "greybox/twin"),
+               "the twin's X and Y axes computed from their parameters: initial stiffness, steady sliding friction "
+               "at mid travel, position factor in the window and over the travel, friction at the travel's ends"),
     # -- end of the pages of h43pages4 --
 )}
 

@@ -966,6 +966,57 @@ def _process_predict_relevel(record: dict) -> str:
             f"`predict-relevel`, `{record['command']}`).\n")
 
 
+def _arts_pooling_share(record: dict) -> str:
+    files = record["figures"]["files"]
+    test = {name: row for name, row in files.items() if row["role"] == "test"}
+    slowest = min(row["peak_speed_mm_s"] / row["amplitude_mm"] for row in test.values())
+    slow = [name for name, row in test.items() if row["peak_speed_mm_s"] / row["amplitude_mm"] < 1.5 * slowest]
+    share = sum(test[name]["samples"] for name in slow) / sum(row["samples"] for row in test.values())
+    names = ", ".join(sorted(slow, key=lambda name: int(name[4:-4])))
+    return (f"   the {len(slow)} test files at the lowest frequency ({names}) hold "
+            f"{100 * share:.0f} % of the test samples, for the same seven periods as every other file (the record "
+            f"`arts-benchmark`).\n")
+
+
+def _discover_emps_asymmetry(record: dict) -> str:
+    ours = record["figures"]["models"]["coulomb_asym_idim_ls"]["params"]
+    published = record["figures"]["published"]["coulomb_asym_idim_ls"]["params"]
+
+    def difference(params: dict) -> str:
+        up, down = params["Fv_pos_N_s_per_m"], params["Fv_neg_N_s_per_m"]
+        return f"Fv+ = {up:.1f} and Fv- = {down:.1f} N s/m, a difference of {up - down:.1f} N s/m"
+
+    return (f"   published {difference(published)}; refitted here (the record `emps-benchmark`) "
+            f"{difference(ours)}.\n")
+
+
+def _twin_axes_properties(record: dict) -> str:
+    axes = record["figures"]["axes"]
+    low, high = record["figures"]["feeds_mm_min"]
+
+    def each(text) -> str:
+        return " and ".join(f"{text(row)} ({name})" for name, row in axes.items())
+
+    stiffness = each(lambda row: f"{row['stiffness_A_mm']:.0f} A/mm")
+    slowest = each(lambda row: f"{row['sliding_min_feed_mm_min']:.0f}")
+    return (f"The total initial stiffness is about {stiffness}: the "
+            f"pre-sliding range is a few micrometres. In steady sliding at mid travel the friction is "
+            f"{each(lambda r: _span(r['sliding_A'], unit=' A'))} between {low:.0f} and {high:.0f} mm/min: it falls "
+            f"from {low:.0f} to about {slowest} mm/min "
+            f"(Stribeck) and rises again above (viscous). The position factor g is "
+            f"{each(lambda r: _span(r['g_window']))} inside the measurement windows (the lead ripple included); over "
+            f"the travel it spans {each(lambda r: _span(r['g_travel']))}. (`{record['command']}`, the record "
+            f"`twin-axes`.)\n")
+
+
+def _twin_axes_ends(record: dict) -> str:
+    axes = record["figures"]["axes"]
+    ends = " and ".join(f"{_span(row['ends_over_middle'])} times its mid-travel level on {name}"
+                        for name, row in axes.items())
+    return (f"B and D reach the travel ends, where the Coulomb part of the friction is {ends} (the record "
+            f"`twin-axes`).\n")
+
+
 # -- end of the pages of h43pages4 --
 
 
@@ -1080,6 +1131,10 @@ VIEWS = {
     "process-teach-in": View(("process-head-to-head",), _process_teach_in),
     "process-head-to-head-says": View(("process-head-to-head",), _process_head_to_head_says),
     "process-predict-relevel": View(("predict-relevel",), _process_predict_relevel),
+    "arts-pooling-share": View(("arts-benchmark",), _arts_pooling_share),
+    "discover-emps-asymmetry": View(("emps-benchmark",), _discover_emps_asymmetry),
+    "twin-axes-properties": View(("twin-axes",), _twin_axes_properties),
+    "twin-axes-ends": View(("twin-axes",), _twin_axes_ends),
     # -- end of the pages of h43pages4 --
 }
 
