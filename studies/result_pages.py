@@ -862,7 +862,8 @@ def _pooling_label(run: dict) -> str:
 
 def _process_pooling(record: dict) -> str:
     runs = _pooling_runs(record)
-    names = [name for name, row in runs[0].items() if isinstance(row, dict) and "max_abs" in row]
+    pooled = sorted((name for name in runs[0] if name.startswith("pooled ")), key=lambda name: int(name.split()[1]))
+    names = ["none", "per part", *pooled, "warm-up law", "true friction"]
     lines = ["| beta | " + " | ".join(f"{_pooling_label(run)}: mean / p95 / max abs, signed mean" for run in runs)
              + " |", "|---|" + "---|" * len(runs)]
     for name in names:
