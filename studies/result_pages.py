@@ -963,7 +963,7 @@ def _process_predict_relevel(record: dict) -> str:
     series = record["figures"]["series"]["warm-up"]
     chunks = ", ".join(f"{row['max_abs_pct']:.2f} % with {chunk} s chunks" for chunk, row in
                        sorted(series["on"].items(), key=lambda item: float(item[0])))
-    return (f"  its largest per-part error on the warm-up series ({series['what']}) is {chunks} (the record "
+    return (f"Its largest per-part error on the warm-up series ({series['what']}) is {chunks} (the record "
             f"`predict-relevel`, `{record['command']}`).\n")
 
 
