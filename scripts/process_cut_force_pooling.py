@@ -19,6 +19,10 @@ Printed per variant: the mean, 95th percentile and largest of the absolute per-p
     greybox train --model gms --train data/X_A.mcap data/X_C.mcap --out gms_x.gbm
     python scripts/process_cut_force_pooling.py --model gms_x.gbm --seed 101
     python scripts/process_cut_force_pooling.py --model gms_x.gbm --seed 111 --good
+    python scripts/process_cut_force_pooling.py --record    # both, the model trained first: one JSON object
+
+``--record`` (the record ``process-pooling``) trains the model into a temporary directory (``greybox train``, in
+this process) unless ``--model`` is given, and runs the protocol's series of seed 101 and the good parts of seed 111.
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
 
+from greybox.cli import main as greybox  # noqa: E402
 from greybox.predict.relevel import relevelled  # noqa: E402
 from greybox.process.check import check_part  # noqa: E402
 from greybox.process.envelope import Envelope  # noqa: E402
@@ -43,6 +48,10 @@ from studies.process_head_to_head import MISSING, OVERSIZED, RATE, TEACH, WEAR_S
 ROOT = Path(__file__).resolve().parents[1]
 HALF_WIDTHS = (1, 2, 3, 5, 8, 12)
 NAMES = ("negative", "positive")
+#: The record's runs: the protocol's series of development seed 101, the good parts of development seed 111.
+RECORD_RUNS = ((101, False), (111, True))
+#: How the model is trained (on the shipped cold machine's air cuts, as the head to head).
+TRAIN = ("train", "--model", "gms", "--train", "data/X_A.mcap", "data/X_C.mcap")
 
 
 def _laid(envelope, part):
@@ -95,18 +104,32 @@ def _summary(errors) -> dict:
             "parts": int(errors.size)}
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--model", required=True, help="GMS model file trained on data/X_A.mcap data/X_C.mcap")
-    parser.add_argument("--axis-config", default=str(ROOT / "examples" / "axis_x.toml"))
-    parser.add_argument("--seed", type=int, default=101)
-    parser.add_argument("--good", action="store_true", help="the seed's series of good parts")
-    args = parser.parse_args(argv)
+def pooled_errors(model: str, axis_config: str, seed: int, good_only: bool) -> dict:
+    """Each checked good part's mean cut force error for every way of choosing the re-levelling factor.
+
+    Parameters
+    ----------
+    model : str
+        GMS model file trained on ``data/X_A.mcap`` and ``data/X_C.mcap``.
+    axis_config : str
+        The axis file.
+    seed : int
+        Seed of the twin's series.
+    good_only : bool
+        The seed's series of good parts instead of the protocol's series.
+
+    Returns
+    -------
+    dict
+        ``seed``, ``good_series``, ``parts`` and, per variant, the summary of the per-part errors [%]
+        (``mean_abs``, ``p95_abs``, ``max_abs``, ``mean``, ``sd``, ``parts``); ``factor_sd_part_to_part``: the
+        part-to-part standard deviation of each direction's factor.
+    """
     with tempfile.TemporaryDirectory() as scratch:
-        path, _ = seed_series(args.seed, Path(scratch), good_only=args.good)
-        parts, unit = PartSignal(model=args.model, axis_config=args.axis_config).parts(str(path))
+        path, _ = seed_series(seed, Path(scratch), good_only=good_only)
+        parts, unit = PartSignal(model=model, axis_config=axis_config).parts(str(path))
     envelope = Envelope(false_alarm_rate=RATE, relevel=True).fit(parts[:TEACH], unit=unit)
-    if args.good:
+    if good_only:
         good = {part.number for part in parts[TEACH:]}
     else:
         good = {k for k in range(TEACH + 1, WEAR_START + 1) if k not in (MISSING, OVERSIZED)}
@@ -122,7 +145,7 @@ def main(argv=None) -> int:
         variants[f"pooled {half}"] = np.column_stack([_local_line(times, betas[:, j], half) for j in range(2)])
     variants["warm-up law"] = np.column_stack([_warm_up_fit(times, betas[:, j]) for j in range(2)])
     keep = [k for k, part in enumerate(checked) if part.number in good]
-    figures = {"seed": args.seed, "good_series": args.good, "parts": len(keep)}
+    figures = {"seed": seed, "good_series": good_only, "parts": len(keep)}
     for name, beta in variants.items():
         errors = [100.0 * (_cut_force(envelope, checked[k], laid[k], _scaled(envelope, laid[k], beta[k]))
                            / truths[k] - 1.0) for k in keep]
@@ -133,14 +156,47 @@ def main(argv=None) -> int:
     errors = [100.0 * (_cut_force(envelope, checked[k], laid[k], laid[k]["true_process"]) / truths[k] - 1.0)
               for k in keep]
     figures["true friction"] = _summary(errors)
-    factor_sd = {name: float(np.std(np.diff(betas[:, j]), ddof=1) / np.sqrt(2.0)) for j, name in enumerate(NAMES)}
-    figures["factor_sd_part_to_part"] = factor_sd
+    figures["factor_sd_part_to_part"] = {name: float(np.std(np.diff(betas[:, j]), ddof=1) / np.sqrt(2.0))
+                                         for j, name in enumerate(NAMES)}
+    return figures
+
+
+def _print(figures: dict) -> None:
     for name, row in figures.items():
         if isinstance(row, dict) and "max_abs" in row:
             print(f"{name:>14}: |error| mean {row['mean_abs']:.2f} %, p95 {row['p95_abs']:.2f} %, max "
                   f"{row['max_abs']:.2f} %; signed mean {row['mean']:+.2f} %, sd {row['sd']:.2f} % "
                   f"({row['parts']} parts)")
-    print(json.dumps(figures))
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--model", help="GMS model file trained on data/X_A.mcap data/X_C.mcap (required but "
+                        "with --record, which trains it when not given)")
+    parser.add_argument("--axis-config", default=str(ROOT / "examples" / "axis_x.toml"))
+    parser.add_argument("--seed", type=int, default=101)
+    parser.add_argument("--good", action="store_true", help="the seed's series of good parts")
+    parser.add_argument("--record", action="store_true", help="seed 101 and the good parts of seed 111, one JSON "
+                        "object printed last (the record process-pooling)")
+    args = parser.parse_args(argv)
+    if not args.record:
+        if not args.model:
+            parser.error("--model is required without --record")
+        figures = pooled_errors(args.model, args.axis_config, args.seed, args.good)
+        _print(figures)
+        print(json.dumps(figures))
+        return 0
+    with tempfile.TemporaryDirectory() as scratch:
+        model = args.model
+        if model is None:
+            model = str(Path(scratch) / "gms_x.gbm")
+            if greybox([*TRAIN, "--quiet", "--out", model]) != 0:
+                raise SystemExit(f"greybox {' '.join(TRAIN)} failed")
+        runs = [pooled_errors(model, args.axis_config, seed, good) for seed, good in RECORD_RUNS]
+    for figures in runs:
+        print(f"seed {figures['seed']}{' (good parts)' if figures['good_series'] else ''}:")
+        _print(figures)
+    print(json.dumps({"model": "greybox " + " ".join(TRAIN) if args.model is None else args.model, "runs": runs}))
     return 0
 
 

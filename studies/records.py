@@ -220,6 +220,20 @@ SPECS = {spec.name: spec for spec in (
                 *_FRICTION_FITS, "data/X_A.mcap"),
                "the example of docs/intervals.md as printed: a GMS on X_A, its parameters' 95 % intervals and flags"),
     # -- end of the walk-through (issue 43, h43pages3) --
+    # -- the pages of h43pages4 (issue 43): process, discover, arts, emps, synthetic axis, compensate --
+    RecordSpec("process-pooling", ("scripts/process_cut_force_pooling.py", "--record"),
+               ("scripts/process_cut_force_pooling.py", "studies/process_head_to_head.py", "greybox/process",
+                "greybox/predict", "greybox/models", "greybox/identify", "greybox/twin", "greybox/data",
+                "greybox/windows.py", "greybox/train", "greybox/cli", "greybox/base.py", "greybox/threads.py", "data",
+                "examples/axis_x.toml"),
+               "each good part's mean cut force error through the twin's warm-up with the re-levelling factor per "
+               "part, pooled over parts, from the warm-up law and with the true friction (development seeds 101 "
+               "and 111)"),
+    RecordSpec("twin-axes", ("scripts/twin_axes.py",),
+               ("scripts/twin_axes.py", "greybox/twin"),
+               "the twin's X and Y axes computed from their parameters: initial stiffness, steady sliding friction "
+               "at mid travel, position factor in the window and over the travel, friction at the travel's ends"),
+    # -- end of the pages of h43pages4 --
 )}
 
 
