@@ -220,6 +220,13 @@ SPECS = {spec.name: spec for spec in (
                 *_FRICTION_FITS, "data/X_A.mcap"),
                "the example of docs/intervals.md as printed: a GMS on X_A, its parameters' 95 % intervals and flags"),
     # -- end of the walk-through (issue 43, h43pages3) --
+    # -- the training region (issue 40, h40region) --
+    RecordSpec("operating-region", ("scripts/operating_region.py",),
+               ("scripts/operating_region.py", "studies/operating_region.py", "studies/arts.py", "studies/arts_data.py",
+                "greybox/data", "greybox/train/logs.py", "data"),
+               "the operating region's rules on the development air cuts (grid, window of the reversals) and the "
+               "shares outside it of held-out twin, axis_dev and ARTS runs and of made-up small oscillations"),
+    # -- end of the training region (issue 40, h40region) --
 )}
 
 

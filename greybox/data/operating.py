@@ -26,8 +26,8 @@ from numba import njit
 
 __all__ = ["SPAN_WINDOW_S", "SPEED_DECADES", "SPAN_DECADES", "CELLS_PER_DECADE", "MIN_CELL_SAMPLES", "MIN_CELL_SHARE",
            "NEIGHBOURS", "REVERSALS_RULE",
-           "OperatingRegion", "check_operating_record", "local_span", "operating_record", "reversal_marks",
-           "trailing_reversals"]
+           "OperatingRegion", "check_operating_record", "local_span", "most_reversals", "operating_record",
+           "reversal_marks", "span_turns", "trailing_reversals"]
 
 #: Trailing window of the local span [s]: long enough to hold a reversal of the slow sweeps of air cuts and
 #: harmonic tests, short enough that a few small oscillations fill it.
@@ -297,17 +297,56 @@ def operating_record(runs, *, cells_per_decade: int = CELLS_PER_DECADE, min_shar
         span, _ = local_span(run.position, samples)
         i, j = _cells(speed, span, _inner(speed_edges), _inner(span_edges))
         np.add.at(counts, (i, j), 1)
-        marks, _ = reversal_marks(run.position, span_edges[0])
-        turns.append((j, trailing_reversals(marks, samples)[0]))
+        turns.append(span_turns(run.position, samples, span_edges, span_edges[0]))
     least = max(MIN_CELL_SAMPLES, int(math.ceil(min_share * counts.sum())))
     cells = [[int(i), int(j)] for i, j in zip(*np.nonzero(counts >= least))]
     return {"window_s": SPAN_WINDOW_S, "speed_edges": speed_edges, "span_edges": span_edges, "cells": cells,
-            _REVERSAL_KEY: _most_reversals(turns, len(span_edges) - 1, MIN_CELL_SAMPLES)}
+            _REVERSAL_KEY: most_reversals(turns, len(span_edges) - 1)}
 
 
-def _most_reversals(turns, cells: int, least: int) -> list[int]:
+def span_turns(position: np.ndarray, samples: int, span_edges, deadband: float) -> tuple[np.ndarray, np.ndarray]:
+    """The span cell of each sample of a whole run and its reversals within the same trailing window.
+
+    Parameters
+    ----------
+    position : ndarray, shape (n,)
+        Position of the run [mm or deg].
+    samples : int
+        Window length [samples], at least 1.
+    span_edges : list of float
+        Edges of the span cells [mm or deg].
+    deadband : float
+        Least turn that counts as a reversal [mm or deg] (:func:`reversal_marks`).
+
+    Returns
+    -------
+    cell : ndarray of int, shape (n,)
+        Span cell of each sample (outer cells take what lies beyond the outer edges).
+    count : ndarray of int64, shape (n,)
+        Reversals within its window [-].
+    """
+    span, _ = local_span(position, samples)
+    marks, _ = reversal_marks(position, deadband)
+    return np.searchsorted(_inner(span_edges), span, side="right"), trailing_reversals(marks, samples)[0]
+
+
+def most_reversals(turns, cells: int, least: int = MIN_CELL_SAMPLES) -> list[int]:
     """Per span cell, the most reversals that at least ``least`` samples of the cell reached (-1 for a cell
-    of fewer samples): the ``reversals`` of an ``operating`` record."""
+    of fewer samples): the ``reversals`` of an ``operating`` record.
+
+    Parameters
+    ----------
+    turns : list of tuple
+        Per training run, :func:`span_turns`.
+    cells : int
+        Span cells of the grid.
+    least : int, default :data:`MIN_CELL_SAMPLES`
+        Samples that must reach a count [-].
+
+    Returns
+    -------
+    list of int
+    """
     span_cell = np.concatenate([j for j, _ in turns])
     count = np.concatenate([c for _, c in turns])
     most = []
