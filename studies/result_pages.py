@@ -882,7 +882,8 @@ def _operating_region(record: dict) -> str:
     lines = ["| trained on | held-out run | outside | by motion | by the grid alone (before the reversals) |",
              "|---|---|---|---|---|"]
     for case, runs in f["cases"].items():
-        for name, shares in runs.items():
+        for name, shares in sorted(runs.items(), key=lambda item: [int(part) if part.isdigit() else part
+                                                                   for part in re.split(r"(\d+)", item[0])]):
             lines.append(f"| {case} | {name} | {100 * shares['outside']:.1f} % | {100 * shares['motion']:.1f} % "
                          f"| {100 * shares['grid']:.1f} % |")
     lines += ["", "| reversals: window | deadband (first span edges) | same kind: " +
