@@ -234,6 +234,13 @@ SPECS = {spec.name: spec for spec in (
                "the twin's X and Y axes computed from their parameters: initial stiffness, steady sliding friction "
                "at mid travel, position factor in the window and over the travel, friction at the travel's ends"),
     # -- end of the pages of h43pages4 --
+    # -- the training region (issue 40, h40region) --
+    RecordSpec("operating-region", ("scripts/operating_region.py",),
+               ("scripts/operating_region.py", "studies/operating_region.py", "studies/arts.py", "studies/arts_data.py",
+                "greybox/data", "greybox/train/logs.py", "data"),
+               "the operating region's rules on the development air cuts (grid, window of the reversals) and the "
+               "shares outside it of held-out twin, axis_dev and ARTS runs and of made-up small oscillations"),
+    # -- end of the training region (issue 40, h40region) --
 )}
 
 

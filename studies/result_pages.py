@@ -1061,6 +1061,43 @@ def _auto_twin_speed(record: dict) -> str:
             f"`{record['command']}` ({_where(record)}).\n")
 
 
+def _operating_region(record: dict) -> str:
+    f = record["figures"]
+    reversals = next(row for row in f["reversal_rule"]["table"]
+                     if row["window_s"] == f["reversal_rule"]["chosen"] and row["deadband"] == 1.0)
+    lines = ["| trained on | held-out run | outside | by motion | by the grid alone (before the reversals) |",
+             "|---|---|---|---|---|"]
+    for case, runs in f["cases"].items():
+        for name, shares in sorted(runs.items(), key=lambda item: [int(part) if part.isdigit() else part
+                                                                   for part in re.split(r"(\d+)", item[0])]):
+            lines.append(f"| {case} | {name} | {100 * shares['outside']:.1f} % | {100 * shares['motion']:.1f} % "
+                         f"| {100 * shares['grid']:.1f} % |")
+    lines += ["", "| reversals: window | deadband (first span edges) | same kind: " +
+              " / ".join(reversals["same"]) + " | other kind: " + " / ".join(reversals["other"]) +
+              " | stand-in (not used by the rule) |", "|---|---|---|---|---|"]
+    for row in f["reversal_rule"]["table"]:
+        lines.append(f"| {row['window_s']} s | {row['deadband']:g} | "
+                     + " / ".join(f"{100 * v:.2f}" for v in row["same"].values()) + " % | "
+                     + " / ".join(f"{100 * v:.1f}" for v in row["other"].values())
+                     + f" % | {100 * row['stand_in']:.1f} % |")
+    arts = next(runs for case, runs in f["cases"].items() if case.startswith("ARTS"))
+    made_up = {name: shares["outside"] for name, shares in arts.items() if name.startswith("small oscillations")}
+    caught = [name for name, share in made_up.items() if share > f["stand_in"]["limit"]]
+    missed = [name for name in made_up if name not in caught]
+    stand_in, held_out = f["stand_in"], f["held_out"]
+    same = ", ".join(f"{name} {100 * share:.2f} %" for name, share in reversals["same"].items())
+    other = ", ".join(f"{name} {100 * share:.1f} %" for name, share in reversals["other"].items())
+    return ("\n".join(lines) + "\n\n"
+            f"Held-out air cuts of the same kind flagged by motion (window {f['reversal_rule']['chosen']} s): {same} "
+            f"(target at most {100 * held_out['limit']:.0f} % each: {_met(held_out['met'])}); of another kind: "
+            f"{other}. The stand-in of issue 40 point 4 ({stand_in['name']}): {100 * stand_in['outside']:.1f} % "
+            f"outside ({100 * stand_in['grid']:.1f} % by the grid alone; target more than "
+            f"{100 * stand_in['limit']:.0f} %: {_met(stand_in['met'])}). Made-up oscillations more than "
+            f"{100 * stand_in['limit']:.0f} % outside: {', '.join(caught) or 'none'}; "
+            f"not: {', '.join(missed) or 'none'}. "
+            f"`{record['command']}` ({_where(record)}).\n")
+
+
 VIEWS = {
     "reproduce-run": View(("reproduce",), _reproduce_run),
     "reproduce-exp1": View(("reproduce",), _reproduce_exp(1)),
@@ -1137,6 +1174,9 @@ VIEWS = {
     "twin-axes-properties": View(("twin-axes",), _twin_axes_properties),
     "twin-axes-ends": View(("twin-axes",), _twin_axes_ends),
     # -- end of the pages of h43pages4 --
+    # -- the training region (issue 40, h40region) --
+    "operating-region": View(("operating-region",), _operating_region),
+    # -- end of the training region (issue 40, h40region) --
 }
 
 

@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Test files of the compiled kernels: GMS and LuGre, SVR kernel sums, plant laws, JSON numbers and MCAP
 #: records, the controller and the controlled plants, the twin's plant and the truth laws of the family of axes,
 #: the ageing twin's play, the live stream's zero-phase filter, the kernel models' frame (kernel sum, hand-over,
-#: input flags), the local span of the operating region.
+#: input flags), the local span and the reversals of the operating region.
 KERNEL_TESTS = ("models/friction/test_kernels.py", "models/kernel/test_rbf.py", "twin/test_plant_laws.py",
                 "data/test_json_numbers.py", "data/test_mcap_io.py", "control/test_pid.py",
                 "control/test_plants.py", "twin/test_plant.py", "twin/test_family.py", "twin/test_ageing.py",

@@ -5,9 +5,12 @@ ranges of the training runs (the training record's ``ranges``) and its *motion* 
 pair (speed ``|v|``, local span) falls in a cell of a grid that training samples occupied, or in a
 neighbouring cell (:data:`NEIGHBOURS`). The local span is ``max - min`` of the position over the trailing window
 :data:`SPAN_WINDOW_S` ending at the sample: a sweep has the span of its travel, a dwell none, and a small
-oscillation a small span at a speed that in the training runs only came with a large one. The region
-depends on the training runs alone, never on the model: every kind of model trained on the same runs has
-the same region (docs/defaults.md, "What counts as inside the training region").
+oscillation a small span at a speed that in the training runs only came with a large one. The motion is
+also outside when the position turned back more often within that window than the training runs ever did
+at that span (:data:`REVERSALS_RULE`): a fast oscillation of a few tenths of a millimetre turns four times a
+second, the slow sweeps of a harmonic test once in two seconds, also where their tapered starts are as
+small. The region depends on the training runs alone, never on the model: every kind of model trained on
+the same runs has the same region (docs/defaults.md, "What counts as inside the training region").
 
 :func:`operating_record` builds the record the training record keeps as ``operating``;
 :func:`check_operating_record` validates one read from a model file; :class:`OperatingRegion` flags the
@@ -22,8 +25,9 @@ import numpy as np
 from numba import njit
 
 __all__ = ["SPAN_WINDOW_S", "SPEED_DECADES", "SPAN_DECADES", "CELLS_PER_DECADE", "MIN_CELL_SAMPLES", "MIN_CELL_SHARE",
-           "NEIGHBOURS",
-           "OperatingRegion", "check_operating_record", "local_span", "operating_record"]
+           "NEIGHBOURS", "REVERSALS_RULE",
+           "OperatingRegion", "check_operating_record", "local_span", "most_reversals", "operating_record",
+           "reversal_marks", "span_turns", "trailing_reversals"]
 
 #: Trailing window of the local span [s]: long enough to hold a reversal of the slow sweeps of air cuts and
 #: harmonic tests, short enough that a few small oscillations fill it.
@@ -55,8 +59,21 @@ MIN_CELL_SHARE = 0.0
 #: (chosen by the rule of :data:`CELLS_PER_DECADE`).
 NEIGHBOURS = 0
 
-#: The keys of an ``operating`` record.
+#: The rule of the reversals, in words (docs/defaults.md): within the trailing window of the local span, the
+#: position may turn back at most as many times as the training runs did at the same span cell (the most
+#: that at least :data:`MIN_CELL_SAMPLES` training samples of the cell reached). A reversal is a turn back by
+#: the smallest span the grid resolves (the first span edge): finer turns are below the grid's resolution
+#: (and in the noise of the position). The window is the span's own: of 0.5, 1 and 2 s, the one rule of
+#: :data:`CELLS_PER_DECADE` (:func:`studies.operating_region.reversal_rule`) keeps only 0.5 s.
+REVERSALS_RULE = "at most the training's reversals within the span window at that span cell"
+
+#: The keys of an ``operating`` record; files of format version 5 on add :data:`_REVERSAL_KEY`.
 _KEYS = {"window_s", "speed_edges", "span_edges", "cells"}
+#: Per span cell, the most reversals within the window the training runs showed (-1: a cell they did not
+#: show).
+_REVERSAL_KEY = "reversals"
+#: Most reversals a record may hold for a cell (a model file is never trusted).
+_MAX_REVERSALS = 1 << 30
 
 #: Most edges of one axis of the grid a record may hold (a model file is never trusted).
 _MAX_EDGES = 257
@@ -129,13 +146,107 @@ def _span_kernel(values, first, window, out):  # pragma: no cover - compiled; re
             out[t - first] = values[high[high_head]] - values[low[low_head]]
 
 
+def reversal_marks(position: np.ndarray, deadband: float, detector: np.ndarray | None = None) -> tuple[np.ndarray,
+                                                                                                       np.ndarray]:
+    """Where the position turns back by at least ``deadband``: True at the sample that confirms a reversal.
+
+    The turn is measured from the running extreme of the current direction of motion (a play operator of
+    width ``deadband``): a reversal counts once the position lies ``deadband`` behind the furthest point
+    of the stroke, so a ripple or noise smaller than ``deadband`` makes none. The first motion of a run by
+    ``deadband`` sets a direction without counting a reversal.
+
+    Parameters
+    ----------
+    position : ndarray, shape (n,)
+        Position of consecutive samples [mm or deg].
+    deadband : float
+        Least turn that counts [mm or deg], positive.
+    detector : ndarray, shape (4,), optional
+        The state a previous chunk left (direction, extreme, highest and lowest position before a direction
+        was set); none at the start of a run.
+
+    Returns
+    -------
+    marks : ndarray of bool, shape (n,)
+        True where a reversal is confirmed.
+    detector : ndarray, shape (4,)
+        The state for the next chunk.
+    """
+    position = np.ascontiguousarray(position, dtype=np.float64)
+    state = np.full(4, np.nan) if detector is None else np.array(detector, dtype=np.float64)
+    marks = np.zeros(position.size, dtype=np.bool_)
+    _reversal_kernel(position, float(deadband), state, marks)
+    return marks, state
+
+
 @njit(cache=True, error_model="numpy")
-def _unseen_kernel(speed, span, speed_inner, span_inner, seen, out):  # pragma: no cover - compiled
+def _reversal_kernel(position, deadband, state, marks):  # pragma: no cover - compiled; reference in the tests
+    """``marks[k]`` = a reversal by ``deadband`` is confirmed at ``position[k]`` (:func:`reversal_marks`);
+    ``state`` = [direction (+1, -1, 0 none yet; NaN before the first sample), extreme, highest, lowest],
+    updated in place. O(1) a sample."""
+    direction, extreme, high, low = state[0], state[1], state[2], state[3]
+    for k in range(position.size):
+        x = position[k]
+        if np.isnan(direction):
+            direction, extreme, high, low = 0.0, x, x, x
+        if direction == 0.0:
+            high = max(high, x)
+            low = min(low, x)
+            if x - low >= deadband:
+                direction, extreme = 1.0, x
+            elif high - x >= deadband:
+                direction, extreme = -1.0, x
+        elif direction > 0.0:
+            if x > extreme:
+                extreme = x
+            elif extreme - x >= deadband:
+                marks[k] = True
+                direction, extreme = -1.0, x
+        else:
+            if x < extreme:
+                extreme = x
+            elif x - extreme >= deadband:
+                marks[k] = True
+                direction, extreme = 1.0, x
+    state[0], state[1], state[2], state[3] = direction, extreme, high, low
+
+
+def trailing_reversals(marks: np.ndarray, samples: int, history: np.ndarray | None = None) -> tuple[np.ndarray,
+                                                                                                  np.ndarray]:
+    """Reversals within the trailing window of ``samples`` samples ending at each sample.
+
+    Parameters
+    ----------
+    marks : ndarray of bool, shape (n,)
+        :func:`reversal_marks` of consecutive samples.
+    samples : int
+        Window length [samples], at least 1.
+    history : ndarray of bool, optional
+        The marks before the first sample (what a previous chunk left); none at the start of a run.
+
+    Returns
+    -------
+    count : ndarray of int64, shape (n,)
+        Reversals within each window [-].
+    history : ndarray of bool
+        The last ``samples - 1`` marks: the ``history`` of the next chunk.
+    """
+    past = np.zeros(0, dtype=np.bool_) if history is None else np.asarray(history, dtype=np.bool_)
+    values = np.concatenate((past, np.asarray(marks, dtype=np.bool_)))
+    total = np.concatenate(([0], np.cumsum(values, dtype=np.int64)))
+    end = np.arange(past.size, values.size) + 1
+    count = total[end] - total[np.maximum(end - samples, 0)]
+    keep = samples - 1
+    return count, values[-keep:].copy() if keep else np.zeros(0, dtype=np.bool_)
+
+
+@njit(cache=True, error_model="numpy")
+def _unseen_kernel(speed, span, count, speed_inner, span_inner, seen, most, out):  # pragma: no cover - compiled
     """``out[k]`` = the grid cell of (``speed[k]``, ``span[k]``) is not ``seen`` (outer cells take what lies
-    beyond the outer edges)."""
+    beyond the outer edges), or ``count[k]`` exceeds the ``most`` reversals of its span cell."""
     for k in range(speed.size):
-        out[k] = not seen[np.searchsorted(speed_inner, speed[k], side="right"),
-                          np.searchsorted(span_inner, span[k], side="right")]
+        j = np.searchsorted(span_inner, span[k], side="right")
+        out[k] = not seen[np.searchsorted(speed_inner, speed[k], side="right"), j] or count[k] > most[j]
 
 
 def _inner(edges) -> np.ndarray:
@@ -166,8 +277,10 @@ def operating_record(runs, *, cells_per_decade: int = CELLS_PER_DECADE, min_shar
     dict
         ``window_s`` [s], ``speed_edges`` [mm/s or deg/s] (geometric, :data:`SPEED_DECADES` decades below
         the largest speed), ``span_edges`` [mm or deg] (geometric, :data:`SPAN_DECADES` decades below the
-        width of the positions) and ``cells``: the ``[speed cell, span cell]`` pairs that held ``min_share``
-        of the training samples (at least :data:`MIN_CELL_SAMPLES`), sorted.
+        width of the positions), ``cells``: the ``[speed cell, span cell]`` pairs that held ``min_share``
+        of the training samples (at least :data:`MIN_CELL_SAMPLES`), sorted, and ``reversals``: per span
+        cell the most reversals by the first span edge within the window that as many training samples of
+        the cell reached, -1 for a cell that held fewer (:data:`REVERSALS_RULE`).
     """
     speeds = [np.abs(np.asarray(run.velocity, dtype=float)) for run in runs]
     top = float(max(np.max(s) for s in speeds))
@@ -178,13 +291,69 @@ def operating_record(runs, *, cells_per_decade: int = CELLS_PER_DECADE, min_shar
         -SPEED_DECADES, 0, SPEED_DECADES * cells_per_decade + 1)]
     span_edges = [float(value) for value in width * np.logspace(-SPAN_DECADES, 0, SPAN_DECADES * cells_per_decade + 1)]
     counts = np.zeros((len(speed_edges) - 1, len(span_edges) - 1), dtype=np.int64)
+    turns = []  # per run: (span cell, reversals in the window) of each sample
     for run, speed in zip(runs, speeds):
-        span, _ = local_span(run.position, _window_samples(SPAN_WINDOW_S, run.sample_time))
+        samples = _window_samples(SPAN_WINDOW_S, run.sample_time)
+        span, _ = local_span(run.position, samples)
         i, j = _cells(speed, span, _inner(speed_edges), _inner(span_edges))
         np.add.at(counts, (i, j), 1)
+        turns.append(span_turns(run.position, samples, span_edges, span_edges[0]))
     least = max(MIN_CELL_SAMPLES, int(math.ceil(min_share * counts.sum())))
     cells = [[int(i), int(j)] for i, j in zip(*np.nonzero(counts >= least))]
-    return {"window_s": SPAN_WINDOW_S, "speed_edges": speed_edges, "span_edges": span_edges, "cells": cells}
+    return {"window_s": SPAN_WINDOW_S, "speed_edges": speed_edges, "span_edges": span_edges, "cells": cells,
+            _REVERSAL_KEY: most_reversals(turns, len(span_edges) - 1)}
+
+
+def span_turns(position: np.ndarray, samples: int, span_edges, deadband: float) -> tuple[np.ndarray, np.ndarray]:
+    """The span cell of each sample of a whole run and its reversals within the same trailing window.
+
+    Parameters
+    ----------
+    position : ndarray, shape (n,)
+        Position of the run [mm or deg].
+    samples : int
+        Window length [samples], at least 1.
+    span_edges : list of float
+        Edges of the span cells [mm or deg].
+    deadband : float
+        Least turn that counts as a reversal [mm or deg] (:func:`reversal_marks`).
+
+    Returns
+    -------
+    cell : ndarray of int, shape (n,)
+        Span cell of each sample (outer cells take what lies beyond the outer edges).
+    count : ndarray of int64, shape (n,)
+        Reversals within its window [-].
+    """
+    span, _ = local_span(position, samples)
+    marks, _ = reversal_marks(position, deadband)
+    return np.searchsorted(_inner(span_edges), span, side="right"), trailing_reversals(marks, samples)[0]
+
+
+def most_reversals(turns, cells: int, least: int = MIN_CELL_SAMPLES) -> list[int]:
+    """Per span cell, the most reversals that at least ``least`` samples of the cell reached (-1 for a cell
+    of fewer samples): the ``reversals`` of an ``operating`` record.
+
+    Parameters
+    ----------
+    turns : list of tuple
+        Per training run, :func:`span_turns`.
+    cells : int
+        Span cells of the grid.
+    least : int, default :data:`MIN_CELL_SAMPLES`
+        Samples that must reach a count [-].
+
+    Returns
+    -------
+    list of int
+    """
+    span_cell = np.concatenate([j for j, _ in turns])
+    count = np.concatenate([c for _, c in turns])
+    most = []
+    for cell in range(cells):
+        reached = np.sort(count[span_cell == cell])[::-1]  # the k-th largest: reached by k samples
+        most.append(int(reached[least - 1]) if reached.size >= least else -1)
+    return most
 
 
 def _edges(values, name: str) -> list[float]:
@@ -218,8 +387,8 @@ def check_operating_record(record) -> dict:
     ValueError
         Naming the first key that is missing, of the wrong type or out of range.
     """
-    if not isinstance(record, dict) or set(record) != _KEYS:
-        raise ValueError(f"operating must hold exactly {', '.join(sorted(_KEYS))}")
+    if not isinstance(record, dict) or set(record) - {_REVERSAL_KEY} != _KEYS:
+        raise ValueError(f"operating must hold exactly {', '.join(sorted(_KEYS))} (and {_REVERSAL_KEY})")
     window = record["window_s"]
     if isinstance(window, bool) or not isinstance(window, (int, float)) or not 0.0 < window <= 60.0:
         raise ValueError(f"operating.window_s must be a number of seconds in (0, 60], got {window!r}")
@@ -234,6 +403,11 @@ def check_operating_record(record) -> dict:
                 isinstance(k, int) and not isinstance(k, bool) and 0 <= k < n for k, n in zip(cell, shape))):
             raise ValueError(f"operating.cells must hold [speed cell, span cell] pairs within the grid "
                              f"{shape[0]} x {shape[1]}, got {cell!r}")
+    most = record.get(_REVERSAL_KEY, [])
+    if not isinstance(most, list) or (_REVERSAL_KEY in record and len(most) != shape[1]) or not all(
+            isinstance(k, int) and not isinstance(k, bool) and -1 <= k <= _MAX_REVERSALS for k in most):
+        raise ValueError(f"operating.{_REVERSAL_KEY} must be a list of {shape[1]} whole numbers from -1 to "
+                         f"{_MAX_REVERSALS}, one per span cell")
     return record
 
 
@@ -260,6 +434,8 @@ class OperatingRegion:
         for i, j in operating["cells"]:
             seen[max(i - neighbours, 0):i + neighbours + 1, max(j - neighbours, 0):j + neighbours + 1] = True
         self._seen = seen
+        most = operating.get(_REVERSAL_KEY)  # None: a file of format version 4, without the rule
+        self._most = None if most is None else np.asarray(most, dtype=np.int64)
         self._speed_inner, self._span_inner = _inner(speed), _inner(span)
         self._bounds = [(channel, *ranges[channel]) for channel in ("position", "velocity", "acceleration")
                         if ranges.get(channel) is not None]
@@ -279,7 +455,7 @@ class OperatingRegion:
 
     def start(self):
         """The state at the start of a run: no position seen yet."""
-        return None
+        return None, None, None
 
     def flags(self, log, state, *, sample_time: float) -> tuple[dict[str, np.ndarray], np.ndarray]:
         """Samples of one chunk of a run outside the region, from the state the previous chunk left.
@@ -298,17 +474,27 @@ class OperatingRegion:
         flags : dict of str to ndarray of bool
             ``"position"``, ``"velocity"``, ``"acceleration"`` (each where the record holds its range):
             True outside the training range; ``"motion"``: True where the pair (speed, local span) lies in
-            no cell seen in training nor within ``neighbours`` cells of one.
-        state : ndarray
-            The positions of the trailing window: the ``state`` of the next chunk.
+            no cell seen in training nor within ``neighbours`` cells of one, or (where the record holds
+            ``reversals``) where the position turned back more often within the window than the training
+            runs did at that span cell.
+        state : tuple
+            The positions and reversal marks of the trailing window and the reversal detector: the ``state``
+            of the next chunk.
         """
         out = {}
         for channel, low, high in self._bounds:
             values = getattr(log, channel, None)
             if values is not None:
                 out[channel] = (values < low) | (values > high)
-        span, state = local_span(log.position, _window_samples(self.operating["window_s"], sample_time), state)
+        positions, detector, marks_before = state
+        samples = _window_samples(self.operating["window_s"], sample_time)
+        span, positions = local_span(log.position, samples, positions)
+        if self._most is None:
+            count, most = np.zeros(span.size, dtype=np.int64), np.full(len(self._span_inner) + 1, _MAX_REVERSALS)
+        else:
+            marks, detector = reversal_marks(log.position, self.operating["span_edges"][0], detector)
+            (count, marks_before), most = trailing_reversals(marks, samples, marks_before), self._most
         out["motion"] = np.empty(span.size, dtype=np.bool_)
-        _unseen_kernel(np.abs(np.asarray(log.velocity, dtype=np.float64)), span, self._speed_inner,
-                       self._span_inner, self._seen, out["motion"])
-        return out, state
+        _unseen_kernel(np.abs(np.asarray(log.velocity, dtype=np.float64)), span, count, self._speed_inner,
+                       self._span_inner, self._seen, most, out["motion"])
+        return out, (positions, detector, marks_before)

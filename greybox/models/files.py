@@ -1,13 +1,13 @@
 """Saving and loading fitted models, without pickle.
 
-File format (format name ``greybox-model``, version 4)
+File format (format name ``greybox-model``, version 5)
 ------------------------------------------------------
 A model file is a ZIP archive (any file name; ``.gbm`` by convention) with
 
 ``model.json``
     A JSON object::
 
-        {"format": "greybox-model", "format_version": 4,
+        {"format": "greybox-model", "format_version": 5,
          "greybox_version": "0.1.0",
          "model": {"kind": "gms",
                    "params": {...},       # get_params(deep=False)
@@ -96,7 +96,10 @@ FORMAT_NAME = "greybox-model"
 #: the ``operating`` record inside the ``training`` record (:mod:`greybox.data.operating`), which an older
 #: greybox's check of that record refuses as an unknown key: with the bump it says "written by a newer
 #: greybox" instead. Files of versions 1 to 3 load as before (a version-3 file may already hold ``operating``).
-FORMAT_VERSION = 4
+#: Version 5 added ``reversals`` to the ``operating`` record (:data:`greybox.data.operating.REVERSALS_RULE`),
+#: which an older greybox refuses as an unknown key; files of version 4 load and predict as before (their
+#: region without the rule of the reversals).
+FORMAT_VERSION = 5
 
 #: Member holding the SHA-256 of every other member (and the signature with the plant's key).
 DIGEST_MEMBER = "digest.json"

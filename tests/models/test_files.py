@@ -518,8 +518,10 @@ def test_a_signed_file_is_checked_with_the_plants_key(tmp_path, data, monkeypatc
 
 
 def test_a_file_with_an_operating_record_tells_an_older_greybox_it_is_newer(tmp_path):
-    """Format 4 added the ``operating`` record: a greybox that reads up to 3 says "newer greybox" (not a record
-    error), and version-3 files (with or without that record) still load and predict the same."""
+    """Format 4 added the ``operating`` record, format 5 its ``reversals``: a greybox that reads up to 4 says
+    "newer greybox" (not a record error), and version-3 files (with or without that record) and version-4
+    files (without ``reversals``) still load and predict the same; a version-4 file's region flags the motion
+    by its grid alone, as before."""
     from export_logs import write_export_logs
 
     from greybox.cli import main
@@ -532,9 +534,10 @@ def test_a_file_with_an_operating_record_tells_an_older_greybox_it_is_newer(tmp_
                  "--quiet"]) == 0
     with zipfile.ZipFile(path) as archive:
         document = json.loads(archive.read("model.json"))
-    assert document["format_version"] == FORMAT_VERSION == 4 and "operating" in document["records"]["training"]
-    with pytest.raises(ModelFileError, match=r"c\.gbm: model file format version 4 was written by a newer greybox"):
-        files.check_format(document, path, name=files.FORMAT_NAME, newest=3, what="model file")
+    assert document["format_version"] == FORMAT_VERSION == 5
+    assert "reversals" in document["records"]["training"]["operating"]
+    with pytest.raises(ModelFileError, match=r"c\.gbm: model file format version 5 was written by a newer greybox"):
+        files.check_format(document, path, name=files.FORMAT_NAME, newest=4, what="model file")
     run = prepare([read_log(logs["aircut_1"])])[0]
     reference = load_model(path).predict(run)
     for name, change in (("v3.gbm", lambda d: d.update(format_version=3)),
@@ -546,3 +549,17 @@ def test_a_file_with_an_operating_record_tells_an_older_greybox_it_is_newer(tmp_
         loaded, records = load_model(older, records=True)
         assert ("operating" in records["training"]) == (name == "v3.gbm")
         np.testing.assert_array_equal(loaded.predict(run), reference)
+    older = tmp_path / "v4.gbm"
+    older.write_bytes(path.read_bytes())
+    _rewrite_json(older, lambda d: (d.update(format_version=4), d["records"]["training"]["operating"].pop("reversals")))
+    loaded, records = load_model(older, records=True)
+    np.testing.assert_array_equal(loaded.predict(run), reference)
+    operating = records["training"]["operating"]
+    assert "reversals" not in operating
+    speed, span = operating["speed_edges"], operating["span_edges"]
+    window = max(int(round(operating["window_s"] / run.sample_time)), 1)
+    seen = {tuple(cell) for cell in operating["cells"]}
+    grid_only = [(int(np.searchsorted(speed[1:-1], abs(v), side="right")),
+                  int(np.searchsorted(span[1:-1], np.ptp(run.position[max(k - window + 1, 0):k + 1]), side="right")))
+                 not in seen for k, v in enumerate(run.velocity)]
+    np.testing.assert_array_equal(loaded.outside_training(run)["motion"], grid_only)
