@@ -40,7 +40,7 @@ from numba import njit
 from ..errors import LogError, Setting
 from ..threads import shared_pool
 from .blocks import CannotStream, reblock
-from .json_numbers import parse_flat_objects
+from .json_numbers import parse_flat_objects, read_u64
 from .log import AxisLog
 from .units import log_from_columns
 
@@ -162,14 +162,6 @@ def write_mcap(logs: AxisLog | Sequence[AxisLog], path) -> None:
 
 # ----------------------------------------------------------------------- scan
 @njit(cache=True, nogil=True)
-def _read_u64(buf, pos):
-    value = np.uint64(0)
-    for k in range(8):
-        value |= np.uint64(buf[pos + k]) << np.uint64(8 * k)
-    return value
-
-
-@njit(cache=True, nogil=True)
 def scan_records(buf, start, stop):
     """Split a byte range into MCAP records (opcode u8, length u64, content).
 
@@ -194,7 +186,7 @@ def scan_records(buf, start, stop):
     count = 0
     pos = start
     while pos + 9 <= stop:
-        length = _read_u64(buf, pos + 1)
+        length = read_u64(buf, pos + 1)
         if length > np.uint64(stop - pos - 9):
             break
         pos += 9 + np.int64(length)
@@ -204,7 +196,7 @@ def scan_records(buf, start, stop):
     lengths = np.empty(count, np.int64)
     pos = start
     for k in range(count):
-        length = np.int64(_read_u64(buf, pos + 1))
+        length = np.int64(read_u64(buf, pos + 1))
         opcodes[k] = buf[pos]
         offsets[k] = pos + 9
         lengths[k] = length
