@@ -31,6 +31,7 @@ import json
 import os
 import zlib
 from collections import deque
+from functools import partial
 from typing import Callable, Iterator, Mapping, Sequence
 
 import numba
@@ -412,24 +413,32 @@ class _MessageCollector:
         """Time stamps [ns] and field columns, in log_time order (missing values NaN)."""
         self.flush()
         stamps = self.take_stamps()
-        names = list(dict.fromkeys(name for _, batch in self.batches for name in batch))
-        table = {}
-        for name in names:
-            parts = [batch.pop(name, None) for _, batch in self.batches]
-            if all(part is None or part.dtype == np.float64 for part in parts):
-                parts = [np.full(rows, np.nan) if part is None else part
-                         for (rows, _), part in zip(self.batches, parts)]
-            else:
-                parts = [np.full(rows, None, object) if part is None else part.astype(object)
-                         for (rows, _), part in zip(self.batches, parts)]
-            table[name] = np.concatenate(parts)
-            del parts
-        self.batches = []
+        batches, self.batches = self.batches, []
+        names = list(dict.fromkeys(name for _, batch in batches for name in batch))
+        threads = min(max(1, numba.get_num_threads()), len(names))
+        join = partial(_join_column, batches)  # a column per thread at a time (copies release the GIL)
+        table = dict(zip(names, shared_pool(threads, "mcap-columns").map(join, names) if threads > 1
+                         else map(join, names)))
         if np.any(stamps[1:] < stamps[:-1]):
             order = np.argsort(stamps, kind="stable")
             stamps = stamps[order]
             table = {name: values[order] for name, values in table.items()}
         return stamps, table
+
+
+def _join_column(batches: list[tuple[int, dict]], name: str) -> np.ndarray:
+    """One field's column from the batches (rows, {name: values}), taken out of them: float64 written into
+    one array made for it (NaN where a batch lacks the field), else objects (None where missing)."""
+    parts = [batch.pop(name, None) for _, batch in batches]
+    if all(part is None or part.dtype == np.float64 for part in parts):
+        column = np.empty(sum(rows for rows, _ in batches))
+        start = 0
+        for (rows, _), part in zip(batches, parts):
+            column[start:start + rows] = np.nan if part is None else part
+            start += rows
+        return column
+    return np.concatenate([np.full(rows, None, object) if part is None else part.astype(object)
+                           for (rows, _), part in zip(batches, parts)])
 
 
 def _parse_messages(buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray,
