@@ -118,7 +118,7 @@ def test_compiled_message_selection_agrees_with_plain_python():
     data = b"".join(bodies)
     buf = np.frombuffer(data, np.uint8)
     opcodes, offsets, lengths, _ = scan_records(buf, 0, buf.size)
-    for kernel in (select_messages, select_messages.py_func):
+    for kernel in (select_messages, getattr(select_messages, "py_func", select_messages)):
         for channel in (1, 2, 3, 9):
             mine = [(o, n) for op, o, n in zip(opcodes.tolist(), offsets.tolist(), lengths.tolist())
                     if op == 5 and int.from_bytes(data[o:o + 2], "little") == channel]
