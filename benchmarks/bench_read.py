@@ -13,16 +13,24 @@ the imports, before reading. Also file size [MB] and write time [s]. The
 read time includes the lazy imports a fresh process needs for that format
 (pyarrow, numba and its cached kernels for MCAP).
 
+``--stages`` instead profiles the MCAP read in this process, kernels warm: CPU
+seconds [s] of each stage run on one thread over the whole file (chunks
+decompressed and CRC-checked, split into records, the channel's messages
+selected with their time stamps, parsed, joined into columns, converted to an
+AxisLog), and wall and CPU seconds of ``read_log`` on the pool.
+
 Usage::
 
     python benchmarks/bench_read.py            # table
     python benchmarks/bench_read.py --json     # one JSON line
+    python benchmarks/bench_read.py --stages   # MCAP read stage by stage (JSON line)
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import resource
 import subprocess
 import sys
 import tempfile
@@ -31,7 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-from greybox.data import AxisLog, read_log, write_log
+from greybox.data import AxisLog, mcap_io, read_log, write_log
+from greybox.data.units import log_from_columns
 
 _CHILD = r"""
 import json, sys, time
@@ -99,12 +108,57 @@ def run(duration_s: float = 3600.0, sample_time: float = 0.002) -> dict:
     return result
 
 
+def _cpu_seconds() -> float:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
+def stages(duration_s: float = 3600.0, sample_time: float = 0.002) -> dict:
+    """CPU seconds of each stage of the MCAP read on one thread, and wall/CPU seconds of ``read_log``."""
+    log = synthetic_log(duration_s, sample_time)
+    result: dict = {"n_samples": len(log)}
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "bench.mcap"
+        write_log(log, path)
+        read_log(path)  # kernels compiled or loaded, pools made
+        wall, cpu = time.perf_counter(), _cpu_seconds()
+        read_log(path)
+        result["read_log_wall_s"] = round(time.perf_counter() - wall, 3)
+        result["read_log_cpu_s"] = round(_cpu_seconds() - cpu, 3)
+        channel = next(iter(mcap_io._walked_channels(path).values()))
+
+        def timed(name, function, items):
+            started = _cpu_seconds()
+            out = [function(*item) for item in items]
+            result[f"{name}_cpu_s"] = round(_cpu_seconds() - started, 3)
+            return out
+
+        contents = [(item, path) for item in mcap_io._stretches(path) if isinstance(item, bytes)]
+        raw = timed("decompress_crc", mcap_io._decompress, contents)
+        records = timed("scan", mcap_io._chunk_records, [(data, path) for data in raw])
+        selected = timed("select", mcap_io._channel_messages,
+                         [(*chunk, channel.id, path) for chunk in records])
+        columns = timed("parse", mcap_io._parse_messages,
+                        [(chunk[0], offs, lens, 1) for chunk, (offs, lens, _) in zip(records, selected)])
+        collector = mcap_io._MessageCollector(path)
+        for chunk, (offs, lens, stamps), parsed in zip(records, selected, columns):
+            collector.add(chunk[0], offs, lens, stamps, parsed)
+        ((stamps, table),) = timed("join", collector.columns, [()])
+        timed("convert", lambda: log_from_columns(table, source=path, time=stamps * 1e-9,
+                                                  **mcap_io._channel_fields(channel, path)), [()])
+    return result
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=3600.0, help="log duration [s] (default 3600)")
     parser.add_argument("--sample-time", type=float, default=0.002, help="sample time [s] (default 0.002)")
     parser.add_argument("--json", action="store_true", help="print one JSON line")
+    parser.add_argument("--stages", action="store_true", help="profile the MCAP read stage by stage (JSON line)")
     args = parser.parse_args(argv)
+    if args.stages:
+        print(json.dumps(stages(args.duration, args.sample_time)))
+        return 0
     result = run(args.duration, args.sample_time)
     if args.json:
         print(json.dumps(result))

@@ -31,6 +31,7 @@ import json
 import os
 import zlib
 from collections import deque
+from functools import partial
 from typing import Callable, Iterator, Mapping, Sequence
 
 import numba
@@ -40,7 +41,7 @@ from numba import njit
 from ..errors import LogError, Setting
 from ..threads import shared_pool
 from .blocks import CannotStream, reblock
-from .json_numbers import parse_flat_objects
+from .json_numbers import parse_flat_objects, read_u64
 from .log import AxisLog
 from .units import log_from_columns
 
@@ -162,14 +163,6 @@ def write_mcap(logs: AxisLog | Sequence[AxisLog], path) -> None:
 
 # ----------------------------------------------------------------------- scan
 @njit(cache=True, nogil=True)
-def _read_u64(buf, pos):
-    value = np.uint64(0)
-    for k in range(8):
-        value |= np.uint64(buf[pos + k]) << np.uint64(8 * k)
-    return value
-
-
-@njit(cache=True, nogil=True)
 def scan_records(buf, start, stop):
     """Split a byte range into MCAP records (opcode u8, length u64, content).
 
@@ -194,7 +187,7 @@ def scan_records(buf, start, stop):
     count = 0
     pos = start
     while pos + 9 <= stop:
-        length = _read_u64(buf, pos + 1)
+        length = read_u64(buf, pos + 1)
         if length > np.uint64(stop - pos - 9):
             break
         pos += 9 + np.int64(length)
@@ -204,7 +197,7 @@ def scan_records(buf, start, stop):
     lengths = np.empty(count, np.int64)
     pos = start
     for k in range(count):
-        length = np.int64(_read_u64(buf, pos + 1))
+        length = np.int64(read_u64(buf, pos + 1))
         opcodes[k] = buf[pos]
         offsets[k] = pos + 9
         lengths[k] = length
@@ -233,6 +226,49 @@ def join_slices(buf, offsets, lengths, separator):
         out[pos:pos + lengths[k]] = buf[offsets[k]:offsets[k] + lengths[k]]
         pos += lengths[k]
     return out
+
+
+@njit(cache=True, nogil=True)
+def select_messages(buf, opcodes, offsets, lengths, channel_id):
+    """The message records of one channel among scanned records, with their ``log_time``, in one pass.
+
+    Parameters
+    ----------
+    buf : ndarray of uint8
+        Bytes holding the records.
+    opcodes : ndarray of uint8
+        Each record's opcode.
+    offsets, lengths : ndarray of int64
+        Each record's content: offset in ``buf`` and length [bytes].
+    channel_id : int
+        Channel whose messages to select.
+
+    Returns
+    -------
+    offsets, lengths : ndarray of int64
+        Offset and length of each selected message record's content.
+    stamps : ndarray of uint64
+        Their ``log_time`` [ns].
+    short : bool
+        True when a message record (of any channel) is shorter than its header; then nothing is selected.
+    """
+    count = 0
+    for k in range(opcodes.shape[0]):
+        if opcodes[k] == _OP_MESSAGE:
+            if lengths[k] < _MESSAGE_HEADER:
+                return np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.uint64), True
+            if np.int64(buf[offsets[k]]) | (np.int64(buf[offsets[k] + 1]) << 8) == channel_id:
+                count += 1
+    offs = np.empty(count, np.int64)
+    lens = np.empty(count, np.int64)
+    stamps = np.empty(count, np.uint64)
+    j = 0
+    for k in range(opcodes.shape[0]):
+        if opcodes[k] == _OP_MESSAGE and np.int64(buf[offsets[k]]) | (np.int64(buf[offsets[k] + 1]) << 8) == channel_id:
+            offs[j], lens[j] = offsets[k], lengths[k]
+            stamps[j] = read_u64(buf, offsets[k] + 6)
+            j += 1
+    return offs, lens, stamps, False
 
 
 # ----------------------------------------------------------------------- read
@@ -318,12 +354,15 @@ class _MessageCollector:
         self.pending_rows = 0
         self.batches: list[tuple[int, dict]] = []
 
-    def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray,
-            parsed: tuple[np.ndarray, dict | None] | None = None) -> None:
-        """Collect the message records at ``offsets`` in ``buf``; ``parsed``: their :func:`_parse_messages`."""
+    def add(self, buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, stamps: np.ndarray,
+            columns: dict | None | bool = False) -> None:
+        """Collect the message records at ``offsets`` in ``buf`` with their ``stamps`` [ns]; ``columns``: their
+        fields by :func:`~greybox.data.json_numbers.parse_flat_objects` if already parsed (False: parse them here).
+        """
         if not offsets.size:
             return
-        stamps, columns = _parse_messages(buf, offsets, lengths) if parsed is None else parsed
+        if columns is False:
+            columns = _parse_messages(buf, offsets, lengths)
         self.stamps.append(stamps)
         self.rows += offsets.size
         if columns is not None:
@@ -374,19 +413,12 @@ class _MessageCollector:
         """Time stamps [ns] and field columns, in log_time order (missing values NaN)."""
         self.flush()
         stamps = self.take_stamps()
-        names = list(dict.fromkeys(name for _, batch in self.batches for name in batch))
-        table = {}
-        for name in names:
-            parts = [batch.pop(name, None) for _, batch in self.batches]
-            if all(part is None or part.dtype == np.float64 for part in parts):
-                parts = [np.full(rows, np.nan) if part is None else part
-                         for (rows, _), part in zip(self.batches, parts)]
-            else:
-                parts = [np.full(rows, None, object) if part is None else part.astype(object)
-                         for (rows, _), part in zip(self.batches, parts)]
-            table[name] = np.concatenate(parts)
-            del parts
-        self.batches = []
+        batches, self.batches = self.batches, []
+        names = list(dict.fromkeys(name for _, batch in batches for name in batch))
+        threads = min(max(1, numba.get_num_threads()), len(names))
+        join = partial(_join_column, batches)  # a column per thread at a time (copies release the GIL)
+        table = dict(zip(names, shared_pool(threads, "mcap-columns").map(join, names) if threads > 1
+                         else map(join, names)))
         if np.any(stamps[1:] < stamps[:-1]):
             order = np.argsort(stamps, kind="stable")
             stamps = stamps[order]
@@ -394,15 +426,29 @@ class _MessageCollector:
         return stamps, table
 
 
-def _parse_messages(buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray,
-                    threads: int | None = None) -> tuple[np.ndarray, dict | None]:
-    """The ``log_time`` [ns] of the message records at ``offsets`` and their fields by the compiled reader.
+def _join_column(batches: list[tuple[int, dict]], name: str) -> np.ndarray:
+    """One field's column from the batches (rows, {name: values}), taken out of them: float64 written into
+    one array made for it (NaN where a batch lacks the field), else objects (None where missing)."""
+    parts = [batch.pop(name, None) for _, batch in batches]
+    if all(part is None or part.dtype == np.float64 for part in parts):
+        column = np.empty(sum(rows for rows, _ in batches))
+        start = 0
+        for (rows, _), part in zip(batches, parts):
+            column[start:start + rows] = np.nan if part is None else part
+            start += rows
+        return column
+    return np.concatenate([np.full(rows, None, object) if part is None else part.astype(object)
+                           for (rows, _), part in zip(batches, parts)])
 
-    The fields are None when the messages are not all flat JSON objects of numbers with the same keys
+
+def _parse_messages(buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray,
+                    threads: int | None = None) -> dict | None:
+    """The fields of the message records at ``offsets`` by the compiled reader.
+
+    None when the messages are not all flat JSON objects of numbers with the same keys
     (:func:`~greybox.data.json_numbers.parse_flat_objects`, on ``threads`` threads).
     """
-    columns = parse_flat_objects(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER, threads=threads)
-    return _log_times(buf, offsets), columns
+    return parse_flat_objects(buf, offsets + _MESSAGE_HEADER, lengths - _MESSAGE_HEADER, threads=threads)
 
 
 def _as_array(column) -> np.ndarray:
@@ -492,18 +538,18 @@ def _stretches(path) -> Iterator[tuple | bytes]:
 def _read_chunk(content: bytes, channel_id: int | None, path) -> tuple:
     """A chunk record's content decompressed and scanned: (buffer, opcodes, offsets, lengths, parsed).
 
-    ``parsed`` is None, or with a ``channel_id`` ``(channel_id, offsets, lengths, messages)``: the offsets
-    and lengths of that channel's message records and their :func:`_parse_messages` on this thread (None
-    when there are none, or when they fail a check, which the caller then meets if it reads that channel).
+    ``parsed`` is None, or with a ``channel_id`` ``(channel_id, offsets, lengths, stamps, columns)``: the
+    offsets, lengths and ``log_time`` of that channel's message records (:func:`select_messages`) and their
+    :func:`_parse_messages` on this thread (None when there are none, or when they fail a check, which the
+    caller then meets if it reads that channel).
     """
     buf, opcodes, offsets, lengths = _chunk_records(_decompress(content, path), path)
     parsed = None
     if channel_id is not None and np.any(opcodes == _OP_MESSAGE):
-        try:
-            offs, lens = _channel_messages(buf, opcodes, offsets, lengths, channel_id, path)
-        except LogError:
+        offs, lens, stamps, short = select_messages(buf, opcodes, offsets, lengths, channel_id)
+        if short:
             return buf, opcodes, offsets, lengths, None
-        parsed = (channel_id, offs, lens, _parse_messages(buf, offs, lens, threads=1) if offs.size else None)
+        parsed = (channel_id, offs, lens, stamps, _parse_messages(buf, offs, lens, threads=1) if offs.size else None)
     return buf, opcodes, offsets, lengths, parsed
 
 
@@ -586,28 +632,20 @@ def _messages(path, topic: str | None, channels: dict[int, _Channel], collector:
         if chosen is None or not np.any(opcodes == _OP_MESSAGE):
             continue
         if parsed is not None and parsed[0] == chosen.id:
-            _, offs, lens, messages = parsed
+            _, offs, lens, stamps, columns = parsed
         else:
-            (offs, lens), messages = _channel_messages(buf, opcodes, offsets, lengths, chosen.id, path), None
-        collector.add(buf, offs, lens, messages)
+            (offs, lens, stamps), columns = _channel_messages(buf, opcodes, offsets, lengths, chosen.id, path), False
+        collector.add(buf, offs, lens, stamps, columns)
         yield collector.rows
 
 
-def _channel_messages(buf, opcodes, offsets, lengths, channel_id: int, path) -> tuple[np.ndarray, np.ndarray]:
-    """Offsets and lengths of the message records of one channel among scanned records."""
-    is_message = opcodes == _OP_MESSAGE
-    offs, lens = offsets[is_message], lengths[is_message]
-    if np.any(lens < _MESSAGE_HEADER):
+def _channel_messages(buf, opcodes, offsets, lengths, channel_id: int,
+                      path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Offsets, lengths and ``log_time`` [ns] of the message records of one channel among scanned records."""
+    offs, lens, stamps, short = select_messages(buf, opcodes, offsets, lengths, channel_id)
+    if short:
         raise LogError(path, "corrupt MCAP file: a message record is shorter than its header")
-    ids = buf[offs].astype(np.uint16) | (buf[offs + 1].astype(np.uint16) << 8)
-    mine = ids == channel_id
-    return offs[mine], lens[mine]
-
-
-def _log_times(buf, offsets) -> np.ndarray:
-    """The ``log_time`` [ns] of the message records at ``offsets``."""
-    header = buf[offsets[:, None] + np.arange(6, 14)]
-    return np.ascontiguousarray(header).view("<u8").ravel().copy()
+    return offs, lens, stamps
 
 
 def _channel_stamps(path, channel_id: int) -> Iterator[np.ndarray]:
@@ -619,10 +657,10 @@ def _channel_stamps(path, channel_id: int) -> Iterator[np.ndarray]:
     for buf, data, opcodes, offsets, lengths, last in _windows(path):
         begin = 0
         for chunk in np.flatnonzero(opcodes == _OP_CHUNK).tolist() + [opcodes.size]:
-            offs, _ = _channel_messages(buf, opcodes[begin:chunk], offsets[begin:chunk], lengths[begin:chunk],
-                                        channel_id, path)  # messages outside chunks
-            if offs.size:
-                yield _log_times(buf, offs)
+            _, _, stamps = _channel_messages(buf, opcodes[begin:chunk], offsets[begin:chunk], lengths[begin:chunk],
+                                             channel_id, path)  # messages outside chunks
+            if stamps.size:
+                yield stamps
             if chunk == opcodes.size:
                 break
             end = chunk + 1
@@ -634,7 +672,7 @@ def _channel_stamps(path, channel_id: int) -> Iterator[np.ndarray]:
             if stamps is None:
                 inner, ops, offs, lens = _chunk_records(
                     _decompress(data[offsets[chunk]:offsets[chunk] + lengths[chunk]], path), path)
-                stamps = _log_times(inner, _channel_messages(inner, ops, offs, lens, channel_id, path)[0])
+                stamps = _channel_messages(inner, ops, offs, lens, channel_id, path)[2]
             if stamps.size:
                 yield stamps
             begin = end

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from numba import njit
 
 from greybox.data import json_numbers, mcap_io
 from greybox.data.json_numbers import MAX_SLOW_NUMBERS, parse_flat_objects
@@ -188,3 +192,62 @@ def test_an_mcap_log_reads_the_same_by_either_parser(tmp_path, monkeypatch):
         np.testing.assert_array_equal(values, dict(general.named_channels(time=True))[name])
     np.testing.assert_array_equal(fast.position, log.position)
     np.testing.assert_array_equal(fast.extras["temperature_C"], log.extras["temperature_C"])
+
+
+def test_the_128_bit_product_is_the_exact_product_compiled_and_plain():
+    """The compiled multiplication (one 128-bit product) and the plain-Python one (32-bit words, what
+    NUMBA_DISABLE_JIT=1 runs) both give the exact product's high and low words."""
+    rng = np.random.default_rng(7)
+    edges = [0, 1, 2 ** 32 - 1, 2 ** 32, 2 ** 63, 2 ** 64 - 1]
+    pairs = [(a, b) for a in edges for b in edges] + [tuple(map(int, pair)) for pair in
+                                                      rng.integers(0, 2 ** 64 - 1, (500, 2), np.uint64, True)]
+    compiled = njit(lambda a, b: json_numbers._multiply(a, b))
+    for a, b in pairs:
+        exact = a * b
+        expected = (exact >> 64, exact & (2 ** 64 - 1))
+        for multiply in (compiled, json_numbers._multiply):
+            high, low = multiply(np.uint64(a), np.uint64(b))
+            assert (int(high), int(low)) == expected, (a, b, multiply)
+
+
+@PROPERTY
+@given(text=st.binary(min_size=0, max_size=10) | st.text("0123456789/:", min_size=8, max_size=9).map(str.encode))
+def test_eight_digits_at_once_read_as_int_reads_them(text):
+    buf = np.frombuffer(text, np.uint8)
+    expected = int(text[:8]) if len(text) >= 8 and text[:8].isdigit() else -1
+    plain = getattr(json_numbers._eight_digits, "py_func", json_numbers._eight_digits)  # what NUMBA_DISABLE_JIT runs
+    for kernel in (json_numbers._eight_digits, plain):
+        assert kernel(buf, 0, buf.size) == expected
+    padded = np.frombuffer(text.ljust(8, b"\0"), np.uint8)
+    for kernel in (json_numbers.read_u64, getattr(json_numbers.read_u64, "py_func", json_numbers.read_u64)):
+        assert kernel(padded, 0) == int.from_bytes(padded[:8].tobytes(), "little")
+
+
+def test_compiled_and_plain_python_parsers_give_the_same_bits(tmp_path):
+    """The kernels with the compiler off (NUMBA_DISABLE_JIT=1, a fresh process) read the same bits as compiled."""
+    rng = np.random.default_rng(9)
+    values = rng.standard_normal((300, 4)) * 10.0 ** rng.integers(-30, 30, (300, 4))
+    texts = [[repr(value) for value in row] for row in values.tolist()]
+    texts[0] = ["0.000123456789012345678", "-0.0", "12345678901234567", "1e-400"]  # leading zeros, -0, long
+    texts[1] = ["123456789.87654321", "0.00000000", "99999999999999999999", "7"]
+    messages = ["{" + ",".join(f'"k{key}":{text}' for key, text in enumerate(row)) + "}" for row in texts]
+    source = tmp_path / "messages.json"
+    source.write_text(json.dumps(messages))
+    script = (
+        "import json, sys, numpy as np\n"
+        "from greybox.data.json_numbers import parse_flat_objects\n"
+        "messages = [m.encode() for m in json.load(open(sys.argv[1]))]\n"
+        "buf = np.frombuffer(b''.join(messages), np.uint8)\n"
+        "lengths = np.array([len(m) for m in messages], np.int64)\n"
+        "offsets = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)\n"
+        "columns = parse_flat_objects(buf, offsets, lengths, threads=1)\n"
+        "print(json.dumps({key: column.view(np.int64).tolist() for key, column in columns.items()}))\n"
+    )
+    environment = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
+    plain = subprocess.run([sys.executable, "-c", script, str(source)], env=environment, check=True,
+                           capture_output=True, text=True)
+    compiled = parse([message.encode() for message in messages], threads=1)
+    assert json.loads(plain.stdout) == {key: column.view(np.int64).tolist() for key, column in compiled.items()}
+    for key, column in compiled.items():
+        expected = [float(row[int(key[1:])]) for row in texts]
+        assert column.view(np.int64).tolist() == np.array(expected).view(np.int64).tolist()

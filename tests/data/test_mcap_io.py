@@ -10,7 +10,7 @@ from log_errors import assert_read_fails
 from mcap.reader import make_reader
 
 from greybox.data.io import read_log, write_log
-from greybox.data.mcap_io import SCHEMA_NAME, join_slices, scan_records
+from greybox.data.mcap_io import SCHEMA_NAME, join_slices, scan_records, select_messages
 from greybox.errors import LogError
 
 
@@ -104,6 +104,32 @@ def test_compiled_scan_and_join_agree_with_plain_python():
     assert end == 5 + len(records)
     joined = join_slices(buf, offsets, lengths, 10).tobytes()
     assert joined == b"\n".join(data[o:o + n] for o, n in zip(ref[1], ref[2]))
+
+
+def test_compiled_message_selection_agrees_with_plain_python():
+    """One channel's message records and their log_time, compiled and with the compiler off (``py_func``, what
+    NUMBA_DISABLE_JIT=1 runs), against the fields read with int.from_bytes."""
+    rng = np.random.default_rng(8)
+    bodies = []
+    for _ in range(300):
+        opcode = int(rng.choice([5, 5, 5, 4, 7]))
+        body = int(rng.integers(1, 4)).to_bytes(2, "little") + rng.bytes(int(rng.integers(20, 60)))
+        bodies.append(bytes([opcode]) + len(body).to_bytes(8, "little") + body)
+    data = b"".join(bodies)
+    buf = np.frombuffer(data, np.uint8)
+    opcodes, offsets, lengths, _ = scan_records(buf, 0, buf.size)
+    for kernel in (select_messages, getattr(select_messages, "py_func", select_messages)):
+        for channel in (1, 2, 3, 9):
+            mine = [(o, n) for op, o, n in zip(opcodes.tolist(), offsets.tolist(), lengths.tolist())
+                    if op == 5 and int.from_bytes(data[o:o + 2], "little") == channel]
+            offs, lens, stamps, short = kernel(buf, opcodes, offsets, lengths, channel)
+            assert not short
+            assert list(zip(offs.tolist(), lens.tolist())) == mine
+            assert stamps.tolist() == [int.from_bytes(data[o + 6:o + 14], "little") for o, _ in mine]
+        short_buf = np.frombuffer(data + b"\x05" + (3).to_bytes(8, "little") + b"\x01\x00\x00", np.uint8)
+        ops, offs, lens, _ = scan_records(short_buf, 0, short_buf.size)
+        offs, lens, stamps, short = kernel(short_buf, ops, offs, lens, 1)  # a message shorter than its header
+        assert short and not offs.size
 
 
 def _write_with_mcap_library(path, messages, *, encoding="json", **writer_options):
