@@ -220,6 +220,18 @@ SPECS = {spec.name: spec for spec in (
                 *_FRICTION_FITS, "data/X_A.mcap"),
                "the example of docs/intervals.md as printed: a GMS on X_A, its parameters' 95 % intervals and flags"),
     # -- end of the walk-through (issue 43, h43pages3) --
+    # -- issue 40's axis_dev targets on the independent development split (h40axisdev) --
+    RecordSpec("axis-dev", ("benchmarks/bench_axis_dev.py", "--part", "force", "--json"),
+               ("benchmarks/bench_axis_dev.py", "greybox/train", "greybox/predict", "greybox/evaluate", "greybox/cli",
+                *_FRICTION_FITS, "greybox/provenance.py"),
+               "axis_dev: the cut force on cut_D of greybox train --model gmssvr on the three air cuts; a GMS on "
+               "each air cut alone, its RMSE on the others over its own (or its refusal)"),
+    RecordSpec("axis-dev-speed", ("benchmarks/bench_axis_dev.py", "--part", "speed", "--json"),
+               ("benchmarks/bench_axis_dev.py", "greybox/train", "greybox/predict", "greybox/evaluate", "greybox/cli",
+                *_FRICTION_FITS, "greybox/provenance.py"),
+               "axis_dev: greybox train --model auto on the slower air cuts A and C against coulomb:offset on the "
+               "fastest, aircut_B, beside the noise floor; the choice's cut force on cut_D"),
+    # -- end of issue 40's axis_dev targets (h40axisdev) --
 )}
 
 
