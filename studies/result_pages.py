@@ -906,11 +906,14 @@ def _axis_dev_speed(record: dict) -> str:
     f = record["figures"]
     re = f["fastest_re"]
     force = f["cut_force"]
+    floor = ("not known: the files hold no noise-free current" if re["noise_floor"] is None
+             else f"{re['noise_floor']:.2f} %")
     return ("| development set | chosen | its RE on the fastest held-out run | `coulomb:offset` there | noise floor | "
             "no worse than `coulomb:offset` |\n|---|---|---|---|---|---|\n"
             f"| `axis_dev`, {' + '.join(cut.removeprefix('aircut_') for cut in f['trained_on'])} -> "
             f"{f['fastest'].removeprefix('aircut_')} | `{f['chosen']}` | {re['auto']:.2f} % "
-            f"| {re['coulomb_offset']:.2f} % | {re['noise_floor']:.2f} % "
+            f"| {re['coulomb_offset']:.2f} % "
+            f"| {floor} "
             f"| {_met(re['auto'] <= re['coulomb_offset'])} |\n\n"
             f"`greybox train --model auto --train {' '.join(cut + '.csv' for cut in f['trained_on'])}` took "
             f"{f['auto_seconds']:.0f} s wall ({f['auto_cpu_seconds']:.0f} s of CPU time); the choice's mean process "
