@@ -902,6 +902,23 @@ def _axis_dev_force(record: dict) -> str:
     return "\n".join(lines) + f"\n\n`{record['command']}` ({_where(record)}).\n"
 
 
+def _axis_dev_speed(record: dict) -> str:
+    f = record["figures"]
+    re = f["fastest_re"]
+    force = f["cut_force"]
+    floor = ("not known: the files hold no noise-free current" if re["noise_floor"] is None
+             else f"{re['noise_floor']:.2f} %")
+    return ("| development set | chosen | its RE on the fastest held-out run | `coulomb:offset` there | noise floor | "
+            "no worse than `coulomb:offset` |\n|---|---|---|---|---|---|\n"
+            f"| `axis_dev`, {' + '.join(cut.removeprefix('aircut_') for cut in f['trained_on'])} -> "
+            f"{f['fastest'].removeprefix('aircut_')} | `{f['chosen']}` | {re['auto']:.2f} % "
+            f"| {re['coulomb_offset']:.2f} % "
+            f"| {floor} "
+            f"| {_met(re['auto'] <= re['coulomb_offset'])} |\n\n"
+            f"`greybox train --model auto --train {' '.join(cut + '.csv' for cut in f['trained_on'])}` took "
+            f"{f['auto_seconds']:.0f} s wall ({f['auto_cpu_seconds']:.0f} s of CPU time); the choice's mean process "
+            f"force on `cut_D` is {force['predicted_N']:.1f} N against the truth's {force['truth_N']:.1f} N "
+            f"({force['error_percent']:+.2f} %). `{record['command']}` ({_where(record)}).\n")
 # -- end of issue 40's axis_dev targets (h40axisdev) --
 
 
@@ -972,6 +989,7 @@ VIEWS = {
     # -- end of the walk-through (issue 43, h43pages3) --
     # -- issue 40's axis_dev targets (h40axisdev) --
     "axis-dev-force": View(("axis-dev",), _axis_dev_force),
+    "axis-dev-speed": View(("axis-dev-speed",), _axis_dev_speed),
     # -- end of issue 40's axis_dev targets (h40axisdev) --
 }
 
