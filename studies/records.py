@@ -241,6 +241,18 @@ SPECS = {spec.name: spec for spec in (
                "the operating region's rules on the development air cuts (grid, window of the reversals) and the "
                "shares outside it of held-out twin, axis_dev and ARTS runs and of made-up small oscillations"),
     # -- end of the training region (issue 40, h40region) --
+    # -- issue 40's axis_dev targets on the independent development split (h40axisdev) --
+    RecordSpec("axis-dev", ("benchmarks/bench_axis_dev.py", "--part", "force", "--json"),
+               ("benchmarks/bench_axis_dev.py", "greybox/train", "greybox/predict", "greybox/evaluate", "greybox/cli",
+                *_FRICTION_FITS, "greybox/provenance.py"),
+               "axis_dev: the cut force on cut_D of greybox train --model gmssvr on the three air cuts; a GMS on "
+               "each air cut alone, its RMSE on the others over its own (or its refusal)"),
+    RecordSpec("axis-dev-speed", ("benchmarks/bench_axis_dev.py", "--part", "speed", "--json"),
+               ("benchmarks/bench_axis_dev.py", "greybox/train", "greybox/predict", "greybox/evaluate", "greybox/cli",
+                *_FRICTION_FITS, "greybox/provenance.py"),
+               "axis_dev: greybox train --model auto on the slower air cuts A and C against coulomb:offset on the "
+               "fastest, aircut_B, beside the noise floor; the choice's cut force on cut_D"),
+    # -- end of issue 40's axis_dev targets (h40axisdev) --
 )}
 
 

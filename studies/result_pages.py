@@ -1096,6 +1096,51 @@ def _operating_region(record: dict) -> str:
             f"{100 * stand_in['limit']:.0f} % outside: {', '.join(caught) or 'none'}; "
             f"not: {', '.join(missed) or 'none'}. "
             f"`{record['command']}` ({_where(record)}).\n")
+# -- issue 40's axis_dev targets (h40axisdev) --
+def _axis_dev_force(record: dict) -> str:
+    f = record["figures"]
+    fit = f["gmssvr"]
+    force = fit["cut_force"]
+    lines = [f"`greybox train --model gmssvr --train aircut_A.csv aircut_B.csv aircut_C.csv` took "
+             f"**{fit['seconds']:.0f} s** wall ({fit['cpu_seconds']:.0f} s of CPU time); `greybox predict` of "
+             f"`cut_D.csv` with `axis.toml`: mean process force **{force['predicted_N']:.1f} N** where "
+             f"`F_cut_true_N != 0` ({force['samples']} samples) against the truth's {force['truth_N']:.1f} N, "
+             f"**{force['error_percent']:+.2f} %** (target within 1 %: {_met(abs(force['error_percent']) <= 1.0)}).",
+             "",
+             "| GMS trained on | fit time | RMSE there [A] | RMSE on the other air cuts [A] | over its own | "
+             "within 3 times or refused |",
+             "|---|---|---|---|---|---|"]
+    for single in f["single"]:
+        if single["refused"] is not None:
+            lines.append(f"| `{single['trained_on']}` | {single['seconds']:.0f} s | - | - | - | refused: "
+                         f"`{single['refused']}` |")
+            continue
+        own = single["rmse"][single["trained_on"]]
+        others = ", ".join(f"{cut} {single['rmse'][cut]:.3f}" for cut in single["ratio"])
+        ratios = ", ".join(f"{value:.2f}" for value in single["ratio"].values())
+        lines.append(f"| `{single['trained_on']}` | {single['seconds']:.0f} s | {own:.3f} | {others} | {ratios} | "
+                     f"{_met(max(single['ratio'].values()) <= 3.0)} |")
+    return "\n".join(lines) + f"\n\n`{record['command']}` ({_where(record)}).\n"
+
+
+def _axis_dev_speed(record: dict) -> str:
+    f = record["figures"]
+    re = f["fastest_re"]
+    force = f["cut_force"]
+    floor = ("not known: the files hold no noise-free current" if re["noise_floor"] is None
+             else f"{re['noise_floor']:.2f} %")
+    return ("| development set | chosen | its RE on the fastest held-out run | `coulomb:offset` there | noise floor | "
+            "no worse than `coulomb:offset` |\n|---|---|---|---|---|---|\n"
+            f"| `axis_dev`, {' + '.join(cut.removeprefix('aircut_') for cut in f['trained_on'])} -> "
+            f"{f['fastest'].removeprefix('aircut_')} | `{f['chosen']}` | {re['auto']:.2f} % "
+            f"| {re['coulomb_offset']:.2f} % "
+            f"| {floor} "
+            f"| {_met(re['auto'] <= re['coulomb_offset'])} |\n\n"
+            f"`greybox train --model auto --train {' '.join(cut + '.csv' for cut in f['trained_on'])}` took "
+            f"{f['auto_seconds']:.0f} s wall ({f['auto_cpu_seconds']:.0f} s of CPU time); the choice's mean process "
+            f"force on `cut_D` is {force['predicted_N']:.1f} N against the truth's {force['truth_N']:.1f} N "
+            f"({force['error_percent']:+.2f} %). `{record['command']}` ({_where(record)}).\n")
+# -- end of issue 40's axis_dev targets (h40axisdev) --
 
 
 VIEWS = {
@@ -1177,6 +1222,10 @@ VIEWS = {
     # -- the training region (issue 40, h40region) --
     "operating-region": View(("operating-region",), _operating_region),
     # -- end of the training region (issue 40, h40region) --
+    # -- issue 40's axis_dev targets (h40axisdev) --
+    "axis-dev-force": View(("axis-dev",), _axis_dev_force),
+    "axis-dev-speed": View(("axis-dev-speed",), _axis_dev_speed),
+    # -- end of issue 40's axis_dev targets (h40axisdev) --
 }
 
 

@@ -31,13 +31,47 @@ from threadpoolctl import threadpool_limits
 from ..errors import ParameterError, Setting
 from .progress import ProgressEvent
 
-__all__ = ["METHODS", "SearchResult", "local_search", "multistart", "multistart_results", "fixed_design"]
+__all__ = ["METHODS", "SearchResult", "Stall", "local_search", "multistart", "multistart_results", "fixed_design"]
 
 #: Names of the local search methods.
 METHODS = ("nelder-mead", "least-squares")
 
 #: Relative finite-difference step of the least-squares Jacobian (in the units of theta).
 _DIFF_STEP = 1e-3
+
+
+@dataclass(frozen=True)
+class Stall:
+    """When a Nelder-Mead search has stalled: its best cost fell by less than ``tolerance`` (relative) over the
+    last ``window`` times ``p + 1`` evaluations (``p`` coordinates).
+
+    One Nelder-Mead iteration replaces one vertex of the ``p + 1`` of the simplex (one or two evaluations, a
+    shrink ``p + 1``), so ``window`` counts how many times, about, every vertex could have been replaced.
+
+    Attributes
+    ----------
+    tolerance : float
+        Least relative decrease of the best cost [-] that counts as progress.
+    window : int
+        Evaluations per vertex of the simplex [-] over which the decrease is measured.
+    """
+
+    tolerance: float
+    window: int
+
+    def evaluations(self, n_coordinates: int) -> int:
+        """The evaluations over which the decrease is measured, for a search of ``n_coordinates``.
+
+        Parameters
+        ----------
+        n_coordinates : int
+            Coordinates ``p`` of the search.
+        """
+        return int(self.window) * (int(n_coordinates) + 1)
+
+
+class _Stalled(Exception):
+    """Raised inside a Nelder-Mead search by a :class:`Stall` rule; the best point so far is the result."""
 
 
 @dataclass
@@ -65,8 +99,12 @@ class SearchResult:
 class _TrackedResiduals:
     """Residual function that remembers the best point and reports progress."""
 
-    def __init__(self, residuals, stage, start, n_starts, progress, best_so_far):
+    def __init__(self, residuals, stage, start, n_starts, progress, best_so_far, stall_after=None,
+                 stall_tolerance=0.0):
         self.residuals = residuals
+        self.stall_after = stall_after
+        self.stall_tolerance = stall_tolerance
+        self.bests = []
         self.stage = stage
         self.start = start
         self.n_starts = n_starts
@@ -91,6 +129,11 @@ class _TrackedResiduals:
         if self.progress is not None:
             self.progress(ProgressEvent(self.stage, self.start, self.n_starts, self.n_evaluations,
                                         cost, self.stage_best))
+        if self.stall_after is not None:
+            self.bests.append(self.best_cost)
+            if (self.n_evaluations > self.stall_after and np.isfinite(self.best_cost)
+                    and self.best_cost > (1.0 - self.stall_tolerance) * self.bests[-1 - self.stall_after]):
+                raise _Stalled
         return r
 
     def cost(self, theta):
@@ -139,7 +182,7 @@ def _check_bounds(x0, lower, upper):
 def local_search(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, scale,
                  method: str = "nelder-mead", max_iter: int = 500, stage: str = "fit",
                  progress=None, start: int = 0, n_starts: int = 1,
-                 best_so_far: float = np.inf) -> SearchResult:
+                 best_so_far: float = np.inf, stall: Stall | None = None) -> SearchResult:
     """One bounded local search from ``x0``.
 
     Parameters
@@ -162,6 +205,10 @@ def local_search(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper
         Labels and running best for the progress events.
     progress : callable, optional
         Receives a :class:`ProgressEvent` after every evaluation.
+    stall : Stall, optional
+        Also end a Nelder-Mead search once it has stalled (:class:`Stall`); by default it runs until its
+        simplex has shrunk (``xatol`` 1e-4 and ``fatol`` 1e-10) or ``max_iter`` ends it. Not used by least
+        squares.
 
     Returns
     -------
@@ -172,7 +219,9 @@ def local_search(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
     x0, lower, upper = _check_bounds(x0, lower, upper)
     scale = np.broadcast_to(np.asarray(scale, dtype=float), x0.shape)
-    tracked = _TrackedResiduals(residuals, stage, start, n_starts, progress, best_so_far)
+    stall_after = stall.evaluations(x0.size) if stall is not None and method == "nelder-mead" else None
+    tracked = _TrackedResiduals(residuals, stage, start, n_starts, progress, best_so_far, stall_after,
+                                stall.tolerance if stall is not None else 0.0)
     # the residuals are tall-and-thin products: threaded BLAS only adds contention there
     with threadpool_limits(limits=1, user_api="blas"):
         if method == "nelder-mead":
@@ -180,9 +229,12 @@ def local_search(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper
             for j in range(x0.size):
                 step = scale[j] if x0[j] + scale[j] <= upper[j] else -scale[j]
                 simplex[j + 1, j] = np.clip(x0[j] + step, lower[j], upper[j])
-            minimize(tracked.cost, x0, method="Nelder-Mead", bounds=list(zip(lower, upper)),
-                     options={"maxiter": int(max_iter), "initial_simplex": simplex,
-                              "xatol": 1e-4, "fatol": 1e-10})
+            try:
+                minimize(tracked.cost, x0, method="Nelder-Mead", bounds=list(zip(lower, upper)),
+                         options={"maxiter": int(max_iter), "initial_simplex": simplex,
+                                  "xatol": 1e-4, "fatol": 1e-10})
+            except _Stalled:
+                pass  # the best point so far is the result
         else:
             least_squares(tracked, x0, bounds=(lower, upper), method="trf", x_scale=scale,
                           diff_step=_DIFF_STEP, max_nfev=int(max_iter))
@@ -251,7 +303,7 @@ def multistart(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, 
 def multistart_results(residuals: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, scale,
                        n_starts: int = 1, random_state=0, method: str = "nelder-mead",
                        max_iter: int = 500, stage: str = "fit", progress=None,
-                       fixed_starts=(), deviates=None) -> list[SearchResult]:
+                       fixed_starts=(), deviates=None, stall: Stall | None = None) -> list[SearchResult]:
     """The result of every start, in the order of the starts.
 
     The starts are ``x0``, then the ``fixed_starts`` (the same for every
@@ -268,6 +320,8 @@ def multistart_results(residuals: Callable[[np.ndarray], np.ndarray], x0, lower,
     deviates : array_like, shape (n_starts - 1, p), optional
         The perturbations of ``x0`` in units of ``scale`` (e.g. :func:`fixed_design`), instead of
         seeded ``N(0, 1)`` draws; ``random_state`` is then not used.
+    stall : Stall, optional
+        The stall rule of every start, as in :func:`local_search`.
 
     Returns
     -------
@@ -292,5 +346,5 @@ def multistart_results(residuals: Callable[[np.ndarray], np.ndarray], x0, lower,
         best_so_far = min((result.cost for result in results), default=np.inf)
         results.append(local_search(residuals, start, lower, upper, scale=scale, method=method,
                                     max_iter=max_iter, stage=stage, progress=progress, start=index,
-                                    n_starts=len(starts), best_so_far=best_so_far))
+                                    n_starts=len(starts), best_so_far=best_so_far, stall=stall))
     return results

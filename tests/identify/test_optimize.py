@@ -113,3 +113,24 @@ def test_fixed_design_fills_the_cube_evenly_and_replaces_the_seeded_draws():
                                      random_state=seed, deviates=fixed_design(2, 2), max_iter=5)
         starts[seed] = [result.x for result in results]
     np.testing.assert_array_equal(starts[0], starts[1])
+
+
+def test_a_stall_rule_ends_a_search_on_a_flat_cost_and_leaves_one_that_progresses():
+    from greybox.identify.optimize import Stall
+
+    stall = Stall(tolerance=1e-4, window=10)
+    flat = local_search(lambda x: np.array([1.0]), [0.0, 0.0], [-1.0, -1.0], [1.0, 1.0], scale=0.1, max_iter=400,
+                        stall=stall)
+    # the best cost never falls: the search ends after one window of 10 (p + 1) evaluations, not at max_iter
+    assert flat.n_evaluations == stall.evaluations(2) + 1
+    target = [0.3, -0.2]
+    free = local_search(shifted(target), [0.0, 0.0], [-1.0, -1.0], [1.0, 1.0], scale=0.5, max_iter=2000)
+    stopped = local_search(shifted(target), [0.0, 0.0], [-1.0, -1.0], [1.0, 1.0], scale=0.5, max_iter=2000,
+                           stall=stall)
+    # a search that still makes progress reaches the minimum; it stops once the cost no longer falls by 1e-4
+    np.testing.assert_allclose(stopped.x, target, atol=1e-3)
+    assert stopped.n_evaluations <= free.n_evaluations
+    # least squares has its own rules: the stall rule does not apply to it
+    squares = local_search(lambda x: np.array([1.0]), [0.0], [-1.0], [1.0], scale=0.1, method="least-squares",
+                           max_iter=400, stall=Stall(tolerance=1e-4, window=1))
+    assert squares.cost == 1.0

@@ -37,7 +37,14 @@ from ...identify.initial import (
     static_initial_guess,
 )
 from ...identify.linear import bounded_lstsq
-from ...identify.optimize import check_search_settings, fixed_design, local_search, multistart, multistart_results
+from ...identify.optimize import (
+    Stall,
+    check_search_settings,
+    fixed_design,
+    local_search,
+    multistart,
+    multistart_results,
+)
 from ...identify.static import check_direction_settings, velocity_range
 from ..estimator import CurrentModel
 from .directions import direction_pair, viscous_columns
@@ -69,6 +76,15 @@ PRUNE_SHARE = 1e-6
 #: then the perturbed ones), so that where the training data leave the shape nearly free (ARTS) the model does
 #: not hang on the seed of the perturbed starts.
 _COST_TIE = 0.01
+
+#: When the Nelder-Mead searches of the staged fit (pre-sliding and joint) stop besides their own rules: once the
+#: best cost fell by less than a hundredth of :data:`_COST_TIE` over the last 10 (p + 1) evaluations (about ten
+#: replacements of every vertex of the simplex). The fit counts joint fits within :data:`_COST_TIE` of the best as
+#: equally good, so a search need not resolve a hundredth of it; and each joint fit is polished by least squares
+#: from where its simplex stopped. Without it every start ran to ``max_iter``: the simplex's own rule (a cost
+#: spread of 1e-10, some 1e-8 of the cost) never held, and a start held at the shape limits (a flat cost) went
+#: on for hundreds of evaluations at one cost.
+SEARCH_STALL = Stall(tolerance=_COST_TIE / 100.0, window=10)
 
 #: Ratio of the largest to the smallest element fraction of the initial guess.
 _ALPHA_SPREAD = 20.0
@@ -637,7 +653,7 @@ class GMSModel(CurrentModel):
                                                 scale=np.concatenate((np.ones(n - 1), np.full(1 + extra, 0.5), [1.0])),
                                                 n_starts=self.n_starts, method=self.method, max_iter=self.max_iter,
                                                 stage="GMS pre-sliding", progress=progress, fixed_starts=slower_slips,
-                                                deviates=fixed_design(self.n_starts - 1, p0.size))
+                                                deviates=fixed_design(self.n_starts - 1, p0.size), stall=SEARCH_STALL)
                 # stage 3: all shape parameters from every pre-sliding fit; the best joint fit wins
                 joints = []  # (result, start index)
                 for index, start in enumerate(presliding):
@@ -645,7 +661,8 @@ class GMSModel(CurrentModel):
                     joint = local_search(full_residuals, np.clip(expand(start.x), full_lower, full_upper), full_lower,
                                          full_upper, scale=full_scale, method=self.method, max_iter=self.max_iter,
                                          stage="GMS joint", progress=progress, start=index, n_starts=len(presliding),
-                                         best_so_far=min((j.cost for j, _ in joints), default=np.inf))
+                                         best_so_far=min((j.cost for j, _ in joints), default=np.inf),
+                                         stall=SEARCH_STALL)
                     n_evaluations += joint.n_evaluations
                     joints.append((joint, index))
                 if self.method == "nelder-mead":
