@@ -1096,6 +1096,8 @@ def _operating_region(record: dict) -> str:
             f"{100 * stand_in['limit']:.0f} % outside: {', '.join(caught) or 'none'}; "
             f"not: {', '.join(missed) or 'none'}. "
             f"`{record['command']}` ({_where(record)}).\n")
+
+
 # -- issue 40's axis_dev targets (h40axisdev) --
 def _axis_dev_force(record: dict) -> str:
     f = record["figures"]
