@@ -220,6 +220,13 @@ SPECS = {spec.name: spec for spec in (
                 *_FRICTION_FITS, "data/X_A.mcap"),
                "the example of docs/intervals.md as printed: a GMS on X_A, its parameters' 95 % intervals and flags"),
     # -- end of the walk-through (issue 43, h43pages3) --
+    # -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
+    RecordSpec("auto-arts", ("benchmarks/bench_auto_arts.py", "--json"),
+               ("benchmarks/bench_auto_arts.py", "studies/arts.py", "greybox/train", "greybox/models",
+                "greybox/identify", "greybox/data", "greybox/metrics.py", "greybox/threads.py"),
+               "--model auto on the ARTS harmonic 0.25 Hz tests (J = 0): wall time, the choice and its folds; the "
+               "chosen model and coulomb:offset on the fastest other test"),
+    # -- end of --model auto on the ARTS harmonic tests --
 )}
 
 

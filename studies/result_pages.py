@@ -835,6 +835,22 @@ def _friction_models_idim(record: dict) -> str:
 # -- end of the walk-through (issue 43, h43pages3) --
 
 
+# -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
+def _auto_arts_speed(record: dict) -> str:
+    f = record["figures"]
+    re = f["fastest_re"]
+    se = re["coulomb_offset_se"]
+    spread = f" (SE over the folds {se:.2f})" if se is not None else " (raced out: no SE)"
+    return ("| development set | chosen | its RE on the fastest held-out run | `coulomb:offset` there | floor (force "
+            "above 20 Hz) | no worse than `coulomb:offset` |\n|---|---|---|---|---|---|\n"
+            f"| ARTS harmonic, test1 + test6 + test10 (0.25 Hz) -> {f['fastest']} ({f['fastest_speed']:.0f} mm/s) "
+            f"| `{f['chosen']}` | {re['auto']:.2f} % | {re['coulomb_offset']:.2f} %{spread} | {re['floor']:.2f} % "
+            f"| {_met(re['auto'] <= re['coulomb_offset'])} |\n\n"
+            f"The choice took **{f['auto_seconds']:.0f} s** wall on {f['workers']} workers "
+            f"(`{record['command']}`, {_where(record)}).\n")
+# -- end of --model auto on the ARTS harmonic tests --
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -940,6 +956,9 @@ VIEWS = {
     "friction-models-idim": View(("emps-benchmark",), _friction_models_idim),
     "readme-more": View(("monitor-detection", "process-head-to-head", "process-speed"), _readme_more),
     # -- end of the walk-through (issue 43, h43pages3) --
+    # -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
+    "auto-arts-speed": View(("auto-arts",), _auto_arts_speed),
+    # -- end of --model auto on the ARTS harmonic tests --
 }
 
 
