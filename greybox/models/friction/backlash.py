@@ -27,8 +27,10 @@ least squared error wins: 0 and a log grid up to half the stroke of the runs,
 refined by a bounded scalar search around the best. The search runs on block
 means of the runs where they sample the pre-sliding transition finely enough
 (:mod:`greybox.identify.coarse`: at least 10 samples within the pre-sliding
-deflection at the top speed), and the base model is then fitted once more on
-the runs themselves at the width found. ``threshold_`` is 5 % of
+deflection at the top speed); each trial fits the base's held-out search
+(:meth:`~greybox.models.estimator.CurrentModel.held_out_search`), and the
+full fit (``refine``) fits the base with its own search once more, on the runs
+themselves, at the width found. ``threshold_`` is 5 % of
 the median absolute training effort, so that noise around zero does not open
 a gap. ``width=0`` is the base model itself.
 """
@@ -148,8 +150,9 @@ class BacklashModel(CurrentModel):
     width : float, optional
         Backlash [mm] (the motor travel across the gap); identified from the data when None.
     refine : bool, default True
-        Refine the best width of the grid by a bounded scalar search (up to 8 more fits of the base); False
-        keeps the grid's best (:meth:`held_out_search`).
+        Refine the best width of the grid by a bounded scalar search (up to 8 more trial fits), then fit the
+        base with its full search on the runs themselves at the width found; False keeps the grid's best width
+        and the base its trial fitted (on block means when :attr:`block_` > 1: :meth:`held_out_search`).
 
     Attributes
     ----------
@@ -189,8 +192,9 @@ class BacklashModel(CurrentModel):
             raise ParameterError(f"width must be a non-negative backlash in mm or None, got {width!r}")
 
     def held_out_search(self) -> "BacklashModel":
-        """A copy whose base model searches less (:meth:`CurrentModel.held_out_search`) and that keeps the grid's
-        best width unrefined: the grid tells a gap from none, which is what a fold scores.
+        """A copy that keeps the grid's best width unrefined and the base its trial fitted (a held-out search of
+        the base, :meth:`CurrentModel.held_out_search`, on block means when the runs are oversampled): the grid
+        tells a gap from none, which is what a fold scores.
 
         Returns
         -------
