@@ -8,9 +8,10 @@ same files, both scored on the fastest of the ten other files (highest 99th perc
 that file's floor (the RE of its force above 20 Hz, :func:`studies.arts.band_split`: what no model of the
 motion predicts) and ``coulomb:offset``'s standard error over the folds (None when it was raced out).
 
-The run takes far longer than a record's 4 minutes (docs/defaults.md says why): run it alone under
-``nice -n 10`` and give the load beside its time. The data folder is ``$GREYBOX_REAL_DATA/ARTS_friction_damper``,
-else ``../shared/data/real/ARTS_friction_damper``.
+The record ``auto-arts`` (``python scripts/record.py auto-arts``) runs it; run it alone under ``nice -n 10``
+and give the load beside its time (docs/defaults.md says what keeps the width search of a GMS behind a backlash
+short). The data folder is ``$GREYBOX_REAL_DATA/ARTS_friction_damper``, else
+``../shared/data/real/ARTS_friction_damper``.
 
 Usage::
 

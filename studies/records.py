@@ -253,6 +253,13 @@ SPECS = {spec.name: spec for spec in (
                "axis_dev: greybox train --model auto on the slower air cuts A and C against coulomb:offset on the "
                "fastest, aircut_B, beside the noise floor; the choice's cut force on cut_D"),
     # -- end of issue 40's axis_dev targets (h40axisdev) --
+    # -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
+    RecordSpec("auto-arts", ("benchmarks/bench_auto_arts.py", "--json"),
+               ("benchmarks/bench_auto_arts.py", "studies/arts.py", "greybox/train", "greybox/models",
+                "greybox/identify", "greybox/data", "greybox/metrics.py", "greybox/threads.py"),
+               "--model auto on the ARTS harmonic 0.25 Hz tests (J = 0): wall time, the choice and its folds; the "
+               "chosen model and coulomb:offset on the fastest other test"),
+    # -- end of --model auto on the ARTS harmonic tests --
 )}
 
 

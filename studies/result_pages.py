@@ -1021,6 +1021,22 @@ def _twin_axes_ends(record: dict) -> str:
 # -- end of the pages of h43pages4 --
 
 
+# -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
+def _auto_arts_speed(record: dict) -> str:
+    f = record["figures"]
+    re = f["fastest_re"]
+    se = re["coulomb_offset_se"]
+    spread = f" (SE over the folds {se:.2f})" if se is not None else " (raced out: no SE)"
+    return ("| development set | chosen | its RE on the fastest held-out run | `coulomb:offset` there | floor (force "
+            "above 20 Hz) | no worse than `coulomb:offset` |\n|---|---|---|---|---|---|\n"
+            f"| ARTS harmonic, test1 + test6 + test10 (0.25 Hz) -> {f['fastest']} ({f['fastest_speed']:.0f} mm/s) "
+            f"| `{f['chosen']}` | {re['auto']:.2f} % | {re['coulomb_offset']:.2f} %{spread} | {re['floor']:.2f} % "
+            f"| {_met(re['auto'] <= re['coulomb_offset'])} |\n\n"
+            f"The choice took **{f['auto_seconds']:.0f} s** wall on {f['workers']} workers "
+            f"(`{record['command']}`, {_where(record)}).\n")
+# -- end of --model auto on the ARTS harmonic tests --
+
+
 @dataclass(frozen=True)
 class View:
     """One rendered stretch: the records it reads, and the function of them that gives its text.
@@ -1228,6 +1244,9 @@ VIEWS = {
     "axis-dev-force": View(("axis-dev",), _axis_dev_force),
     "axis-dev-speed": View(("axis-dev-speed",), _axis_dev_speed),
     # -- end of issue 40's axis_dev targets (h40axisdev) --
+    # -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
+    "auto-arts-speed": View(("auto-arts",), _auto_arts_speed),
+    # -- end of --model auto on the ARTS harmonic tests --
 }
 
 

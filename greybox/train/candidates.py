@@ -64,7 +64,8 @@ DEFAULT_CANDIDATES = (
 
 #: Candidates tried only when the runs show a gap: when a static model behind an identified backlash
 #: predicts the held-out runs better than the same model without it (:data:`GAP_EVIDENCE`). A dynamic model
-#: behind a backlash is identified by one fit per trial width (about 18), too slow to try on every axis.
+#: behind a backlash is identified by one fit per trial width (11 in a fold, up to 19 in the
+#: full fit; on block means of oversampled runs, :mod:`greybox.identify.coarse`), too slow to try on every axis.
 GAP_CANDIDATES = ("gms:offset,backlash", "gms:asymmetric,backlash")
 
 #: (model without a gap, the same behind a backlash): both among the candidates, the second better on the

@@ -72,7 +72,7 @@ CASES = {
 
 #: Learned attributes that describe the fit, the data scaling or a nested stage rather than a parameter.
 NOT_PARAMETERS = {"effort_unit_", "motion_", "sample_time_", "n_samples_fit_", "cost_", "n_evaluations_", "n_train_",
-                  "n_pruned_", "notes_", "selection_",
+                  "n_pruned_", "block_", "notes_", "selection_",
                   "cv_rmse_", "optimised_", "at_bounds_", "search_history_", "input_mean_", "input_scale_",
                   "input_weights_", "support_vectors_",
                   "dual_coef_", "gms_", "base_", "effects_", "velocity_scale_mm_s_", "position_range_mm_",

@@ -24,7 +24,13 @@ runs are found from the *measured* effort by the same rule, and the base
 model is fitted on the runs with the motion set to standstill inside them;
 the model then predicts the runs with its own gaps, and the width with the
 least squared error wins: 0 and a log grid up to half the stroke of the runs,
-refined by a bounded scalar search around the best. ``threshold_`` is 5 % of
+refined by a bounded scalar search around the best. The search runs on block
+means of the runs where they sample the pre-sliding transition finely enough
+(:mod:`greybox.identify.coarse`: at least 10 samples within the pre-sliding
+deflection at the top speed); each trial fits the base's held-out search
+(:meth:`~greybox.models.estimator.CurrentModel.held_out_search`), and the
+full fit (``refine``) fits the base with its own search once more, on the runs
+themselves, at the width found. ``threshold_`` is 5 % of
 the median absolute training effort, so that noise around zero does not open
 a gap. ``width=0`` is the base model itself.
 """
@@ -41,6 +47,7 @@ from sklearn.utils.validation import check_is_fitted
 from ...base import EFFORT, LENGTH, Parameter
 from ...data.log import AxisLog
 from ...errors import ParameterError
+from ...identify.coarse import block_means, coarse_block
 from ...identify.progress import ProgressEvent
 from ..estimator import CurrentModel
 from .gms import GMSModel
@@ -143,8 +150,9 @@ class BacklashModel(CurrentModel):
     width : float, optional
         Backlash [mm] (the motor travel across the gap); identified from the data when None.
     refine : bool, default True
-        Refine the best width of the grid by a bounded scalar search (up to 8 more fits of the base); False
-        keeps the grid's best (:meth:`held_out_search`).
+        Refine the best width of the grid by a bounded scalar search (up to 8 more trial fits), then fit the
+        base with its full search on the runs themselves at the width found; False keeps the grid's best width
+        and the base its trial fitted (on block means when :attr:`block_` > 1: :meth:`held_out_search`).
 
     Attributes
     ----------
@@ -160,6 +168,9 @@ class BacklashModel(CurrentModel):
         Offset of the base model [A].
     cost_ : float
         Squared error of the training prediction over ``n var(effort)``.
+    block_ : int
+        Samples per block mean of the runs the width was searched on (:func:`greybox.identify.coarse.coarse_block`;
+        1: the runs themselves).
     effort_unit_ : str
         "A" or "N".
     """
@@ -181,8 +192,9 @@ class BacklashModel(CurrentModel):
             raise ParameterError(f"width must be a non-negative backlash in mm or None, got {width!r}")
 
     def held_out_search(self) -> "BacklashModel":
-        """A copy whose base model searches less (:meth:`CurrentModel.held_out_search`) and that keeps the grid's
-        best width unrefined: the grid tells a gap from none, which is what a fold scores.
+        """A copy that keeps the grid's best width unrefined and the base its trial fitted (a held-out search of
+        the base, :meth:`CurrentModel.held_out_search`, on block means when the runs are oversampled): the grid
+        tells a gap from none, which is what a fold scores.
 
         Returns
         -------
@@ -197,41 +209,50 @@ class BacklashModel(CurrentModel):
     def _fit_runs(self, runs, progress) -> None:
         target = np.concatenate([run.effort for run in runs])
         self.threshold_ = _THRESHOLD_FRACTION * float(np.median(np.abs(target)))
-        norm = target.size * max(float(np.var(target)), np.finfo(float).tiny)
+        self.block_ = 1 if self.width is not None else coarse_block(runs)
+        width, searched = (float(self.width), None) if self.width is not None else self._search_width(runs, progress)
+        if searched is None or self.refine:
+            self.base_ = self._base_template().fit(self._contact_runs(runs, width))
+        else:  # a held-out search keeps the base its width search fitted (on block means): it only scores
+            self.base_ = searched
+        self.cost_ = self._cost(runs, width, self.base_)
+        self.width_ = width
+        self.J_, self.offset_ = float(self.base_.J_), float(self.base_.offset_)
+
+    def _search_width(self, runs, progress):
+        """The width of least cost and its base: 0 and the grid, refined when ``refine``; each trial fits the
+        base's held-out search on the runs' block means (:attr:`block_`)."""
+        coarse = [block_means(run, self.block_) for run in runs]
+        widths = [0.0] + list(np.geomspace(1e-3, 1.0, _N_GRID) * 0.5 * stroke(runs))
+        n_trials = len(widths) + _N_REFINE * int(self.refine)
         trials = {}
 
         def cost(width):
             if width not in trials:
-                trials[width] = self._trial(runs, width, target, norm)
+                base = self._base_template().held_out_search().fit(self._contact_runs(coarse, width))
+                trials[width] = (self._cost(coarse, width, base), base)
                 if progress is not None:
                     best = min(trial[0] for trial in trials.values())
                     progress(ProgressEvent("backlash width", len(trials) - 1, n_trials, 1, trials[width][0],
                                            best, done=True))
             return trials[width][0]
 
-        if self.width is not None:
-            n_trials = 1
-            cost(float(self.width))
-        else:
-            widths = [0.0] + list(np.geomspace(1e-3, 1.0, _N_GRID) * 0.5 * stroke(runs))
-            n_trials = len(widths) + _N_REFINE * int(self.refine)
-            best = int(np.argmin([cost(w) for w in widths]))
-            if best > 0 and self.refine:
-                logs = np.log(widths[1:])
-                low, high = logs[max(best - 2, 0)], logs[min(best, len(logs) - 1)]
-                minimize_scalar(lambda x: cost(float(np.exp(x))), bounds=(low, high), method="bounded",
-                                options={"xatol": 0.02, "maxiter": _N_REFINE})
+        best = int(np.argmin([cost(w) for w in widths]))
+        if best > 0 and self.refine:
+            logs = np.log(widths[1:])
+            low, high = logs[max(best - 2, 0)], logs[min(best, len(logs) - 1)]
+            minimize_scalar(lambda x: cost(float(np.exp(x))), bounds=(low, high), method="bounded",
+                            options={"xatol": 0.02, "maxiter": _N_REFINE})
         width = min(trials, key=lambda w: (trials[w][0], w))
-        self.cost_, self.base_ = trials[width]
-        self.width_ = float(width)
-        self.J_, self.offset_ = float(self.base_.J_), float(self.base_.offset_)
+        return float(width), trials[width][1]
 
-    def _trial(self, runs, width, target, norm):
-        """Cost and base model of one trial width: the base fitted with the measured gaps at standstill."""
-        base = self._base_template().fit(self._contact_runs(runs, width))
+    def _cost(self, runs, width, base) -> float:
+        """Squared error over ``n var(effort)`` of ``base`` behind a backlash of ``width`` predicting ``runs``."""
+        target = np.concatenate([run.effort for run in runs])
         prediction = np.concatenate([_through_gaps(base, width, self.threshold_, run, None, run.sample_time,
                                                    "_effort")[0] for run in runs])
-        return float(np.sum((prediction - target) ** 2) / norm), base
+        return float(np.sum((prediction - target) ** 2) / (target.size * max(float(np.var(target)),
+                                                                             np.finfo(float).tiny)))
 
     def _contact_runs(self, runs, width: float) -> list[AxisLog]:
         """The runs as the base model is fitted on them: motion zeroed where the measured effort crosses the gap."""

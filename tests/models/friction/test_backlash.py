@@ -121,3 +121,24 @@ def test_bad_width_is_refused(width):
     log = sine_log()
     with pytest.raises(ParameterError, match="width must be"):
         BacklashModel(width=width).fit(log.replace(effort=np.sign(log.velocity)))
+
+
+def test_on_oversampled_runs_the_width_is_searched_on_block_means_and_found():
+    # slow motion (0.2 Hz sines at 500 Hz) and the truth's deflections ten times wider: a sample spans far less
+    # than a tenth of the pre-sliding deflection, so the width search runs on block means
+    t = np.arange(int(20.0 / STEP)) * STEP
+    velocity = 2.0 * np.pi * 0.2 * (3.0 * np.cos(2.0 * np.pi * 0.2 * t) + 1.5 * np.cos(2.0 * np.pi * 0.46 * t))
+    log = motion_log(velocity)
+    truth = behind_backlash()
+    truth.base_.s_0_, truth.base_.s_inf_ = 10.0 * TRUTH["s_0"], 10.0 * TRUTH["s_inf"]
+    log = log.replace(effort=truth.predict(log) + 0.003 * np.random.default_rng(5).standard_normal(len(log)))
+    full = BacklashModel(base=GMSModel(n_elements=2, n_starts=2)).fit(log)
+    held_out = full.held_out_search().fit(log)
+    assert full.block_ > 1 and held_out.block_ == full.block_
+    for model in (full, held_out):
+        assert model.width_ == pytest.approx(WIDTH, rel=0.1)
+        rmse = np.sqrt(np.mean((model.predict(log) - log.effort) ** 2))
+        assert rmse < 0.1 * np.std(log.effort)
+    # the full fit refits its base on the runs themselves; the held-out search keeps the block means' fit
+    assert full.base_.sample_time_ == pytest.approx(STEP)
+    assert held_out.base_.sample_time_ == pytest.approx(full.block_ * STEP)
