@@ -8,6 +8,7 @@ import json
 from ..errors import GreyboxError
 from ..models.friction.backlash import BacklashModel
 from ..models.registry import model_class
+from ..train.defaults import with_training_defaults
 from ._model_options import MODEL_OPTIONS, CommandLineError
 from ._types import NON_NEGATIVE, POSITIVE_INT, SEED
 
@@ -29,9 +30,9 @@ def add_model_arguments(parser: argparse.ArgumentParser, *, title: str = "model 
     backlash : bool, default False
         Also offer ``--backlash`` (a model behind an identified backlash).
     offset_default : bool, default False
-        Fit a constant effort offset unless ``--no-offset`` (or ``--asymmetric``) is given: a current
-        sensor's offset, or the weight a vertical axis carries, is in every real drive's current, and a
-        model without it reads the offset as process force (``greybox train``).
+        Offer ``--offset/--no-offset`` and leave the options not given to the training defaults
+        (:func:`greybox.train.defaults.with_training_defaults`: a constant effort offset where the model takes
+        one, unless ``--no-offset`` or ``--asymmetric`` is given), as ``greybox train`` does.
     """
     group = parser.add_argument_group(title)
     if offset_default:
@@ -76,8 +77,9 @@ def build_model(kind: str, args: argparse.Namespace):
     model does not take but its first stage does (``--asymmetric``,
     ``--elements``, ``--offset`` of gmssvr) is set on the first stage.
     ``--backlash`` wraps the model in a :class:`BacklashModel`. With ``offset_default`` set on
-    ``args`` (:func:`add_model_arguments`), a model that takes an offset fits one unless ``--no-offset``
-    or ``--asymmetric`` says otherwise.
+    ``args`` (:func:`add_model_arguments`), the options not given take the training defaults of
+    :func:`greybox.train.defaults.with_training_defaults` (an offset where the model takes one), as
+    :func:`greybox.train.train_logs` gives a model kind named without options.
 
     Parameters
     ----------
@@ -97,14 +99,11 @@ def build_model(kind: str, args: argparse.Namespace):
     accepted = model.get_params(deep=False)
     stage = model.first_stage()
     params, stage_params = {}, {}
+    given = set()  # hyperparameters the command line sets: the library's training defaults leave them
     for option, attribute, name in MODEL_OPTIONS:
         value = getattr(args, attribute, None)
-        if value is None and name == "fit_offset" and getattr(args, "offset_default", False) \
-                and not getattr(args, "asymmetric", False) \
-                and not any(setting.partition("=")[0].strip() in ("asymmetric", name)
-                            for setting in getattr(args, "set", None) or []):
-            takes = name in accepted or (stage is not None and name in stage.get_params(deep=False))
-            value = True if takes else None  # the default where the model takes an offset
+        if value is not None and (value is not False or name == "fit_offset"):
+            given.add(name)  # --no-offset (False) chooses too
         if value is None or value is False:
             continue
         if name in accepted:
@@ -125,7 +124,10 @@ def build_model(kind: str, args: argparse.Namespace):
             takes = ", ".join(offered.get(other, f"--set {other}=...") for other in sorted(accepted))
             raise CommandLineError(f"--set {name}=...: the {kind} model has no such hyperparameter; it takes {takes}")
         params[name] = parse_setting(text)
+        given.add(name)
     model.set_params(**params)
+    if getattr(args, "offset_default", False):
+        with_training_defaults(model, given)
     return BacklashModel(base=model) if getattr(args, "backlash", False) else model
 
 

@@ -211,9 +211,12 @@ def _reversal_kernel(position, deadband, state, marks):  # pragma: no cover - co
     state[0], state[1], state[2], state[3] = direction, extreme, high, low
 
 
-def trailing_reversals(marks: np.ndarray, samples: int, history: np.ndarray | None = None) -> tuple[np.ndarray,
-                                                                                                  np.ndarray]:
+def trailing_reversals(marks: np.ndarray, samples: int, history: tuple | None = None) -> tuple[np.ndarray, tuple]:
     """Reversals within the trailing window of ``samples`` samples ending at each sample.
+
+    A running count: each sample adds its mark and drops the one that leaves the window, kept in a ring of the
+    window's marks that carries over from chunk to chunk, so a chunk costs O(1) a sample whatever the window
+    (a live stream flags each message without looking back over the window).
 
     Parameters
     ----------
@@ -221,23 +224,43 @@ def trailing_reversals(marks: np.ndarray, samples: int, history: np.ndarray | No
         :func:`reversal_marks` of consecutive samples.
     samples : int
         Window length [samples], at least 1.
-    history : ndarray of bool, optional
-        The marks before the first sample (what a previous chunk left); none at the start of a run.
+    history : tuple, optional
+        The window state a previous chunk left (its ``history``): none at the start of a run. It is
+        updated in place and returned (a chunk consumes the state it is given).
 
     Returns
     -------
     count : ndarray of int64, shape (n,)
         Reversals within each window [-].
-    history : ndarray of bool
-        The last ``samples - 1`` marks: the ``history`` of the next chunk.
+    history : tuple of (ndarray of bool, shape (samples,), ndarray of int64, shape (2,))
+        The marks of the window in a ring, and the ring's next slot with the window's count: the ``history``
+        of the next chunk.
     """
-    past = np.zeros(0, dtype=np.bool_) if history is None else np.asarray(history, dtype=np.bool_)
-    values = np.concatenate((past, np.asarray(marks, dtype=np.bool_)))
-    total = np.concatenate(([0], np.cumsum(values, dtype=np.int64)))
-    end = np.arange(past.size, values.size) + 1
-    count = total[end] - total[np.maximum(end - samples, 0)]
-    keep = samples - 1
-    return count, values[-keep:].copy() if keep else np.zeros(0, dtype=np.bool_)
+    if history is None:
+        ring, cursor = np.zeros(samples, dtype=np.bool_), np.zeros(2, dtype=np.int64)
+    else:
+        ring, cursor = history
+        if ring.size != samples:
+            raise ValueError(f"the window state holds {ring.size} samples, not the window's {samples}")
+    count = np.empty(np.size(marks), dtype=np.int64)
+    _window_count_kernel(np.ascontiguousarray(marks, dtype=np.bool_), ring, cursor, count)
+    return count, (ring, cursor)
+
+
+@njit(cache=True, error_model="numpy")
+def _window_count_kernel(marks, ring, cursor, out):  # pragma: no cover - compiled; reference in the tests
+    """``out[k]`` = marks within the trailing window of ``ring.size`` samples ending at ``marks[k]``
+    (:func:`trailing_reversals`); ``ring`` holds the window's marks, ``cursor`` = [next slot of the ring,
+    marks in the ring], both updated in place. O(1) a sample."""
+    slot, total = cursor[0], cursor[1]
+    for k in range(marks.size):
+        total += np.int64(marks[k]) - np.int64(ring[slot])
+        ring[slot] = marks[k]
+        out[k] = total
+        slot += 1
+        if slot == ring.size:
+            slot = 0
+    cursor[0], cursor[1] = slot, total
 
 
 @njit(cache=True, error_model="numpy")
@@ -297,14 +320,15 @@ def operating_record(runs, *, cells_per_decade: int = CELLS_PER_DECADE, min_shar
         span, _ = local_span(run.position, samples)
         i, j = _cells(speed, span, _inner(speed_edges), _inner(span_edges))
         np.add.at(counts, (i, j), 1)
-        turns.append(span_turns(run.position, samples, span_edges, span_edges[0]))
+        turns.append(span_turns(run.position, samples, span_edges, span_edges[0], span=span))
     least = max(MIN_CELL_SAMPLES, int(math.ceil(min_share * counts.sum())))
     cells = [[int(i), int(j)] for i, j in zip(*np.nonzero(counts >= least))]
     return {"window_s": SPAN_WINDOW_S, "speed_edges": speed_edges, "span_edges": span_edges, "cells": cells,
             _REVERSAL_KEY: most_reversals(turns, len(span_edges) - 1)}
 
 
-def span_turns(position: np.ndarray, samples: int, span_edges, deadband: float) -> tuple[np.ndarray, np.ndarray]:
+def span_turns(position: np.ndarray, samples: int, span_edges, deadband: float, *,
+               span: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The span cell of each sample of a whole run and its reversals within the same trailing window.
 
     Parameters
@@ -317,6 +341,8 @@ def span_turns(position: np.ndarray, samples: int, span_edges, deadband: float) 
         Edges of the span cells [mm or deg].
     deadband : float
         Least turn that counts as a reversal [mm or deg] (:func:`reversal_marks`).
+    span : ndarray, shape (n,), optional
+        The run's :func:`local_span` over the same window [mm or deg], where the caller has it already.
 
     Returns
     -------
@@ -325,7 +351,8 @@ def span_turns(position: np.ndarray, samples: int, span_edges, deadband: float) 
     count : ndarray of int64, shape (n,)
         Reversals within its window [-].
     """
-    span, _ = local_span(position, samples)
+    if span is None:
+        span, _ = local_span(position, samples)
     marks, _ = reversal_marks(position, deadband)
     return np.searchsorted(_inner(span_edges), span, side="right"), trailing_reversals(marks, samples)[0]
 
@@ -435,7 +462,8 @@ class OperatingRegion:
             seen[max(i - neighbours, 0):i + neighbours + 1, max(j - neighbours, 0):j + neighbours + 1] = True
         self._seen = seen
         most = operating.get(_REVERSAL_KEY)  # None: a file of format version 4, without the rule
-        self._most = None if most is None else np.asarray(most, dtype=np.int64)
+        self._reversals = most is not None
+        self._most = np.asarray(most, dtype=np.int64) if self._reversals else np.full(seen.shape[1], _MAX_REVERSALS)
         self._speed_inner, self._span_inner = _inner(speed), _inner(span)
         self._bounds = [(channel, *ranges[channel]) for channel in ("position", "velocity", "acceleration")
                         if ranges.get(channel) is not None]
@@ -465,7 +493,8 @@ class OperatingRegion:
         log : AxisLog
             Prepared chunk: consecutive samples of one run.
         state : object
-            :meth:`start` at the start of a run, else what the previous chunk returned.
+            :meth:`start` at the start of a run, else what the previous chunk returned (consumed: the
+            window's reversal count in it is updated in place).
         sample_time : float
             Step [s] of the whole run.
 
@@ -478,23 +507,23 @@ class OperatingRegion:
             ``reversals``) where the position turned back more often within the window than the training
             runs did at that span cell.
         state : tuple
-            The positions and reversal marks of the trailing window and the reversal detector: the ``state``
-            of the next chunk.
+            The positions of the trailing window, the reversal detector and the window's reversal count
+            (:func:`trailing_reversals`, carried over and updated in place): the ``state`` of the next chunk.
         """
         out = {}
         for channel, low, high in self._bounds:
             values = getattr(log, channel, None)
             if values is not None:
                 out[channel] = (values < low) | (values > high)
-        positions, detector, marks_before = state
+        positions, detector, window = state
         samples = _window_samples(self.operating["window_s"], sample_time)
         span, positions = local_span(log.position, samples, positions)
-        if self._most is None:
-            count, most = np.zeros(span.size, dtype=np.int64), np.full(len(self._span_inner) + 1, _MAX_REVERSALS)
-        else:
+        if self._reversals:
             marks, detector = reversal_marks(log.position, self.operating["span_edges"][0], detector)
-            (count, marks_before), most = trailing_reversals(marks, samples, marks_before), self._most
+            count, window = trailing_reversals(marks, samples, window)
+        else:  # a file of format version 4: no count exceeds the most of every cell
+            count = np.zeros(span.size, dtype=np.int64)
         out["motion"] = np.empty(span.size, dtype=np.bool_)
         _unseen_kernel(np.abs(np.asarray(log.velocity, dtype=np.float64)), span, count, self._speed_inner,
-                       self._span_inner, self._seen, most, out["motion"])
-        return out, (positions, detector, marks_before)
+                       self._span_inner, self._seen, self._most, out["motion"])
+        return out, (positions, detector, window)

@@ -26,6 +26,7 @@ from ..identify.intervals import attach_intervals
 from ..models.files import save_verified
 from ..models.registry import model_class, model_kind
 from .advice import offset_note, takes_hyperparameter
+from .defaults import with_training_defaults
 from .record import record_training, run_names
 
 __all__ = ["DEFAULT_BOOTSTRAP", "axis_file_inertia", "check_intervals", "fit_runs", "intervals_line",
@@ -201,13 +202,15 @@ def unfitted(kind, params: Mapping | None = None):
     Parameters
     ----------
     kind : str or estimator
-        Registered model kind (:data:`greybox.models.registry.MODEL_CLASSES`) or an unfitted model (copied,
-        never changed).
+        Registered model kind (:data:`greybox.models.registry.MODEL_CLASSES`), with the training defaults
+        (:func:`~greybox.train.defaults.with_training_defaults`) for the hyperparameters ``params`` does not
+        set, as ``greybox train --model KIND`` builds it; or an unfitted model, copied as it is, never changed.
     params : mapping, optional
         Hyperparameters of a kind given by name.
     """
     if isinstance(kind, str):
-        return model_class(kind)(**dict(params or {}))
+        params = dict(params or {})
+        return with_training_defaults(model_class(kind)(**params), given=params)
     if params:
         raise GreyboxError("params apply to a model kind given by name; set them on the model given")
     return copy.deepcopy(kind)
@@ -222,7 +225,9 @@ def train_logs(kind, logs, *, params: Mapping | None = None, stage2=(), read: Ma
     Parameters
     ----------
     kind : str or estimator
-        Model kind (``"gms"``, ``"gmssvr"``, ...) or an unfitted model with its hyperparameters (copied).
+        Model kind (``"gms"``, ``"gmssvr"``, ...), with the training defaults of ``greybox train --model KIND``
+        for what ``params`` does not set (an offset where the model takes one, :func:`unfitted`); or an
+        unfitted model with its hyperparameters (copied as it is).
     logs : sequence of (str, path-like or AxisLog)
         Training logs, each a separate run (or several where split at gaps); or prepared runs.
     params : mapping, optional

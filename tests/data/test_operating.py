@@ -1,6 +1,7 @@
 """The operating region of training runs: local span, grid, flags chunk by chunk, record check."""
 
 import copy
+import functools
 from collections import Counter
 
 import numpy as np
@@ -13,6 +14,7 @@ from greybox.data.operating import (
     OperatingRegion,
     _reversal_kernel,
     _span_kernel,
+    _window_count_kernel,
     check_operating_record,
     local_span,
     operating_record,
@@ -101,6 +103,10 @@ def test_the_reversals_equal_the_plain_detector_and_carry_across_chunks(steps, d
     np.testing.assert_array_equal(plain, expected)
     count, _ = trailing_reversals(whole, window)
     np.testing.assert_array_equal(count, [expected[max(k - window + 1, 0):k + 1].sum() for k in range(position.size)])
+    plain_count = np.empty(position.size, dtype=np.int64)
+    getattr(_window_count_kernel, "py_func", _window_count_kernel)(whole, np.zeros(window, dtype=bool),
+                                                                   np.zeros(2, dtype=np.int64), plain_count)
+    np.testing.assert_array_equal(plain_count, count)
     marks, counts, detector, history = [], [], None, None
     for piece in np.array_split(position, sorted(set(cuts))):
         part, detector = reversal_marks(piece, deadband, detector)
@@ -225,3 +231,53 @@ def test_the_compiled_motion_flags_equal_the_plain_grid_lookup():
     plain = [(i, j) not in seen or c > region.operating["reversals"][j] for i, j, c in plain_cells(run)]
     np.testing.assert_array_equal(flags["motion"], plain)
     assert flags["motion"].any() and not flags["motion"].all()
+
+
+@functools.cache
+def _trained_region(reversals: bool) -> OperatingRegion:
+    """The region of two sine runs; without ``reversals``, as a model file of format version 4 holds it."""
+    training = [_run(20.0, 0.25), _run(5.0, 1.0)]
+    region = _region(training)
+    operating = {key: value for key, value in region.operating.items() if reversals or key != "reversals"}
+    return OperatingRegion(region.ranges, check_operating_record(operating))
+
+
+def _plain_motion(region: OperatingRegion, log: AxisLog, window: int) -> np.ndarray:
+    """The plain-Python reference of the motion flags: a window's span and reversals sample by sample."""
+    speed_edges, span_edges = region.operating["speed_edges"], region.operating["span_edges"]
+    seen = {tuple(cell) for cell in region.operating["cells"]}
+    span = _reference_kernel(log.position, [], window)
+    turns = _reference_reversals(log.position, span_edges[0])
+    most = region.operating.get("reversals")
+    out = []
+    for k, (v, s) in enumerate(zip(log.velocity, span)):
+        i = int(np.searchsorted(speed_edges[1:-1], abs(v), side="right"))
+        j = int(np.searchsorted(span_edges[1:-1], s, side="right"))
+        count = int(turns[max(k - window + 1, 0):k + 1].sum())
+        out.append((i, j) not in seen or (most is not None and count > most[j]))
+    return np.array(out, dtype=bool)
+
+
+@settings(max_examples=40, deadline=None)
+@given(amplitudes=st.lists(st.floats(0.05, 25.0), min_size=1, max_size=3),
+       frequencies=st.lists(st.floats(0.05, 6.0), min_size=3, max_size=3),
+       samples=st.integers(1, 400), cuts=st.lists(st.integers(0, 400), max_size=8), reversals=st.booleans())
+def test_flags_are_the_plain_ones_whatever_the_chunks(amplitudes, frequencies, samples, cuts, reversals):
+    """Any split of a run into chunks (single samples, empty chunks, chunks longer than the window) gives the
+    flags of the whole run and of the plain reference, for records with the reversal rule and without it
+    (format 4); run with NUMBA_DISABLE_JIT=1 too."""
+    region = _trained_region(reversals)
+    step = 0.01  # a window of 50 samples: runs of a few hundred cross it many times
+    time = np.arange(samples) * step
+    position = sum(a * np.sin(2 * np.pi * f * time) for a, f in zip(amplitudes, frequencies))
+    velocity = sum(2 * np.pi * f * a * np.cos(2 * np.pi * f * time) for a, f in zip(amplitudes, frequencies))
+    run = AxisLog(time=time, position=position, effort=np.sign(velocity), velocity=velocity,
+                  acceleration=np.zeros(samples))
+    whole, _ = region.flags(run, region.start(), sample_time=step)
+    np.testing.assert_array_equal(whole["motion"], _plain_motion(region, run, 50))
+    state, parts, bounds = region.start(), [], [0, *sorted(min(cut, samples) for cut in cuts), samples]
+    for first, last in zip(bounds, bounds[1:]):
+        flags, state = region.flags(run.select(slice(first, last)), state, sample_time=step)
+        parts.append(flags)
+    for name, values in whole.items():
+        np.testing.assert_array_equal(np.concatenate([part[name] for part in parts]), values)
