@@ -84,8 +84,12 @@ def _window_samples(window_s: float, sample_time: float) -> int:
     return max(int(round(window_s / sample_time)), 1)
 
 
-def local_span(position: np.ndarray, samples: int, history: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def local_span(position: np.ndarray, samples: int, history: tuple | None = None) -> tuple[np.ndarray, tuple]:
     """``max - min`` of the position over the trailing window of ``samples`` samples ending at each sample.
+
+    A running maximum and minimum whose queues carry over from chunk to chunk, so a chunk costs O(1)
+    amortised a sample whatever the window (a live stream's message is not scanned together with the
+    window before it).
 
     Parameters
     ----------
@@ -93,57 +97,63 @@ def local_span(position: np.ndarray, samples: int, history: np.ndarray | None = 
         Position of consecutive samples [mm or deg].
     samples : int
         Window length [samples], at least 1.
-    history : ndarray, optional
-        The positions before the first sample (the state a previous chunk left); none at the start of a run,
-        where the window holds what the run has shown so far.
+    history : tuple, optional
+        The window state a previous chunk left (its ``history``); none at the start of a run, where the
+        window holds what the run has shown so far. It is updated in place and returned (a chunk consumes
+        the state it is given).
 
     Returns
     -------
     span : ndarray, shape (n,)
         Local span [mm or deg].
-    history : ndarray
-        The last ``samples - 1`` positions: the ``history`` of the next chunk.
+    history : tuple of (ndarray, ndarray of int64, ndarray of int64)
+        The window's positions in a ring (shape ``(samples,)``), the two monotone queues of sample
+        indices (shape ``(2, samples)``) and their counters (samples seen, heads and tails; shape ``(5,)``):
+        the ``history`` of the next chunk.
     """
-    position = np.ascontiguousarray(position, dtype=np.float64)
-    past = np.empty(0) if history is None else np.ascontiguousarray(history, dtype=np.float64)
-    span = np.empty(position.size)
-    if position.size == 0:
-        return span, past
-    values = np.concatenate((past, position))
-    _span_kernel(values, past.size, samples, span)
-    keep = samples - 1
-    return span, values[-keep:].copy() if keep else np.empty(0)
+    if history is None:
+        history = (np.zeros(samples), np.zeros((2, samples), dtype=np.int64), np.zeros(5, dtype=np.int64))
+    ring, queues, counters = history
+    if ring.size != samples:
+        raise ValueError(f"the window state holds {ring.size} samples, not the window's {samples}")
+    span = np.empty(np.size(position))
+    _span_kernel(np.ascontiguousarray(position, dtype=np.float64), ring, queues, counters, span)
+    return span, history
 
 
 @njit(cache=True, error_model="numpy")
-def _span_kernel(values, first, window, out):  # pragma: no cover - compiled; reference in the tests
-    """``out[k]`` = ``max - min`` of the trailing ``window`` of ``values`` ending at ``values[first + k]``
-    (fewer at the start: what the sequence has shown so far, :func:`local_span`).
+def _span_kernel(position, ring, queues, counters, out):  # pragma: no cover - compiled; reference in the tests
+    """``out[k]`` = ``max - min`` of the trailing window of ``ring.size`` samples ending at ``position[k]``
+    (fewer at the start of a run: what it has shown so far, :func:`local_span`).
 
-    A running maximum and minimum: two monotone queues of indices (the maximum's values decreasing, the
-    minimum's increasing), each index pushed and popped once: O(1) amortised a sample whatever the window,
-    and the same values as taking ``max - min`` of each window.
+    A running maximum and minimum: two monotone queues of sample indices (``queues[0]``, the maximum's,
+    values decreasing; ``queues[1]``, the minimum's, increasing), rings of the window's length addressed by
+    ever-growing counters ``counters`` = [samples seen, maximum's head, tail, minimum's head, tail]; the
+    window's values in ``ring``. Each index is pushed and popped once: O(1) amortised a sample, and the same
+    values as taking ``max - min`` of each window. All state is updated in place.
     """
-    high = np.empty(values.size, dtype=np.int64)
-    low = np.empty(values.size, dtype=np.int64)
-    high_head, high_tail, low_head, low_tail = 0, 0, 0, 0
-    for t in range(values.size):
-        value = values[t]
-        while high_tail > high_head and values[high[high_tail - 1]] <= value:
-            high_tail -= 1
-        high[high_tail] = t
-        high_tail += 1
-        while low_tail > low_head and values[low[low_tail - 1]] >= value:
-            low_tail -= 1
-        low[low_tail] = t
-        low_tail += 1
+    window = ring.size
+    high, low = queues[0], queues[1]
+    t, high_head, high_tail, low_head, low_tail = counters[0], counters[1], counters[2], counters[3], counters[4]
+    for k in range(position.size):
+        value = position[k]
         oldest = t - window + 1
-        while high[high_head] < oldest:
+        while high_tail > high_head and high[high_head % window] < oldest:
             high_head += 1
-        while low[low_head] < oldest:
+        while low_tail > low_head and low[low_head % window] < oldest:
             low_head += 1
-        if t >= first:
-            out[t - first] = values[high[high_head]] - values[low[low_head]]
+        ring[t % window] = value
+        while high_tail > high_head and ring[high[(high_tail - 1) % window] % window] <= value:
+            high_tail -= 1
+        high[high_tail % window] = t
+        high_tail += 1
+        while low_tail > low_head and ring[low[(low_tail - 1) % window] % window] >= value:
+            low_tail -= 1
+        low[low_tail % window] = t
+        low_tail += 1
+        out[k] = ring[high[high_head % window] % window] - ring[low[low_head % window] % window]
+        t += 1
+    counters[0], counters[1], counters[2], counters[3], counters[4] = t, high_head, high_tail, low_head, low_tail
 
 
 def reversal_marks(position: np.ndarray, deadband: float, detector: np.ndarray | None = None) -> tuple[np.ndarray,
@@ -494,7 +504,7 @@ class OperatingRegion:
             Prepared chunk: consecutive samples of one run.
         state : object
             :meth:`start` at the start of a run, else what the previous chunk returned (consumed: the
-            window's reversal count in it is updated in place).
+            window's span and reversal count in it are updated in place).
         sample_time : float
             Step [s] of the whole run.
 
@@ -507,17 +517,18 @@ class OperatingRegion:
             ``reversals``) where the position turned back more often within the window than the training
             runs did at that span cell.
         state : tuple
-            The positions of the trailing window, the reversal detector and the window's reversal count
-            (:func:`trailing_reversals`, carried over and updated in place): the ``state`` of the next chunk.
+            The trailing window's running span (:func:`local_span`), the reversal detector and the window's
+            reversal count (:func:`trailing_reversals`), carried over and updated in place: the ``state`` of
+            the next chunk.
         """
         out = {}
         for channel, low, high in self._bounds:
             values = getattr(log, channel, None)
             if values is not None:
                 out[channel] = (values < low) | (values > high)
-        positions, detector, window = state
+        spans, detector, window = state
         samples = _window_samples(self.operating["window_s"], sample_time)
-        span, positions = local_span(log.position, samples, positions)
+        span, spans = local_span(log.position, samples, spans)
         if self._reversals:
             marks, detector = reversal_marks(log.position, self.operating["span_edges"][0], detector)
             count, window = trailing_reversals(marks, samples, window)
@@ -526,4 +537,4 @@ class OperatingRegion:
         out["motion"] = np.empty(span.size, dtype=np.bool_)
         _unseen_kernel(np.abs(np.asarray(log.velocity, dtype=np.float64)), span, count, self._speed_inner,
                        self._span_inner, self._seen, self._most, out["motion"])
-        return out, (positions, detector, window)
+        return out, (spans, detector, window)

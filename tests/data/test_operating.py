@@ -58,10 +58,13 @@ def test_the_running_span_equals_the_plain_windows_on_random_data(values, repeat
     history, position = sequence[:min(cut, sequence.size - 1)], sequence[min(cut, sequence.size - 1):]
     expected = _reference_kernel(position, history, window)
     for kernel in (_span_kernel, getattr(_span_kernel, "py_func", _span_kernel)):
+        ring, queues, counters = np.zeros(window), np.zeros((2, window), dtype=np.int64), np.zeros(5, np.int64)
+        kernel(history, ring, queues, counters, np.empty(history.size))
         out = np.empty(position.size)
-        kernel(np.concatenate((history, position)), history.size, window, out)
+        kernel(position, ring, queues, counters, out)
         np.testing.assert_array_equal(out, expected)
-    span, _ = local_span(position, window, history if history.size else None)
+    state = local_span(history, window)[1] if history.size else None
+    span, _ = local_span(position, window, state)
     np.testing.assert_array_equal(span, expected)
 
 
