@@ -1053,6 +1053,34 @@ class View:
     render: Callable[..., str]
 
 
+# -- the docs' last typed figures (issue 43, h43docs5) --
+def _coarse_block(record: dict) -> str:
+    out = ["| development set | `delta` [mm] | `v99 T` [mm per sample] | `m` |", "|---|---|---|---|"]
+    for name, row in record["figures"]["sets"].items():
+        delta = "none" if row["delta_mm"] is None else f"{row['delta_mm']:.2g}"
+        m = f"{row['m']} (nothing changes)" if row["m"] == 1 else f"{row['m']}"
+        out.append(f"| {name} | {delta} | {row['travel_per_sample_mm']:.3g} | {m} |")
+    return "\n".join(out) + "\n"
+
+
+def _data_files_arts(record: dict) -> str:
+    out = ["| file | amplitude mm | frequency Hz | samples | peak speed mm/s |", "|---|---|---|---|---|"]
+    for name, row in record["figures"]["arts"].items():
+        out.append(f"| {name} | {row['amplitude_mm']:.1f} | {row['frequency_hz']:.3g} | {row['samples']} | "
+                   f"{row['peak_speed_mm_s']:.0f} |")
+    rates = sorted({f"{row['sample_rate_hz']:.0f}" for row in record["figures"]["arts"].values()})
+    return "\n".join(out) + f"\n\nAll sampled at {' / '.join(rates)} Hz (the record `data-files`).\n"
+
+
+def _data_files_emps(record: dict) -> str:
+    files = record["figures"]["emps"]
+    train, test = files["DATA_EMPS.mat"], files["DATA_EMPS_PULSES.mat"]
+    return (f"   Samples (the record `data-files`): the training file keeps {train['samples_1khz']} at 1 kHz after steps "
+            f"1-2 and {train['samples_decimated']} after the decimation by {train['decimation']}; the cross-test "
+            f"file {test['samples_1khz']} and {test['samples_decimated']}.\n")
+# -- end of the docs' last typed figures (h43docs5) --
+
+
 #: The views the pages render, by name.
 def _auto_twin_time(record: dict) -> str:
     f = record["figures"]
@@ -1247,6 +1275,11 @@ VIEWS = {
     # -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
     "auto-arts-speed": View(("auto-arts",), _auto_arts_speed),
     # -- end of --model auto on the ARTS harmonic tests --
+    # -- the docs' last typed figures (issue 43, h43docs5) --
+    "coarse-block": View(("coarse-block",), _coarse_block),
+    "data-files-arts": View(("data-files",), _data_files_arts),
+    "data-files-emps": View(("data-files",), _data_files_emps),
+    # -- end of the docs' last typed figures (h43docs5) --
 }
 
 
