@@ -46,16 +46,16 @@ SETS = {
 
 
 def measure() -> dict:
-    """``delta``, ``v99 T`` and ``m`` of every development set, JSON-ready."""
-    sets = {}
+    """``delta``, ``v99 T`` and ``m`` of every development set in order, JSON-ready."""
+    sets = []
     for name, read in SETS.items():
         runs = read()
         delta = presliding_deflection(runs, static_initial_guess(runs, fit_offset=True))
         v99 = float(np.percentile(np.abs(np.concatenate([run.velocity for run in runs])), 99))
         step = max(run.sample_time for run in runs)
-        sets[name] = {"runs": len(runs), "samples": int(sum(len(run) for run in runs)),
+        sets.append({"set": name, "runs": len(runs), "samples": int(sum(len(run) for run in runs)),
                       "delta_mm": None if delta is None else float(delta), "v99_mm_s": v99, "sample_time_s": step,
-                      "travel_per_sample_mm": v99 * step, "m": coarse_block(runs)}
+                      "travel_per_sample_mm": v99 * step, "m": coarse_block(runs)})
     return {"samples_per_deflection": SAMPLES_PER_DEFLECTION, "sets": sets}
 
 
@@ -67,8 +67,8 @@ def main(argv=None) -> int:
     if args.json:
         print(json.dumps(result))
         return 0
-    for name, row in result["sets"].items():
-        print(f"{name}: delta {row['delta_mm']} mm, v99 T {row['travel_per_sample_mm']:.4g} mm, m = {row['m']}")
+    for row in result["sets"]:
+        print(f"{row['set']}: delta {row['delta_mm']} mm, v99 T {row['travel_per_sample_mm']:.4g} mm, m = {row['m']}")
     return 0
 
 

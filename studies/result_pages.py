@@ -1056,16 +1056,16 @@ class View:
 # -- the docs' last typed figures (issue 43, h43docs5) --
 def _coarse_block(record: dict) -> str:
     out = ["| development set | `delta` [mm] | `v99 T` [mm per sample] | `m` |", "|---|---|---|---|"]
-    for name, row in record["figures"]["sets"].items():
+    for row in record["figures"]["sets"]:
         delta = "none" if row["delta_mm"] is None else f"{row['delta_mm']:.2g}"
         m = f"{row['m']} (nothing changes)" if row["m"] == 1 else f"{row['m']}"
-        out.append(f"| {name} | {delta} | {row['travel_per_sample_mm']:.3g} | {m} |")
+        out.append(f"| {row['set']} | {delta} | {row['travel_per_sample_mm']:.3g} | {m} |")
     return "\n".join(out) + "\n"
 
 
 def _data_files_arts(record: dict) -> str:
     out = ["| file | amplitude mm | frequency Hz | samples | peak speed mm/s |", "|---|---|---|---|---|"]
-    for name, row in record["figures"]["arts"].items():
+    for name, row in sorted(record["figures"]["arts"].items(), key=lambda item: int(item[0][4:])):
         out.append(f"| {name} | {row['amplitude_mm']:.1f} | {row['frequency_hz']:.3g} | {row['samples']} | "
                    f"{row['peak_speed_mm_s']:.0f} |")
     rates = sorted({f"{row['sample_rate_hz']:.0f}" for row in record["figures"]["arts"].values()})
