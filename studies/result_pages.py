@@ -1075,8 +1075,8 @@ def _data_files_arts(record: dict) -> str:
 def _data_files_emps(record: dict) -> str:
     files = record["figures"]["emps"]
     train, test = files["DATA_EMPS.mat"], files["DATA_EMPS_PULSES.mat"]
-    return (f"   Samples (the record `data-files`): the training file keeps {train['samples_1khz']} at 1 kHz after steps "
-            f"1-2 and {train['samples_decimated']} after the decimation by {train['decimation']}; the cross-test "
+    return (f"   Samples (the record `data-files`): the training file keeps {train['samples_1khz']} at 1 kHz after "
+            f"steps 1-2 and {train['samples_decimated']} after the decimation by {train['decimation']}; the cross-test "
             f"file {test['samples_1khz']} and {test['samples_decimated']}.\n")
 # -- end of the docs' last typed figures (h43docs5) --
 
