@@ -1078,6 +1078,21 @@ def _data_files_emps(record: dict) -> str:
     return (f"   Samples (the record `data-files`): the training file keeps {train['samples_1khz']} at 1 kHz after "
             f"steps 1-2 and {train['samples_decimated']} after the decimation by {train['decimation']}; the cross-test "
             f"file {test['samples_1khz']} and {test['samples_decimated']}.\n")
+
+
+#: The features of a friction fingerprint in the order the monitor page names them.
+_FINGERPRINT_ORDER = ("sliding_pos", "sliding_neg", "breakaway_pos", "breakaway_neg", "viscous_pos", "viscous_neg",
+                      "noise", "backlash", "periodic_amp", "local_excess")
+
+
+def _monitor_thresholds(record: dict) -> str:
+    variants = record["figures"]["variants"]
+    spindle, found = variants["spindle"]["thresholds"], variants["plain"]["thresholds"]
+    names = [name for name in _FINGERPRINT_ORDER if name in spindle] + sorted(set(spindle) - set(_FINGERPRINT_ORDER))
+    listed = ", ".join(f"{name} {spindle[name]:.2f}" for name in names)
+    apart = max(abs(found[name] - spindle[name]) for name in names)
+    return (f"with the spindle-load column: {listed}; with `--find-cuts` instead within {apart:.2f} of these "
+            f"({min(found.values()):.2f} to {max(found.values()):.2f}) (`{record['command']}`, {_where(record)}).\n")
 # -- end of the docs' last typed figures (h43docs5) --
 
 
@@ -1279,6 +1294,7 @@ VIEWS = {
     "coarse-block": View(("coarse-block",), _coarse_block),
     "data-files-arts": View(("data-files",), _data_files_arts),
     "data-files-emps": View(("data-files",), _data_files_emps),
+    "monitor-thresholds": View(("monitor-independent",), _monitor_thresholds),
     # -- end of the docs' last typed figures (h43docs5) --
 }
 
