@@ -260,6 +260,18 @@ SPECS = {spec.name: spec for spec in (
                "--model auto on the ARTS harmonic 0.25 Hz tests (J = 0): wall time, the choice and its folds; the "
                "chosen model and coulomb:offset on the fastest other test"),
     # -- end of --model auto on the ARTS harmonic tests --
+    # -- the docs' last typed figures (issue 43, h43docs5) --
+    RecordSpec("coarse-block", ("benchmarks/bench_coarse_block.py", "--json"),
+               ("benchmarks/bench_coarse_block.py", "greybox/identify/coarse.py", "greybox/identify/initial.py",
+                "greybox/identify/static.py", "greybox/data", "greybox/train/logs.py", "studies/arts.py",
+                "studies/arts_data.py", "data"),
+               "the block size m of the backlash width search (greybox.identify.coarse) on the twin, axis_dev and "
+               "ARTS development sets: pre-sliding deflection, travel per sample at the 99th percentile of |v|"),
+    RecordSpec("data-files", ("studies/data_files.py", "--json"),
+               ("studies/data_files.py", "studies/arts.py", "studies/arts_data.py", "studies/emps.py", "greybox/data"),
+               "facts of the real data files: per ARTS file amplitude, frequency, samples and peak speed; the "
+               "EMPS samples after the benchmark's steps 1-2 and after its decimation"),
+    # -- end of the docs' last typed figures (h43docs5) --
 )}
 
 

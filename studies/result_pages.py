@@ -1053,6 +1053,49 @@ class View:
     render: Callable[..., str]
 
 
+# -- the docs' last typed figures (issue 43, h43docs5) --
+def _coarse_block(record: dict) -> str:
+    out = ["| development set | `delta` [mm] | `v99 T` [mm per sample] | `m` |", "|---|---|---|---|"]
+    for row in record["figures"]["sets"]:
+        delta = "none" if row["delta_mm"] is None else f"{row['delta_mm']:.2g}"
+        m = f"{row['m']} (nothing changes)" if row["m"] == 1 else f"{row['m']}"
+        out.append(f"| {row['set']} | {delta} | {row['travel_per_sample_mm']:.3g} | {m} |")
+    return "\n".join(out) + "\n"
+
+
+def _data_files_arts(record: dict) -> str:
+    out = ["| file | amplitude mm | frequency Hz | samples | peak speed mm/s |", "|---|---|---|---|---|"]
+    for name, row in sorted(record["figures"]["arts"].items(), key=lambda item: int(item[0][4:])):
+        out.append(f"| {name} | {row['amplitude_mm']:.1f} | {row['frequency_hz']:.3g} | {row['samples']} | "
+                   f"{row['peak_speed_mm_s']:.0f} |")
+    rates = sorted({f"{row['sample_rate_hz']:.0f}" for row in record["figures"]["arts"].values()})
+    return "\n".join(out) + f"\n\nAll sampled at {' / '.join(rates)} Hz (the record `data-files`).\n"
+
+
+def _data_files_emps(record: dict) -> str:
+    files = record["figures"]["emps"]
+    train, test = files["DATA_EMPS.mat"], files["DATA_EMPS_PULSES.mat"]
+    return (f"   Samples (the record `data-files`): the training file keeps {train['samples_1khz']} at 1 kHz after "
+            f"steps 1-2 and {train['samples_decimated']} after the decimation by {train['decimation']}; the cross-test "
+            f"file {test['samples_1khz']} and {test['samples_decimated']}.\n")
+
+
+#: The features of a friction fingerprint in the order the monitor page names them.
+_FINGERPRINT_ORDER = ("sliding_pos", "sliding_neg", "breakaway_pos", "breakaway_neg", "viscous_pos", "viscous_neg",
+                      "noise", "backlash", "periodic_amp", "local_excess")
+
+
+def _monitor_thresholds(record: dict) -> str:
+    variants = record["figures"]["variants"]
+    spindle, found = variants["spindle"]["thresholds"], variants["plain"]["thresholds"]
+    names = [name for name in _FINGERPRINT_ORDER if name in spindle] + sorted(set(spindle) - set(_FINGERPRINT_ORDER))
+    listed = ", ".join(f"{name} {spindle[name]:.2f}" for name in names)
+    apart = max(abs(found[name] - spindle[name]) for name in names)
+    return (f"with the spindle-load column: {listed}; with `--find-cuts` instead within {apart:.2f} of these "
+            f"({min(found.values()):.2f} to {max(found.values()):.2f}) (`{record['command']}`, {_where(record)}).\n")
+# -- end of the docs' last typed figures (h43docs5) --
+
+
 #: The views the pages render, by name.
 def _auto_twin_time(record: dict) -> str:
     f = record["figures"]
@@ -1247,6 +1290,12 @@ VIEWS = {
     # -- --model auto on the ARTS harmonic tests (issue 40, h40arts2) --
     "auto-arts-speed": View(("auto-arts",), _auto_arts_speed),
     # -- end of --model auto on the ARTS harmonic tests --
+    # -- the docs' last typed figures (issue 43, h43docs5) --
+    "coarse-block": View(("coarse-block",), _coarse_block),
+    "data-files-arts": View(("data-files",), _data_files_arts),
+    "data-files-emps": View(("data-files",), _data_files_emps),
+    "monitor-thresholds": View(("monitor-independent",), _monitor_thresholds),
+    # -- end of the docs' last typed figures (h43docs5) --
 }
 
 
