@@ -272,6 +272,13 @@ SPECS = {spec.name: spec for spec in (
                "facts of the real data files: per ARTS file amplitude, frequency, samples and peak speed; the "
                "EMPS samples after the benchmark's steps 1-2 and after its decimation"),
     # -- end of the docs' last typed figures (h43docs5) --
+    # -- the example of monitor.md (issue 43, lead) --
+    RecordSpec("monitor-example", ("scripts/monitor_example.py", "--figures", "docs/figures"),
+               ("scripts/monitor_example.py", "studies/as_printed.py", "greybox/monitor", "greybox/twin",
+                "greybox/identify", "greybox/data", "greybox/cli/monitor.py", "greybox/cli/synth.py"),
+               "the example of docs/monitor.md run as printed: 45 days of the ageing twin's X axis with a local "
+               "defect from day 35, greybox monitor on them; the console lines, the dashboard's size and pictures"),
+    # -- end of the example of monitor.md --
 )}
 
 

@@ -1204,6 +1204,22 @@ def _axis_dev_speed(record: dict) -> str:
 # -- end of issue 40's axis_dev targets (h40axisdev) --
 
 
+# -- the example of monitor.md (issue 43, lead) --
+#: Log lines of ``greybox monitor`` the page shows before the summary (one per log follows in the run).
+_MONITOR_LOG_LINES = 2
+
+
+def _monitor_example(record: dict) -> str:
+    f = record["figures"]
+    lines = f["monitor_lines"]
+    summary = next(i for i, line in enumerate(lines) if " logs fingerprinted, " in line)
+    shown = [f"$ {f['synth_command']}", "$ greybox monitor logs/*.mcap --history history/ --out report/",
+             *lines[:_MONITOR_LOG_LINES], "...", *lines[summary:]]
+    return (_console(shown) + f"\n(the drift's onset, day {f['onset_day']}, is {f['onset_date']}; the dashboard "
+            f"`report/index.html` is {f['dashboard_mb']:.1f} MB with its plotly.js inline; `{record['command']}`, "
+            f"{_where(record)}.)\n")
+# -- end of the example of monitor.md --
+
 VIEWS = {
     "reproduce-run": View(("reproduce",), _reproduce_run),
     "reproduce-exp1": View(("reproduce",), _reproduce_exp(1)),
@@ -1296,6 +1312,9 @@ VIEWS = {
     "data-files-emps": View(("data-files",), _data_files_emps),
     "monitor-thresholds": View(("monitor-independent",), _monitor_thresholds),
     # -- end of the docs' last typed figures (h43docs5) --
+    # -- the example of monitor.md (issue 43, lead) --
+    "monitor-example": View(("monitor-example",), _monitor_example),
+    # -- end of the example of monitor.md --
 }
 
 
