@@ -2,10 +2,11 @@
 
 Writes 45 days of the ageing twin's X axis with a local defect from day 35 (``greybox synth --history``),
 fingerprints them into a history and writes the dashboard (``greybox monitor``), in a temporary folder, with
-the greybox of this Python. Prints the console output of both commands and the figures the page quotes, as
-one JSON object last (the record ``monitor-example`` of ``scripts/record.py``); with ``--figures DIR`` the
-dashboard's first two pictures (the axis' features over the days, its friction along the travel) are copied
-there as ``monitor-twin-X.png`` and ``monitor-twin-X-travel.png``.
+the greybox of this Python. Prints the console output of both commands and the figures the page quotes (with
+the backlash feature's range over the days before the onset), as one JSON object last (the record
+``monitor-example`` of ``scripts/record.py``); with ``--figures DIR`` the dashboard's first two pictures (the
+axis' features over the days, its friction along the travel) are copied there as ``monitor-twin-X.png`` and
+``monitor-twin-X-travel.png``.
 
 Usage::
 
@@ -21,6 +22,8 @@ import re
 import sys
 from datetime import date
 from pathlib import Path
+
+import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is beside greybox/, not installed
 
@@ -45,6 +48,9 @@ def monitor_example(folder: Path) -> tuple[dict, list[bytes]]:
     lines = run_greybox(folder, "monitor", *logs, "--history", "history/", "--out", "report/")
     onset = next(path for path in (folder / "logs").glob("*.mcap")
                  if int(read_log(path).attrs.get("day", -1)) == ONSET_DAY)
+    onset_date = date.fromisoformat(str(read_log(onset).attrs["date"])[:10])
+    history = pd.read_parquet(folder / "history")
+    before = history[pd.to_datetime(history["date"].astype(str)) < pd.Timestamp(onset_date)]
     page = (folder / "report" / "index.html").read_text(encoding="utf-8")
     pictures = [base64.b64decode(found) for found in _EMBEDDED_PNG.findall(page)[:len(PICTURES)]]
     return {
@@ -52,7 +58,9 @@ def monitor_example(folder: Path) -> tuple[dict, list[bytes]]:
         "monitor_lines": lines,
         "logs": len(logs),
         "onset_day": ONSET_DAY,
-        "onset_date": date.fromisoformat(str(read_log(onset).attrs["date"])[:10]).isoformat(),
+        "onset_date": onset_date.isoformat(),
+        "days_before_onset": len(before),
+        "backlash_before_onset_um": [1e3 * float(before["backlash"].min()), 1e3 * float(before["backlash"].max())],
         "dashboard_mb": (folder / "report" / "index.html").stat().st_size / 1e6,
     }, pictures
 

@@ -1215,9 +1215,11 @@ def _monitor_example(record: dict) -> str:
     summary = next(i for i, line in enumerate(lines) if " logs fingerprinted, " in line)
     shown = [f"$ {f['synth_command']}", "$ greybox monitor logs/*.mcap --history history/ --out report/",
              *lines[:_MONITOR_LOG_LINES], "...", *lines[summary:]]
-    return (_console(shown) + f"\n(the drift's onset, day {f['onset_day']}, is {f['onset_date']}; the dashboard "
-            f"`report/index.html` is {f['dashboard_mb']:.1f} MB with its plotly.js inline; `{record['command']}`, "
-            f"{_where(record)}.)\n")
+    low, high = f["backlash_before_onset_um"]
+    return (_console(shown) + f"\n(the drift's onset, day {f['onset_day']}, is {f['onset_date']}; over the "
+            f"{f['days_before_onset']} days before it the backlash width, the pre-sliding distance to half the "
+            f"level, came out {low:.2f} to {high:.2f} um; the dashboard `report/index.html` is "
+            f"{f['dashboard_mb']:.1f} MB with its plotly.js inline; `{record['command']}`, {_where(record)}.)\n")
 # -- end of the example of monitor.md --
 
 VIEWS = {
