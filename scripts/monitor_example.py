@@ -29,6 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # studies/ is besi
 
 from greybox.atomic import write_bytes_atomic
 from greybox.data import read_log
+from greybox.monitor.history import read_history
 from studies.as_printed import reader_folder, run_greybox
 
 #: The page's synth command after ``greybox``.
@@ -49,7 +50,7 @@ def monitor_example(folder: Path) -> tuple[dict, list[bytes]]:
     onset = next(path for path in (folder / "logs").glob("*.mcap")
                  if int(read_log(path).attrs.get("day", -1)) == ONSET_DAY)
     onset_date = date.fromisoformat(str(read_log(onset).attrs["date"])[:10])
-    history = pd.read_parquet(folder / "history")
+    history = read_history(folder / "history").to_pandas()
     before = history[pd.to_datetime(history["date"].astype(str)) < pd.Timestamp(onset_date)]
     page = (folder / "report" / "index.html").read_text(encoding="utf-8")
     pictures = [base64.b64decode(found) for found in _EMBEDDED_PNG.findall(page)[:len(PICTURES)]]
