@@ -34,7 +34,7 @@ constants of the compiled code, and the text reaches the number reader as a view
 that is not reference counted (:func:`_borrow`): passing arrays to a compiled
 function that is not inlined otherwise counts references up and down at every
 number, atomic operations on memory shared by the parsing threads, which took
-about half of the parsing time.
+a third to a half of the parsing time.
 """
 
 from __future__ import annotations
