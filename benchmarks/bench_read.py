@@ -19,17 +19,25 @@ decompressed and CRC-checked, split into records, the channel's messages
 selected with their time stamps, parsed, joined into columns, converted to an
 AxisLog), and wall and CPU seconds of ``read_log`` on the pool.
 
+``--hour`` times reading only, on the one-hour log that ``bench_predict_hour.py``
+reads (the twin's axis X, run 21, with cutting: 1.8 M samples of 10 numbers):
+the median of ``--reads`` reads by ``read_log`` in this process after one read
+that warms imports and kernels, and the first read in a fresh process, for MCAP
+and Parquet; with the 1-minute load average before and after. It writes no record.
+
 Usage::
 
     python benchmarks/bench_read.py            # table
     python benchmarks/bench_read.py --json     # one JSON line
     python benchmarks/bench_read.py --stages   # MCAP read stage by stage (JSON line)
+    python benchmarks/bench_read.py --hour     # read-only timing of the predict-hour log (JSON line)
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import resource
 import subprocess
 import sys
@@ -41,6 +49,7 @@ import numpy as np
 
 from greybox.data import AxisLog, mcap_io, read_log, write_log
 from greybox.data.units import log_from_columns
+from greybox.twin import make_dataset
 
 _CHILD = r"""
 import json, sys, time
@@ -149,13 +158,64 @@ def stages(duration_s: float = 3600.0, sample_time: float = 0.002) -> dict:
     return result
 
 
+def hour_reads(duration_s: float = 3600.0, reads: int = 5, folder: str | None = None) -> dict:
+    """Read-only timing of the one-hour log of ``bench_predict_hour.py``, MCAP and Parquet.
+
+    Parameters
+    ----------
+    duration_s : float
+        Length of the log [s].
+    reads : int
+        Warm reads whose median is reported.
+    folder : str, optional
+        Directory to keep the written files in and to take them from when they are there already
+        (default: a temporary one, removed).
+
+    Returns
+    -------
+    dict
+        Per format: samples, median / min / max seconds of the warm reads, samples per second at the
+        median, and seconds of the first read in a fresh process; cores and load averages.
+    """
+    result: dict = {"cores": len(os.sched_getaffinity(0)), "load_before": os.getloadavg()[0], "reads": reads}
+    with tempfile.TemporaryDirectory() as scratch:
+        root = Path(folder or scratch)
+        root.mkdir(parents=True, exist_ok=True)
+        log = None
+        for fmt in ("mcap", "parquet"):
+            path = root / f"hour_{int(duration_s)}s.{fmt}"
+            if not path.exists():
+                log = log or make_dataset("X", "A", 21, duration_s=duration_s, cutting=True)
+                write_log(log, path)
+            first = _read_in_subprocess(path)
+            n = len(read_log(path))  # imports and compiled readers warm
+            seconds = []
+            for _ in range(reads):
+                started = time.perf_counter()
+                read_log(path)
+                seconds.append(time.perf_counter() - started)
+            median = float(np.median(seconds))
+            result[fmt] = {"samples": n, "file_mb": round(path.stat().st_size / 1e6, 1), "seconds": round(median, 3),
+                           "min_s": round(min(seconds), 3), "max_s": round(max(seconds), 3),
+                           "samples_per_s": n / median, "fresh_first_read_s": round(first["seconds"], 3)}
+    result["load_after"] = os.getloadavg()[0]
+    return result
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=3600.0, help="log duration [s] (default 3600)")
     parser.add_argument("--sample-time", type=float, default=0.002, help="sample time [s] (default 0.002)")
     parser.add_argument("--json", action="store_true", help="print one JSON line")
     parser.add_argument("--stages", action="store_true", help="profile the MCAP read stage by stage (JSON line)")
+    parser.add_argument("--hour", action="store_true",
+                        help="time reading only: the predict-hour log, median of --reads warm reads (JSON line)")
+    parser.add_argument("--reads", type=int, default=5, help="warm reads for --hour (default 5)")
+    parser.add_argument("--dir", help="for --hour: keep the written logs here, reuse them when present")
     args = parser.parse_args(argv)
+    if args.hour:
+        print(json.dumps(hour_reads(args.duration, args.reads, args.dir)))
+        return 0
     if args.stages:
         print(json.dumps(stages(args.duration, args.sample_time)))
         return 0

@@ -251,3 +251,26 @@ def test_compiled_and_plain_python_parsers_give_the_same_bits(tmp_path):
     for key, column in compiled.items():
         expected = [float(row[int(key[1:])]) for row in texts]
         assert column.view(np.int64).tolist() == np.array(expected).view(np.int64).tolist()
+
+
+def test_a_borrowed_view_is_the_array_itself_compiled_and_plain():
+    """The view passed to the number reader without reference counting reads and writes the array's memory."""
+    @njit
+    def through_view(array, row, value):
+        view = json_numbers._borrow(array)
+        view[row, 1] = value
+        return view.shape, view.strides, view.sum()
+
+    array = np.arange(12.0).reshape(4, 3)[::2]  # not contiguous: strides carried over
+    shape, strides, total = through_view(array, 1, -100.0)
+    assert shape == array.shape and strides == array.strides
+    assert array[1, 1] == -100.0 and total == array.sum()
+    assert json_numbers._borrow(array) is array
+
+
+def test_results_at_the_ends_of_the_normal_range_are_scaled_exactly():
+    """Numbers converted through the 128-bit product whose double has the smallest or the largest exponent."""
+    texts = ["2.2250738585072014e-308", "2.2250738585072019e-308", "4.4501477170144023e-308",
+             "1.7976931348623157e308", "8.98846567431158e307", "1.2345678901234567e-307"]
+    got = parse([f'{{"v":{text}}}'.encode() for text in texts])
+    np.testing.assert_array_equal(got["v"].view(np.int64), np.array([float(text) for text in texts]).view(np.int64))
