@@ -278,6 +278,11 @@ SPECS = {spec.name: spec for spec in (
                 "greybox/identify", "greybox/data", "greybox/cli/monitor.py", "greybox/cli/synth.py"),
                "the example of docs/monitor.md run as printed: 45 days of the ageing twin's X axis with a local "
                "defect from day 35, greybox monitor on them; the console lines, the dashboard's size and pictures"),
+    RecordSpec("find-cuts-tolerance", ("studies/find_cuts_tolerance.py", "--json"),
+               ("studies/find_cuts_tolerance.py", "greybox/monitor/cutting.py", "greybox/monitor/fingerprint.py",
+                "greybox/identify/static.py", "greybox/data", "greybox/twin"),
+               "--find-cuts at four tolerances on every fourth day of the independent production histories against "
+               "their spindle-load column, and on the twin's air-move days"),
     # -- end of the example of monitor.md --
 )}
 
