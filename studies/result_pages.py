@@ -1220,6 +1220,30 @@ def _monitor_example(record: dict) -> str:
             f"{f['days_before_onset']} days before it the backlash width, the pre-sliding distance to half the "
             f"level, came out {low:.2f} to {high:.2f} um; the dashboard `report/index.html` is "
             f"{f['dashboard_mb']:.1f} MB with its plotly.js inline; `{record['command']}`, {_where(record)}.)\n")
+
+
+def _find_cuts_tolerance(record: dict) -> str:
+    f = record["figures"]
+    days = f["days"]
+    late_defect = [d for d in days if d["kind"] == "local_defect" and d["after_onset"]]
+    others = [d for d in days if d not in late_defect]
+
+    def kept(group, tolerance):
+        ratios = [100.0 * (d["kept"][tolerance] / d["spindle_kept"] - 1.0) for d in group]
+        return f"{min(ratios):+.1f} to {max(ratios):+.1f} %"
+
+    lines = [f"| `tolerance` | cutting samples kept ({len(days)} days) | samples kept against the spindle-load "
+             f"column: {len(others)} days | the same: the defect machine's {len(late_defect)} days after its "
+             f"onset |", "|---|---|---|---|"]
+    for tolerance in map(str, f["tolerances"]):
+        default = " (default)" if float(tolerance) == f["default"] else ""
+        lines.append(f"| {tolerance}{default} | {sum(d['cutting_kept'][tolerance] for d in days)} "
+                     f"| {kept(others, tolerance)} | {kept(late_defect, tolerance)} |")
+    twin = f["twin_air_days"]
+    share = ", ".join(f"day {d['day']} of seed {d['seed']} {d['kept_percent']:.1f} %" for d in twin)
+    return ("\n".join(lines) + f"\n\nCutting: spindle load above {f['cutting_load_pct']:.0f} %; every "
+            f"{f['every_days']}th day of each machine. On the twin's air-move days, the moving samples kept at the "
+            f"default: {share}. `{record['command']}` ({_where(record)}).\n")
 # -- end of the example of monitor.md --
 
 VIEWS = {
@@ -1316,6 +1340,7 @@ VIEWS = {
     # -- end of the docs' last typed figures (h43docs5) --
     # -- the example of monitor.md (issue 43, lead) --
     "monitor-example": View(("monitor-example",), _monitor_example),
+    "find-cuts-tolerance": View(("find-cuts-tolerance",), _find_cuts_tolerance),
     # -- end of the example of monitor.md --
 }
 
