@@ -283,6 +283,11 @@ SPECS = {spec.name: spec for spec in (
                 "greybox/identify/static.py", "greybox/data", "greybox/twin"),
                "--find-cuts at four tolerances on every fourth day of the independent production histories against "
                "their spindle-load column, and on the twin's air-move days"),
+    RecordSpec("monitor-calibration", ("studies/monitor_calibration.py", "--json"),
+               ("studies/monitor_calibration.py", "greybox/monitor/detect.py",
+                "greybox/monitor/stable_twin_shapes.json"),
+               "the change detector's calibrated thresholds (28 and 14 baseline days; 0.5 and 1 false alarm per "
+               "axis-year; the twin's shapes and normal days) and the skewness and tails of the shipped shapes"),
     # -- end of the example of monitor.md --
 )}
 

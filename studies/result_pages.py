@@ -1244,6 +1244,27 @@ def _find_cuts_tolerance(record: dict) -> str:
     return ("\n".join(lines) + f"\n\nCutting: spindle load above {f['cutting_load_pct']:.0f} %; every "
             f"{f['every_days']}th day of each machine. On the twin's air-move days, the moving samples kept at the "
             f"default: {share}. `{record['command']}` ({_where(record)}).\n")
+
+
+def _monitor_shapes(record: dict) -> str:
+    f = record["figures"]
+    shapes, tail = f["shapes"], f["tail_sd"]
+    excess, backlash = shapes["local_excess"], shapes["backlash"]
+    others = [stats["skewness"] for name, stats in shapes.items() if name not in ("local_excess", "backlash")]
+    widest = max(abs(value) for value in others)
+    return (f"Read from the shipped quantiles: the local excess (the largest rise along the travel) is skewed to "
+            f"high values (skewness {excess['skewness']:+.2f}; {excess['above_percent']:.1f} % of its days beyond "
+            f"+{tail} standard deviations, {excess['below_percent']:.2f} % below -{tail}; a normal day 0.6 % each), "
+            f"the backlash width a little ({backlash['skewness']:+.2f}); every other feature is within "
+            f"+-{widest:.2f} of a normal skewness (`{record['command']}`, {_where(record)}).\n")
+
+
+def _monitor_calibrated(record: dict) -> str:
+    h = record["figures"]["thresholds"]
+    return (f"With 28 baseline days on the twin's shapes, h = {h['twin_28_days_0.5']:.2f} for 0.5 false alarms per "
+            f"axis-year ({h['twin_28_days_1']:.2f} for 1; {h['twin_14_days_0.5']:.2f} with 14 baseline days); on "
+            f"normal days, {h['normal_28_days_1']:.2f} for 1 per axis-year (`{record['command']}`, "
+            f"{_where(record)}).\n")
 # -- end of the example of monitor.md --
 
 VIEWS = {
@@ -1341,6 +1362,8 @@ VIEWS = {
     # -- the example of monitor.md (issue 43, lead) --
     "monitor-example": View(("monitor-example",), _monitor_example),
     "find-cuts-tolerance": View(("find-cuts-tolerance",), _find_cuts_tolerance),
+    "monitor-shapes": View(("monitor-calibration",), _monitor_shapes),
+    "monitor-calibrated": View(("monitor-calibration",), _monitor_calibrated),
     # -- end of the example of monitor.md --
 }
 
