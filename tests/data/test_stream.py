@@ -162,12 +162,23 @@ def models(tmp_path_factory):
     root = tmp_path_factory.mktemp("stream_models")
     train = prepare([make_dataset("X", "A", seed=11, duration_s=30)])
     gms = GMSModel(n_starts=1, max_iter=80).fit(train)
+    # the GMS+SVR freezes that GMS: the stage its own fit on these runs would identify (tests/models/test_contract.py)
     gmssvr = GMSSVRModel(gms=GMSModel(n_starts=1, max_iter=80), optimize=False, C=0.5, epsilon=0.02, gamma=3.0,
-                         n_subset=400).fit(train)
+                         n_subset=400).fit_staged(train, first_stage=gms)
     paths = {"gms": root / "gms.gbm", "gmssvr": root / "gmssvr.gbm"}
     save_model(gms, paths["gms"])
     save_model(gmssvr, paths["gmssvr"])
     return paths
+
+
+@pytest.fixture(scope="module")
+def whole_and_calibration(tmp_path_factory, logs):
+    """The cutting log as CSV (read whole) and an air-cut calibration log, written once (read only)."""
+    root = tmp_path_factory.mktemp("stream_inputs")
+    whole_log, calibration = root / "cut.csv", root / "air.mcap"
+    write_log(read_log(logs["cut.parquet"]), whole_log)
+    write_log(make_dataset("X", "C", seed=21, duration_s=20), calibration)
+    return whole_log, calibration
 
 
 def _table(path: Path):
@@ -179,12 +190,10 @@ def _table(path: Path):
 @pytest.mark.parametrize("kind", ["gms", "gmssvr"])
 @pytest.mark.parametrize(("log_suffix", "suffix"), [(".parquet", ".parquet"), (".parquet", ".csv"),
                                                      (".mcap", ".parquet")])
-def test_streamed_predict_writes_what_the_whole_log_gives(tmp_path, capsys, logs, models, kind, log_suffix, suffix):
+def test_streamed_predict_writes_what_the_whole_log_gives(tmp_path, capsys, logs, whole_and_calibration, models, kind,
+                                                         log_suffix, suffix):
     """The same cutting log as Parquet or MCAP (streamed) and as CSV (read whole): equal tables and metadata."""
-    whole_log = tmp_path / "cut.csv"
-    write_log(read_log(logs["cut.parquet"]), whole_log)
-    calibration = tmp_path / "air.mcap"
-    write_log(make_dataset("X", "C", seed=21, duration_s=20), calibration)
+    whole_log, calibration = whole_and_calibration
     outputs = {}
     for name, log in (("streamed", logs["cut" + log_suffix]), ("whole", whole_log)):
         out = tmp_path / f"{name}{suffix}"
