@@ -413,7 +413,7 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
                    axis_config: AxisConfig | None = None, interval: ProcessInterval | None = None,
                    chunk_s: float = DEFAULT_CHUNK_S, tally: ProcessTally | None = None,
                    progress: Callable[[float], None] | None = None,
-                   relevel: Relevel | None = None) -> Iterator[ProcessResult]:
+                   relevel: Relevel | None = None, read_ahead: bool = False) -> Iterator[ProcessResult]:
     """The process result of one run given block by block, one block at a time.
 
     The model runs over each block in chunks of ``chunk_s``, carrying its state (and the state of its
@@ -441,6 +441,11 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
     relevel : Relevel, optional
         Scales the model's current of each chunk per direction to the chunk's air moves
         (:mod:`greybox.predict.relevel`).
+    read_ahead : bool, default False
+        Predict block k on a thread of its own (the ``"model"`` pool) while ``blocks`` gives block k + 1 and
+        the consumer takes block k - 1's result: a file's reading and writing overlap the model's work. The
+        results are the same; block k's result comes out only after block k + 1 was taken from ``blocks``
+        (so not for a live stream, which needs each block's result before it has the next).
 
     Yields
     ------
@@ -449,11 +454,17 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
     """
     carried = [model.initial_state(), model.region_state()]
 
+    per_chunk = samples_per_chunk(sample_time, chunk_s)
+
+    def chunks(block: AxisLog) -> list[slice]:
+        # a live message's few samples make one chunk: no need to cut it
+        return [slice(0, len(block))] if len(block) <= per_chunk else chunk_slices(len(block), per_chunk)
+
     def predict(block: AxisLog):
         """The prediction and the training-region flags of one block, its chunks in turn (the state carried)."""
         predicted = np.empty(len(block))
         parts = []
-        for samples in chunk_slices(len(block), samples_per_chunk(sample_time, chunk_s)):
+        for samples in chunks(block):
             chunk = block if samples.stop - samples.start == len(block) else block.select(samples)
             predicted[samples], carried[0], flags, carried[1] = model.predict_flag_chunk(
                 chunk, carried[0], carried[1], sample_time=sample_time)
@@ -466,16 +477,20 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
 
     def finished(block: AxisLog, predicted: np.ndarray, regions: dict) -> ProcessResult:
         if progress is not None:
-            for samples in chunk_slices(len(block), samples_per_chunk(sample_time, chunk_s)):
+            for samples in chunks(block):
                 progress(float(block.time[samples.stop - 1]))
         result = _block_result(block, predicted, regions, axis_config, interval)
         if tally is not None:
             tally.add(result, regions)
         return result
 
-    # The model runs over block k on its own thread while this one reads block k + 1 (below, ``next``) and
-    # the consumer writes block k - 1 (at ``yield``): the blocks are predicted in order, one at a time, each
-    # from the state the one before ended in, so the results are those of one block after the other.
+    if not read_ahead:
+        for block in blocks:
+            yield finished(block, *predict(block))
+        return
+    # The model runs over block k on its own thread while this one takes block k + 1 from ``blocks`` and the
+    # consumer writes block k - 1 (at ``yield``): the blocks are predicted in order, one at a time, each from
+    # the state the one before ended in, so the results are those of one block after the other.
     pending = None  # (block, future of its prediction)
     try:
         for block in blocks:

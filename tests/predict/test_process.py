@@ -105,7 +105,8 @@ def test_blocks_predicted_on_the_model_thread_give_the_whole_run_and_read_ahead(
             yield block
 
     results = []
-    for k, result in enumerate(process_blocks(model, reading(), sample_time=cut.sample_time, chunk_s=0.7)):
+    for k, result in enumerate(process_blocks(model, reading(), sample_time=cut.sample_time, chunk_s=0.7,
+                                                   read_ahead=True)):
         events.append(("result", k))
         results.append(result)
     np.testing.assert_array_equal(np.concatenate([r.model for r in results]), model.predict(cut))
@@ -135,9 +136,9 @@ def test_a_failing_block_and_an_early_stop_leave_no_model_work_behind():
         raise RuntimeError("the third block is corrupt")
 
     with pytest.raises(RuntimeError, match="third block"):
-        list(process_blocks(model, failing(), sample_time=cut.sample_time))
+        list(process_blocks(model, failing(), sample_time=cut.sample_time, read_ahead=True))
     assert not running  # the second block's prediction ended before the error came out
-    results = process_blocks(model, iter(_blocks_of(cut, 1000)), sample_time=cut.sample_time)
+    results = process_blocks(model, iter(_blocks_of(cut, 1000)), sample_time=cut.sample_time, read_ahead=True)
     next(results)
     results.close()
     assert not running
