@@ -54,6 +54,7 @@ table (e.g. the cutting force along the axis) is its opposite.
 
 from __future__ import annotations
 
+from concurrent.futures import wait
 from dataclasses import dataclass, field, replace
 from typing import Callable, Iterable, Iterator, Sequence
 
@@ -69,6 +70,7 @@ from ..errors import GreyboxError
 from ..models.chunked import DEFAULT_CHUNK_S, chunk_slices, samples_per_chunk
 from ..models.estimator import EXTRAPOLATION_WARNING_SHARE, outside_any
 from ..models.registry import model_kind
+from ..threads import shared_pool
 from .interval import ProcessInterval
 from .relevel import Relevel
 
@@ -411,7 +413,7 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
                    axis_config: AxisConfig | None = None, interval: ProcessInterval | None = None,
                    chunk_s: float = DEFAULT_CHUNK_S, tally: ProcessTally | None = None,
                    progress: Callable[[float], None] | None = None,
-                   relevel: Relevel | None = None) -> Iterator[ProcessResult]:
+                   relevel: Relevel | None = None, read_ahead: bool = False) -> Iterator[ProcessResult]:
     """The process result of one run given block by block, one block at a time.
 
     The model runs over each block in chunks of ``chunk_s``, carrying its state (and the state of its
@@ -439,32 +441,71 @@ def process_blocks(model, blocks: Iterable[AxisLog], *, sample_time: float,
     relevel : Relevel, optional
         Scales the model's current of each chunk per direction to the chunk's air moves
         (:mod:`greybox.predict.relevel`).
+    read_ahead : bool, default False
+        Predict block k on a thread of its own (the ``"model"`` pool) while ``blocks`` gives block k + 1 and
+        the consumer takes block k - 1's result: a file's reading and writing overlap the model's work. The
+        results are the same; block k's result comes out only after block k + 1 was taken from ``blocks``
+        (so not for a live stream, which needs each block's result before it has the next).
 
     Yields
     ------
     ProcessResult
         One per block, ``attrs`` empty.
     """
-    state = model.initial_state()
-    region = model.region_state()
-    for block in blocks:
+    carried = [model.initial_state(), model.region_state()]
+
+    per_chunk = samples_per_chunk(sample_time, chunk_s)
+
+    def chunks(block: AxisLog) -> list[slice]:
+        # a live message's few samples make one chunk: no need to cut it
+        return [slice(0, len(block))] if len(block) <= per_chunk else chunk_slices(len(block), per_chunk)
+
+    def predict(block: AxisLog):
+        """The prediction and the training-region flags of one block, its chunks in turn (the state carried)."""
         predicted = np.empty(len(block))
         parts = []
-        for samples in chunk_slices(len(block), samples_per_chunk(sample_time, chunk_s)):
+        for samples in chunks(block):
             chunk = block if samples.stop - samples.start == len(block) else block.select(samples)
-            predicted[samples], state, flags, region = model.predict_flag_chunk(
-                chunk, state, region, sample_time=sample_time)
+            predicted[samples], carried[0], flags, carried[1] = model.predict_flag_chunk(
+                chunk, carried[0], carried[1], sample_time=sample_time)
             if relevel is not None and chunk.effort_unit == "A":
                 predicted[samples] = relevel.model(chunk.time, chunk.effort, predicted[samples], chunk.velocity)
             parts.append(flags)
-            if progress is not None:
-                progress(float(block.time[samples.stop - 1]))
         regions = parts[0] if len(parts) == 1 else \
             {name: np.concatenate([flags[name] for flags in parts]) for name in parts[0]}
+        return predicted, regions
+
+    def finished(block: AxisLog, predicted: np.ndarray, regions: dict) -> ProcessResult:
+        if progress is not None:
+            for samples in chunks(block):
+                progress(float(block.time[samples.stop - 1]))
         result = _block_result(block, predicted, regions, axis_config, interval)
         if tally is not None:
             tally.add(result, regions)
-        yield result
+        return result
+
+    if not read_ahead:
+        for block in blocks:
+            yield finished(block, *predict(block))
+        return
+    # The model runs over block k on its own thread while this one takes block k + 1 from ``blocks`` and the
+    # consumer writes block k - 1 (at ``yield``): the blocks are predicted in order, one at a time, each from
+    # the state the one before ended in, so the results are those of one block after the other.
+    pending = None  # (block, future of its prediction)
+    try:
+        for block in blocks:
+            done = None
+            if pending is not None:
+                done = (pending[0], *pending[1].result())
+            pending = (block, shared_pool(1, "model").submit(predict, block))
+            if done is not None:
+                yield finished(*done)
+        if pending is not None:
+            done, pending = (pending[0], *pending[1].result()), None
+            yield finished(*done)
+    finally:
+        if pending is not None:  # the consumer stopped early or reading failed: let the model's work end first
+            wait([pending[1]])
 
 
 def _block_result(block: AxisLog, predicted: np.ndarray, regions: dict, axis_config: AxisConfig | None,

@@ -128,7 +128,7 @@ def stream_process(model, log, out, *, axis_config: AxisConfig | None = None,
     level = Relevel(sample_time=nominal) if relevel else None
     results = process_blocks(model, chain([first], blocks), sample_time=nominal, axis_config=axis_config,
                              interval=interval, chunk_s=chunk_s, tally=tally,
-                             progress=None if progress is None else step, relevel=level)
+                             progress=None if progress is None else step, relevel=level, read_ahead=True)
     described: dict = {}
 
     def metadata() -> dict:

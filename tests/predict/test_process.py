@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
+import pytest
 
 from greybox.data.prepare import prepare
 from greybox.models.friction import GMSModel
-from greybox.predict.process import predict_process
+from greybox.predict.process import predict_process, process_blocks
 from greybox.twin import make_dataset
 
 #: Resolution of the logged current [A]: the cut and air-cut logs differ by the process current up to it.
@@ -75,3 +78,67 @@ def test_process_panel_draws_the_moving_mean():
     matplotlib.pyplot.close(figure)
     assert len(plot_process(result, mean_s=0.0).axes[2].lines) == 2  # process line and zero line only
     matplotlib.pyplot.close("all")
+
+
+def _blocks_of(log, samples):
+    return [log.select(slice(start, min(start + samples, len(log)))) for start in range(0, len(log), samples)]
+
+
+def test_blocks_predicted_on_the_model_thread_give_the_whole_run_and_read_ahead():
+    """Block k is predicted on its own thread while block k + 1 is read: the results are still those of the
+    whole run, and the blocks' iterator is advanced before block k's result comes out."""
+    model = GMSModel(n_starts=1, max_iter=40).fit(prepare([make_dataset("X", "A", seed=21, duration_s=6)])[0])
+    cut = prepare([make_dataset("X", "C", seed=22, duration_s=6, cutting=True)])[0]
+    events = []
+    callers = set()
+    predict_flag_chunk = model.predict_flag_chunk
+
+    def recorded(*args, **kwargs):
+        callers.add(threading.get_ident())
+        return predict_flag_chunk(*args, **kwargs)
+
+    model.predict_flag_chunk = recorded
+
+    def reading():
+        for k, block in enumerate(_blocks_of(cut, 1000)):
+            events.append(("read", k))
+            yield block
+
+    results = []
+    for k, result in enumerate(process_blocks(model, reading(), sample_time=cut.sample_time, chunk_s=0.7,
+                                                   read_ahead=True)):
+        events.append(("result", k))
+        results.append(result)
+    np.testing.assert_array_equal(np.concatenate([r.model for r in results]), model.predict(cut))
+    n = len(results)
+    assert n == -(-len(cut) // 1000) > 2
+    for k in range(n - 1):
+        assert events.index(("read", k + 1)) < events.index(("result", k))
+    assert threading.get_ident() not in callers
+
+
+def test_a_failing_block_and_an_early_stop_leave_no_model_work_behind():
+    model = GMSModel(n_starts=1, max_iter=40).fit(prepare([make_dataset("X", "A", seed=21, duration_s=4)])[0])
+    cut = prepare([make_dataset("X", "C", seed=22, duration_s=4, cutting=True)])[0]
+    running = []
+    predict_flag_chunk = model.predict_flag_chunk
+
+    def recorded(*args, **kwargs):
+        running.append(1)
+        out = predict_flag_chunk(*args, **kwargs)
+        running.pop()
+        return out
+
+    model.predict_flag_chunk = recorded
+
+    def failing():
+        yield from _blocks_of(cut, 1000)[:2]
+        raise RuntimeError("the third block is corrupt")
+
+    with pytest.raises(RuntimeError, match="third block"):
+        list(process_blocks(model, failing(), sample_time=cut.sample_time, read_ahead=True))
+    assert not running  # the second block's prediction ended before the error came out
+    results = process_blocks(model, iter(_blocks_of(cut, 1000)), sample_time=cut.sample_time, read_ahead=True)
+    next(results)
+    results.close()
+    assert not running

@@ -67,6 +67,9 @@ MAX_CUTOFF = 64.0
 #: Blocks below which one thread does all the work (a thread pool costs more than it saves).
 _MIN_BLOCKS_PER_THREAD = 64
 
+#: Parts of the samples' blocks per thread of :func:`add_expansion`, taken by the threads as they come free.
+_PARTS_PER_THREAD = 4
+
 #: The table of the compiled exponential holds ``exp(-n / _EXP_STEPS)``: a power of two, so that ``t * _EXP_STEPS``
 #: and ``n / _EXP_STEPS`` are exact.
 _EXP_STEPS = 32
@@ -298,8 +301,11 @@ def add_expansion(X, support_t, alpha, gamma: float, cutoff: float, out, threads
     if threads == 1:
         _expansion_blocks(X, support_t, alpha, gamma, cutoff, BLOCK_SAMPLES, 0, 1, out)
         return
-    # blocks dealt out in turn: the work per block varies along a log, neighbouring blocks alike
+    # blocks dealt out in turn (the work per block varies along a log, neighbouring blocks alike) to
+    # _PARTS_PER_THREAD parts per thread, which the threads take as they come free: a thread slowed by other work
+    # on its core (reading and writing a log's next blocks) leaves more of the parts to the others
+    n_parts = min(threads * _PARTS_PER_THREAD, -(-X.shape[0] // BLOCK_SAMPLES))
     parts = [shared_pool(threads).submit(_expansion_blocks, X, support_t, alpha, gamma, cutoff,
-                                         BLOCK_SAMPLES, k, threads, out) for k in range(threads)]
+                                         BLOCK_SAMPLES, k, n_parts, out) for k in range(n_parts)]
     for part in parts:
         part.result()
