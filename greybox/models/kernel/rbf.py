@@ -52,8 +52,10 @@ __all__ = ["rbf_expansion", "add_expansion", "threads_for", "expansion_cutoff",
            "DEFAULT_TOLERANCE", "BLOCK_SAMPLES", "EXP_RELATIVE_ERROR",
            "MAX_CUTOFF"]
 
-#: Default bound on the sum of the terms left out of one sample [unit of the output, e.g. A].
-DEFAULT_TOLERANCE = 1e-10
+#: Default bound on the sum of the terms left out of one sample [unit of the output, e.g. A]: a micro-ampere, a
+#: thousandth of the milliampere a drive's trace resolves current to (and as far below any current noise), so the
+#: terms left out cannot show in a predicted current; a smaller bound keeps more terms of every sum for nothing.
+DEFAULT_TOLERANCE = 1e-6
 
 #: Consecutive samples that share one selection of support vectors.
 BLOCK_SAMPLES = 64
@@ -167,7 +169,7 @@ def expansion_cutoff(dual_coef, tolerance: float = DEFAULT_TOLERANCE) -> float |
     ----------
     dual_coef : ndarray, shape (n_support,)
         Dual coefficients [unit of the output].
-    tolerance : float, default 1e-10
+    tolerance : float, default 1e-6
         Bound on the sum of the terms left out of each sample's sum [unit of the output], > 0.
 
     Returns
@@ -215,7 +217,7 @@ def rbf_expansion(
         Constant added to every output, same unit.
     gamma : float, default 1.0
         Kernel width parameter [1 / (unit of X)^2], > 0.
-    tolerance : float, default 1e-10
+    tolerance : float, default 1e-6
         Bound on the sum of the terms left out of each sample's sum [unit of
         the output], > 0. The result differs from the exact expansion by at
         most ``tolerance + EXP_RELATIVE_ERROR * sum(|dual_coef|)`` plus rounding.
