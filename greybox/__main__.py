@@ -1,8 +1,6 @@
 """Allow ``python -m greybox``."""
 
-import sys
-
-from .cli import main
+from .cli import run
 
 if __name__ == "__main__":  # importing the module (e.g. the API reference of the docs) runs nothing
-    sys.exit(main())
+    run()

@@ -288,5 +288,20 @@ def _run(args: argparse.Namespace, argv: list[str] | None) -> int:
             signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
+def run() -> None:
+    """The ``greybox`` command (and ``python -m greybox``): :func:`main`, then exit with its status.
+
+    A command stopped by a signal (status 143 or 130) has removed its temporary files and said so; it then
+    exits without waiting for the worker threads of its pools. A pool that was starting a thread when the
+    signal came may not know that thread yet, so the interpreter's exit would wait for it forever.
+    """
+    status = main()
+    if status in (143, 130):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)
+
+
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    run()
